@@ -1,0 +1,47 @@
+//! `inbetween`: the command-line front end of every engine.
+
+mod cmd_camera;
+mod cmd_io;
+mod cmd_mocap;
+mod cmd_preview;
+mod demo;
+mod progress;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "inbetween", version, about = "AI-assisted keyframe animation: in-betweening, keyframe extraction, previews")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a motion file's skeleton, frame count, rate, duration and channels.
+    Info(cmd_io::InfoArgs),
+    /// Convert ASF/AMC or BVH to BVH, optionally resampled and cropped.
+    Convert(cmd_io::ConvertArgs),
+    /// Render a motion file to an animated GIF (or a PNG of one frame).
+    Preview(cmd_preview::PreviewArgs),
+    /// Run the built-in demo on procedural data (no files needed) and write its outputs.
+    Demo(demo::DemoArgs),
+    /// Mocap engine: SIDQL keyframe extraction, reconstruction, codec, streaming, benchmark.
+    #[command(subcommand)]
+    Mocap(cmd_mocap::MocapCommand),
+    /// Camera engine: style-aware camera in-betweening in Toric space.
+    #[command(subcommand)]
+    Camera(cmd_camera::CameraCommand),
+}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Info(a) => cmd_io::info(a),
+        Command::Convert(a) => cmd_io::convert(a),
+        Command::Preview(a) => cmd_preview::run(a),
+        Command::Demo(a) => demo::run(a),
+        Command::Mocap(c) => cmd_mocap::run(c),
+        Command::Camera(c) => cmd_camera::run(c),
+    }
+}

@@ -1,0 +1,33 @@
+//! Core types and math every inbetween engine speaks: skeletons, motion clips, rotations, forward
+//! kinematics, resampling and windowing, keyed curves, keyframe sets, interpolation and error metrics.
+
+pub mod curve;
+pub mod fk;
+pub mod interp;
+pub mod keyframes;
+pub mod metrics;
+pub mod motion;
+pub mod procedural;
+pub mod rotation;
+pub mod skeleton;
+
+pub use curve::{Animatable, Curve, Interpolation, Key, ScalarTrack, Track};
+pub use fk::{forward, forward_clip, positions_clip, GlobalPose};
+pub use keyframes::KeyframeSet;
+pub use metrics::{position_error, rotation_error, ErrorStats};
+pub use motion::{Motion, Pose};
+pub use rotation::{Axis, EulerOrder};
+pub use skeleton::{Channel, Joint, Skeleton};
+
+/// Errors from building core types out of invalid values.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum CoreError {
+    #[error("invalid skeleton: {0}")]
+    InvalidSkeleton(String),
+    #[error("invalid motion: {0}")]
+    InvalidMotion(String),
+    #[error("invalid curve: {0}")]
+    InvalidCurve(String),
+    #[error("invalid keyframes: {0}")]
+    InvalidKeyframes(String),
+}
