@@ -1,7 +1,75 @@
 //! File formats: BVH, ASF/AMC, and the shared file helpers (atomic writes, locating shared data).
+//!
+//! Every reader returns [`IoError`] on bad input (never panics); its message names the file, the
+//! 1-based line and what was expected there.
 
+pub mod asf;
+pub mod bvh;
 pub mod data;
 pub mod fsutil;
+mod lexer;
 
+pub use asf::{parse_asf_amc, read_asf_amc};
+pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
 pub use data::shared_data_dir;
 pub use fsutil::write_atomic;
+
+use inbetween_core::Motion;
+use std::path::{Path, PathBuf};
+
+/// Everything that can go wrong reading or writing a motion file.
+#[derive(Debug, thiserror::Error)]
+pub enum IoError {
+    /// The operating system refused a read or write.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text does not follow the format: `file:line: expected …, found …`.
+    #[error("{file}:{line}: expected {expected}, found {found}")]
+    Syntax { file: String, line: usize, expected: String, found: String },
+    /// The text parses but describes an invalid skeleton or motion.
+    #[error("{file}:{line}: {message}")]
+    Invalid { file: String, line: usize, message: String },
+    /// `load_motion` cannot tell the format from the file name.
+    #[error("{}: unknown motion format; expected a .bvh or .amc file", path.display())]
+    UnknownFormat { path: PathBuf },
+    /// An `.amc` file whose skeleton `.asf` is not beside it.
+    #[error("{}: no skeleton file found; expected one of {}", amc.display(), list_paths(tried))]
+    MissingAsf { amc: PathBuf, tried: Vec<PathBuf> },
+}
+
+fn list_paths(paths: &[PathBuf]) -> String {
+    paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+}
+
+/// Reads a whole file as UTF-8 text; invalid UTF-8 is a syntax error at the line where it occurs.
+pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
+    let bytes = std::fs::read(path).map_err(|source| IoError::Io { path: path.to_path_buf(), source })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = e.utf8_error().valid_up_to();
+        let line = 1 + e.as_bytes()[..valid].iter().filter(|&&b| b == b'\n').count();
+        IoError::Syntax {
+            file: path.display().to_string(),
+            line,
+            expected: "UTF-8 text".into(),
+            found: format!("invalid byte 0x{:02x}", e.as_bytes()[valid]),
+        }
+    })
+}
+
+/// Loads a motion file by extension: `.bvh`, or `.amc` with its `.asf` beside it (CMU naming
+/// `01_01.amc` → `01.asf`, or the same stem `walk.amc` → `walk.asf`).
+pub fn load_motion(path: &Path) -> Result<Motion, IoError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("bvh") => bvh::read_bvh(path),
+        Some("amc") => {
+            let asf = asf::find_asf_for(path)?;
+            asf::read_asf_amc(&asf, path)
+        }
+        _ => Err(IoError::UnknownFormat { path: path.to_path_buf() }),
+    }
+}
