@@ -1,0 +1,1 @@
+//! The SIDQL deep Q-network: in progress.

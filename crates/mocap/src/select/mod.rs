@@ -1,0 +1,31 @@
+//! Keyframe selectors. All keep the first and last frame (constraint 19b–c of the paper) and return
+//! `k` keyframes in total.
+//!
+//! - [`random`]: RC, `k − 2` interior frames drawn uniformly (seeded).
+//! - [`uniform`]: UC, evenly spaced frames.
+//! - [`greedy`]: the paper's Greedy (§5.4), adding the frame that lowers the error most, one at a time.
+//! - [`optimal`]: the exact minimum of the total error for `k` keys, a dynamic programme over the
+//!   per-segment costs (beyond the paper); never worse than Greedy.
+//! - [`error_bounded`]: the fewest keys keeping every frame's error under a bound, also exact.
+//! - [`sidql`]: the paper's deep Q-network policy (§4).
+
+pub mod greedy;
+pub mod optimal;
+pub mod random;
+pub mod sidql;
+pub mod uniform;
+
+pub use greedy::greedy;
+pub use optimal::{error_bounded, optimal};
+pub use random::random;
+pub use uniform::uniform;
+
+use crate::{MocapError, Result};
+
+/// Checks that `k` keys fit a clip of `n` frames.
+pub(crate) fn check_k(n: usize, k: usize) -> Result<()> {
+    if n < 2 || k < 2 || k > n {
+        return Err(MocapError::Invalid(format!("{k} keyframes do not fit a clip of {n} frames (need 2 ≤ k ≤ n)")));
+    }
+    Ok(())
+}

@@ -1,0 +1,1 @@
+//! SIDQL selection (§4): placeholder until the DQN lands.
