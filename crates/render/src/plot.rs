@@ -1,0 +1,312 @@
+//! PNG charts (line, scatter, grouped bars) drawn with plotters.
+//!
+//! plotters' default text path asks fontconfig for system fonts, which a fresh CI machine does not
+//! have. We build plotters with its `ab_glyph` text backend instead and register Noto Sans (SIL Open
+//! Font License, bytes shipped by the `notosans` crate) as the "sans-serif" family, so labels render
+//! identically everywhere.
+
+use crate::stick::DEFAULT_COLORS;
+use crate::RenderError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// One named curve or point set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    /// None picks the next default colour.
+    pub color: Option<[u8; 3]>,
+}
+
+impl Series {
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>) -> Series {
+        Series { name: name.into(), points, color: None }
+    }
+}
+
+/// Chart size in pixels.
+pub const PLOT_WIDTH: u32 = 900;
+pub const PLOT_HEIGHT: u32 = 560;
+const FONT: &str = "sans-serif";
+const TITLE_SIZE: i32 = 26;
+const LABEL_SIZE: i32 = 17;
+
+/// Registers the bundled font with plotters once per process.
+fn ensure_fonts() -> Result<(), RenderError> {
+    static DONE: OnceLock<bool> = OnceLock::new();
+    let ok = *DONE.get_or_init(|| {
+        let regular = plotters::style::register_font(FONT, FontStyle::Normal, notosans::REGULAR_TTF).is_ok();
+        let bold = plotters::style::register_font(FONT, FontStyle::Bold, notosans::BOLD_TTF).is_ok();
+        regular && bold
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(RenderError::Encode("the bundled Noto Sans font could not be registered with plotters".into()))
+    }
+}
+
+fn plot_err(title: &str, e: impl std::fmt::Display) -> RenderError {
+    RenderError::Plot { title: title.to_string(), message: e.to_string() }
+}
+
+fn rgb(c: [u8; 3]) -> RGBColor {
+    RGBColor(c[0], c[1], c[2])
+}
+
+fn series_color(series: &Series, i: usize) -> RGBColor {
+    rgb(series.color.unwrap_or(DEFAULT_COLORS[i % DEFAULT_COLORS.len()]))
+}
+
+/// `lo..hi` widened by 5% on each side; a single value becomes a unit-wide range around it.
+fn padded(lo: f64, hi: f64) -> std::ops::Range<f64> {
+    let span = hi - lo;
+    if span <= f64::EPSILON * hi.abs().max(1.0) {
+        let half = (lo.abs() * 0.1).max(0.5);
+        return lo - half..hi + half;
+    }
+    lo - span * 0.05..hi + span * 0.05
+}
+
+/// Data ranges over all series, rejecting empty input and non-finite points.
+fn data_ranges(title: &str, series: &[Series]) -> Result<(std::ops::Range<f64>, std::ops::Range<f64>), RenderError> {
+    let mut lo = (f64::INFINITY, f64::INFINITY);
+    let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for s in series {
+        if let Some(i) = s.points.iter().position(|p| !(p.0.is_finite() && p.1.is_finite())) {
+            return Err(plot_err(title, format!("series '{}', point {i}: {:?} is not finite", s.name, s.points[i])));
+        }
+        for &(x, y) in &s.points {
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+    }
+    if !lo.0.is_finite() {
+        return Err(plot_err(title, "no data points in any series"));
+    }
+    Ok((padded(lo.0, hi.0), padded(lo.1, hi.1)))
+}
+
+/// Draws into an RGB buffer with plotters, then writes it as PNG.
+fn render_png(
+    path: &Path,
+    title: &str,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), RenderError>,
+) -> Result<(), RenderError> {
+    ensure_fonts()?;
+    let mut buf = vec![255u8; (PLOT_WIDTH * PLOT_HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (PLOT_WIDTH, PLOT_HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(title, e))?;
+        draw(&root)?;
+        root.present().map_err(|e| plot_err(title, e))?;
+    }
+    let img = image::RgbImage::from_raw(PLOT_WIDTH, PLOT_HEIGHT, buf).expect("buffer has the chart's size");
+    crate::write_png(path, &img)
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Style {
+    Lines,
+    Points,
+}
+
+fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series], style: Style) -> Result<(), RenderError> {
+    let (xr, yr) = data_ranges(title, series)?;
+    render_png(path, title, |root| {
+        let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, TITLE_SIZE).into_font())
+            .margin(18)
+            .x_label_area_size(52)
+            .y_label_area_size(78)
+            .build_cartesian_2d(xr, yr)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style((FONT, LABEL_SIZE))
+            .axis_desc_style((FONT, LABEL_SIZE + 1))
+            .light_line_style(RGBColor(236, 236, 236))
+            .bold_line_style(RGBColor(214, 214, 214))
+            .draw()
+            .map_err(e)?;
+        for (i, s) in series.iter().enumerate() {
+            let color = series_color(s, i);
+            let anno = match style {
+                Style::Lines => chart.draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(2))),
+                Style::Points => chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, color.filled()))),
+            }
+            .map_err(e)?;
+            if !s.name.is_empty() {
+                anno.label(s.name.as_str()).legend(move |(x, y)| match style {
+                    Style::Lines => Rectangle::new([(x, y - 1), (x + 22, y + 1)], color.filled()),
+                    Style::Points => Rectangle::new([(x + 7, y - 4), (x + 15, y + 4)], color.filled()),
+                });
+            }
+        }
+        if series.iter().any(|s| !s.name.is_empty()) {
+            chart
+                .configure_series_labels()
+                .label_font((FONT, LABEL_SIZE))
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(180, 180, 180))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(e)?;
+        }
+        Ok(())
+    })
+}
+
+/// Line chart of one or more curves (points joined in the given order).
+pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<(), RenderError> {
+    xy_chart(path, title, x_label, y_label, series, Style::Lines)
+}
+
+/// Scatter chart of one or more point sets.
+pub fn scatter_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<(), RenderError> {
+    xy_chart(path, title, x_label, y_label, series, Style::Points)
+}
+
+/// Grouped bar chart: `series[s].1[g]` is the bar of series `s` in group `g` (e.g. error per
+/// method, grouped by clip).
+pub fn grouped_bar_chart(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    groups: &[String],
+    series: &[(String, Vec<f64>)],
+) -> Result<(), RenderError> {
+    if groups.is_empty() || series.is_empty() {
+        return Err(plot_err(title, "a bar chart needs at least one group and one series"));
+    }
+    for (name, values) in series {
+        if values.len() != groups.len() {
+            return Err(plot_err(title, format!("series '{name}' has {} values for {} groups", values.len(), groups.len())));
+        }
+        if let Some(g) = values.iter().position(|v| !v.is_finite()) {
+            return Err(plot_err(title, format!("series '{name}', group '{}': value is not finite", groups[g])));
+        }
+    }
+    let all = series.iter().flat_map(|s| s.1.iter().copied());
+    let (lo, hi) = all.fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    let span = (hi - lo).max(1e-12);
+    let yr = if lo < 0.0 { lo - span * 0.05 } else { 0.0 }..if hi > 0.0 { hi + span * 0.08 } else { span * 0.05 };
+    let n = groups.len() as f64;
+    // Each group is one unit wide: bars fill 80% of it, side by side.
+    let bar_w = 0.8 / series.len() as f64;
+    render_png(path, title, |root| {
+        let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, TITLE_SIZE).into_font())
+            .margin(18)
+            .x_label_area_size(40)
+            .y_label_area_size(78)
+            .build_cartesian_2d(0.0..n, yr.clone())
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(0)
+            .y_desc(y_label)
+            .label_style((FONT, LABEL_SIZE))
+            .axis_desc_style((FONT, LABEL_SIZE + 1))
+            .light_line_style(RGBColor(236, 236, 236))
+            .bold_line_style(RGBColor(214, 214, 214))
+            .draw()
+            .map_err(e)?;
+        for (s, (name, values)) in series.iter().enumerate() {
+            let color = rgb(DEFAULT_COLORS[s % DEFAULT_COLORS.len()]);
+            chart
+                .draw_series(values.iter().enumerate().map(|(g, &v)| {
+                    let x0 = g as f64 + 0.1 + s as f64 * bar_w;
+                    Rectangle::new([(x0, 0.0), (x0 + bar_w * 0.92, v)], color.filled())
+                }))
+                .map_err(e)?
+                .label(name.as_str())
+                .legend(move |(x, y)| Rectangle::new([(x + 4, y - 5), (x + 14, y + 5)], color.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FONT, LABEL_SIZE))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(e)?;
+        // Group names centred under their bars, placed in pixels below the x axis.
+        let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+        for (g, name) in groups.iter().enumerate() {
+            let (px, py) = chart.backend_coord(&(g as f64 + 0.5, yr.start));
+            root.draw(&Text::new(name.as_str(), (px, py + 8), style.clone())).map_err(e)?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dark_pixels(img: &image::RgbImage, region: (u32, u32, u32, u32)) -> usize {
+        let (x0, y0, x1, y1) = region;
+        (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&v| v < 120)).count()
+    }
+
+    #[test]
+    fn line_plot_renders_title_and_axis_text() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("line.png");
+        let sine: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 * 0.1, (i as f64 * 0.1).sin())).collect();
+        let cosine: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 * 0.1, (i as f64 * 0.1).cos())).collect();
+        line_plot(&path, "Error over time", "time (s)", "error (cm)", &[Series::new("sin", sine), Series::new("cos", cosine)]).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (PLOT_WIDTH, PLOT_HEIGHT));
+        // Title band across the top centre: text pixels, not an empty strip.
+        let title = dark_pixels(&img, (PLOT_WIDTH / 2 - 150, 0, PLOT_WIDTH / 2 + 150, 45));
+        assert!(title > 150, "title text pixels: {title}");
+        // X axis description below the axis.
+        let x_desc = dark_pixels(&img, (PLOT_WIDTH / 2 - 100, PLOT_HEIGHT - 40, PLOT_WIDTH / 2 + 100, PLOT_HEIGHT));
+        assert!(x_desc > 50, "x label text pixels: {x_desc}");
+        // Both curve colours appear.
+        for c in &DEFAULT_COLORS[..2] {
+            assert!(img.pixels().filter(|p| p.0 == *c).count() > 100);
+        }
+    }
+
+    #[test]
+    fn scatter_and_bars_render() {
+        let dir = tempfile::tempdir().unwrap();
+        let scatter = dir.path().join("s.png");
+        let pts: Vec<(f64, f64)> = (0..30).map(|i| (i as f64, (i * i % 17) as f64)).collect();
+        scatter_plot(&scatter, "Scatter", "x", "y", &[Series::new("", pts)]).unwrap();
+        assert!(image::open(&scatter).is_ok());
+        let bars = dir.path().join("b.png");
+        let groups = vec!["walk".to_string(), "run".to_string(), "jump".to_string()];
+        let series = vec![("uniform".to_string(), vec![3.0, 5.0, 4.0]), ("SIDQL".to_string(), vec![1.5, 2.5, 2.0])];
+        grouped_bar_chart(&bars, "Reconstruction error", "cm", &groups, &series).unwrap();
+        let img = image::open(&bars).unwrap().to_rgb8();
+        // Group labels sit in the band under the plot area.
+        let labels = dark_pixels(&img, (80, PLOT_HEIGHT - 60, PLOT_WIDTH - 20, PLOT_HEIGHT - 5));
+        assert!(labels > 60, "group label pixels: {labels}");
+        assert!(img.pixels().filter(|p| p.0 == DEFAULT_COLORS[1]).count() > 1000, "red bars drawn");
+    }
+
+    #[test]
+    fn bad_plot_input_is_a_clear_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.png");
+        let err = line_plot(&p, "t", "x", "y", &[Series::new("a", vec![(0.0, 1.0), (1.0, f64::NAN)])]).unwrap_err().to_string();
+        assert!(err.contains("series 'a', point 1"), "{err}");
+        assert!(line_plot(&p, "t", "x", "y", &[]).is_err());
+        let err = grouped_bar_chart(&p, "t", "y", &["a".into()], &[("s".into(), vec![1.0, 2.0])]).unwrap_err().to_string();
+        assert!(err.contains("2 values for 1 groups"), "{err}");
+        assert!(!p.exists());
+    }
+}
