@@ -1,1 +1,50 @@
-//! placeholder; filled by its issue.
+//! Camera engine: style-aware camera keyframing in Toric space, after Jiang, Christie, Wang, Liu,
+//! Wang & Chen, "Camera Keyframing with Style and Control" (ACM TOG 40(6), 2021).
+//!
+//! Pipeline (one module per stage): [`toric`] space ↔ camera poses, cinematic [`features`] (Eq. 1–2),
+//! the synthetic [`dataset`] (scenes + four behaviours), the three networks in [`model`], [`train`],
+//! inference with keyframes in [`infer`], and exports ([`gltf`], [`preview`]) and the [`bench`].
+
+pub mod dataset;
+pub mod features;
+pub mod toric;
+
+use std::path::{Path, PathBuf};
+
+/// Errors of the camera engine; every one names the file (and line, frame or key) at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraError {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse { path: PathBuf, line: usize, column: usize, message: String },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+    #[error("{0}")]
+    Toric(#[from] toric::ToricError),
+    #[error("model: {0}")]
+    Model(String),
+}
+
+impl CameraError {
+    pub fn invalid(path: &Path, message: impl Into<String>) -> CameraError {
+        CameraError::Invalid { path: path.to_path_buf(), message: message.into() }
+    }
+}
+
+/// Reads a JSON file; syntax and shape errors give file:line:column.
+pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CameraError> {
+    let text = std::fs::read_to_string(path).map_err(|source| CameraError::Io { path: path.into(), source })?;
+    serde_json::from_str(&text).map_err(|e| CameraError::Parse {
+        path: path.into(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })
+}
+
+/// Writes pretty JSON atomically.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<(), CameraError> {
+    let bytes = serde_json::to_vec(value).map_err(|e| CameraError::invalid(path, e.to_string()))?;
+    inbetween_io::write_atomic(path, &bytes).map_err(|source| CameraError::Io { path: path.into(), source })
+}
