@@ -1,1 +1,40 @@
-//! placeholder; filled by its issue.
+//! Shared machine-learning building blocks for the inbetween engines, on burn 0.22.
+//!
+//! Tensors in burn 0.22 carry no backend type parameter: a [`Tensor<D>`](burn::tensor::Tensor)
+//! lives on a [`Device`](burn::tensor::Device), and every constructor here takes `&Device`, so the
+//! same model code runs on the pure-Rust flex CPU backend (default, see [`backend::cpu`]), with
+//! autodiff ([`backend::cpu_autodiff`]) or, behind the opt-in `cuda` crate feature, on a GPU.
+//!
+//! Modules:
+//! - [`backend`]: device helpers (flex CPU, autodiff, seeding, thread count, optional CUDA).
+//! - [`lstm`]: fused LSTM cell ([`lstm::FusedLstm`]) and stacked bidirectional LSTM
+//!   ([`lstm::BiLstm`]) over sequences kept as `Vec` of per-step `[batch, features]` tensors.
+//! - [`tta`]: time-to-arrival sinusoidal embedding (Harvey et al. 2020).
+//! - [`spectral`]: spectral-normalised linear and 1-D convolution layers.
+//! - [`train`]: a small seeded training loop (Adam, exponential LR decay, progress bar,
+//!   periodic checkpoints, resume).
+//! - [`checkpoint`]: atomic save/load of a module record plus a JSON sidecar.
+//! - [`bench`]: throughput helpers the CLI's `bench` subcommand can call.
+//!
+//! # Note for a future WGAN-GP critic (face engine)
+//! burn has no double backward (`backward()` consumes the graph), so the gradient penalty
+//! `(‖∇ₓD(x̂)‖₂ − 1)²` cannot be differentiated through autodiff's own gradient. For a
+//! conv1d + LeakyReLU critic, compute `∇ₓD` by hand (transpose convolutions through the saved
+//! LeakyReLU masks) as a differentiable expression of the weights; the penalty then needs only one
+//! ordinary backward. This was checked against autodiff and finite differences
+//! (see /work/shared/notes/ml-stack.md).
+
+pub mod backend;
+pub mod bench;
+pub mod checkpoint;
+pub mod lstm;
+pub mod spectral;
+pub mod train;
+pub mod tta;
+
+mod error;
+
+pub use error::NnError;
+
+/// Re-export of the pinned burn, so engine crates can name the exact same types.
+pub use burn;

@@ -1,0 +1,69 @@
+//! Device helpers: which backend runs the models, autodiff, seeding.
+//!
+//! burn 0.22 selects the backend at runtime through [`Device`]; a tensor's device decides where
+//! it is computed and whether autodiff records it. Models in this crate take `&Device` in their
+//! `init` functions and work on any device, so engines pick the device once:
+//!
+//! ```
+//! use inbetween_nn::backend;
+//! let infer = backend::cpu();             // flex, no gradients
+//! let train = backend::cpu_autodiff();    // flex + autodiff for training
+//! backend::seed(&train, 7);               // parameter init and random tensors become reproducible
+//! # let _ = infer;
+//! ```
+
+pub use burn::tensor::{Device, Tensor};
+
+/// The default CPU device: burn's pure-Rust flex backend.
+pub fn cpu() -> Device {
+    Device::flex()
+}
+
+/// The flex CPU device with autodiff enabled: parameters created on it are trainable.
+pub fn cpu_autodiff() -> Device {
+    Device::flex().autodiff()
+}
+
+/// The same device with autodiff enabled (idempotent).
+pub fn with_autodiff(device: &Device) -> Device {
+    device.clone().autodiff()
+}
+
+/// The same device without autodiff, for inference (idempotent).
+pub fn without_autodiff(device: &Device) -> Device {
+    device.clone().without_autodiff()
+}
+
+/// Seed the device's random number generator. Parameter initialisation and
+/// [`Tensor::random`] draw from it, so two runs seeded alike start from bit-identical weights.
+///
+/// burn notes the seed may be global to the backend rather than per device; seed right before
+/// building a model and do not share the device across threads while doing so.
+pub fn seed(device: &Device, seed: u64) {
+    device.seed(seed);
+}
+
+/// Threads used by the flex backend for one operation.
+///
+/// The workspace pins burn with `default-features = false`, which builds flex without its
+/// `rayon` and `simd` features: every op runs on the calling thread. Parallelism therefore comes
+/// from batching (one matmul over many trajectories) or from running independent work on
+/// separate threads, not from a thread-count knob.
+pub const FLEX_THREADS_PER_OP: usize = 1;
+
+/// The CUDA device at `index` (only with the crate feature `cuda`, which does not build offline).
+#[cfg(feature = "cuda")]
+pub fn cuda(index: usize) -> Device {
+    Device::cuda(index)
+}
+
+/// The CUDA device at `index` with autodiff (only with the crate feature `cuda`).
+#[cfg(feature = "cuda")]
+pub fn cuda_autodiff(index: usize) -> Device {
+    Device::cuda(index).autodiff()
+}
+
+/// Human-readable name of the backend a device uses, for logs and bench tables.
+pub fn describe(device: &Device) -> String {
+    format!("{device:?}{}", if device.is_autodiff() { " (autodiff)" } else { "" })
+}

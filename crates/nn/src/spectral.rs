@@ -1,0 +1,1 @@
+//! Spectral normalisation (placeholder, filled next).

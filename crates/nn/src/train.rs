@@ -1,0 +1,1 @@
+//! Training loop (placeholder, filled next).
