@@ -1,7 +1,10 @@
 //! `inbetween demo`: the main job. Runs on a fresh clone with no data: a procedural walk, written as
-//! BVH and previewed, then each engine's own demo.
+//! BVH and previewed as a GIF, then each engine's own demo on built-in data.
 
+use crate::progress;
+use anyhow::Context;
 use clap::Args;
+use inbetween_core::procedural::{gait, GaitParams};
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -15,10 +18,34 @@ pub struct DemoArgs {
 }
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
-    std::fs::create_dir_all(&a.out)?;
-    let mut lines = Vec::new();
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let steps = progress::bar(3, "demo");
+    let mut params = GaitParams::walk().jittered(a.seed, 0.15);
+    params.frames = 150;
+    params.turn_rate = 0.35;
+    let walk = gait(&params);
+    let bvh = a.out.join("walk.bvh");
+    inbetween_io::bvh::write_bvh(&bvh, &walk).with_context(|| format!("writing {}", bvh.display()))?;
+    let gif = a.out.join("walk.gif");
+    let opts = inbetween_render::stick::StickOptions {
+        title: Some(format!("procedural walk (seed {})", a.seed)),
+        ..Default::default()
+    };
+    inbetween_render::stick::render_motion_gif(&gif, &[&walk], &opts)
+        .with_context(|| format!("writing {}", gif.display()))?;
+    steps.inc(1);
+    let mut lines = vec![format!(
+        "walk: {} frames at {:.0} fps, {} joints -> {} and {}",
+        walk.num_frames(),
+        walk.fps(),
+        walk.skeleton.len(),
+        bvh.display(),
+        gif.display()
+    )];
     lines.extend(crate::cmd_mocap::demo(&a.out)?);
+    steps.inc(1);
     lines.extend(crate::cmd_camera::demo(&a.out)?);
+    steps.finish_and_clear();
     for l in lines {
         println!("{l}");
     }

@@ -24,6 +24,12 @@ pub fn write_atomic_with(
         buf.flush()?;
     }
     tmp.as_file().sync_all()?;
+    // Temp files are created private (0600); outputs are ordinary user files.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }
