@@ -4,14 +4,15 @@
 //! entries on the background and can shift a figure's colour from frame to frame; instead we keep
 //! the most frequent colours exactly (background, grid, every figure's solid colour) and spread the
 //! remaining entries over the blended edge shades. Each frame after the first stores only the
-//! rectangle that changed, which keeps files small.
+//! rectangle that changed, and inside it marks unchanged pixels transparent (long runs of one index
+//! compress to almost nothing), which keeps files small.
 
 use crate::RenderError;
 use image::RgbImage;
 use std::collections::HashMap;
 
-/// Palette size of a GIF.
-const MAX_COLORS: usize = 256;
+/// Palette entries for colours; the 256th entry of a GIF palette is kept for "unchanged" pixels.
+const MAX_COLORS: usize = 255;
 
 /// Colours closer than this (Euclidean RGB) to an already chosen entry are skipped in the first
 /// passes, so that rare shades still find a nearby entry.
@@ -161,9 +162,10 @@ pub(crate) fn encode(frames: &[RgbImage], fps: f64, progress: &mut dyn FnMut(usi
         return Err(RenderError::InvalidInput(format!("GIF frame rate {fps} must be a positive number")));
     }
     let palette = build_palette(frames);
+    let transparent = palette.len() as u8;
     let mut flat: Vec<u8> = palette.iter().flatten().copied().collect();
-    // A GIF palette has a power-of-two size; pad with black.
-    flat.resize(3 * palette.len().next_power_of_two().max(2), 0);
+    // A GIF palette has a power-of-two size; pad with black (the pad includes the transparent entry).
+    flat.resize(3 * (palette.len() + 1).next_power_of_two().max(2), 0);
     let mut mapper = Mapper { palette: &palette, cache: HashMap::new() };
     let mut bytes = Vec::new();
     {
@@ -181,9 +183,14 @@ pub(crate) fn encode(frames: &[RgbImage], fps: f64, progress: &mut dyn FnMut(usi
             let (x0, y0, x1, y1) = rect.unwrap_or((0, 0, 1, 1));
             let mut sub = Vec::with_capacity((x1 - x0) * (y1 - y0));
             for y in y0..y1 {
-                sub.extend_from_slice(&idx[y * w as usize + x0..y * w as usize + x1]);
+                let row = y * w as usize + x0..y * w as usize + x1;
+                match &prev {
+                    None => sub.extend_from_slice(&idx[row]),
+                    Some(p) => sub.extend(idx[row.clone()].iter().zip(&p[row]).map(|(&c, &o)| if c == o { transparent } else { c })),
+                }
             }
             let frame = gif::Frame {
+                transparent: prev.as_ref().map(|_| transparent),
                 delay: delays[i],
                 left: x0 as u16,
                 top: y0 as u16,
@@ -232,7 +239,7 @@ mod tests {
             }
         }
         let pal = build_palette(&[img]);
-        assert_eq!(pal.len(), 256);
+        assert_eq!(pal.len(), 255);
         assert!(pal.contains(&[31, 119, 180]) && pal.contains(&[214, 39, 40]));
     }
 

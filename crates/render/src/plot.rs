@@ -132,7 +132,8 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
             .y_desc(y_label)
             .label_style((FONT, LABEL_SIZE))
             .axis_desc_style((FONT, LABEL_SIZE + 1))
-            .light_line_style(RGBColor(236, 236, 236))
+            .max_light_lines(4)
+            .light_line_style(RGBColor(238, 238, 238))
             .bold_line_style(RGBColor(214, 214, 214))
             .draw()
             .map_err(e)?;
@@ -217,7 +218,8 @@ pub fn grouped_bar_chart(
             .y_desc(y_label)
             .label_style((FONT, LABEL_SIZE))
             .axis_desc_style((FONT, LABEL_SIZE + 1))
-            .light_line_style(RGBColor(236, 236, 236))
+            .max_light_lines(4)
+            .light_line_style(RGBColor(238, 238, 238))
             .bold_line_style(RGBColor(214, 214, 214))
             .draw()
             .map_err(e)?;

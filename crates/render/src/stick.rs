@@ -208,21 +208,27 @@ fn view_heading(figs: &[Figure], height: f64) -> DVec3 {
 /// Vertical field of view of the automatic camera, degrees.
 const AUTO_FOV_Y: f64 = 35.0;
 /// View direction: this many degrees off the figure's front, and this many above the ground.
-const AUTO_AZIMUTH: f64 = 40.0;
-const AUTO_ELEVATION: f64 = 15.0;
+const AUTO_AZIMUTH: f64 = 55.0;
+const AUTO_ELEVATION: f64 = 14.0;
 /// Fraction of the image the framed points may fill.
 const FILL: f64 = 0.86;
 
-/// A camera looking along the 3/4 front-side direction whose distance and aim make every point fit.
+/// A camera looking along the 3/4 front-side direction whose distance and aim make every point fit
+/// between `top` and `height - bottom` pixels (bands kept free for the title, legend and caption).
 /// The eye distance is exact: a point p (relative to the target) with screen offsets x, y and
 /// depth D − p·d fits when |x| ≤ tx·(D − p·d), so D = max(|x|/tx, |y|/ty) + p·d over all points.
-pub fn auto_camera(points: &[DVec3], heading: DVec3, width: u32, height: u32) -> Camera3 {
+pub fn auto_camera(points: &[DVec3], heading: DVec3, width: u32, height: u32, top: f64, bottom: f64) -> Camera3 {
     let (lo, hi) = bounds(points);
     let side = DVec3::Y.cross(heading).normalize_or(DVec3::X);
     let (az, el) = (AUTO_AZIMUTH.to_radians(), AUTO_ELEVATION.to_radians());
     let to_eye = (heading * az.cos() + side * az.sin()) * el.cos() + DVec3::Y * el.sin();
-    let ty = (AUTO_FOV_Y.to_radians() * 0.5).tan() * FILL;
-    let tx = ty * width as f64 / height.max(1) as f64;
+    let (w, h) = (width as f64, height.max(1) as f64);
+    let avail = (h - top - bottom).max(h * 0.3);
+    let half_tan = (AUTO_FOV_Y.to_radians() * 0.5).tan();
+    let ty = half_tan * FILL * avail / h;
+    let tx = half_tan * FILL * w / h;
+    // Where the centre of the framed points should land on screen.
+    let (want_x, want_y) = (w * 0.5, top + avail * 0.5);
     let mut target = (lo + hi) * 0.5;
     let mut cam = Camera3::new(target + to_eye, target, DVec3::Y, AUTO_FOV_Y).with_viewport(width, height);
     for _ in 0..4 {
@@ -235,11 +241,11 @@ pub fn auto_camera(points: &[DVec3], heading: DVec3, width: u32, height: u32) ->
             })
             .fold(1e-3, f64::max);
         cam = Camera3::new(target + to_eye * dist, target, DVec3::Y, AUTO_FOV_Y).with_viewport(width, height);
-        // Re-aim at the centre of the projected bounding box so the margins come out even.
+        // Re-aim so that the projected bounding box is centred in the free area.
         let proj: Vec<(f32, f32, f32)> = points.iter().filter_map(|&p| cam.project(p)).collect();
         let (x0, x1) = proj.iter().fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
         let (y0, y1) = proj.iter().fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-        let (dx, dy) = ((x0 + x1) as f64 * 0.5 - width as f64 * 0.5, (y0 + y1) as f64 * 0.5 - height as f64 * 0.5);
+        let (dx, dy) = ((x0 + x1) as f64 * 0.5 - want_x, (y0 + y1) as f64 * 0.5 - want_y);
         let px_to_world = dist / cam.focal_px();
         target += right * dx * px_to_world - up * dy * px_to_world;
     }
@@ -290,6 +296,18 @@ fn text_size(opts: &StickOptions) -> f32 {
     (opts.height as f32 / 24.0).clamp(10.0, 28.0)
 }
 
+/// Pixel heights of the bands at the top (title, legend) and bottom (caption) that figures keep clear of.
+fn reserved_bands(opts: &StickOptions, figure_count: usize) -> (f64, f64) {
+    let size = text_size(opts);
+    let title = if opts.title.is_some() { size * 1.9 } else { 0.0 };
+    let legend = match opts.labels.len().min(figure_count) {
+        0 => 0.0,
+        n => n as f32 * size * 1.35 + size * 1.5,
+    };
+    let caption = if opts.show_frame_number { size * 1.8 } else { 0.0 };
+    (title.max(legend) as f64, caption as f64)
+}
+
 fn draw_title_and_legend(canvas: &mut Canvas, opts: &StickOptions, figure_count: usize) {
     let size = text_size(opts);
     let pad = size * 0.5;
@@ -324,7 +342,10 @@ fn build_scene(figs: &[Figure], opts: &StickOptions) -> Result<Scene, RenderErro
     let ground_y = bounds(&points).0.y;
     let cam = match opts.camera {
         Some(c) => c.with_viewport(opts.width, opts.height),
-        None => auto_camera(&points, view_heading(figs, fig_height), opts.width, opts.height),
+        None => {
+            let (top, bottom) = reserved_bands(opts, figs.len());
+            auto_camera(&points, view_heading(figs, fig_height), opts.width, opts.height, top, bottom)
+        }
     };
     let mut canvas = Canvas::new(opts.width, opts.height, opts.background);
     if opts.grid {
@@ -424,7 +445,7 @@ fn timeline(figs: &[Figure], opts: &StickOptions) -> Result<(Vec<Vec<usize>>, f6
 fn caption(opts: &StickOptions, figs: &[Figure], frame: usize) -> Option<String> {
     opts.show_frame_number.then(|| {
         let f = &figs[0];
-        format!("frame {} / {}   {:.2} s", frame, f.frames.len(), frame as f64 / f.fps)
+        format!("frame {} / {}   {:.2} s", frame, f.frames.len() - 1, frame as f64 / f.fps)
     })
 }
 
