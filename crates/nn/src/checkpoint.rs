@@ -1,1 +1,196 @@
-//! Checkpoints (placeholder, filled next).
+//! Checkpoints: a module's parameters (burnpack record), the optimizer state (burnpack record)
+//! and a small JSON sidecar (epoch, optimizer steps, loss history, config), so a training run
+//! can stop and resume.
+//!
+//! Every file is written atomically (temporary file in the same folder, then rename), and the
+//! sidecar is written last: a checkpoint whose sidecar exists is complete, so a crash mid-save
+//! never leaves a "latest" checkpoint that cannot be loaded.
+//!
+//! Layout in a checkpoint folder, for epoch `N` (number of completed epochs):
+//! `epoch-0000N.model.bpk`, `epoch-0000N.optim.bpk`, `epoch-0000N.json`.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use burn::module::Module;
+use burn::optim::ModuleOptimizer;
+use burn::store::ModuleRecord;
+use burn::tensor::Bytes;
+use serde::{Deserialize, Serialize};
+
+use crate::NnError;
+
+/// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed to disk,
+/// then renamed over `path`. Readers see the old file or the new one, never a partial one.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), NnError> {
+    let io_err = |source| NnError::Io { path: path.to_path_buf(), source };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).map_err(io_err)?;
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io_err)
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, NnError> {
+    std::fs::read(path).map_err(|source| NnError::Io { path: path.to_path_buf(), source })
+}
+
+fn record_err(path: &Path, err: impl std::fmt::Display) -> NnError {
+    NnError::Record { path: path.to_path_buf(), message: err.to_string() }
+}
+
+/// Save a module's parameters to `path` (burnpack format), atomically.
+pub fn save_module<M: Module>(module: &M, path: &Path) -> Result<(), NnError> {
+    let bytes = module.clone().into_record().into_bytes().map_err(|e| record_err(path, e))?;
+    write_atomic(path, &bytes)
+}
+
+/// Load parameters saved by [`save_module`] into `module` (which fixes the architecture and the
+/// device). Shape mismatches and missing parameters are errors naming the file and parameter.
+pub fn load_module<M: Module>(module: M, path: &Path) -> Result<M, NnError> {
+    let bytes = read_file(path)?;
+    let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))?;
+    module.try_load_record(record).map_err(|e| record_err(path, e))
+}
+
+/// Save an optimizer's state (Adam moments and step counts, keyed by parameter id).
+pub fn save_optimizer(optim: &ModuleOptimizer, path: &Path) -> Result<(), NnError> {
+    let bytes = optim.into_bytes().map_err(|e| record_err(path, e))?;
+    write_atomic(path, &bytes)
+}
+
+/// Load optimizer state saved by [`save_optimizer`] into a freshly configured optimizer.
+///
+/// The state is keyed by parameter id; [`load_module`] restores the ids saved with the model,
+/// so load the model from the same checkpoint.
+pub fn load_optimizer(optim: ModuleOptimizer, path: &Path) -> Result<ModuleOptimizer, NnError> {
+    let bytes = read_file(path)?;
+    optim.from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))
+}
+
+/// The JSON sidecar of a checkpoint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckpointMeta {
+    /// Completed epochs; training resumes at this epoch index.
+    pub epoch: usize,
+    /// Optimizer steps taken so far.
+    pub optimizer_steps: u64,
+    /// Mean loss of every completed epoch, in order.
+    pub loss_history: Vec<f64>,
+    /// Learning rate used in the last completed epoch.
+    pub lr: f64,
+    /// The run's configuration (free-form, e.g. a serialised `TrainConfig` and model config).
+    pub config: serde_json::Value,
+}
+
+impl CheckpointMeta {
+    /// Write the sidecar as pretty JSON, atomically.
+    pub fn save(&self, path: &Path) -> Result<(), NnError> {
+        let json = serde_json::to_vec_pretty(self).map_err(|e| NnError::Metadata {
+            path: path.to_path_buf(),
+            line: 0,
+            column: 0,
+            message: e.to_string(),
+        })?;
+        write_atomic(path, &json)
+    }
+
+    /// Read a sidecar; malformed JSON is an error naming the file, line and column.
+    pub fn load(path: &Path) -> Result<Self, NnError> {
+        let bytes = read_file(path)?;
+        serde_json::from_slice(&bytes).map_err(|e| NnError::Metadata {
+            path: path.to_path_buf(),
+            line: e.line(),
+            column: e.column(),
+            message: e.to_string(),
+        })
+    }
+}
+
+/// The three files of one checkpoint.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CheckpointFiles {
+    /// Completed epochs at save time.
+    pub epoch: usize,
+    /// Module parameters (burnpack).
+    pub model: PathBuf,
+    /// Optimizer state (burnpack).
+    pub optimizer: PathBuf,
+    /// JSON sidecar ([`CheckpointMeta`]).
+    pub meta: PathBuf,
+}
+
+impl CheckpointFiles {
+    /// File names for epoch `epoch` inside `dir`.
+    pub fn in_dir(dir: &Path, epoch: usize) -> Self {
+        let stem = format!("epoch-{epoch:06}");
+        Self {
+            epoch,
+            model: dir.join(format!("{stem}.model.bpk")),
+            optimizer: dir.join(format!("{stem}.optim.bpk")),
+            meta: dir.join(format!("{stem}.json")),
+        }
+    }
+}
+
+/// Save model, optimizer and sidecar for `meta.epoch` into `dir` (sidecar last).
+pub fn save_checkpoint<M: Module>(
+    dir: &Path,
+    model: &M,
+    optim: &ModuleOptimizer,
+    meta: &CheckpointMeta,
+) -> Result<CheckpointFiles, NnError> {
+    let files = CheckpointFiles::in_dir(dir, meta.epoch);
+    save_module(model, &files.model)?;
+    save_optimizer(optim, &files.optimizer)?;
+    meta.save(&files.meta)?;
+    Ok(files)
+}
+
+/// The most recent complete checkpoint in `dir` (highest epoch whose sidecar exists), or
+/// `None` if the folder is missing or holds none.
+pub fn latest_checkpoint(dir: &Path) -> Result<Option<CheckpointFiles>, NnError> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => return Err(NnError::Io { path: dir.to_path_buf(), source }),
+    };
+    let mut best: Option<usize> = None;
+    for entry in entries {
+        let entry = entry.map_err(|source| NnError::Io { path: dir.to_path_buf(), source })?;
+        let name = entry.file_name();
+        let epoch = name
+            .to_str()
+            .and_then(|n| n.strip_prefix("epoch-"))
+            .and_then(|n| n.strip_suffix(".json"))
+            .and_then(|n| n.parse::<usize>().ok());
+        if let Some(epoch) = epoch {
+            best = Some(best.map_or(epoch, |b| b.max(epoch)));
+        }
+    }
+    Ok(best.map(|epoch| CheckpointFiles::in_dir(dir, epoch)))
+}
+
+/// Load a checkpoint into `model` and `optim` (both freshly built with the run's configuration).
+pub fn load_checkpoint<M: Module>(
+    files: &CheckpointFiles,
+    model: M,
+    optim: ModuleOptimizer,
+) -> Result<(M, ModuleOptimizer, CheckpointMeta), NnError> {
+    let meta = CheckpointMeta::load(&files.meta)?;
+    let model = load_module(model, &files.model)?;
+    let optim = load_optimizer(optim, &files.optimizer)?;
+    Ok((model, optim, meta))
+}

@@ -19,7 +19,7 @@ use burn::config::Config;
 use burn::module::{Module, Param};
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::activation::sigmoid;
-use burn::tensor::{Device, Tensor};
+use burn::tensor::{Device, Tensor, TensorData};
 
 /// Hidden and cell state of an LSTM, each `[batch, hidden]`.
 #[derive(Debug, Clone)]
@@ -80,8 +80,12 @@ impl FusedLstmConfig {
         let mut gates = LinearConfig::new(self.d_input + hidden, 4 * hidden).init(device);
         if self.forget_bias != 0.0 {
             if let Some(bias) = gates.bias.take() {
-                let shift = forget_bias_shift(hidden, self.forget_bias, device);
-                gates.bias = Some(Param::from_tensor(bias.val().detach() + shift));
+                // Built from plain data so the bias stays a leaf parameter under autodiff.
+                let mut values = bias.val().into_data().try_to_vec::<f32>().unwrap_or_default();
+                for v in &mut values[hidden..2 * hidden] {
+                    *v += self.forget_bias as f32;
+                }
+                gates.bias = Some(Param::from_data(TensorData::new(values, [4 * hidden]), device));
             }
         }
         FusedLstm {
@@ -90,14 +94,6 @@ impl FusedLstmConfig {
             d_hidden: hidden,
         }
     }
-}
-
-/// `[4·hidden]` vector that is `value` on the forget block (`hidden..2·hidden`) and 0 elsewhere.
-fn forget_bias_shift(hidden: usize, value: f64, device: &Device) -> Tensor<1> {
-    let values: Vec<f32> = (0..4 * hidden)
-        .map(|k| if (hidden..2 * hidden).contains(&k) { value as f32 } else { 0.0 })
-        .collect();
-    Tensor::from_floats(values.as_slice(), device)
 }
 
 impl FusedLstm {
