@@ -1,18 +1,370 @@
-//! `inbetween mocap …` (owned by the mocap engine work).
+//! `inbetween mocap …` (owned by the mocap engine work): compress / decompress / preview a clip with
+//! the keyframe codec, benchmark the keyframe selectors, train SIDQL, stream keys over TCP.
 
-use clap::Subcommand;
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand};
+use inbetween_core::{positions_clip, KeyframeSet, Motion};
+use inbetween_io::fsutil::write_atomic;
+use inbetween_mocap::bench::{self, Method, Protocol};
+use inbetween_mocap::codec::{self, Budget};
+use inbetween_mocap::error::{Objective, SegmentModel, SegmentTable};
+use inbetween_mocap::representation::{JointFilter, SphericalMotion};
+use inbetween_mocap::rotations::RotationMotion;
+use inbetween_render::StickOptions;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 #[derive(Subcommand)]
 pub enum MocapCommand {
-    /// Benchmark keyframe selection methods.
-    Bench,
+    /// Pick keyframes and write them as a compact .ibk file.
+    Compress(CompressArgs),
+    /// Rebuild a whole clip from an .ibk file and write it as BVH.
+    Decompress(DecompressArgs),
+    /// Overlay a clip and its reconstruction from keyframes in one GIF.
+    Preview(PreviewArgs),
+    /// Benchmark keyframe selection methods (RC, UC, Greedy, SIDQL, Optimal) on the CMU clips.
+    Bench(BenchArgs),
 }
 
-pub fn run(_c: MocapCommand) -> anyhow::Result<()> {
-    anyhow::bail!("`inbetween mocap` is not implemented yet")
+#[derive(Args, Clone)]
+pub struct BudgetArgs {
+    /// Number of keyframes (first and last frame included).
+    #[arg(short, long, conflicts_with = "max_error")]
+    pub k: Option<usize>,
+    /// Largest allowed position error of any joint in any frame, e.g. 1cm, 5mm.
+    #[arg(long)]
+    pub max_error: Option<String>,
+    /// Longest gap between two keys, in seconds (bounds the search; -k widens it as needed).
+    #[arg(long, default_value_t = 0.5)]
+    pub max_gap_s: f64,
+    /// Joints to keep: `all`, `paper` (drop fingers, thumbs, toes) or comma-separated name parts to drop.
+    #[arg(long, default_value = "all")]
+    pub joints: String,
+    /// Drop the first frame (the T-pose of CMU cgspeed files).
+    #[arg(long)]
+    pub skip_first: bool,
+}
+
+impl BudgetArgs {
+    fn budget(&self) -> anyhow::Result<Budget> {
+        match (self.k, &self.max_error) {
+            (Some(k), None) => Ok(Budget::Keys(k)),
+            (None, Some(e)) => Ok(Budget::MaxErrorCm(codec::parse_length_cm(e)?)),
+            _ => bail!("give either -k N or --max-error LENGTH (e.g. --max-error 1cm)"),
+        }
+    }
+
+    fn load(&self, path: &Path) -> anyhow::Result<Motion> {
+        let m = inbetween_io::load_motion(path).with_context(|| format!("reading {}", path.display()))?;
+        let m = if self.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
+        Ok(JointFilter::parse(&self.joints).apply(&m))
+    }
+
+    fn max_gap(&self, m: &Motion) -> usize {
+        ((self.max_gap_s / m.frame_time).round() as usize).max(1)
+    }
+}
+
+#[derive(Args)]
+pub struct CompressArgs {
+    /// Input .bvh (or .amc with its .asf beside it).
+    pub input: PathBuf,
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub budget: BudgetArgs,
+}
+
+#[derive(Args)]
+pub struct DecompressArgs {
+    pub input: PathBuf,
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Args)]
+pub struct PreviewArgs {
+    /// The original clip.
+    pub input: PathBuf,
+    /// GIF to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Reconstruct from this .ibk file instead of choosing keys here.
+    #[arg(long)]
+    pub ibk: Option<PathBuf>,
+    #[command(flatten)]
+    pub budget: BudgetArgs,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Data folder (default: the shared corpus); clips are read from <DIR>/mocap/cmu/cgspeed or DIR itself.
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// Write the table as CSV.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write a bar chart of the mean angle error (PNG).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Window stride in frames (60 = non-overlapping windows, as in the paper).
+    #[arg(long, default_value_t = 60)]
+    pub stride: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Also report codec compression at these max errors (cm), on the full-rate clips.
+    #[arg(long, value_delimiter = ',', default_value = "1,0.1")]
+    pub codec_bounds: Vec<f64>,
+}
+
+pub fn run(c: MocapCommand) -> anyhow::Result<()> {
+    match c {
+        MocapCommand::Compress(a) => compress(a),
+        MocapCommand::Decompress(a) => decompress(a),
+        MocapCommand::Preview(a) => preview(a),
+        MocapCommand::Bench(a) => bench_cmd(a),
+    }
+}
+
+fn compress(a: CompressArgs) -> anyhow::Result<()> {
+    let m = a.budget.load(&a.input)?;
+    let t = Instant::now();
+    let c = codec::compress(&m, a.budget.budget()?, a.budget.max_gap(&m))?;
+    let secs = t.elapsed().as_secs_f64();
+    write_atomic(&a.output, &c.bytes).with_context(|| format!("writing {}", a.output.display()))?;
+    for l in compress_report(&m, &c) {
+        println!("{l}");
+    }
+    println!("wrote {} in {secs:.2} s", a.output.display());
+    Ok(())
+}
+
+fn compress_report(m: &Motion, c: &codec::Compressed) -> Vec<String> {
+    let raw = codec::raw_bytes(m);
+    vec![
+        format!(
+            "{} frames, {} joints, {} keys; {} bytes ({} bytes per key) vs {} raw f32 bytes: ratio {:.1}x",
+            m.num_frames(),
+            m.skeleton.len(),
+            c.keys.len(),
+            c.bytes.len(),
+            codec::bytes_per_key(&m.skeleton),
+            raw,
+            raw as f64 / c.bytes.len() as f64
+        ),
+        format!(
+            "error: mean {:.3} cm, max {:.3} cm (decoded file); mean local rotation error {:.3} deg",
+            c.decoded_mean_cm,
+            c.decoded_max_cm,
+            c.planned.mean_angle.to_degrees()
+        ),
+    ]
+}
+
+fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
+    let bytes = std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
+    let d = codec::decode(&bytes).with_context(|| format!("decoding {}", a.input.display()))?;
+    let m = d.reconstruct()?;
+    inbetween_io::write_bvh(&a.output, &m)?;
+    println!("{} keys → {} frames at {:.1} fps; wrote {}", d.key_frames.len(), m.num_frames(), m.fps(), a.output.display());
+    Ok(())
+}
+
+fn preview(a: PreviewArgs) -> anyhow::Result<()> {
+    let m = a.budget.load(&a.input)?;
+    let (rec, keys) = match &a.ibk {
+        Some(p) => {
+            let d = codec::decode(&std::fs::read(p).with_context(|| format!("reading {}", p.display()))?)
+                .with_context(|| format!("decoding {}", p.display()))?;
+            if d.skeleton != m.skeleton || d.num_frames != m.num_frames() {
+                bail!("{} does not match {} (skeleton or frame count differ; use the same --joints/--skip-first)", p.display(), a.input.display());
+            }
+            (d.reconstruct()?, d.key_frames.len())
+        }
+        None => {
+            let c = codec::compress(&m, a.budget.budget()?, a.budget.max_gap(&m))?;
+            (codec::decode(&c.bytes)?.reconstruct()?, c.keys.len())
+        }
+    };
+    let e = inbetween_core::position_error(&positions_clip(&m), &positions_clip(&rec));
+    let cm = inbetween_core::procedural::CM_PER_CMU_UNIT;
+    let opts = StickOptions {
+        labels: vec!["original".into(), format!("from {keys} keys")],
+        title: Some(format!("{} keys: mean {:.2} cm, max {:.2} cm", keys, e.mean * cm, e.max * cm)),
+        ..StickOptions::default()
+    };
+    inbetween_render::render_motion_gif(&a.output, &[&m, &rec], &opts)?;
+    println!("{keys} keys; mean {:.3} cm, max {:.3} cm; wrote {}", e.mean * cm, e.max * cm, a.output.display());
+    Ok(())
+}
+
+/// The cgspeed BVH clips of a data folder, with their names.
+fn cmu_clips(dir: &Path) -> anyhow::Result<Vec<(String, Motion)>> {
+    let sub = dir.join("mocap/cmu/cgspeed");
+    let folder = if sub.is_dir() { sub } else { dir.to_path_buf() };
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .with_context(|| format!("listing {}", folder.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")))
+        .collect();
+    paths.sort();
+    if paths.is_empty() {
+        bail!("no .bvh clips in {}", folder.display());
+    }
+    paths
+        .iter()
+        .map(|p| {
+            let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            Ok((name, inbetween_io::read_bvh(p)?))
+        })
+        .collect()
+}
+
+fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
+    let dir = match a.data.clone() {
+        Some(d) => d,
+        None => match inbetween_io::data::shared_data_dir() {
+            Ok(d) => d,
+            Err(p) => bail!("no data at {} (give --data DIR)", p.display()),
+        },
+    };
+    let clips = cmu_clips(&dir)?;
+    let protocol = Protocol { stride: a.stride, seed: a.seed, ..Protocol::paper() };
+    let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
+    let (train, test) = bench::split_clips(&names, &protocol);
+    let mut all = Vec::new();
+    for (name, m) in &clips {
+        all.extend(bench::clip_windows(name, m, &protocol)?);
+    }
+    let test_windows: Vec<_> = all.iter().filter(|w| test.contains(&w.clip)).cloned().collect();
+    println!(
+        "{} clips ({}), {} windows of {} frames at {} fps, {} joints; test split: {:?} ({} windows), train: {:?}",
+        clips.len(),
+        dir.display(),
+        all.len(),
+        protocol.window,
+        protocol.fps,
+        all.first().map(|w| w.rep.num_joints).unwrap_or(0),
+        test,
+        test_windows.len(),
+        train
+    );
+    let ks = [5, 10, 15];
+    let mut rows = bench::evaluate("all", &all, &Method::ALL, &ks, a.seed, None)?;
+    rows.extend(bench::evaluate("test", &test_windows, &Method::ALL, &ks, a.seed, None)?);
+    println!("{}", bench::to_table(&rows));
+    if let Some(p) = &a.csv {
+        write_atomic(p, bench::to_csv(&rows).as_bytes()).with_context(|| format!("writing {}", p.display()))?;
+        println!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.plot {
+        bench_plot(p, &rows)?;
+        println!("wrote {}", p.display());
+    }
+    reconstruction_throughput(&all);
+    for &bound in &a.codec_bounds {
+        codec_ratio(&clips, bound)?;
+    }
+    Ok(())
+}
+
+fn bench_plot(path: &Path, rows: &[bench::Row]) -> anyhow::Result<()> {
+    let groups: Vec<String> = [5, 10, 15].iter().map(|k| format!("K = {k}")).collect();
+    let mut series = Vec::new();
+    for m in Method::ALL {
+        let vals: Vec<f64> = [5, 10, 15]
+            .iter()
+            .filter_map(|&k| rows.iter().find(|r| r.split == "all" && r.method == m && r.k == k).map(|r| r.mean_angle_error))
+            .collect();
+        if vals.len() == 3 {
+            series.push((m.name().to_string(), vals));
+        }
+    }
+    inbetween_render::plot::grouped_bar_chart(path, "Mean angle error, CMU 60-frame windows", "mean angle error (rad)", &groups, &series)?;
+    Ok(())
+}
+
+/// Frames per second of the spherical reconstruction (all frames of all windows, K = 10, uniform).
+fn reconstruction_throughput(windows: &[bench::Window]) {
+    let t = Instant::now();
+    let mut frames = 0usize;
+    for _ in 0..5 {
+        for w in windows {
+            let keys = KeyframeSet::uniform(w.rep.num_frames, 10).expect("60-frame window");
+            let rec = inbetween_mocap::reconstruct_spherical(&w.rep, &keys);
+            frames += rec.positions.len() / w.rep.num_joints;
+        }
+    }
+    let secs = t.elapsed().as_secs_f64();
+    println!("reconstruction throughput (spherical, positions of {} joints): {:.0} frames/s", windows.first().map(|w| w.rep.num_joints).unwrap_or(0), frames as f64 / secs);
+}
+
+/// Codec size at an error bound over the full-rate, full-skeleton clips (T-pose frame dropped).
+fn codec_ratio(clips: &[(String, Motion)], bound_cm: f64) -> anyhow::Result<()> {
+    let (mut raw, mut packed, mut keys, mut frames, mut max_cm) = (0usize, 0usize, 0usize, 0usize, 0.0f64);
+    let t = Instant::now();
+    for (_, m) in clips {
+        let m = m.crop(1, m.num_frames())?;
+        let gap = ((0.5 / m.frame_time).round() as usize).max(1);
+        let c = codec::compress(&m, Budget::MaxErrorCm(bound_cm), gap)?;
+        raw += codec::raw_bytes(&m);
+        packed += c.bytes.len();
+        keys += c.keys.len();
+        frames += m.num_frames();
+        max_cm = max_cm.max(c.decoded_max_cm);
+    }
+    println!(
+        "codec at max error {bound_cm} cm: {keys} keys for {frames} frames, {packed} bytes vs {raw} raw f32 bytes = ratio {:.1}x (decoded max error {max_cm:.3} cm, {:.1} s)",
+        raw as f64 / packed as f64,
+        t.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 /// The mocap part of `inbetween demo`: writes its outputs under `out` and returns lines to print.
-pub fn demo(_out: &std::path::Path) -> anyhow::Result<Vec<String>> {
-    Ok(Vec::new())
+pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
+    let t = Instant::now();
+    let mut p = inbetween_core::procedural::GaitParams::walk();
+    p.frames = 60;
+    let walk = inbetween_core::procedural::gait(&p);
+    let paper = JointFilter::paper().apply(&walk);
+    let rep = SphericalMotion::from_motion(&paper)?;
+    let table = SegmentTable::full(&rep);
+    let mut lines = vec!["mocap: procedural walk, 60 frames at 30 fps, 23 joints (paper representation)".to_string()];
+    for k in [5, 10] {
+        let opt = inbetween_mocap::select::optimal(&table, k, Objective::Angle)?;
+        let uc = inbetween_mocap::select::uniform(60, k)?;
+        let (eo, eu) = (rep.error(&opt), rep.error(&uc));
+        lines.push(format!(
+            "  K={k:<2} optimal keys {:?}: angle err {:.4}, mean {:.2} cm, max {:.2} cm | uniform: {:.4}, {:.2} cm, {:.2} cm",
+            opt.frames(),
+            eo.mean_angle,
+            eo.mean_cm,
+            eo.max_cm,
+            eu.mean_angle,
+            eu.mean_cm,
+            eu.max_cm
+        ));
+    }
+    let c = codec::compress(&walk, Budget::MaxErrorCm(1.0), 15)?;
+    lines.extend(compress_report(&walk, &c).into_iter().map(|l| format!("  codec (31 joints, ≤ 1 cm): {l}")));
+    let ibk = out.join("mocap_walk.ibk");
+    write_atomic(&ibk, &c.bytes)?;
+    let rec = codec::decode(&c.bytes)?.reconstruct()?;
+    let bvh = out.join("mocap_walk_reconstructed.bvh");
+    inbetween_io::write_bvh(&bvh, &rec)?;
+    let gif = out.join("mocap_overlay.gif");
+    let opts = StickOptions {
+        labels: vec!["original".into(), format!("from {} keys", c.keys.len())],
+        title: Some(format!("mocap codec: {} keys, max {:.2} cm", c.keys.len(), c.decoded_max_cm)),
+        max_frames: 60,
+        ..StickOptions::default()
+    };
+    inbetween_render::render_motion_gif(&gif, &[&walk, &rec], &opts)?;
+    // The rotation model is the one the codec uses; say how it compares to the spherical one.
+    let rm = RotationMotion::from_motion(&paper)?;
+    let k10 = inbetween_mocap::select::optimal(&table, 10, Objective::Angle)?;
+    lines.push(format!("  K=10 on 23 joints: rotation reconstruction mean {:.2} cm vs spherical {:.2} cm", rm.error(&k10).mean_cm, rep.error(&k10).mean_cm));
+    lines.push(format!("  wrote {}, {}, {} ({:.1} s)", ibk.display(), bvh.display(), gif.display(), t.elapsed().as_secs_f64()));
+    Ok(lines)
 }

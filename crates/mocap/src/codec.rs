@@ -372,3 +372,95 @@ mod tests {
         }
     }
 }
+
+/// How many keys a compression may use.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Budget {
+    /// Exactly this many keys, placed to minimise the mean position error.
+    Keys(usize),
+    /// The fewest keys keeping every joint of every frame within this many cm (before quantisation).
+    MaxErrorCm(f64),
+}
+
+/// The outcome of [`compress`].
+#[derive(Clone, Debug)]
+pub struct Compressed {
+    pub keys: KeyframeSet,
+    pub bytes: Vec<u8>,
+    /// Error of the exact (unquantised) reconstruction, as the selector saw it.
+    pub planned: crate::ReconstructionError,
+    /// Mean and max position error in cm of the decoded file against the source.
+    pub decoded_mean_cm: f64,
+    pub decoded_max_cm: f64,
+}
+
+/// Picks keys with the exact selectors over segments of at most `max_gap` frames, encodes them and
+/// measures the decoded result. In `Keys(k)` mode the gap is widened to at least twice the average
+/// spacing so that `k` keys can cover the clip.
+pub fn compress(motion: &Motion, budget: Budget, max_gap: usize) -> Result<Compressed> {
+    use crate::error::{Objective, SegmentModel, SegmentTable};
+    let model = RotationMotion::from_motion(motion)?;
+    let n = model.num_frames();
+    let keys = match budget {
+        Budget::Keys(k) => {
+            crate::select::check_k(n, k)?;
+            let gap = max_gap.max((2 * (n - 1)).div_ceil(k - 1));
+            crate::select::optimal(&SegmentTable::banded(&model, gap), k, Objective::Position)?
+        }
+        Budget::MaxErrorCm(cm) => {
+            if !(cm.is_finite() && cm >= 0.0) {
+                return Err(MocapError::Invalid(format!("max error {cm} cm must be a non-negative number")));
+            }
+            crate::select::error_bounded(&SegmentTable::bounded(&model, max_gap, cm), cm, Objective::Position)?
+        }
+    };
+    let planned = model.error(&keys);
+    let bytes = encode(&model, &keys);
+    let decoded = decode(&bytes)?.reconstruct()?;
+    let e = inbetween_core::position_error(&inbetween_core::positions_clip(motion), &inbetween_core::positions_clip(&decoded));
+    Ok(Compressed { keys, bytes, planned, decoded_mean_cm: e.mean * model.cm_per_unit, decoded_max_cm: e.max * model.cm_per_unit })
+}
+
+/// Parses an error bound such as `1cm`, `0.5 cm`, `10mm` or `0.01m` (a bare number is cm).
+pub fn parse_length_cm(s: &str) -> Result<f64> {
+    let t = s.trim().to_ascii_lowercase();
+    let (num, scale) = if let Some(v) = t.strip_suffix("mm") {
+        (v, 0.1)
+    } else if let Some(v) = t.strip_suffix("cm") {
+        (v, 1.0)
+    } else if let Some(v) = t.strip_suffix('m') {
+        (v, 100.0)
+    } else {
+        (t.as_str(), 1.0)
+    };
+    let v: f64 = num.trim().parse().map_err(|_| MocapError::Invalid(format!("'{s}' is not a length; expected e.g. 1cm, 5mm or 0.01m")))?;
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(MocapError::Invalid(format!("'{s}': a length must be non-negative")));
+    }
+    Ok(v * scale)
+}
+
+#[cfg(test)]
+mod compress_tests {
+    use super::*;
+    use inbetween_core::procedural::{gait, GaitParams};
+
+    #[test]
+    fn max_error_mode_meets_its_bound_and_k_mode_uses_k_keys() {
+        let mut p = GaitParams::walk();
+        p.frames = 60;
+        let m = gait(&p);
+        let c = compress(&m, Budget::MaxErrorCm(1.0), 30).unwrap();
+        assert!(c.planned.max_cm <= 1.0 + 1e-9);
+        assert!(c.decoded_max_cm < 1.1, "decoded max {}", c.decoded_max_cm);
+        assert!(c.keys.len() < 30, "{} keys", c.keys.len());
+        let tight = compress(&m, Budget::MaxErrorCm(0.1), 30).unwrap();
+        assert!(tight.keys.len() > c.keys.len());
+        let k = compress(&m, Budget::Keys(6), 10).unwrap();
+        assert_eq!(k.keys.len(), 6);
+        assert_eq!(decode(&k.bytes).unwrap().key_frames, k.keys.frames());
+        assert_eq!(parse_length_cm("10mm").unwrap(), 1.0);
+        assert_eq!(parse_length_cm("0.5 cm").unwrap(), 0.5);
+        assert!(parse_length_cm("fast").is_err());
+    }
+}

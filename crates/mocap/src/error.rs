@@ -70,8 +70,33 @@ pub trait SegmentModel: Sync {
     /// Terms per frame of the angle mean (joints × 2 for θ, φ; joints for rotation errors).
     fn angle_terms_per_frame(&self) -> usize;
     fn scratch(&self) -> Scratch;
+    /// The error of frame `f` reconstructed from keys `a < f < b`.
+    fn frame_cost(&self, a: usize, b: usize, f: usize, scratch: &mut Scratch) -> SegmentCost;
+
     /// The error of the frames strictly between keys `a < b`.
-    fn segment_cost(&self, a: usize, b: usize, scratch: &mut Scratch) -> SegmentCost;
+    fn segment_cost(&self, a: usize, b: usize, scratch: &mut Scratch) -> SegmentCost {
+        (a + 1..b).fold(SegmentCost::default(), |acc, f| acc.add(self.frame_cost(a, b, f, scratch)))
+    }
+
+    /// Like [`SegmentModel::segment_cost`], but gives up with `None` as soon as one frame exceeds
+    /// `max_cm`. Frames are visited from the middle outwards, where in-betweens drift most, so
+    /// infeasible segments are rejected after a frame or two.
+    fn segment_cost_within(&self, a: usize, b: usize, max_cm: f64, scratch: &mut Scratch) -> Option<SegmentCost> {
+        let mid = (a + b) / 2;
+        let mut acc = SegmentCost::default();
+        for d in 0..b - a {
+            let right = mid + d;
+            let left = mid.checked_sub(d).filter(|_| d > 0);
+            for f in [Some(right), left].into_iter().flatten().filter(|&f| f > a && f < b) {
+                let c = self.frame_cost(a, b, f, scratch);
+                if c.cm_max > max_cm {
+                    return None;
+                }
+                acc = acc.add(c);
+            }
+        }
+        Some(acc)
+    }
 
     /// Error of a whole keyframe set, as the sum of its segments.
     fn error(&self, keys: &KeyframeSet) -> ReconstructionError {
@@ -117,21 +142,19 @@ impl SegmentModel for SphericalMotion {
         Scratch { angles: vec![0.0; 2 * self.num_joints], positions: vec![DVec3::ZERO; self.num_joints], ..Scratch::default() }
     }
 
-    fn segment_cost(&self, a: usize, b: usize, s: &mut Scratch) -> SegmentCost {
+    fn frame_cost(&self, a: usize, b: usize, f: usize, s: &mut Scratch) -> SegmentCost {
         let (n, nj) = (self.num_frames, self.num_joints);
         let mut cost = SegmentCost::default();
-        for f in a + 1..b {
-            segment_frame(self, a, b, f, &mut s.angles, &mut s.positions);
-            for j in 0..nj {
-                if self.has_angles[j] {
-                    let i = j * n + f;
-                    cost.angle_sum += (s.angles[2 * j] - self.theta[i]).abs()
-                        + wrapped_angle_difference(s.angles[2 * j + 1], self.phi[i]);
-                }
-                let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
-                cost.cm_sum += d;
-                cost.cm_max = cost.cm_max.max(d);
+        segment_frame(self, a, b, f, &mut s.angles, &mut s.positions);
+        for j in 0..nj {
+            if self.has_angles[j] {
+                let i = j * n + f;
+                cost.angle_sum +=
+                    (s.angles[2 * j] - self.theta[i]).abs() + wrapped_angle_difference(s.angles[2 * j + 1], self.phi[i]);
             }
+            let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
+            cost.cm_sum += d;
+            cost.cm_max = cost.cm_max.max(d);
         }
         cost
     }
@@ -185,6 +208,28 @@ impl SegmentTable {
                     let b = a + k + 1;
                     if b < n {
                         *slot = model.segment_cost(a, b, scratch);
+                    }
+                }
+            },
+        );
+        SegmentTable { num_frames: n, max_gap: g, costs }
+    }
+
+    /// Segments up to `max_gap` frames long whose every frame stays within `max_cm`; the others are
+    /// stored with an infinite `cm_max` (not computed in full), which is all the error-bounded
+    /// selector needs to know about them.
+    pub fn bounded(model: &dyn SegmentModel, max_gap: usize, max_cm: f64) -> SegmentTable {
+        let n = model.num_frames();
+        let g = max_gap.clamp(1, n.saturating_sub(1).max(1));
+        let infeasible = SegmentCost { angle_sum: f64::INFINITY, cm_sum: f64::INFINITY, cm_max: f64::INFINITY };
+        let mut costs = vec![SegmentCost::default(); n * g];
+        costs.par_chunks_mut(g).enumerate().for_each_init(
+            || model.scratch(),
+            |scratch, (a, row)| {
+                for (k, slot) in row.iter_mut().enumerate() {
+                    let b = a + k + 1;
+                    if b < n {
+                        *slot = model.segment_cost_within(a, b, max_cm, scratch).unwrap_or(infeasible);
                     }
                 }
             },
@@ -261,6 +306,12 @@ mod tests {
         for a in 0..30 {
             for b in a + 1..30 {
                 assert_eq!(full.get(a, b), serial.get(a, b));
+                let bounded = SegmentTable::bounded(&rep, 29, 2.0);
+                let c = full.get(a, b).unwrap();
+                match bounded.get(a, b) {
+                    Some(x) if x.cm_max.is_finite() => assert!((x.cm_sum - c.cm_sum).abs() < 1e-9 && c.cm_max <= 2.0),
+                    _ => assert!(c.cm_max > 2.0),
+                }
                 if b - a <= 5 {
                     assert_eq!(full.get(a, b), band.get(a, b));
                 } else {

@@ -171,22 +171,20 @@ impl SegmentModel for RotationMotion {
         }
     }
 
-    fn segment_cost(&self, a: usize, b: usize, s: &mut Scratch) -> SegmentCost {
+    fn frame_cost(&self, a: usize, b: usize, f: usize, s: &mut Scratch) -> SegmentCost {
         let nj = self.skeleton.len();
         let h = (b - a) as f64 * self.frame_time;
+        let u = (f - a) as f64 / (b - a) as f64;
         let mut cost = SegmentCost::default();
-        for f in a + 1..b {
-            let u = (f - a) as f64 / (b - a) as f64;
-            interpolate_pose_into(&self.frames[a], &self.frames[b], h, u, &mut s.locals, &mut s.translations);
-            forward_into(&self.skeleton, &s.locals, &s.translations, &mut s.positions, &mut s.rotations);
-            for j in 0..nj {
-                if self.skeleton.joint(j).rotation_order().is_some() {
-                    cost.angle_sum += angle_between(s.locals[j], self.frames[f].rotations[j]);
-                }
-                let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
-                cost.cm_sum += d;
-                cost.cm_max = cost.cm_max.max(d);
+        interpolate_pose_into(&self.frames[a], &self.frames[b], h, u, &mut s.locals, &mut s.translations);
+        forward_into(&self.skeleton, &s.locals, &s.translations, &mut s.positions, &mut s.rotations);
+        for j in 0..nj {
+            if self.skeleton.joint(j).rotation_order().is_some() {
+                cost.angle_sum += angle_between(s.locals[j], self.frames[f].rotations[j]);
             }
+            let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
+            cost.cm_sum += d;
+            cost.cm_max = cost.cm_max.max(d);
         }
         cost
     }

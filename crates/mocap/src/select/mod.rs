@@ -23,7 +23,7 @@ pub use uniform::uniform;
 use crate::{MocapError, Result};
 
 /// Checks that `k` keys fit a clip of `n` frames.
-pub(crate) fn check_k(n: usize, k: usize) -> Result<()> {
+pub fn check_k(n: usize, k: usize) -> Result<()> {
     if n < 2 || k < 2 || k > n {
         return Err(MocapError::Invalid(format!("{k} keyframes do not fit a clip of {n} frames (need 2 ≤ k ≤ n)")));
     }
