@@ -1,25 +1,107 @@
 //! `info` and `convert` (owned by the io work).
 
+use anyhow::Context;
 use clap::Args;
-use std::path::PathBuf;
+use inbetween_core::{Motion, Skeleton};
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct InfoArgs {
     /// A .bvh file, or an .amc file (its .asf is looked up beside it or given with --asf).
     pub file: PathBuf,
+    /// The ASF skeleton of an .amc file, when it is not beside it (`01_01.amc` → `01.asf`).
+    #[arg(long)]
+    pub asf: Option<PathBuf>,
 }
 
 #[derive(Args)]
 pub struct ConvertArgs {
+    /// Input motion: .bvh, or .amc (with its .asf beside it or given with --asf).
     pub input: PathBuf,
+    /// Output BVH file (written atomically).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// The ASF skeleton of an .amc input, when it is not beside it.
+    #[arg(long)]
+    pub asf: Option<PathBuf>,
+    /// Resample to this frame rate (after cropping).
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// First input frame to keep (0-based).
+    #[arg(long)]
+    pub start: Option<usize>,
+    /// Input frame to stop before (exclusive; default: the end of the clip).
+    #[arg(long)]
+    pub end: Option<usize>,
 }
 
-pub fn info(_a: InfoArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`inbetween info` is not implemented yet")
+fn load(file: &Path, asf: Option<&Path>) -> anyhow::Result<Motion> {
+    let motion = match asf {
+        Some(asf) => inbetween_io::read_asf_amc(asf, file)?,
+        None => inbetween_io::load_motion(file)?,
+    };
+    Ok(motion)
 }
 
-pub fn convert(_a: ConvertArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`inbetween convert` is not implemented yet")
+pub fn info(a: InfoArgs) -> anyhow::Result<()> {
+    let m = load(&a.file, a.asf.as_deref())?;
+    println!("file:      {}", a.file.display());
+    println!("joints:    {}", m.skeleton.len());
+    println!("channels:  {}", m.num_channels());
+    println!("frames:    {}", m.num_frames());
+    println!("fps:       {:.3} (frame time {} s)", m.fps(), m.frame_time);
+    println!("duration:  {:.3} s", m.duration());
+    println!("skeleton:");
+    print_tree(&m.skeleton);
+    Ok(())
+}
+
+/// One line per joint, indented by depth: name, offset, channels.
+fn print_tree(s: &Skeleton) {
+    let mut depth = vec![0usize; s.len()];
+    let mut stack = vec![0usize];
+    while let Some(j) = stack.pop() {
+        let joint = s.joint(j);
+        if let Some(p) = joint.parent {
+            depth[j] = depth[p] + 1;
+        }
+        let channels: Vec<&str> = joint.channels.iter().map(|c| c.name()).collect();
+        let end = joint.end_site.map(|e| format!("  end site ({:.3}, {:.3}, {:.3})", e.x, e.y, e.z)).unwrap_or_default();
+        println!(
+            "  {}{}  offset ({:.3}, {:.3}, {:.3})  [{}] {}{end}",
+            "  ".repeat(depth[j]),
+            joint.name,
+            joint.offset.x,
+            joint.offset.y,
+            joint.offset.z,
+            channels.len(),
+            channels.join(" "),
+        );
+        let children: Vec<usize> = s.children(j).collect();
+        stack.extend(children.into_iter().rev());
+    }
+}
+
+pub fn convert(a: ConvertArgs) -> anyhow::Result<()> {
+    let mut m = load(&a.input, a.asf.as_deref())?;
+    let n = m.num_frames();
+    if a.start.is_some() || a.end.is_some() {
+        let (start, end) = (a.start.unwrap_or(0), a.end.unwrap_or(n));
+        m = m.crop(start, end).with_context(|| format!("cropping {}", a.input.display()))?;
+    }
+    if let Some(fps) = a.fps {
+        m = m.resample(fps).with_context(|| format!("resampling to {fps} fps"))?;
+    }
+    inbetween_io::write_bvh(&a.output, &m)?;
+    println!(
+        "wrote {}: {} joints, {} channels, {} frames at {:.3} fps ({:.3} s) from {} input frames",
+        a.output.display(),
+        m.skeleton.len(),
+        m.num_channels(),
+        m.num_frames(),
+        m.fps(),
+        m.duration(),
+        n
+    );
+    Ok(())
 }

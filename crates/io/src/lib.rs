@@ -67,6 +67,9 @@ pub fn load_motion(path: &Path) -> Result<Motion, IoError> {
     match ext.as_deref() {
         Some("bvh") => bvh::read_bvh(path),
         Some("amc") => {
+            if !path.is_file() {
+                return Err(IoError::Io { path: path.to_path_buf(), source: std::io::ErrorKind::NotFound.into() });
+            }
             let asf = asf::find_asf_for(path)?;
             asf::read_asf_amc(&asf, path)
         }
