@@ -397,8 +397,12 @@ fn draw_frame(scene: &Scene, figs: &[Figure], frames: &[usize], opts: &StickOpti
                 prims.push((depth, Prim::Bone { a: (a.0, a.1), b: (b.0, b.1), width: scene.line_width * persp(depth), color }));
             }
             if let Some((x, y, depth)) = cam.project(pts[j]) {
+                let full = scene.line_width * 0.95 * persp(depth);
+                // Joints at the end of short bones (fingers, toes) get small dots, so hands stay
+                // hands instead of blobs.
+                let bone_px = parent.and_then(|p| cam.project(pts[p])).map(|q| ((q.0 - x).powi(2) + (q.1 - y).powi(2)).sqrt());
+                let radius = bone_px.map_or(full, |l| full * (l / (4.0 * full)).clamp(0.3, 1.0));
                 // Dots sit just in front of the bones that meet at them.
-                let radius = scene.line_width * 0.95 * persp(depth);
                 prims.push((depth * 0.999, Prim::Dot { at: (x, y), radius, color: darken(color, 0.35) }));
             }
         }
