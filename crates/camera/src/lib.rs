@@ -7,7 +7,9 @@
 
 pub mod dataset;
 pub mod features;
+pub mod model;
 pub mod toric;
+pub mod train;
 
 use std::path::{Path, PathBuf};
 

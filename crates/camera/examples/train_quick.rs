@@ -1,0 +1,33 @@
+//! The quick training run behind the committed weights, runnable without the CLI:
+//! `cargo run -p inbetween-camera --example train_quick -- MINUTES OUT.bpk CHECKPOINT_DIR [ITERS_PER_EPOCH] [BATCH]`.
+//! (`inbetween camera train` is the full-featured front end.)
+
+use inbetween_camera::train::{self, TrainConfig, TrainEvent};
+use std::path::PathBuf;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let minutes: f64 = args.first().map_or(Ok(20.0), |s| s.parse())?;
+    let out = PathBuf::from(args.get(1).map_or("crates/camera/weights/camera.bpk", |s| s));
+    let ckpt = PathBuf::from(args.get(2).map_or("out/camera-train", |s| s));
+    let mut cfg = TrainConfig { time_limit_s: Some(minutes * 60.0), ..TrainConfig::default() };
+    if let Some(i) = args.get(3) {
+        cfg.iters_per_epoch = i.parse()?;
+    }
+    if let Some(b) = args.get(4) {
+        cfg.batch = b.parse()?;
+    }
+    let t0 = std::time::Instant::now();
+    let mut report = |e: TrainEvent| match e {
+        TrainEvent::Iteration { epoch, iter, loss } if iter % 10 == 0 => {
+            println!("  epoch {} iter {iter} loss {loss:.4} ({:.1} s)", epoch + 1, t0.elapsed().as_secs_f64())
+        }
+        TrainEvent::Epoch { epoch, loss, lr, seconds } => println!("epoch {:>3} loss {loss:.5} lr {lr:.2e} {seconds:.0} s", epoch + 1),
+        _ => {}
+    };
+    let (model, summary) = train::train(&cfg, Some(&ckpt), &mut report)?;
+    train::save_model(&model, &out)?;
+    inbetween_camera::write_json(&out.with_extension("json"), &summary)?;
+    println!("done: {} epochs, {} iterations, {:.1} min, final loss {:.4}", summary.epochs_done, summary.iterations, summary.seconds / 60.0, summary.final_loss);
+    Ok(())
+}

@@ -1,0 +1,53 @@
+//! The autoregressive camera motion generator (§4.2, Eq. 3):
+//! x^c_i = f(z, x^c_{i−1}, x^v_i, K, z_tta, h_{i−1}) with an encoder of two FC+ReLU layers, a 256-unit
+//! LSTM and a decoder FC+ReLU, FC. K is the next keyframe's camera and character features and
+//! z_tta the time-to-arrival embedding (Eq. 4–5, tta capped at 200 frames).
+
+use super::ModelConfig;
+use burn::module::Module;
+use burn::nn::{Linear, LinearConfig};
+use burn::tensor::activation::relu;
+use burn::tensor::{Device, Tensor};
+use inbetween_nn::lstm::{FusedLstm, FusedLstmConfig, LstmState};
+
+#[derive(Module, Debug)]
+pub struct Generator {
+    pub enc1: Linear,
+    pub enc2: Linear,
+    pub lstm: FusedLstm,
+    pub dec1: Linear,
+    pub dec2: Linear,
+}
+
+/// Everything but the recurrent state that one generator step reads, each `[batch, ·]`.
+pub struct StepInput {
+    pub style: Tensor<2>,
+    pub prev_camera: Tensor<2>,
+    pub character: Tensor<2>,
+    /// Next keyframe: x^c_K (6) then encoded x^v_K (8).
+    pub key: Tensor<2>,
+    pub tta: Tensor<2>,
+}
+
+impl Generator {
+    pub fn new(c: &ModelConfig, device: &Device) -> Generator {
+        let h = c.hidden;
+        Generator {
+            enc1: LinearConfig::new(c.generator_input(), h).init(device),
+            enc2: LinearConfig::new(h, h).init(device),
+            lstm: FusedLstmConfig::new(h, h).init(device),
+            dec1: LinearConfig::new(h, h).init(device),
+            dec2: LinearConfig::new(h, crate::features::CAM_DIM).init(device),
+        }
+    }
+
+    /// One step: returns x̂^c_i (`[batch, 6]`) and the new LSTM state.
+    pub fn step(&self, x: StepInput, state: Option<LstmState>) -> (Tensor<2>, LstmState) {
+        let prev = x.prev_camera.clone();
+        let input = Tensor::cat(vec![x.style, x.prev_camera, x.character, x.key, x.tta], 1);
+        let e = relu(self.enc2.forward(relu(self.enc1.forward(input))));
+        let state = self.lstm.step(e, state);
+        let delta = self.dec2.forward(relu(self.dec1.forward(state.h.clone())));
+        (prev + delta, state)
+    }
+}
