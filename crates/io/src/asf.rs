@@ -502,7 +502,9 @@ fn build_hierarchy(asf: &mut Asf, lines: &[(usize, Vec<&str>)], file: &str) -> R
         stack.extend(children[node].iter().rev());
     }
     if order.len() != n {
-        let missing = (1..n).find(|i| !order.contains(i)).unwrap_or(1);
+        let mut reached = vec![false; n];
+        order.iter().for_each(|&i| reached[i] = true);
+        let missing = (1..n).find(|&i| !reached[i]).unwrap_or(1);
         return Err(invalid(
             file,
             asf.bones[missing - 1].line,
