@@ -43,6 +43,22 @@ pub fn seed(device: &Device, seed: u64) {
     device.seed(seed);
 }
 
+/// Serialises [`seeded`] sections: flex keeps one random generator for the whole process.
+static SEED_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Seed the device and run `f` (e.g. build a model, draw random inputs) while holding a
+/// process-wide lock, so other threads that also go through `seeded` cannot draw from the shared
+/// generator in between. flex's generator is global to the process: a bare [`seed`] followed by
+/// initialisation is only reproducible when no other thread uses random tensors meanwhile
+/// (parallel tests do). Random draws outside any `seeded` section are not excluded.
+pub fn seeded<T>(device: &Device, seed: u64, f: impl FnOnce() -> T) -> T {
+    let _guard = SEED_LOCK
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    device.seed(seed);
+    f()
+}
+
 /// Threads used by the flex backend for one operation.
 ///
 /// The workspace pins burn with `default-features = false`, which builds flex without its
@@ -65,5 +81,12 @@ pub fn cuda_autodiff(index: usize) -> Device {
 
 /// Human-readable name of the backend a device uses, for logs and bench tables.
 pub fn describe(device: &Device) -> String {
-    format!("{device:?}{}", if device.is_autodiff() { " (autodiff)" } else { "" })
+    format!(
+        "{device:?}{}",
+        if device.is_autodiff() {
+            " (autodiff)"
+        } else {
+            ""
+        }
+    )
 }

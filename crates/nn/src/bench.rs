@@ -1,1 +1,231 @@
-//! Benchmarks (placeholder, filled next).
+//! Throughput helpers for a `bench` subcommand (speed goals live here, never in unit tests).
+//!
+//! [`lstm_throughput`] measures the blocks the engines use: a 256-unit [`FusedLstm`] stepping
+//! one trajectory and a batch of trajectories (inference, no autodiff), and a stacked
+//! [`BiLstm`] forward + backward + Adam step (training). [`format_table`] prints the rows.
+
+use std::time::Instant;
+
+use burn::module::Module;
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::tensor::{Device, Distribution, Tensor};
+
+use crate::backend;
+use crate::lstm::{BiLstmConfig, FusedLstmConfig, LstmState};
+
+/// One measured quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchRow {
+    /// What was measured.
+    pub name: String,
+    /// The measured value (see `unit`).
+    pub value: f64,
+    /// Unit of `value`, e.g. "frames/s" or "s/step".
+    pub unit: String,
+    /// Sizes and repetitions behind the number.
+    pub detail: String,
+}
+
+/// Wall-clock seconds per call of `f`, after `warmup` unmeasured calls, averaged over
+/// `iterations` calls. `f` must finish its device work (read a value back) before returning.
+pub fn seconds_per_call(warmup: usize, iterations: usize, mut f: impl FnMut()) -> f64 {
+    for _ in 0..warmup {
+        f();
+    }
+    let start = Instant::now();
+    for _ in 0..iterations.max(1) {
+        f();
+    }
+    start.elapsed().as_secs_f64() / iterations.max(1) as f64
+}
+
+/// Sizes for [`lstm_throughput`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LstmBenchOptions {
+    /// Hidden units of the unidirectional LSTM (256 in the camera generator).
+    pub hidden: usize,
+    /// Input features per frame.
+    pub d_input: usize,
+    /// Frames per trajectory in the inference runs.
+    pub frames: usize,
+    /// Trajectories in the batched inference run.
+    pub batch: usize,
+    /// BiLSTM hidden units per direction.
+    pub bi_hidden: usize,
+    /// BiLSTM stacked layers.
+    pub bi_layers: usize,
+    /// BiLSTM training batch.
+    pub bi_batch: usize,
+    /// BiLSTM sequence length.
+    pub bi_frames: usize,
+    /// Measured repetitions of each case (after one warm-up).
+    pub repeats: usize,
+}
+
+impl Default for LstmBenchOptions {
+    fn default() -> Self {
+        Self {
+            hidden: 256,
+            d_input: 64,
+            frames: 900,
+            batch: 16,
+            bi_hidden: 128,
+            bi_layers: 2,
+            bi_batch: 32,
+            bi_frames: 200,
+            repeats: 3,
+        }
+    }
+}
+
+impl LstmBenchOptions {
+    /// Small sizes for a quick check that the bench runs (not meaningful numbers).
+    pub fn smoke() -> Self {
+        Self {
+            hidden: 16,
+            d_input: 4,
+            frames: 10,
+            batch: 2,
+            bi_hidden: 8,
+            bi_layers: 1,
+            bi_batch: 2,
+            bi_frames: 6,
+            repeats: 1,
+        }
+    }
+}
+
+fn random_frames(frames: usize, batch: usize, features: usize, device: &Device) -> Vec<Tensor<2>> {
+    (0..frames)
+        .map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device))
+        .collect()
+}
+
+/// Frames per second of a `hidden`-unit FusedLstm stepping `batch` trajectories of `frames`
+/// frames (inference device, inputs generated up front).
+fn lstm_inference_fps(opts: &LstmBenchOptions, batch: usize, device: &Device) -> f64 {
+    let (lstm, xs) = backend::seeded(device, 0, || {
+        let lstm = FusedLstmConfig::new(opts.d_input, opts.hidden).init(device);
+        (
+            lstm,
+            random_frames(opts.frames, batch, opts.d_input, device),
+        )
+    });
+    let secs = seconds_per_call(1, opts.repeats, || {
+        let mut state: Option<LstmState> = None;
+        for x in &xs {
+            state = Some(lstm.step(x.clone(), state));
+        }
+        // Reading the result back makes sure all the work ran.
+        let _ = state.map(|s| s.h.sum().into_scalar::<f32>());
+    });
+    (opts.frames * batch) as f64 / secs
+}
+
+/// Seconds per BiLSTM training step: forward over the sequence, mean-square loss, backward,
+/// Adam update.
+fn bilstm_train_step_seconds(opts: &LstmBenchOptions, device: &Device) -> f64 {
+    let (model, xs) = backend::seeded(device, 0, || {
+        let config =
+            BiLstmConfig::new(opts.d_input, opts.bi_hidden).with_num_layers(opts.bi_layers);
+        (
+            config.init(device),
+            random_frames(opts.bi_frames, opts.bi_batch, opts.d_input, device),
+        )
+    });
+    let mut model = Some(model);
+    let mut optim = AdamConfig::new().init();
+    seconds_per_call(1, opts.repeats, || {
+        let current = model.take().expect("model is put back after every step");
+        let outputs = current.forward_seq(&xs);
+        let loss = Tensor::cat(outputs, 1).square().mean();
+        let grads = GradientsParams::from_grads(loss.backward(), &current);
+        let updated = optim.step(1e-3, current, grads);
+        // Read one parameter back so the update has run.
+        let _ = updated.layers[0]
+            .forward
+            .gates
+            .weight
+            .val()
+            .sum()
+            .into_scalar::<f32>();
+        model = Some(updated);
+    })
+}
+
+/// Measure the LSTM blocks on the flex CPU backend; see the module docs for the cases.
+pub fn lstm_throughput(opts: &LstmBenchOptions) -> Vec<BenchRow> {
+    let infer = backend::cpu();
+    let single = lstm_inference_fps(opts, 1, &infer);
+    let batched = lstm_inference_fps(opts, opts.batch, &infer);
+    let train = backend::cpu_autodiff();
+    let bi = bilstm_train_step_seconds(opts, &train);
+    let model = FusedLstmConfig::new(opts.d_input, opts.hidden).init(&infer);
+    vec![
+        BenchRow {
+            name: format!("FusedLstm {} units, 1 trajectory", opts.hidden),
+            value: single,
+            unit: "frames/s".into(),
+            detail: format!(
+                "{} frames, input {}, {} params",
+                opts.frames,
+                opts.d_input,
+                model.num_params()
+            ),
+        },
+        BenchRow {
+            name: format!(
+                "FusedLstm {} units, {} trajectories",
+                opts.hidden, opts.batch
+            ),
+            value: batched,
+            unit: "frames/s".into(),
+            detail: format!("{} frames each, counted over all trajectories", opts.frames),
+        },
+        BenchRow {
+            name: format!("BiLstm {}×{} fwd+bwd+Adam", opts.bi_layers, opts.bi_hidden),
+            value: bi,
+            unit: "s/step".into(),
+            detail: format!(
+                "batch {} × {} frames, input {}",
+                opts.bi_batch, opts.bi_frames, opts.d_input
+            ),
+        },
+    ]
+}
+
+/// Plain-text table of bench rows, one per line, aligned.
+pub fn format_table(rows: &[BenchRow]) -> String {
+    let name_width = rows
+        .iter()
+        .map(|r| r.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    let mut out = format!(
+        "{:<name_width$}  {:>12}  {:<9}  {}\n",
+        "case", "value", "unit", "detail"
+    );
+    for row in rows {
+        out.push_str(&format!(
+            "{:<name_width$}  {:>12.3}  {:<9}  {}\n",
+            row.name, row.value, row.unit, row.detail
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bench_runs_on_tiny_sizes_and_formats_a_table() {
+        let rows = lstm_throughput(&LstmBenchOptions::smoke());
+        assert_eq!(rows.len(), 3);
+        assert!(rows.iter().all(|r| r.value.is_finite() && r.value > 0.0));
+        let table = format_table(&rows);
+        assert_eq!(table.lines().count(), 4);
+        assert!(table.contains("frames/s") && table.contains("s/step"));
+    }
+}

@@ -23,13 +23,19 @@ use crate::NnError;
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed to disk,
 /// then renamed over `path`. Readers see the old file or the new one, never a partial one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), NnError> {
-    let io_err = |source| NnError::Io { path: path.to_path_buf(), source };
+    let io_err = |source| NnError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
     std::fs::create_dir_all(&dir).map_err(io_err)?;
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     let result = (|| {
         let mut file = std::fs::File::create(&tmp)?;
@@ -44,16 +50,26 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), NnError> {
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, NnError> {
-    std::fs::read(path).map_err(|source| NnError::Io { path: path.to_path_buf(), source })
+    std::fs::read(path).map_err(|source| NnError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 fn record_err(path: &Path, err: impl std::fmt::Display) -> NnError {
-    NnError::Record { path: path.to_path_buf(), message: err.to_string() }
+    NnError::Record {
+        path: path.to_path_buf(),
+        message: err.to_string(),
+    }
 }
 
 /// Save a module's parameters to `path` (burnpack format), atomically.
 pub fn save_module<M: Module>(module: &M, path: &Path) -> Result<(), NnError> {
-    let bytes = module.clone().into_record().into_bytes().map_err(|e| record_err(path, e))?;
+    let bytes = module
+        .clone()
+        .into_record()
+        .into_bytes()
+        .map_err(|e| record_err(path, e))?;
     write_atomic(path, &bytes)
 }
 
@@ -61,8 +77,11 @@ pub fn save_module<M: Module>(module: &M, path: &Path) -> Result<(), NnError> {
 /// device). Shape mismatches and missing parameters are errors naming the file and parameter.
 pub fn load_module<M: Module>(module: M, path: &Path) -> Result<M, NnError> {
     let bytes = read_file(path)?;
-    let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))?;
-    module.try_load_record(record).map_err(|e| record_err(path, e))
+    let record =
+        ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))?;
+    module
+        .try_load_record(record)
+        .map_err(|e| record_err(path, e))
 }
 
 /// Save an optimizer's state (Adam moments and step counts, keyed by parameter id).
@@ -77,7 +96,9 @@ pub fn save_optimizer(optim: &ModuleOptimizer, path: &Path) -> Result<(), NnErro
 /// so load the model from the same checkpoint.
 pub fn load_optimizer(optim: ModuleOptimizer, path: &Path) -> Result<ModuleOptimizer, NnError> {
     let bytes = read_file(path)?;
-    optim.from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))
+    optim
+        .from_bytes(Bytes::from_bytes_vec(bytes))
+        .map_err(|e| record_err(path, e))
 }
 
 /// The JSON sidecar of a checkpoint.
@@ -165,11 +186,19 @@ pub fn latest_checkpoint(dir: &Path) -> Result<Option<CheckpointFiles>, NnError>
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(source) => return Err(NnError::Io { path: dir.to_path_buf(), source }),
+        Err(source) => {
+            return Err(NnError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })
+        }
     };
     let mut best: Option<usize> = None;
     for entry in entries {
-        let entry = entry.map_err(|source| NnError::Io { path: dir.to_path_buf(), source })?;
+        let entry = entry.map_err(|source| NnError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
         let name = entry.file_name();
         let epoch = name
             .to_str()

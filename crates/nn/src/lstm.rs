@@ -81,11 +81,18 @@ impl FusedLstmConfig {
         if self.forget_bias != 0.0 {
             if let Some(bias) = gates.bias.take() {
                 // Built from plain data so the bias stays a leaf parameter under autodiff.
-                let mut values = bias.val().into_data().try_to_vec::<f32>().unwrap_or_default();
+                let mut values = bias
+                    .val()
+                    .into_data()
+                    .try_to_vec::<f32>()
+                    .unwrap_or_default();
                 for v in &mut values[hidden..2 * hidden] {
                     *v += self.forget_bias as f32;
                 }
-                gates.bias = Some(Param::from_data(TensorData::new(values, [4 * hidden]), device));
+                gates.bias = Some(Param::from_data(
+                    TensorData::new(values, [4 * hidden]),
+                    device,
+                ));
             }
         }
         FusedLstm {
@@ -175,11 +182,19 @@ pub struct BiLstm {
 impl BiLstmConfig {
     /// Build the stack on `device`.
     pub fn init(&self, device: &Device) -> BiLstm {
-        assert!(self.num_layers >= 1, "BiLstmConfig: num_layers must be at least 1");
+        assert!(
+            self.num_layers >= 1,
+            "BiLstmConfig: num_layers must be at least 1"
+        );
         let layers = (0..self.num_layers)
             .map(|k| {
-                let d_in = if k == 0 { self.d_input } else { 2 * self.d_hidden };
-                let cell = FusedLstmConfig::new(d_in, self.d_hidden).with_forget_bias(self.forget_bias);
+                let d_in = if k == 0 {
+                    self.d_input
+                } else {
+                    2 * self.d_hidden
+                };
+                let cell =
+                    FusedLstmConfig::new(d_in, self.d_hidden).with_forget_bias(self.forget_bias);
                 BiLstmLayer {
                     forward: cell.init(device),
                     backward: cell.init(device),
@@ -245,16 +260,17 @@ mod tests {
     }
 
     fn random_seq(steps: usize, batch: usize, features: usize, device: &Device) -> Vec<Tensor<2>> {
-        (0..steps)
-            .map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device))
-            .collect()
+        backend::seeded(device, steps as u64, || {
+            (0..steps)
+                .map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device))
+                .collect()
+        })
     }
 
     #[test]
     fn step_by_step_matches_forward_seq() {
         let device = backend::cpu();
-        backend::seed(&device, 1);
-        let lstm = FusedLstmConfig::new(3, 8).init(&device);
+        let lstm = backend::seeded(&device, 1, || FusedLstmConfig::new(3, 8).init(&device));
         let xs = random_seq(12, 4, 3, &device);
         let (outputs, last) = lstm.forward_seq(&xs, None);
         let mut state = None;
@@ -273,10 +289,23 @@ mod tests {
     fn cell_matches_hand_computed_lstm_equations() {
         // One step of a 1-input, 1-unit cell checked against the scalar equations in f64.
         let device = backend::cpu();
-        backend::seed(&device, 2);
-        let lstm = FusedLstmConfig::new(1, 1).init(&device);
-        let w: Vec<f32> = lstm.gates.weight.val().into_data().try_to_vec::<f32>().unwrap();
-        let b: Vec<f32> = lstm.gates.bias.as_ref().unwrap().val().into_data().try_to_vec::<f32>().unwrap();
+        let lstm = backend::seeded(&device, 2, || FusedLstmConfig::new(1, 1).init(&device));
+        let w: Vec<f32> = lstm
+            .gates
+            .weight
+            .val()
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
+        let b: Vec<f32> = lstm
+            .gates
+            .bias
+            .as_ref()
+            .unwrap()
+            .val()
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
         let (x, h0, c0) = (0.7_f64, -0.3_f64, 0.5_f64);
         // weight is [d_input + d_hidden, 4·hidden] = [2, 4]: row 0 multiplies x, row 1 multiplies h.
         let z = |k: usize| x * w[k] as f64 + h0 * w[4 + k] as f64 + b[k] as f64;
@@ -299,8 +328,9 @@ mod tests {
     #[test]
     fn bilstm_shape_and_backward_half_sees_the_future() {
         let device = backend::cpu();
-        backend::seed(&device, 3);
-        let bilstm = BiLstmConfig::new(5, 6).with_num_layers(2).init(&device);
+        let bilstm = backend::seeded(&device, 3, || {
+            BiLstmConfig::new(5, 6).with_num_layers(2).init(&device)
+        });
         let mut xs = random_seq(10, 2, 5, &device);
         let out = bilstm.forward_seq(&xs);
         assert_eq!(out.len(), 10);
@@ -314,7 +344,7 @@ mod tests {
         assert!(max_abs_diff(&out[0], &perturbed[0]) > 1e-4);
 
         // In a single layer the forward half of the first output must not change.
-        let single = BiLstmConfig::new(5, 6).init(&device);
+        let single = backend::seeded(&device, 30, || BiLstmConfig::new(5, 6).init(&device));
         let a = single.forward_seq(&xs[..]);
         xs[9] = xs[9].clone() - 2.0;
         let b = single.forward_seq(&xs);
@@ -327,7 +357,6 @@ mod tests {
     #[test]
     fn stack_and_unstack_time_round_trip() {
         let device = backend::cpu();
-        backend::seed(&device, 4);
         let xs = random_seq(7, 3, 2, &device);
         let stacked = stack_time(&xs);
         assert_eq!(stacked.dims(), [3, 7, 2]);

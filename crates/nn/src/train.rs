@@ -2,7 +2,8 @@
 //! bar, periodic checkpoints and resume from the latest checkpoint.
 //!
 //! The caller supplies two closures: one that builds the model on a device (called once, right
-//! after seeding, so the initial weights depend only on [`TrainConfig::seed`]) and one that
+//! after seeding, inside [`backend::seeded`](crate::backend::seeded), so the initial weights
+//! depend only on [`TrainConfig::seed`]) and one that
 //! returns the loss of one optimisation step. The loss closure gets a [`Step`] whose
 //! [`Step::seed`] depends only on (seed, epoch, step): draw batches from an RNG seeded with it and
 //! a resumed run sees exactly the batches an uninterrupted run would.
@@ -79,14 +80,22 @@ impl TrainConfig {
             return Err(NnError::Config("steps_per_epoch must be at least 1".into()));
         }
         if !(self.lr > 0.0 && self.lr.is_finite()) {
-            return Err(NnError::Config(format!("lr must be positive and finite, got {}", self.lr)));
+            return Err(NnError::Config(format!(
+                "lr must be positive and finite, got {}",
+                self.lr
+            )));
         }
         if !(self.lr_decay > 0.0 && self.lr_decay <= 1.0) {
-            return Err(NnError::Config(format!("lr_decay must be in (0, 1], got {}", self.lr_decay)));
+            return Err(NnError::Config(format!(
+                "lr_decay must be in (0, 1], got {}",
+                self.lr_decay
+            )));
         }
         if let Some(clip) = self.grad_clip_norm {
             if !(clip > 0.0 && clip.is_finite()) {
-                return Err(NnError::Config(format!("grad_clip_norm must be positive, got {clip}")));
+                return Err(NnError::Config(format!(
+                    "grad_clip_norm must be positive, got {clip}"
+                )));
             }
         }
         Ok(())
@@ -159,9 +168,9 @@ fn progress_bar(config: &TrainConfig, start_epoch: usize) -> ProgressBar {
         ProgressDrawTarget::hidden()
     };
     let bar = ProgressBar::with_draw_target(Some(total), target);
-    if let Ok(style) =
-        ProgressStyle::with_template("{bar:30} {pos}/{len} steps, {elapsed} elapsed, eta {eta} {msg}")
-    {
+    if let Ok(style) = ProgressStyle::with_template(
+        "{bar:30} {pos}/{len} steps, {elapsed} elapsed, eta {eta} {msg}",
+    ) {
         bar.set_style(style);
     }
     bar.set_position((start_epoch * config.steps_per_epoch) as u64);
@@ -182,7 +191,12 @@ fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
 /// history are restored from the latest one and training continues at its epoch. Given the same
 /// config and a loss closure that samples data only from [`Step::seed`], the result is
 /// bit-identical to an uninterrupted run (flex runs every op on one thread in a fixed order).
-pub fn fit<M, B, L>(config: &TrainConfig, device: &Device, build: B, mut loss: L) -> Result<TrainReport<M>, NnError>
+pub fn fit<M, B, L>(
+    config: &TrainConfig,
+    device: &Device,
+    build: B,
+    mut loss: L,
+) -> Result<TrainReport<M>, NnError>
 where
     M: Module,
     B: FnOnce(&Device) -> M,
@@ -190,10 +204,11 @@ where
 {
     config.validate()?;
     if !device.is_autodiff() {
-        return Err(NnError::Config("fit needs an autodiff device (e.g. backend::cpu_autodiff())".into()));
+        return Err(NnError::Config(
+            "fit needs an autodiff device (e.g. backend::cpu_autodiff())".into(),
+        ));
     }
-    device.seed(config.seed);
-    let mut model = build(device);
+    let mut model = crate::backend::seeded(device, config.seed, || build(device));
     let mut optim = new_optimizer(config);
     let mut loss_history = Vec::new();
     let mut optimizer_steps = 0u64;
@@ -218,11 +233,15 @@ where
     for epoch in start_epoch..config.epochs {
         // Re-seed per epoch so random ops inside the model (noise, dropout) replay identically
         // after a resume.
-        device.seed(step_seed(config.seed, epoch, usize::MAX));
+        crate::backend::seeded(device, step_seed(config.seed, epoch, usize::MAX), || ());
         let lr = config.lr_at(epoch);
         let mut sum = 0.0;
         for step in 0..config.steps_per_epoch {
-            let step = Step { epoch, step, seed: step_seed(config.seed, epoch, step) };
+            let step = Step {
+                epoch,
+                step,
+                seed: step_seed(config.seed, epoch, step),
+            };
             let value = loss(&model, &step);
             let scalar = f64::from(value.clone().into_scalar::<f32>());
             if !scalar.is_finite() {
@@ -259,18 +278,30 @@ where
         }
     }
     bar.finish_and_clear();
-    Ok(TrainReport { model, loss_history, start_epoch, optimizer_steps, resumed_from, last_checkpoint })
+    Ok(TrainReport {
+        model,
+        loss_history,
+        start_epoch,
+        optimizer_steps,
+        resumed_from,
+        last_checkpoint,
+    })
 }
 
 /// A checkpoint written with a different seed, lr, decay, steps per epoch or clipping would not
 /// continue the same run: refuse rather than silently mixing trajectories.
-fn check_resumable(config: &TrainConfig, meta: &CheckpointMeta, path: &std::path::Path) -> Result<(), NnError> {
-    let saved: TrainConfig = serde_json::from_value(meta.config.clone()).map_err(|e| NnError::Metadata {
-        path: path.to_path_buf(),
-        line: 0,
-        column: 0,
-        message: format!("field \"config\" is not a TrainConfig: {e}"),
-    })?;
+fn check_resumable(
+    config: &TrainConfig,
+    meta: &CheckpointMeta,
+    path: &std::path::Path,
+) -> Result<(), NnError> {
+    let saved: TrainConfig =
+        serde_json::from_value(meta.config.clone()).map_err(|e| NnError::Metadata {
+            path: path.to_path_buf(),
+            line: 0,
+            column: 0,
+            message: format!("field \"config\" is not a TrainConfig: {e}"),
+        })?;
     if saved.resume_key() != config.resume_key() {
         return Err(NnError::Config(format!(
             "{}: checkpoint was written with seed {}, lr {}, lr_decay {}, steps_per_epoch {}, grad_clip_norm {:?}; \
@@ -330,8 +361,14 @@ mod tests {
                 Tensor::from_data(TensorData::new(column, [BATCH, 1]), device)
             })
             .collect();
-        let targets: Vec<f32> = (0..BATCH).flat_map(|b| (1..=STEPS).map(move |t| (b, t))).map(|(b, t)| sample(b, t)).collect();
-        (inputs, Tensor::from_data(TensorData::new(targets, [BATCH, STEPS]), device))
+        let targets: Vec<f32> = (0..BATCH)
+            .flat_map(|b| (1..=STEPS).map(move |t| (b, t)))
+            .map(|(b, t)| sample(b, t))
+            .collect();
+        (
+            inputs,
+            Tensor::from_data(TensorData::new(targets, [BATCH, STEPS]), device),
+        )
     }
 
     fn predict(model: &SinePredictor, inputs: &[Tensor<2>]) -> Tensor<2> {
@@ -359,8 +396,23 @@ mod tests {
     }
 
     fn weights(model: &SinePredictor) -> Vec<f32> {
-        let mut all = model.lstm.gates.weight.val().into_data().try_to_vec::<f32>().unwrap();
-        all.extend(model.head.weight.val().into_data().try_to_vec::<f32>().unwrap());
+        let mut all = model
+            .lstm
+            .gates
+            .weight
+            .val()
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
+        all.extend(
+            model
+                .head
+                .weight
+                .val()
+                .into_data()
+                .try_to_vec::<f32>()
+                .unwrap(),
+        );
         all
     }
 
@@ -370,10 +422,16 @@ mod tests {
         let report = fit(&config(30), &device, build, sine_loss(&device)).unwrap();
         let first = report.loss_history[0];
         let last = *report.loss_history.last().unwrap();
-        println!("sine smoke: first-epoch loss {first:.5}, last-epoch loss {last:.5}, ratio {:.4}", last / first);
+        println!(
+            "sine smoke: first-epoch loss {first:.5}, last-epoch loss {last:.5}, ratio {:.4}",
+            last / first
+        );
         assert_eq!(report.loss_history.len(), 30);
         assert_eq!(report.optimizer_steps, 150);
-        assert!(last < 0.2 * first, "loss did not fall enough: {first} -> {last}");
+        assert!(
+            last < 0.2 * first,
+            "loss did not fall enough: {first} -> {last}"
+        );
     }
 
     #[test]
@@ -383,7 +441,10 @@ mod tests {
         let b = fit(&config(2), &device, build, sine_loss(&device)).unwrap();
         assert_eq!(a.loss_history, b.loss_history);
         assert_eq!(weights(&a.model), weights(&b.model));
-        let other = TrainConfig { seed: 43, ..config(2) };
+        let other = TrainConfig {
+            seed: 43,
+            ..config(2)
+        };
         let c = fit(&other, &device, build, sine_loss(&device)).unwrap();
         assert_ne!(weights(&a.model), weights(&c.model));
     }
@@ -398,11 +459,29 @@ mod tests {
             checkpoint_dir: Some(dir.to_path_buf()),
             ..config(epochs)
         };
-        let straight = fit(&with_dir(4, straight_dir.path()), &device, build, sine_loss(&device)).unwrap();
+        let straight = fit(
+            &with_dir(4, straight_dir.path()),
+            &device,
+            build,
+            sine_loss(&device),
+        )
+        .unwrap();
         // Interrupted after 2 epochs, then restarted with the full epoch count.
-        let first = fit(&with_dir(2, split_dir.path()), &device, build, sine_loss(&device)).unwrap();
+        let first = fit(
+            &with_dir(2, split_dir.path()),
+            &device,
+            build,
+            sine_loss(&device),
+        )
+        .unwrap();
         assert_eq!(first.loss_history.len(), 2);
-        let resumed = fit(&with_dir(4, split_dir.path()), &device, build, sine_loss(&device)).unwrap();
+        let resumed = fit(
+            &with_dir(4, split_dir.path()),
+            &device,
+            build,
+            sine_loss(&device),
+        )
+        .unwrap();
         assert_eq!(resumed.start_epoch, 2);
         assert!(resumed.resumed_from.is_some());
         assert_eq!(resumed.optimizer_steps, straight.optimizer_steps);
@@ -410,8 +489,13 @@ mod tests {
         assert_eq!(weights(&resumed.model), weights(&straight.model));
 
         // A checkpoint from another seed is refused with a message naming both.
-        let mismatched = TrainConfig { seed: 7, ..with_dir(6, split_dir.path()) };
-        let err = fit(&mismatched, &device, build, sine_loss(&device)).unwrap_err().to_string();
+        let mismatched = TrainConfig {
+            seed: 7,
+            ..with_dir(6, split_dir.path())
+        };
+        let err = fit(&mismatched, &device, build, sine_loss(&device))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("seed 42") && err.contains("seed 7"), "{err}");
     }
 
@@ -423,35 +507,55 @@ mod tests {
         let path = dir.path().join("sine.bpk");
         checkpoint::save_module(&report.model, &path).unwrap();
         // A differently seeded fresh model, then loaded: must reproduce the trained outputs.
-        backend::seed(&device, 999);
-        let loaded = checkpoint::load_module(build(&device), &path).unwrap();
+        let fresh = backend::seeded(&device, 999, || build(&device));
+        let loaded = checkpoint::load_module(fresh, &path).unwrap();
         let (inputs, _) = sine_batch(5, &device);
-        let expected = predict(&report.model, &inputs).into_data().try_to_vec::<f32>().unwrap();
-        let got = predict(&loaded, &inputs).into_data().try_to_vec::<f32>().unwrap();
+        let expected = predict(&report.model, &inputs)
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
+        let got = predict(&loaded, &inputs)
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
         assert_eq!(expected, got);
     }
 
     #[test]
     fn bad_config_and_files_give_clear_errors() {
         let device = backend::cpu_autodiff();
-        let bad = TrainConfig { lr_decay: 1.5, ..config(1) };
-        let err = fit(&bad, &device, build, sine_loss(&device)).unwrap_err().to_string();
+        let bad = TrainConfig {
+            lr_decay: 1.5,
+            ..config(1)
+        };
+        let err = fit(&bad, &device, build, sine_loss(&device))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("lr_decay"), "{err}");
         let plain = backend::cpu();
-        let err = fit(&config(1), &plain, build, sine_loss(&plain)).unwrap_err().to_string();
+        let err = fit(&config(1), &plain, build, sine_loss(&plain))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("autodiff"), "{err}");
 
         let dir = tempfile::tempdir().unwrap();
         let garbage = dir.path().join("garbage.bpk");
         std::fs::write(&garbage, b"not a burnpack").unwrap();
-        let err = checkpoint::load_module(build(&device), &garbage).unwrap_err().to_string();
+        let err = checkpoint::load_module(build(&device), &garbage)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("garbage.bpk"), "{err}");
         let meta = dir.path().join("epoch-000001.json");
         std::fs::write(&meta, "{\n  \"epoch\": 1,\n  oops\n}").unwrap();
         let err = CheckpointMeta::load(&meta).unwrap_err().to_string();
-        assert!(err.contains("epoch-000001.json") && err.contains("line 3"), "{err}");
+        assert!(
+            err.contains("epoch-000001.json") && err.contains("line 3"),
+            "{err}"
+        );
         let missing = dir.path().join("missing.bpk");
-        let err = checkpoint::load_module(build(&device), &missing).unwrap_err().to_string();
+        let err = checkpoint::load_module(build(&device), &missing)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("missing.bpk"), "{err}");
     }
 }

@@ -30,8 +30,15 @@ impl TtaEmbedding {
     /// # Panics
     /// If `dim` is odd or zero: sin/cos pairs need an even size.
     pub fn new(dim: usize, max_tta: f32) -> Self {
-        assert!(dim > 0 && dim % 2 == 0, "TtaEmbedding: dim must be even and > 0, got {dim}");
-        Self { dim, basis: 10_000.0, max_tta }
+        assert!(
+            dim > 0 && dim % 2 == 0,
+            "TtaEmbedding: dim must be even and > 0, got {dim}"
+        );
+        Self {
+            dim,
+            basis: 10_000.0,
+            max_tta,
+        }
     }
 
     /// The same embedding with another frequency basis.
