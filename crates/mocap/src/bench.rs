@@ -90,7 +90,7 @@ impl Method {
 }
 
 /// A learned selector (SIDQL) as the bench sees it.
-pub type PolicyFn<'a> = &'a (dyn Fn(&SphericalMotion, usize) -> Result<KeyframeSet> + Sync);
+pub type PolicyFn<'a> = &'a dyn Fn(&SphericalMotion, usize) -> Result<KeyframeSet>;
 
 /// Selects `k` keys of one window with a method; `seed` drives RC.
 pub fn select_keys(method: Method, rep: &SphericalMotion, k: usize, seed: u64, policy: Option<PolicyFn>) -> Result<KeyframeSet> {

@@ -94,6 +94,23 @@ pub fn encode(model: &RotationMotion, keys: &KeyframeSet) -> Vec<u8> {
     out.extend_from_slice(&(keys.len() as u32).to_le_bytes());
     out.extend_from_slice(&(max_w as f32 * 1.0001).to_le_bytes());
     let w_scale = f32::from_le_bytes(out[out.len() - 4..].try_into().expect("4 bytes")) as f64;
+    write_skeleton(&mut out, sk);
+    let mut prev = 0;
+    for &f in keys.frames() {
+        write_varint(&mut out, (f - prev) as u64);
+        prev = f;
+    }
+    for p in &poses {
+        write_key(&mut out, sk, p, w_scale);
+    }
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out
+}
+
+
+/// Appends the skeleton section (joint count, then each joint).
+pub fn write_skeleton(out: &mut Vec<u8>, sk: &Skeleton) {
     out.extend_from_slice(&(sk.len() as u16).to_le_bytes());
     for j in sk.joints() {
         out.extend_from_slice(&(j.name.len() as u16).to_le_bytes());
@@ -114,31 +131,25 @@ pub fn encode(model: &RotationMotion, keys: &KeyframeSet) -> Vec<u8> {
             None => out.push(0),
         }
     }
-    let mut prev = 0;
-    for &f in keys.frames() {
-        write_varint(&mut out, (f - prev) as u64);
-        prev = f;
-    }
-    for p in &poses {
-        for (j, joint) in sk.joints().iter().enumerate() {
-            if joint.rotation_order().is_some() {
-                for v in quat_to_rotvec(p.rotations[j]).to_array() {
-                    out.extend_from_slice(&quantize(v, PI).to_le_bytes());
-                }
-                for v in p.angular_velocities[j].to_array() {
-                    out.extend_from_slice(&quantize(v, w_scale).to_le_bytes());
-                }
+}
+
+/// Appends one key's values (quantised rotations and angular velocities, f32 translations).
+pub fn write_key(out: &mut Vec<u8>, sk: &Skeleton, p: &KeyPose, w_scale: f64) {
+    for (j, joint) in sk.joints().iter().enumerate() {
+        if joint.rotation_order().is_some() {
+            for v in quat_to_rotvec(p.rotations[j]).to_array() {
+                out.extend_from_slice(&quantize(v, PI).to_le_bytes());
             }
-            if joint.has_translation() {
-                for v in p.translations[j].to_array().into_iter().chain(p.velocities[j].to_array()) {
-                    out.extend_from_slice(&(v as f32).to_le_bytes());
-                }
+            for v in p.angular_velocities[j].to_array() {
+                out.extend_from_slice(&quantize(v, w_scale).to_le_bytes());
+            }
+        }
+        if joint.has_translation() {
+            for v in p.translations[j].to_array().into_iter().chain(p.velocities[j].to_array()) {
+                out.extend_from_slice(&(v as f32).to_le_bytes());
             }
         }
     }
-    let crc = crc32fast::hash(&out);
-    out.extend_from_slice(&crc.to_le_bytes());
-    out
 }
 
 fn write_varint(out: &mut Vec<u8>, mut v: u64) {
@@ -154,12 +165,18 @@ fn write_varint(out: &mut Vec<u8>, mut v: u64) {
 }
 
 /// A bounds-checked reader whose errors say what was expected at which byte.
-struct Reader<'a> {
+pub struct Reader<'a> {
     bytes: &'a [u8],
     pos: usize,
 }
 
 impl<'a> Reader<'a> {
+    pub fn new(bytes: &'a [u8]) -> Reader<'a> {
+        Reader { bytes, pos: 0 }
+    }
+    pub fn remaining(&self) -> usize {
+        self.bytes.len() - self.pos
+    }
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8]> {
         if self.bytes.len() - self.pos < n {
             return Err(MocapError::Codec(format!(
@@ -175,28 +192,28 @@ impl<'a> Reader<'a> {
     fn arr<const N: usize>(&mut self, what: &str) -> Result<[u8; N]> {
         Ok(self.take(N, what)?.try_into().expect("length checked"))
     }
-    fn u8(&mut self, what: &str) -> Result<u8> {
+    pub fn u8(&mut self, what: &str) -> Result<u8> {
         Ok(self.take(1, what)?[0])
     }
-    fn u16(&mut self, what: &str) -> Result<u16> {
+    pub fn u16(&mut self, what: &str) -> Result<u16> {
         Ok(u16::from_le_bytes(self.arr(what)?))
     }
-    fn i16(&mut self, what: &str) -> Result<i16> {
+    pub fn i16(&mut self, what: &str) -> Result<i16> {
         Ok(i16::from_le_bytes(self.arr(what)?))
     }
-    fn u32(&mut self, what: &str) -> Result<u32> {
+    pub fn u32(&mut self, what: &str) -> Result<u32> {
         Ok(u32::from_le_bytes(self.arr(what)?))
     }
-    fn f32(&mut self, what: &str) -> Result<f64> {
+    pub fn f32(&mut self, what: &str) -> Result<f64> {
         Ok(f32::from_le_bytes(self.arr(what)?) as f64)
     }
-    fn f64(&mut self, what: &str) -> Result<f64> {
+    pub fn f64(&mut self, what: &str) -> Result<f64> {
         Ok(f64::from_le_bytes(self.arr(what)?))
     }
     fn vec3_f64(&mut self, what: &str) -> Result<DVec3> {
         Ok(DVec3::new(self.f64(what)?, self.f64(what)?, self.f64(what)?))
     }
-    fn varint(&mut self, what: &str) -> Result<u64> {
+    pub fn varint(&mut self, what: &str) -> Result<u64> {
         let mut v = 0u64;
         for shift in (0..64).step_by(7) {
             let b = self.u8(what)?;
@@ -207,6 +224,69 @@ impl<'a> Reader<'a> {
         }
         Err(MocapError::Codec(format!("{what} at byte {}: varint longer than 64 bits", self.pos)))
     }
+}
+
+/// Reads `nj` joints written by [`write_skeleton`] (after its joint count).
+pub fn read_skeleton_joints(r: &mut Reader, nj: usize) -> Result<Skeleton> {
+    let mut joints = Vec::with_capacity(nj);
+    for i in 0..nj {
+        let len = r.u16("joint name length")? as usize;
+        let name = String::from_utf8(r.take(len, "joint name")?.to_vec())
+            .map_err(|_| MocapError::Codec(format!("joint {i}: name is not UTF-8")))?;
+        let parent = r.i16("joint parent")?;
+        let offset = r.vec3_f64("joint offset")?;
+        let nch = r.u8("channel count")? as usize;
+        let channels = (0..nch)
+            .map(|_| {
+                let c = r.u8("channel code")?;
+                channel_from_code(c).ok_or_else(|| MocapError::Codec(format!("joint {i} '{name}': unknown channel code {c}")))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let end_site = if r.u8("end site flag")? == 1 { Some(r.vec3_f64("end site")?) } else { None };
+        let parent = if parent < 0 { None } else { Some(parent as usize) };
+        joints.push(Joint { name, parent, offset, channels, end_site });
+    }
+    Skeleton::new(joints).map_err(|e| MocapError::Codec(format!("skeleton: {e}")))
+}
+
+/// Reads a skeleton written by [`write_skeleton`].
+pub fn read_skeleton(r: &mut Reader) -> Result<Skeleton> {
+    let nj = r.u16("joint count")? as usize;
+    if nj == 0 {
+        return Err(MocapError::Codec("skeleton with no joints".into()));
+    }
+    read_skeleton_joints(r, nj)
+}
+
+/// Reads one key written by [`write_key`].
+pub fn read_key(r: &mut Reader, skeleton: &Skeleton, w_scale: f64) -> Result<KeyPose> {
+    let nj = skeleton.len();
+    let mut p = KeyPose {
+        rotations: vec![DQuat::IDENTITY; nj],
+        angular_velocities: vec![DVec3::ZERO; nj],
+        translations: skeleton.joints().iter().map(|j| j.offset).collect(),
+        velocities: vec![DVec3::ZERO; nj],
+    };
+    for (j, joint) in skeleton.joints().iter().enumerate() {
+        if joint.rotation_order().is_some() {
+        let mut v = [0.0; 6];
+        for (i, x) in v.iter_mut().enumerate() {
+            let q = r.i16("key rotation")?;
+            *x = if i < 3 { dequantize(q, PI) } else { dequantize(q, w_scale) };
+        }
+        p.rotations[j] = rotvec_to_quat(DVec3::new(v[0], v[1], v[2]));
+        p.angular_velocities[j] = DVec3::new(v[3], v[4], v[5]);
+        }
+        if joint.has_translation() {
+        let mut v = [0.0; 6];
+        for x in &mut v {
+            *x = r.f32("key translation")?;
+        }
+        p.translations[j] = DVec3::new(v[0], v[1], v[2]);
+        p.velocities[j] = DVec3::new(v[3], v[4], v[5]);
+        }
+    }
+    Ok(p)
 }
 
 /// Decodes an `.ibk` file, checking magic, version, checksum and every length.
@@ -241,25 +321,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
             "invalid header: frame time {frame_time}, {num_frames} frames, {num_keys} keys, {nj} joints"
         )));
     }
-    let mut joints = Vec::with_capacity(nj);
-    for i in 0..nj {
-        let len = r.u16("joint name length")? as usize;
-        let name = String::from_utf8(r.take(len, "joint name")?.to_vec())
-            .map_err(|_| MocapError::Codec(format!("joint {i}: name is not UTF-8")))?;
-        let parent = r.i16("joint parent")?;
-        let offset = r.vec3_f64("joint offset")?;
-        let nch = r.u8("channel count")? as usize;
-        let channels = (0..nch)
-            .map(|_| {
-                let c = r.u8("channel code")?;
-                channel_from_code(c).ok_or_else(|| MocapError::Codec(format!("joint {i} '{name}': unknown channel code {c}")))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let end_site = if r.u8("end site flag")? == 1 { Some(r.vec3_f64("end site")?) } else { None };
-        let parent = if parent < 0 { None } else { Some(parent as usize) };
-        joints.push(Joint { name, parent, offset, channels, end_site });
-    }
-    let skeleton = Skeleton::new(joints).map_err(|e| MocapError::Codec(format!("skeleton: {e}")))?;
+    let skeleton = read_skeleton_joints(&mut r, nj)?;
     let mut key_frames = Vec::with_capacity(num_keys);
     let mut f = 0u64;
     for k in 0..num_keys {
@@ -275,31 +337,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
     }
     let mut keys = Vec::with_capacity(num_keys);
     for _ in 0..num_keys {
-        let mut p = KeyPose {
-            rotations: vec![DQuat::IDENTITY; nj],
-            angular_velocities: vec![DVec3::ZERO; nj],
-            translations: skeleton.joints().iter().map(|j| j.offset).collect(),
-            velocities: vec![DVec3::ZERO; nj],
-        };
-        for (j, joint) in skeleton.joints().iter().enumerate() {
-            if joint.rotation_order().is_some() {
-                let mut v = [0.0; 6];
-                for (i, x) in v.iter_mut().enumerate() {
-                    let q = r.i16("key rotation")?;
-                    *x = if i < 3 { dequantize(q, PI) } else { dequantize(q, w_scale) };
-                }
-                p.rotations[j] = rotvec_to_quat(DVec3::new(v[0], v[1], v[2]));
-                p.angular_velocities[j] = DVec3::new(v[3], v[4], v[5]);
-            }
-            if joint.has_translation() {
-                let mut v = [0.0; 6];
-                for x in &mut v {
-                    *x = r.f32("key translation")?;
-                }
-                p.translations[j] = DVec3::new(v[0], v[1], v[2]);
-                p.velocities[j] = DVec3::new(v[3], v[4], v[5]);
-            }
-        }
+        let p = read_key(&mut r, &skeleton, w_scale)?;
         keys.push(p);
     }
     if r.pos != body.len() {

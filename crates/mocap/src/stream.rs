@@ -1,1 +1,446 @@
-//! stream: in progress.
+//! Live keyframe stream (the paper's motivation: avatars over a network). The sender reads a clip as
+//! if it were being captured, chooses keys online with a bounded look-ahead and sends them over TCP;
+//! the receiver rebuilds and emits the frames between each pair of keys as soon as the second
+//! arrives.
+//!
+//! Online choice: with the last key at `a` and frames up to `t` captured, a key's velocity needs the
+//! frame after it, so candidates are `b ≤ t − 1`. While segment `(a, t−1)` keeps every joint within
+//! the error bound and is shorter than the look-ahead, the sender waits; otherwise it sends the
+//! farthest feasible `b` (at least `a + 1`). A frame therefore waits at most `lookahead + 1` frames.
+//!
+//! Wire format: messages `type u8 | length u32 | payload | crc32(type, length, payload) u32`.
+//! Hello (1): magic "IBS1", frame time f64, frame count u32, skeleton (as in the `.ibk` codec).
+//! Key (2): frame u32, angular velocity scale f32, key values (as in the codec). End (3): empty.
+//! A sender whose connection breaks reconnects and resends Hello and its last key; a receiver whose
+//! peer vanishes keeps the frames it has and waits for the peer to come back.
+
+use crate::codec::{read_key, read_skeleton, write_key, write_skeleton, Reader};
+use crate::error::SegmentModel;
+use crate::rotations::{interpolate_pose_into, KeyPose, RotationMotion};
+use crate::{MocapError, Result};
+use glam::{DQuat, DVec3};
+use inbetween_core::{Motion, Pose, Skeleton};
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream, ToSocketAddrs};
+use std::time::{Duration, Instant};
+
+const HELLO: u8 = 1;
+const KEY: u8 = 2;
+const END: u8 = 3;
+const STREAM_MAGIC: &[u8; 4] = b"IBS1";
+/// Upper bound on one message, so a corrupt length cannot make the receiver allocate gigabytes.
+const MAX_MESSAGE: usize = 16 << 20;
+
+/// A key decision: key frame `key` is sent once frame `at` has been captured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KeyEvent {
+    pub key: usize,
+    pub at: usize,
+}
+
+/// Chooses keys online (see the module doc). The first key (frame 0) is sent at frame 0 and the
+/// last frame is always a key.
+pub fn online_keys(model: &dyn SegmentModel, max_cm: f64, lookahead: usize) -> Vec<KeyEvent> {
+    let n = model.num_frames();
+    let lookahead = lookahead.max(1);
+    let mut scratch = model.scratch();
+    let mut events = vec![KeyEvent { key: 0, at: 0 }];
+    let mut a = 0;
+    for t in 2..n {
+        // Candidates end at t − 1 (its velocity needs frame t).
+        let newest = t - 1;
+        if newest <= a {
+            continue;
+        }
+        let fits = |b: usize, s: &mut crate::error::Scratch| model.segment_cost_within(a, b, max_cm, s).is_some();
+        if newest - a < lookahead && fits(newest, &mut scratch) {
+            continue;
+        }
+        let b = (a + 1..=newest).rev().find(|&b| b == a + 1 || fits(b, &mut scratch)).expect("a + 1 always fits");
+        events.push(KeyEvent { key: b, at: t });
+        a = b;
+    }
+    // End of the clip: the last frame is known (one-sided velocity); close with feasible keys.
+    while a != n - 1 {
+        let b = (a + 1..n).rev().find(|&b| b == a + 1 || model.segment_cost_within(a, b, max_cm, &mut scratch).is_some()).expect("a + 1 always fits");
+        events.push(KeyEvent { key: b, at: n - 1 });
+        a = b;
+    }
+    events
+}
+
+/// Latency each frame waits beyond its capture, in frames: until the key closing its segment is sent.
+pub fn added_latency_frames(events: &[KeyEvent]) -> Vec<usize> {
+    let mut lat = vec![0usize];
+    for w in events.windows(2) {
+        for f in w[0].key + 1..=w[1].key {
+            lat.push(w[1].at.saturating_sub(f));
+        }
+    }
+    lat
+}
+
+fn frame_message(kind: u8, payload: &[u8]) -> Vec<u8> {
+    let mut m = Vec::with_capacity(payload.len() + 9);
+    m.push(kind);
+    m.extend_from_slice(&(payload.len() as u32).to_le_bytes());
+    m.extend_from_slice(payload);
+    let crc = crc32fast::hash(&m);
+    m.extend_from_slice(&crc.to_le_bytes());
+    m
+}
+
+fn hello_payload(skeleton: &Skeleton, frame_time: f64, frames: usize) -> Vec<u8> {
+    let mut p = STREAM_MAGIC.to_vec();
+    p.extend_from_slice(&frame_time.to_le_bytes());
+    p.extend_from_slice(&(frames as u32).to_le_bytes());
+    write_skeleton(&mut p, skeleton);
+    p
+}
+
+fn key_payload(skeleton: &Skeleton, frame: usize, key: &KeyPose) -> Vec<u8> {
+    let w_scale = key.angular_velocities.iter().map(|w| w.abs().max_element()).fold(1e-6, f64::max) as f32 * 1.0001;
+    let mut p = (frame as u32).to_le_bytes().to_vec();
+    p.extend_from_slice(&w_scale.to_le_bytes());
+    write_key(&mut p, skeleton, key, w_scale as f64);
+    p
+}
+
+/// Sender settings.
+#[derive(Clone, Debug)]
+pub struct SendOptions {
+    pub max_cm: f64,
+    pub lookahead: usize,
+    /// Pace messages at the clip's frame rate (off in tests).
+    pub realtime: bool,
+    /// Reconnection attempts after a broken connection, 200 ms apart.
+    pub retries: usize,
+}
+
+/// What a sender did.
+#[derive(Clone, Debug, Default)]
+pub struct SendReport {
+    pub frames: usize,
+    pub keys: usize,
+    pub bytes_sent: usize,
+    /// Bytes of the same frames as raw f32 channels.
+    pub raw_bytes: usize,
+    pub seconds: f64,
+    pub mean_latency_ms: f64,
+    pub max_latency_ms: f64,
+    pub reconnects: usize,
+}
+
+fn connect(addr: &str, retries: usize) -> Result<TcpStream> {
+    let mut last = None;
+    for attempt in 0..=retries {
+        if attempt > 0 {
+            std::thread::sleep(Duration::from_millis(200));
+        }
+        let addrs = addr.to_socket_addrs().map_err(|e| MocapError::Stream(format!("bad address {addr}: {e}")))?;
+        for a in addrs {
+            match TcpStream::connect_timeout(&a, Duration::from_secs(2)) {
+                Ok(s) => {
+                    let _ = s.set_nodelay(true);
+                    return Ok(s);
+                }
+                Err(e) => last = Some(e),
+            }
+        }
+    }
+    Err(MocapError::Stream(format!("cannot connect to {addr} after {} attempts: {}", retries + 1, last.map(|e| e.to_string()).unwrap_or_default())))
+}
+
+/// Streams `motion` to a receiver at `addr`.
+pub fn send(addr: &str, motion: &Motion, opts: &SendOptions) -> Result<SendReport> {
+    let model = RotationMotion::from_motion(motion)?;
+    let events = online_keys(&model, opts.max_cm, opts.lookahead);
+    let sk = &model.skeleton;
+    let hello = frame_message(HELLO, &hello_payload(sk, model.frame_time, model.num_frames()));
+    let mut report = SendReport { frames: model.num_frames(), keys: events.len(), raw_bytes: inbetween_core::Motion::num_channels(motion) * 4 * model.num_frames(), ..Default::default() };
+    let start = Instant::now();
+    let mut conn = connect(addr, opts.retries)?;
+    conn.write_all(&hello).map_err(|e| MocapError::Stream(format!("sending hello: {e}")))?;
+    report.bytes_sent += hello.len();
+    let mut last_key: Option<Vec<u8>> = None;
+    for ev in &events {
+        if opts.realtime {
+            let due = Duration::from_secs_f64(ev.at as f64 * model.frame_time);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+        }
+        let msg = frame_message(KEY, &key_payload(sk, ev.key, &model.frames[ev.key]));
+        if conn.write_all(&msg).is_err() {
+            // The receiver went away: reconnect, say hello again and resend the previous key so
+            // it can rebuild the segment this key closes.
+            conn = connect(addr, opts.retries)?;
+            report.reconnects += 1;
+            let mut resume = hello.clone();
+            if let Some(prev) = &last_key {
+                resume.extend_from_slice(prev);
+            }
+            resume.extend_from_slice(&msg);
+            conn.write_all(&resume).map_err(|e| MocapError::Stream(format!("resending after reconnect: {e}")))?;
+            report.bytes_sent += resume.len() - msg.len();
+        }
+        report.bytes_sent += msg.len();
+        last_key = Some(msg);
+    }
+    let end = frame_message(END, &[]);
+    let _ = conn.write_all(&end);
+    let _ = conn.flush();
+    report.bytes_sent += end.len();
+    report.seconds = start.elapsed().as_secs_f64();
+    let lat = added_latency_frames(&events);
+    report.mean_latency_ms = lat.iter().sum::<usize>() as f64 / lat.len() as f64 * model.frame_time * 1000.0;
+    report.max_latency_ms = lat.iter().copied().max().unwrap_or(0) as f64 * model.frame_time * 1000.0;
+    Ok(report)
+}
+
+/// One received message.
+enum Message {
+    Hello { skeleton: Skeleton, frame_time: f64 },
+    Key { frame: usize, key: KeyPose },
+    End,
+}
+
+fn read_message(conn: &mut impl Read, skeleton: Option<&Skeleton>) -> Result<(Message, usize)> {
+    let mut head = [0u8; 5];
+    conn.read_exact(&mut head).map_err(|e| MocapError::Stream(format!("connection closed while waiting for a message: {e}")))?;
+    let len = u32::from_le_bytes(head[1..5].try_into().expect("4 bytes")) as usize;
+    if len > MAX_MESSAGE {
+        return Err(MocapError::Stream(format!("message of {len} bytes exceeds the {MAX_MESSAGE}-byte limit")));
+    }
+    let mut body = vec![0u8; len + 4];
+    conn.read_exact(&mut body).map_err(|e| MocapError::Stream(format!("connection closed inside a {len}-byte message: {e}")))?;
+    let mut check = head.to_vec();
+    check.extend_from_slice(&body[..len]);
+    if crc32fast::hash(&check).to_le_bytes() != body[len..] {
+        return Err(MocapError::Stream("message checksum mismatch".into()));
+    }
+    let mut r = Reader::new(&body[..len]);
+    let msg = match head[0] {
+        HELLO => {
+            let magic = [r.u8("magic")?, r.u8("magic")?, r.u8("magic")?, r.u8("magic")?];
+            if &magic != STREAM_MAGIC {
+                return Err(MocapError::Stream("hello without the IBS1 magic".into()));
+            }
+            let frame_time = r.f64("frame time")?;
+            let _frames = r.u32("frame count")?;
+            Message::Hello { skeleton: read_skeleton(&mut r)?, frame_time }
+        }
+        KEY => {
+            let sk = skeleton.ok_or_else(|| MocapError::Stream("key before hello".into()))?;
+            let frame = r.u32("key frame")? as usize;
+            let w_scale = r.f32("angular velocity scale")?;
+            Message::Key { frame, key: read_key(&mut r, sk, w_scale)? }
+        }
+        END => Message::End,
+        other => return Err(MocapError::Stream(format!("unknown message type {other}"))),
+    };
+    if r.remaining() != 0 {
+        return Err(MocapError::Stream(format!("{} stray bytes at the end of a message", r.remaining())));
+    }
+    Ok((msg, len + 9))
+}
+
+/// Receiver settings.
+#[derive(Clone, Debug)]
+pub struct RecvOptions {
+    /// Sessions (connections) to accept before giving up on an unfinished stream.
+    pub max_sessions: usize,
+    /// How long to wait for a (re)connection.
+    pub accept_timeout: Duration,
+}
+
+/// What a receiver rebuilt.
+#[derive(Clone, Debug)]
+pub struct Received {
+    pub motion: Motion,
+    pub keys: usize,
+    pub bytes: usize,
+    /// True when the sender's End arrived.
+    pub complete: bool,
+    pub sessions: usize,
+    /// Problems met on the way (broken connections, bad messages), for the log.
+    pub warnings: Vec<String>,
+}
+
+struct Rebuild {
+    skeleton: Skeleton,
+    frame_time: f64,
+    poses: Vec<Pose>,
+    last: Option<(usize, KeyPose)>,
+    keys: usize,
+}
+
+impl Rebuild {
+    /// Adds a key; emits the frames after the previous key up to this one.
+    fn key(&mut self, frame: usize, key: KeyPose) {
+        let nj = self.skeleton.len();
+        match &self.last {
+            Some((a, k0)) if frame > *a => {
+                let (a, h) = (*a, (frame - a) as f64 * self.frame_time);
+                for f in a + 1..frame {
+                    let mut p = Pose { rotations: vec![DQuat::IDENTITY; nj], translations: vec![DVec3::ZERO; nj] };
+                    interpolate_pose_into(k0, &key, h, (f - a) as f64 / (frame - a) as f64, &mut p.rotations, &mut p.translations);
+                    self.poses.push(p);
+                }
+            }
+            Some(_) => return, // a repeated (resent) or stale key
+            None => {}
+        }
+        self.poses.push(Pose { rotations: key.rotations.clone(), translations: key.translations.clone() });
+        self.last = Some((frame, key));
+        self.keys += 1;
+    }
+}
+
+/// Receives one stream on `listener`, surviving dropped connections (up to `max_sessions`).
+pub fn recv(listener: &TcpListener, opts: &RecvOptions) -> Result<Received> {
+    listener.set_nonblocking(false).ok();
+    let mut state: Option<Rebuild> = None;
+    let (mut bytes, mut sessions, mut warnings, mut complete) = (0usize, 0usize, Vec::new(), false);
+    while sessions < opts.max_sessions && !complete {
+        let mut conn = match accept_with_timeout(listener, opts.accept_timeout) {
+            Ok(c) => c,
+            Err(e) => {
+                warnings.push(e.to_string());
+                break;
+            }
+        };
+        sessions += 1;
+        loop {
+            let sk = state.as_ref().map(|s| s.skeleton.clone());
+            match read_message(&mut conn, sk.as_ref()) {
+                Ok((Message::Hello { skeleton, frame_time }, size)) => {
+                    bytes += size;
+                    match &state {
+                        Some(s) if s.skeleton != skeleton => {
+                            warnings.push("a reconnecting sender sent a different skeleton; ignoring it".into());
+                            break;
+                        }
+                        Some(_) => {}
+                        None => state = Some(Rebuild { skeleton, frame_time, poses: Vec::new(), last: None, keys: 0 }),
+                    }
+                }
+                Ok((Message::Key { frame, key }, size)) => {
+                    bytes += size;
+                    if let Some(s) = &mut state {
+                        s.key(frame, key);
+                    }
+                }
+                Ok((Message::End, size)) => {
+                    bytes += size;
+                    complete = true;
+                    break;
+                }
+                Err(e) => {
+                    warnings.push(e.to_string());
+                    break;
+                }
+            }
+        }
+    }
+    let s = state.ok_or_else(|| MocapError::Stream(format!("no stream received ({})", warnings.join("; "))))?;
+    let motion = Motion::from_poses(s.skeleton.clone(), s.frame_time, &s.poses)?;
+    Ok(Received { motion, keys: s.keys, bytes, complete, sessions, warnings })
+}
+
+fn accept_with_timeout(listener: &TcpListener, timeout: Duration) -> Result<TcpStream> {
+    listener.set_nonblocking(true).map_err(|e| MocapError::Stream(e.to_string()))?;
+    let start = Instant::now();
+    loop {
+        match listener.accept() {
+            Ok((c, _)) => {
+                c.set_nonblocking(false).map_err(|e| MocapError::Stream(e.to_string()))?;
+                c.set_read_timeout(Some(timeout)).ok();
+                return Ok(c);
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                if start.elapsed() > timeout {
+                    return Err(MocapError::Stream(format!("no sender connected within {:.1} s", timeout.as_secs_f64())));
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            Err(e) => return Err(MocapError::Stream(format!("accept failed: {e}"))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
+    use inbetween_core::positions_clip;
+
+    fn walk() -> Motion {
+        let mut p = GaitParams::walk();
+        p.frames = 90;
+        gait(&p)
+    }
+
+    fn recv_opts() -> RecvOptions {
+        RecvOptions { max_sessions: 3, accept_timeout: Duration::from_secs(5) }
+    }
+
+    #[test]
+    fn online_keys_respect_bound_and_lookahead() {
+        let m = RotationMotion::from_motion(&walk()).unwrap();
+        let ev = online_keys(&m, 1.0, 12);
+        assert_eq!(ev.last().unwrap().key, 89);
+        for w in ev.windows(2) {
+            assert!(w[1].key > w[0].key && w[1].key - w[0].key <= 12);
+            assert!(w[1].at >= w[0].at);
+            assert!(w[1].at > w[1].key || w[1].key == 89, "a key's velocity needs the next frame");
+            let c = m.segment_cost(w[0].key, w[1].key, &mut m.scratch());
+            assert!(c.cm_max <= 1.0 + 1e-9);
+        }
+        assert!(added_latency_frames(&ev).iter().all(|&l| l <= 13));
+    }
+
+    #[test]
+    fn loopback_stream_rebuilds_the_clip() {
+        let m = walk();
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        let rx = std::thread::spawn(move || recv(&listener, &recv_opts()));
+        let opts = SendOptions { max_cm: 1.0, lookahead: 15, realtime: false, retries: 3 };
+        let sent = send(&addr, &m, &opts).unwrap();
+        let got = rx.join().unwrap().unwrap();
+        assert!(got.complete);
+        assert_eq!(got.motion.num_frames(), 90);
+        assert_eq!(got.keys, sent.keys);
+        assert!(sent.bytes_sent < sent.raw_bytes);
+        let e = inbetween_core::position_error(&positions_clip(&m), &positions_clip(&got.motion));
+        assert!(e.max * CM_PER_CMU_UNIT < 1.1, "max {} cm", e.max * CM_PER_CMU_UNIT);
+    }
+
+    #[test]
+    fn a_dropped_peer_crashes_neither_side() {
+        // Nobody listening: the sender gives up with an error.
+        let probe = TcpListener::bind("127.0.0.1:0").unwrap();
+        let dead = probe.local_addr().unwrap().to_string();
+        drop(probe);
+        let opts = SendOptions { max_cm: 1.0, lookahead: 15, realtime: false, retries: 1 };
+        assert!(send(&dead, &walk(), &opts).is_err());
+        // A peer that says hello, sends half a key and vanishes; then a real sender connects.
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        let rx = std::thread::spawn(move || recv(&listener, &recv_opts()));
+        let m = walk();
+        {
+            let mut c = TcpStream::connect(&addr).unwrap();
+            let model = RotationMotion::from_motion(&m).unwrap();
+            c.write_all(&frame_message(HELLO, &hello_payload(&model.skeleton, model.frame_time, 90))).unwrap();
+            let key = frame_message(KEY, &key_payload(&model.skeleton, 0, &model.frames[0]));
+            c.write_all(&key[..key.len() / 2]).unwrap();
+        }
+        send(&addr, &m, &SendOptions { retries: 3, ..opts }).unwrap();
+        let got = rx.join().unwrap().unwrap();
+        assert!(got.complete && got.sessions == 2, "{:?}", got.warnings);
+        assert!(!got.warnings.is_empty());
+        assert_eq!(got.motion.num_frames(), 90);
+    }
+}

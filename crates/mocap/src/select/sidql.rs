@@ -1,1 +1,13 @@
-//! SIDQL selection (§4): placeholder until the DQN lands.
+//! SIDQL selection (§4): a trained deep Q-network adds, one at a time, the frame with the highest
+//! Q-value until `k` keys are chosen. Training lives in [`crate::dqn`].
+
+pub use crate::dqn::train::SidqlPolicy;
+
+use crate::representation::SphericalMotion;
+use crate::Result;
+use inbetween_core::KeyframeSet;
+
+/// `k` keys for a window chosen by `policy`.
+pub fn sidql(policy: &SidqlPolicy, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
+    policy.select(rep, k)
+}
