@@ -7,6 +7,7 @@
 
 pub mod dataset;
 pub mod features;
+pub mod infer;
 pub mod model;
 pub mod toric;
 pub mod train;

@@ -1,18 +1,230 @@
 //! `inbetween camera …` (owned by the camera engine work).
 
-use clap::Subcommand;
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
+use inbetween_camera::infer::{self, FastModel, GenerateOptions, Keys, NamedStyle, ReferenceClip};
+use inbetween_camera::train::{self, TrainConfig, TrainEvent};
+use std::path::{Path, PathBuf};
 
 #[derive(Subcommand)]
 pub enum CameraCommand {
-    /// Benchmark the camera networks.
-    Bench,
+    /// Generate a camera track through keyframes in a style (toric track + world poses as JSON).
+    Generate(GenerateArgs),
+    /// Write a procedural two-character scene, example keyframes and a reference clip per behaviour.
+    Scene(SceneArgs),
+    /// Train extractor, generator and mapping end to end on the synthetic dataset (resumable).
+    Train(TrainArgs),
 }
 
-pub fn run(_c: CameraCommand) -> anyhow::Result<()> {
-    anyhow::bail!("`inbetween camera` is not implemented yet")
+#[derive(Args)]
+pub struct GenerateArgs {
+    /// Scene JSON (characters' root and shoulder positions per frame).
+    #[arg(long)]
+    pub scene: PathBuf,
+    /// Keyframes JSON: {"keys": [{"frame", "camera": {"pa", "pb", "theta", "phi"}, "targets"?, "velocity"?}], "main"?}.
+    #[arg(long)]
+    pub keys: PathBuf,
+    /// A behaviour's style code: direct, relative, side or orbit.
+    #[arg(long, conflicts_with_all = ["reference", "all_styles"])]
+    pub style: Option<String>,
+    /// Extract the style from a reference clip (JSON with per-frame "characters" features and "camera" toric).
+    #[arg(long, conflicts_with = "all_styles")]
+    pub reference: Option<PathBuf>,
+    /// One track per style (the paper's UI flow): writes OUT with the style name inserted.
+    #[arg(long)]
+    pub all_styles: bool,
+    /// Output JSON (per-frame toric coordinates, targets, camera position and rotation).
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// Keep the network's own keyframe misses instead of correcting them away.
+    #[arg(long)]
+    pub no_exact_keys: bool,
+    /// Weights (default: the committed quick-training weights).
+    #[arg(long)]
+    pub weights: Option<PathBuf>,
 }
 
-/// The camera part of `inbetween demo`: writes its outputs under `out` and returns lines to print.
-pub fn demo(_out: &std::path::Path) -> anyhow::Result<Vec<String>> {
-    Ok(Vec::new())
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Output folder: scene.json, keys.json, reference-<behaviour>.json.
+    #[arg(short, long)]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long, default_value_t = 450)]
+    pub frames: usize,
+}
+
+#[derive(Args)]
+pub struct TrainArgs {
+    /// Where the trained weights go (a JSON summary is written beside them).
+    #[arg(short, long, default_value = "crates/camera/weights/camera.bpk")]
+    pub out: PathBuf,
+    /// Checkpoint folder: saved every epoch, and training resumes from it when it holds one.
+    #[arg(long, default_value = "out/camera-train")]
+    pub checkpoints: PathBuf,
+    /// Epochs (the paper: 200).
+    #[arg(long, default_value_t = 200)]
+    pub epochs: usize,
+    /// Optimiser steps per epoch (the learning rate decays ×0.97 per epoch).
+    #[arg(long, default_value_t = 50)]
+    pub iters_per_epoch: usize,
+    /// Batch size (the paper: 1024).
+    #[arg(long, default_value_t = 64)]
+    pub batch: usize,
+    /// Procedural scenes in the training set (8 filmed sequences each).
+    #[arg(long, default_value_t = 96)]
+    pub scenes: usize,
+    /// Stop after this many minutes (the running epoch is finished and saved).
+    #[arg(long)]
+    pub minutes: Option<f64>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// LSTM / FC width (the paper: 256).
+    #[arg(long, default_value_t = 256)]
+    pub hidden: usize,
+}
+
+pub fn run(c: CameraCommand) -> anyhow::Result<()> {
+    match c {
+        CameraCommand::Generate(a) => run_generate(a),
+        CameraCommand::Scene(a) => run_scene(a),
+        CameraCommand::Train(a) => run_train(a),
+    }
+}
+
+fn load_model(weights: Option<&Path>) -> anyhow::Result<FastModel> {
+    let path = weights.map(Path::to_path_buf).unwrap_or_else(FastModel::committed_weights_path);
+    FastModel::load(&path).with_context(|| format!("loading camera weights {}", path.display()))
+}
+
+/// Style codes per behaviour, seeded so every run names the same codes.
+fn named_styles(model: &FastModel) -> Vec<NamedStyle> {
+    model.behaviour_styles(777, 2)
+}
+
+fn style_code(styles: &[NamedStyle], behaviour: Behaviour) -> Vec<f32> {
+    styles.iter().find(|s| s.behaviour == behaviour && s.main_is_a).map(|s| s.code.clone()).unwrap_or_default()
+}
+
+fn reference_style(model: &FastModel, path: &Path) -> anyhow::Result<Vec<f32>> {
+    let clip: ReferenceClip = inbetween_camera::read_json(path)?;
+    Ok(clip.style(model, path)?)
+}
+
+fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    path.with_file_name(format!("{stem}-{suffix}{ext}"))
+}
+
+fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
+    let model = load_model(a.weights.as_deref())?;
+    let scene = Scene::load(&a.scene)?;
+    let keys = Keys::load(&a.keys)?;
+    let opts = GenerateOptions { exact_keys: !a.no_exact_keys, ..GenerateOptions::default() };
+    let styles = named_styles(&model);
+    let jobs: Vec<(String, Vec<f32>, PathBuf)> = if a.all_styles {
+        BEHAVIOURS.iter().map(|b| (b.name().to_string(), style_code(&styles, *b), with_suffix(&a.out, b.name()))).collect()
+    } else if let Some(r) = &a.reference {
+        vec![(format!("reference:{}", r.display()), reference_style(&model, r)?, a.out.clone())]
+    } else {
+        let name = a.style.clone().unwrap_or_else(|| "relative".into());
+        let b = Behaviour::parse(&name).with_context(|| format!("unknown style `{name}` (direct, relative, side, orbit)"))?;
+        vec![(name, style_code(&styles, b), a.out.clone())]
+    };
+    for (name, code, out) in jobs {
+        let track = infer::generate(&model, &scene, &keys, &code, &name, &opts, &a.keys)?;
+        inbetween_camera::write_json(&out, &track)?;
+        let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+        println!(
+            "{name}: {} frames -> {} (network keyframe miss max {worst:.4}, after correction {:.1e})",
+            track.frames.len(),
+            out.display(),
+            track.max_corrected_residual
+        );
+    }
+    Ok(())
+}
+
+fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let scene = Scene::procedural(a.seed, a.frames, 30.0);
+    scene.save(&a.out.join("scene.json"))?;
+    let n = a.frames - 1;
+    inbetween_camera::write_json(&a.out.join("keys.json"), &infer::example_keys(&scene, &[0, n / 2, n]))?;
+    let lens = inbetween_camera::toric::Lens::default();
+    for (i, b) in BEHAVIOURS.into_iter().enumerate() {
+        let mut rng = inbetween_camera::dataset::seeded_rng(a.seed + i as u64);
+        let seq = inbetween_camera::dataset::film_sequence(&scene, a.seed, b, true, &mut rng, &lens);
+        inbetween_camera::write_json(&a.out.join(format!("reference-{}.json", b.name())), &seq)?;
+    }
+    println!("wrote scene.json, keys.json and reference-{{direct,relative,side,orbit}}.json to {}", a.out.display());
+    Ok(())
+}
+
+fn run_train(a: TrainArgs) -> anyhow::Result<()> {
+    let mut cfg = TrainConfig {
+        seed: a.seed,
+        scenes: a.scenes,
+        epochs: a.epochs,
+        iters_per_epoch: a.iters_per_epoch,
+        batch: a.batch,
+        time_limit_s: a.minutes.map(|m| m * 60.0),
+        ..TrainConfig::default()
+    };
+    cfg.model.hidden = a.hidden;
+    let bar = crate::progress::bar((cfg.epochs * cfg.iters_per_epoch) as u64, "training");
+    let mut report = |e: TrainEvent| match e {
+        TrainEvent::Iteration { epoch, iter, loss } => {
+            bar.set_position((epoch * cfg.iters_per_epoch + iter + 1) as u64);
+            bar.set_message(format!("loss {loss:.4}"));
+        }
+        TrainEvent::Epoch { epoch, loss, lr, seconds } => {
+            bar.println(format!("epoch {:>3}  loss {loss:.5}  lr {lr:.2e}  {seconds:.0} s", epoch + 1));
+        }
+    };
+    let (model, summary) = train::train(&cfg, Some(&a.checkpoints), &mut report)?;
+    bar.finish_and_clear();
+    if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    train::save_model(&model, &a.out)?;
+    inbetween_camera::write_json(&a.out.with_extension("json"), &summary)?;
+    println!(
+        "trained {} epochs ({} iterations) in {:.1} min, final loss {:.4}; weights: {}",
+        summary.epochs_done,
+        summary.iterations,
+        summary.seconds / 60.0,
+        summary.final_loss,
+        a.out.display()
+    );
+    Ok(())
+}
+
+/// The camera part of `inbetween demo`: a built-in scene, keyframes, the committed weights, one
+/// track per style; writes cam.json (orbit style) and one JSON per style under `out`.
+pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
+    let t0 = std::time::Instant::now();
+    let model = load_model(None)?;
+    let scene = Scene::procedural(3, 300, 30.0);
+    let keys = infer::example_keys(&scene, &[0, 150, 299]);
+    let styles = named_styles(&model);
+    let dir = out.join("camera");
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    scene.save(&dir.join("scene.json"))?;
+    inbetween_camera::write_json(&dir.join("keys.json"), &keys)?;
+    let mut lines = Vec::new();
+    for b in BEHAVIOURS {
+        let track = infer::generate(&model, &scene, &keys, &style_code(&styles, b), b.name(), &GenerateOptions::default(), &dir.join("keys.json"))?;
+        let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+        inbetween_camera::write_json(&dir.join(format!("cam-{}.json", b.name())), &track)?;
+        if b == Behaviour::Orbit {
+            inbetween_camera::write_json(&out.join("cam.json"), &track)?;
+        }
+        lines.push(format!("camera {:<8} {} frames, network key miss {worst:.3} (corrected to {:.0e})", b.name(), track.frames.len(), track.max_corrected_residual));
+    }
+    lines.push(format!("camera demo: {} in {:.1} s", out.join("cam.json").display(), t0.elapsed().as_secs_f64()));
+    Ok(lines)
 }

@@ -19,6 +19,11 @@ pub const FPS: f64 = 30.0;
 /// The networks see every 5th frame (§4.5).
 pub const DOWNSAMPLE: usize = 5;
 
+/// The crate's seeded random generator (ChaCha8).
+pub fn seeded_rng(seed: u64) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seed)
+}
+
 /// One filmed sequence: character features and the camera track, frame by frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Sequence {
