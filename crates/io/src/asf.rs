@@ -537,10 +537,10 @@ fn parse_amc(asf: &Asf, text: &str, file: &str) -> Result<Vec<f64>, IoError> {
         next += if node == 0 { 6 } else { 3 };
     }
     let nc = next;
-    for node in 0..n {
+    for (node, &channel_start) in channel.iter().enumerate() {
         let frame = asf.axis_frame(node);
         let dofs = if node == 0 { asf.root_order.clone() } else { asf.bones[node - 1].dofs.iter().map(|&a| Dof::Rotate(a)).collect() };
-        layouts.push(NodeLayout { dofs, frame, frame_inv: frame.inverse(), channel_start: channel[node] });
+        layouts.push(NodeLayout { dofs, frame, frame_inv: frame.inverse(), channel_start });
     }
     let mut node_of: HashMap<&str, usize> = HashMap::with_capacity(n);
     node_of.insert("root", 0);

@@ -130,3 +130,23 @@ fn asf_amc_matches_cgspeed_bvh_of_the_same_take() {
         assert!(max_a < 0.01, "{max_a}");
     });
 }
+
+/// ASF/AMC → BVH text → BVH reader keeps every joint within print precision (6 decimals).
+#[test]
+fn converted_amc_survives_bvh_round_trip() {
+    use inbetween_core::positions_clip;
+    use inbetween_io::bvh::{parse_bvh, to_bvh_string};
+    with_shared_data("CMU 11_01 ASF/AMC", |data| {
+        let amc = load_motion(&data.join("mocap/cmu/asf_amc/11_01.amc")).unwrap();
+        let back = parse_bvh(&to_bvh_string(&amc), "11_01.bvh").unwrap();
+        assert_eq!(back.skeleton.len(), amc.skeleton.len());
+        let (pa, pb) = (positions_clip(&amc), positions_clip(&back));
+        let worst = pa
+            .iter()
+            .zip(&pb)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (*x - *y).length()))
+            .fold(0.0, f64::max);
+        println!("11_01 AMC -> BVH -> read: worst joint position difference {worst:.2e} CMU units");
+        assert!(worst < 1e-4, "{worst}");
+    });
+}
