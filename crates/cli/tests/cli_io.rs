@@ -32,3 +32,22 @@ fn convert_crops_and_resamples_and_info_reports_it() {
     let (ok, text) = inbetween(&["convert", input.to_str().unwrap(), "-o", output.to_str().unwrap()]);
     assert!(!ok && text.contains("walk.bvh:5: expected OFFSET z"), "{text}");
 }
+
+#[test]
+fn amc_input_is_converted_with_its_asf() {
+    let dir = tempfile::tempdir().unwrap();
+    let asf = ":units\n angle deg\n:root\n order TX TY TZ RX RY RZ\n axis XYZ\n position 0 0 0\n orientation 0 0 0\n:bonedata\n begin\n  name a\n  direction 0 1 0\n  length 2\n  axis 0 0 0 XYZ\n  dof rx\n end\n:hierarchy\n begin\n  root a\n end\n";
+    let amc = ":FULLY-SPECIFIED\r\n:DEGREES\r\n1\r\nroot 0 1 2 0 0 0\r\na 10\r\n2\r\nroot 0 1 2 0 0 0\r\na 20\r\n";
+    std::fs::write(dir.path().join("skel.asf"), asf).unwrap();
+    std::fs::write(dir.path().join("05_01.amc"), amc).unwrap();
+    let input = dir.path().join("05_01.amc");
+    let (ok, text) = inbetween(&["info", input.to_str().unwrap()]);
+    assert!(!ok && text.contains("05.asf"), "no ASF beside it: {text}");
+    let output = dir.path().join("o.bvh");
+    let asf_path = dir.path().join("skel.asf");
+    let (ok, text) = inbetween(&["convert", input.to_str().unwrap(), "--asf", asf_path.to_str().unwrap(), "-o", output.to_str().unwrap()]);
+    assert!(ok, "{text}");
+    assert!(text.contains("2 joints, 9 channels, 2 frames at 120.000 fps"), "{text}");
+    let m = inbetween_io::load_motion(&output).unwrap();
+    assert!((m.frame(1)[8] - 20.0).abs() < 1e-6, "a's Xrotation: {:?}", m.frame(1));
+}
