@@ -153,7 +153,7 @@ impl Canvas {
                 }
             }
         }
-        (t0 <= t1).then(|| ((a.0 + t0 * dx, a.1 + t0 * dy), (a.0 + t1 * dx, a.1 + t1 * dy)))
+        (t0 <= t1).then_some(((a.0 + t0 * dx, a.1 + t0 * dy), (a.0 + t1 * dx, a.1 + t1 * dy)))
     }
 
     /// Draws `text` with its top-left corner at `pos`; `size` is the font's pixel height.
@@ -228,6 +228,9 @@ pub struct Camera3 {
     pub height: u32,
 }
 
+/// A projected point: pixel x, pixel y (down), depth along the view axis.
+pub type Projected = (f32, f32, f32);
+
 /// Points closer to the eye than this (along the view axis) are not projected.
 pub const NEAR: f64 = 1e-3;
 
@@ -267,12 +270,12 @@ impl Camera3 {
     }
 
     /// Pixel position and depth of `p`, or None when it is behind (or too close to) the eye.
-    pub fn project(&self, p: DVec3) -> Option<(f32, f32, f32)> {
+    pub fn project(&self, p: DVec3) -> Option<Projected> {
         self.project_camera(self.to_camera(p))
     }
 
-    fn project_camera(&self, c: DVec3) -> Option<(f32, f32, f32)> {
-        if !(c.z > NEAR) || !c.is_finite() {
+    fn project_camera(&self, c: DVec3) -> Option<Projected> {
+        if !c.is_finite() || c.z <= NEAR {
             return None;
         }
         let f = self.focal_px();
@@ -282,7 +285,7 @@ impl Camera3 {
     }
 
     /// Projects the part of segment a–b in front of the eye (clipped at the near plane).
-    pub fn project_segment(&self, a: DVec3, b: DVec3) -> Option<((f32, f32, f32), (f32, f32, f32))> {
+    pub fn project_segment(&self, a: DVec3, b: DVec3) -> Option<(Projected, Projected)> {
         let (mut ca, mut cb) = (self.to_camera(a), self.to_camera(b));
         let near = NEAR * 10.0;
         if ca.z < near && cb.z < near {

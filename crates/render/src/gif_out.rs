@@ -9,7 +9,33 @@
 
 use crate::RenderError;
 use image::RgbImage;
+use rayon::prelude::*;
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// Hash for packed RGB keys: one multiply (Fibonacci hashing) instead of SipHash, which would
+/// dominate the time spent counting and mapping millions of pixels.
+#[derive(Default)]
+struct ColorHasher(u64);
+
+impl Hasher for ColorHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.0 = (v as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26);
+    }
+}
+
+type ColorMap<V> = HashMap<u32, V, BuildHasherDefault<ColorHasher>>;
+
+/// Frames per batch: drawn into indices and LZW-compressed in parallel, then written in order.
+const BATCH: usize = 16;
 
 /// Palette entries for colours; the 256th entry of a GIF palette is kept for "unchanged" pixels.
 const MAX_COLORS: usize = 255;
@@ -30,36 +56,43 @@ fn dist2(a: [u8; 3], b: [u8; 3]) -> u32 {
     a.iter().zip(b).map(|(&x, y)| (x as i32 - y as i32).pow(2) as u32).sum()
 }
 
-/// Counts of every exact colour over all frames.
-fn histogram(frames: &[RgbImage]) -> HashMap<u32, u64> {
-    let mut counts: HashMap<u32, u64> = HashMap::new();
-    for f in frames {
-        let mut run_color = u32::MAX;
-        let mut run = 0u64;
-        for p in f.pixels() {
-            let c = pack(p.0);
-            if c == run_color {
-                run += 1;
-            } else {
-                if run > 0 {
-                    *counts.entry(run_color).or_default() += run;
-                }
-                run_color = c;
-                run = 1;
+/// Counts of every exact colour in one frame (runs of one colour counted at once).
+fn frame_histogram(f: &RgbImage) -> ColorMap<u64> {
+    let mut counts = ColorMap::default();
+    let mut run_color = u32::MAX;
+    let mut run = 0u64;
+    for p in f.pixels() {
+        let c = pack(p.0);
+        if c == run_color {
+            run += 1;
+        } else {
+            if run > 0 {
+                *counts.entry(run_color).or_default() += run;
             }
+            run_color = c;
+            run = 1;
         }
-        if run > 0 {
-            *counts.entry(run_color).or_default() += run;
-        }
+    }
+    if run > 0 {
+        *counts.entry(run_color).or_default() += run;
     }
     counts
 }
 
+/// Counts of every exact colour over all frames.
+fn histogram(frames: &[RgbImage]) -> ColorMap<u64> {
+    frames.par_iter().map(frame_histogram).reduce(ColorMap::default, |mut a, b| {
+        for (c, n) in b {
+            *a.entry(c).or_default() += n;
+        }
+        a
+    })
+}
+
 /// Up to 256 colours: all of them when few enough, otherwise a popularity pick that skips
 /// near-duplicates of already chosen colours (threshold relaxed pass by pass).
-pub(crate) fn build_palette(frames: &[RgbImage]) -> Vec<[u8; 3]> {
-    let counts = histogram(frames);
-    let mut by_count: Vec<(u32, u64)> = counts.into_iter().collect();
+fn build_palette(counts: &ColorMap<u64>) -> Vec<[u8; 3]> {
+    let mut by_count: Vec<(u32, u64)> = counts.iter().map(|(&c, &n)| (c, n)).collect();
     // Ties broken by the colour value so the palette is deterministic.
     by_count.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     if by_count.len() <= MAX_COLORS {
@@ -83,33 +116,33 @@ pub(crate) fn build_palette(frames: &[RgbImage]) -> Vec<[u8; 3]> {
     chosen
 }
 
-/// Maps colours to their nearest palette index, remembering every answer.
-struct Mapper<'a> {
-    palette: &'a [[u8; 3]],
-    cache: HashMap<u32, u8>,
+/// Nearest palette index of every colour that occurs (computed once, in parallel).
+fn nearest_lookup(counts: &ColorMap<u64>, palette: &[[u8; 3]]) -> ColorMap<u8> {
+    let colors: Vec<u32> = counts.keys().copied().collect();
+    colors
+        .par_iter()
+        .map(|&c| {
+            let rgb = unpack(c);
+            let best = (0..palette.len()).min_by_key(|&i| dist2(palette[i], rgb)).expect("palette is not empty");
+            (c, best as u8)
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect()
 }
 
-impl Mapper<'_> {
-    fn index(&mut self, p: [u8; 3]) -> u8 {
-        let palette = self.palette;
-        *self.cache.entry(pack(p)).or_insert_with(|| {
-            let best = (0..palette.len()).min_by_key(|&i| dist2(palette[i], p)).expect("palette is not empty");
-            best as u8
-        })
-    }
-
-    fn indices(&mut self, img: &RgbImage) -> Vec<u8> {
-        let mut out = Vec::with_capacity((img.width() * img.height()) as usize);
-        let mut last = (u32::MAX, 0u8);
-        for p in img.pixels() {
-            let c = pack(p.0);
-            if c != last.0 {
-                last = (c, self.index(p.0));
-            }
-            out.push(last.1);
+/// Palette indices of every pixel.
+fn indices(img: &RgbImage, lookup: &ColorMap<u8>) -> Vec<u8> {
+    let mut out = Vec::with_capacity((img.width() * img.height()) as usize);
+    let mut last = (u32::MAX, 0u8);
+    for p in img.pixels() {
+        let c = pack(p.0);
+        if c != last.0 {
+            last = (c, lookup[&c]);
         }
-        out
+        out.push(last.1);
     }
+    out
 }
 
 /// Bounding box (x0, y0, x1, y1), exclusive ends, of the pixels whose index differs.
@@ -161,50 +194,68 @@ pub(crate) fn encode(frames: &[RgbImage], fps: f64, progress: &mut dyn FnMut(usi
     if !(fps.is_finite() && fps > 0.0) {
         return Err(RenderError::InvalidInput(format!("GIF frame rate {fps} must be a positive number")));
     }
-    let palette = build_palette(frames);
+    let counts = histogram(frames);
+    let palette = build_palette(&counts);
+    let lookup = nearest_lookup(&counts, &palette);
     let transparent = palette.len() as u8;
     let mut flat: Vec<u8> = palette.iter().flatten().copied().collect();
     // A GIF palette has a power-of-two size; pad with black (the pad includes the transparent entry).
     flat.resize(3 * (palette.len() + 1).next_power_of_two().max(2), 0);
-    let mut mapper = Mapper { palette: &palette, cache: HashMap::new() };
+    let delays = delays_cs(frames.len(), fps);
     let mut bytes = Vec::new();
     {
         let mut enc = gif::Encoder::new(&mut bytes, w as u16, h as u16, &flat).map_err(gif_err)?;
         enc.set_repeat(gif::Repeat::Infinite).map_err(gif_err)?;
-        let delays = delays_cs(frames.len(), fps);
-        let mut prev: Option<Vec<u8>> = None;
-        for (i, img) in frames.iter().enumerate() {
-            let idx = mapper.indices(img);
-            let rect = match &prev {
-                None => Some((0, 0, w as usize, h as usize)),
-                Some(p) => changed_rect(p, &idx, w as usize),
-            };
-            // An unchanged frame still needs its delay: a 1×1 patch of an unchanged pixel.
-            let (x0, y0, x1, y1) = rect.unwrap_or((0, 0, 1, 1));
-            let mut sub = Vec::with_capacity((x1 - x0) * (y1 - y0));
-            for y in y0..y1 {
-                let row = y * w as usize + x0..y * w as usize + x1;
-                match &prev {
-                    None => sub.extend_from_slice(&idx[row]),
-                    Some(p) => sub.extend(idx[row.clone()].iter().zip(&p[row]).map(|(&c, &o)| if c == o { transparent } else { c })),
-                }
+        let mut prev_last: Option<Vec<u8>> = None;
+        for start in (0..frames.len()).step_by(BATCH) {
+            let end = (start + BATCH).min(frames.len());
+            let indices: Vec<Vec<u8>> = frames[start..end].par_iter().map(|f| indices(f, &lookup)).collect();
+            let encoded: Vec<gif::Frame<'static>> = (start..end)
+                .into_par_iter()
+                .map(|i| {
+                    let prev = if i == start { prev_last.as_deref() } else { Some(indices[i - start - 1].as_slice()) };
+                    let mut frame = delta_frame(prev, &indices[i - start], w as usize, h as usize, transparent);
+                    frame.delay = delays[i];
+                    frame.make_lzw_pre_encoded();
+                    frame
+                })
+                .collect();
+            for (k, frame) in encoded.iter().enumerate() {
+                enc.write_lzw_pre_encoded_frame(frame).map_err(gif_err)?;
+                progress(start + k + 1, frames.len());
             }
-            let frame = gif::Frame {
-                transparent: prev.as_ref().map(|_| transparent),
-                delay: delays[i],
-                left: x0 as u16,
-                top: y0 as u16,
-                width: (x1 - x0) as u16,
-                height: (y1 - y0) as u16,
-                buffer: std::borrow::Cow::Owned(sub),
-                ..gif::Frame::default()
-            };
-            enc.write_frame(&frame).map_err(gif_err)?;
-            prev = Some(idx);
-            progress(i + 1, frames.len());
+            prev_last = indices.into_iter().last();
         }
     }
     Ok(bytes)
+}
+
+/// The GIF frame that turns `prev` into `cur`: only the changed rectangle, with pixels that did not
+/// change set to the `transparent` index (the whole image when there is no previous frame).
+fn delta_frame(prev: Option<&[u8]>, cur: &[u8], w: usize, h: usize, transparent: u8) -> gif::Frame<'static> {
+    let rect = match prev {
+        None => Some((0, 0, w, h)),
+        Some(p) => changed_rect(p, cur, w),
+    };
+    // An unchanged frame still needs its delay: a 1×1 patch of an unchanged pixel.
+    let (x0, y0, x1, y1) = rect.unwrap_or((0, 0, 1, 1));
+    let mut sub = Vec::with_capacity((x1 - x0) * (y1 - y0));
+    for y in y0..y1 {
+        let row = y * w + x0..y * w + x1;
+        match prev {
+            None => sub.extend_from_slice(&cur[row]),
+            Some(p) => sub.extend(cur[row.clone()].iter().zip(&p[row]).map(|(&c, &o)| if c == o { transparent } else { c })),
+        }
+    }
+    gif::Frame {
+        transparent: prev.map(|_| transparent),
+        left: x0 as u16,
+        top: y0 as u16,
+        width: (x1 - x0) as u16,
+        height: (y1 - y0) as u16,
+        buffer: std::borrow::Cow::Owned(sub),
+        ..gif::Frame::default()
+    }
 }
 
 fn gif_err(e: gif::EncodingError) -> RenderError {
@@ -238,7 +289,7 @@ mod tests {
                 img.put_pixel(x + 100, y, Rgb([214, 39, 40]));
             }
         }
-        let pal = build_palette(&[img]);
+        let pal = build_palette(&histogram(&[img]));
         assert_eq!(pal.len(), 255);
         assert!(pal.contains(&[31, 119, 180]) && pal.contains(&[214, 39, 40]));
     }

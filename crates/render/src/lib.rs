@@ -5,6 +5,7 @@
 //! Every file is written through [`inbetween_io::write_atomic`]: a failed render never leaves a
 //! half-written file.
 
+pub mod bench;
 pub mod canvas;
 mod gif_out;
 pub mod plot;
