@@ -10,6 +10,7 @@ use inbetween_mocap::codec::{self, Budget};
 use inbetween_mocap::error::{Objective, SegmentModel, SegmentTable};
 use inbetween_mocap::representation::{JointFilter, SphericalMotion};
 use inbetween_mocap::rotations::RotationMotion;
+use inbetween_mocap::dqn::{train::SidqlPolicy, DqnConfig, TrainOptions};
 use inbetween_render::StickOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -24,6 +25,77 @@ pub enum MocapCommand {
     Preview(PreviewArgs),
     /// Benchmark keyframe selection methods (RC, UC, Greedy, SIDQL, Optimal) on the CMU clips.
     Bench(BenchArgs),
+    /// Train the SIDQL deep Q-network (CMU 80% split or procedural gaits) and save the policy.
+    Train(TrainArgs),
+    /// Stream keyframes over TCP: `send` a clip in real time, `recv` and rebuild it.
+    #[command(subcommand)]
+    Stream(StreamCommand),
+}
+
+#[derive(Args)]
+pub struct TrainArgs {
+    /// Policy file to write (burnpack weights; the shape goes beside it as .json).
+    #[arg(short, long, default_value = "out/sidql_cmu.bpk")]
+    pub output: PathBuf,
+    /// Train on procedural gaits (our own data, safe to commit) instead of the CMU training split.
+    #[arg(long)]
+    pub procedural: bool,
+    /// Data folder for the CMU clips (default: the shared corpus).
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    #[arg(long, default_value_t = 600)]
+    pub episodes: usize,
+    /// Hyper-parameters: `quick` (Adam 1e-3, batch 64) or `paper` (§5.2: lr 0.01, batch 256).
+    #[arg(long, default_value = "quick")]
+    pub preset: String,
+    /// Stride of the training windows (overlapping windows give more training data).
+    #[arg(long, default_value_t = 10)]
+    pub stride: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+#[derive(Subcommand)]
+pub enum StreamCommand {
+    /// Read a clip as if captured live, choose keys online and send them.
+    Send(SendArgs),
+    /// Accept a stream, rebuild the frames and write them as BVH.
+    Recv(RecvArgs),
+}
+
+#[derive(Args)]
+pub struct SendArgs {
+    pub input: PathBuf,
+    #[arg(long, default_value = "127.0.0.1:7878")]
+    pub addr: String,
+    #[arg(long, default_value = "1cm")]
+    pub max_error: String,
+    /// Look-ahead window in frames (bounds the added latency).
+    #[arg(long, default_value_t = 15)]
+    pub lookahead: usize,
+    /// Send as fast as possible instead of at the clip's frame rate.
+    #[arg(long)]
+    pub fast: bool,
+    #[arg(long)]
+    pub skip_first: bool,
+    #[arg(long, default_value_t = 10)]
+    pub retries: usize,
+}
+
+#[derive(Args)]
+pub struct RecvArgs {
+    #[arg(long, default_value = "127.0.0.1:7878")]
+    pub addr: String,
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Compare against this clip and print the error.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    #[arg(long)]
+    pub skip_first: bool,
+    /// Seconds to wait for a (re)connection.
+    #[arg(long, default_value_t = 30.0)]
+    pub timeout_s: f64,
 }
 
 #[derive(Args, Clone)]
@@ -112,6 +184,13 @@ pub struct BenchArgs {
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// A SIDQL policy trained by `mocap train` (on the CMU training split); without it the bench
+    /// trains one on the training split first (see --train-episodes).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Episodes for the inline SIDQL training when no --model is given (0 skips SIDQL).
+    #[arg(long, default_value_t = 600)]
+    pub train_episodes: usize,
     /// Also report codec compression at these max errors (cm), on the full-rate clips.
     #[arg(long, value_delimiter = ',', default_value = "1,0.1")]
     pub codec_bounds: Vec<f64>,
@@ -123,6 +202,9 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
         MocapCommand::Decompress(a) => decompress(a),
         MocapCommand::Preview(a) => preview(a),
         MocapCommand::Bench(a) => bench_cmd(a),
+        MocapCommand::Train(a) => train_cmd(a),
+        MocapCommand::Stream(StreamCommand::Send(a)) => stream_send(a),
+        MocapCommand::Stream(StreamCommand::Recv(a)) => stream_recv(a),
     }
 }
 
@@ -250,8 +332,30 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
         train
     );
     let ks = [5, 10, 15];
-    let mut rows = bench::evaluate("all", &all, &Method::ALL, &ks, a.seed, None)?;
-    rows.extend(bench::evaluate("test", &test_windows, &Method::ALL, &ks, a.seed, None)?);
+    let policy = match (&a.model, a.train_episodes) {
+        (Some(p), _) => {
+            println!("SIDQL: loaded {} (trained by `mocap train` on the CMU training split)", p.display());
+            Some(SidqlPolicy::load(p)?)
+        }
+        (None, 0) => None,
+        (None, episodes) => {
+            let train_windows = training_windows(&clips, &train, &protocol, 10)?;
+            let opts = TrainOptions { episodes, seed: a.seed, ..TrainOptions::quick() };
+            println!("SIDQL: training {episodes} episodes on {} windows of the training split (stride 10)…", train_windows.len());
+            let (policy, report) = inbetween_mocap::dqn::train(&train_windows, &DqnConfig::paper(), &opts)?;
+            println!("SIDQL: trained in {:.0} s, {} updates, loss per 50 episodes {:?}", report.seconds, report.updates, report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>());
+            let path = PathBuf::from("out/sidql_cmu.bpk");
+            std::fs::create_dir_all("out").ok();
+            policy.save(&path)?;
+            println!("SIDQL: saved {} (weights trained on CMU data: keep out of the repository)", path.display());
+            Some(policy)
+        }
+    };
+    let policy_fn = policy.as_ref().map(|p| move |rep: &SphericalMotion, k: usize| p.select(rep, k));
+    let pf: Option<bench::PolicyFn> = policy_fn.as_ref().map(|f| f as bench::PolicyFn);
+    let all_methods: Vec<Method> = Method::ALL.into_iter().filter(|m| *m != Method::Sidql).collect();
+    let mut rows = bench::evaluate("all", &all, &all_methods, &ks, a.seed, None)?;
+    rows.extend(bench::evaluate("test", &test_windows, &Method::ALL, &ks, a.seed, pf)?);
     println!("{}", bench::to_table(&rows));
     if let Some(p) = &a.csv {
         write_atomic(p, bench::to_csv(&rows).as_bytes()).with_context(|| format!("writing {}", p.display()))?;
@@ -274,13 +378,13 @@ fn bench_plot(path: &Path, rows: &[bench::Row]) -> anyhow::Result<()> {
     for m in Method::ALL {
         let vals: Vec<f64> = [5, 10, 15]
             .iter()
-            .filter_map(|&k| rows.iter().find(|r| r.split == "all" && r.method == m && r.k == k).map(|r| r.mean_angle_error))
+            .filter_map(|&k| rows.iter().find(|r| r.split == "test" && r.method == m && r.k == k).map(|r| r.mean_angle_error))
             .collect();
         if vals.len() == 3 {
             series.push((m.name().to_string(), vals));
         }
     }
-    inbetween_render::plot::grouped_bar_chart(path, "Mean angle error, CMU 60-frame windows", "mean angle error (rad)", &groups, &series)?;
+    inbetween_render::plot::grouped_bar_chart(path, "Mean angle error, CMU test-split 60-frame windows", "mean angle error (rad)", &groups, &series)?;
     Ok(())
 }
 
@@ -367,4 +471,118 @@ pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
     lines.push(format!("  K=10 on 23 joints: rotation reconstruction mean {:.2} cm vs spherical {:.2} cm", rm.error(&k10).mean_cm, rep.error(&k10).mean_cm));
     lines.push(format!("  wrote {}, {}, {} ({:.1} s)", ibk.display(), bvh.display(), gif.display(), t.elapsed().as_secs_f64()));
     Ok(lines)
+}
+
+/// Windows of the named clips with the given stride (overlapping windows for training).
+fn training_windows(clips: &[(String, Motion)], names: &[String], protocol: &Protocol, stride: usize) -> anyhow::Result<Vec<SphericalMotion>> {
+    let p = Protocol { stride, ..protocol.clone() };
+    let mut out = Vec::new();
+    for (name, m) in clips.iter().filter(|(n, _)| names.contains(n)) {
+        out.extend(bench::clip_windows(name, m, &p)?.into_iter().map(|w| w.rep));
+    }
+    Ok(out)
+}
+
+fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
+    let protocol = Protocol { seed: a.seed, ..Protocol::paper() };
+    let windows = if a.procedural {
+        let clips: Vec<(String, Motion)> = inbetween_core::procedural::gait_library(a.seed, 24, 241, 30.0)
+            .into_iter()
+            .enumerate()
+            .map(|(i, m)| (format!("gait{i}"), m))
+            .collect();
+        let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
+        let p = Protocol { skip_first_frame: false, ..protocol.clone() };
+        println!("training on {} procedural gaits (seed {})", clips.len(), a.seed);
+        training_windows(&clips, &names, &p, a.stride)?
+    } else {
+        let dir = match a.data.clone() {
+            Some(d) => d,
+            None => inbetween_io::data::shared_data_dir().map_err(|p| anyhow::anyhow!("no data at {} (give --data DIR or --procedural)", p.display()))?,
+        };
+        let clips = cmu_clips(&dir)?;
+        let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
+        let (train, test) = bench::split_clips(&names, &protocol);
+        println!("training on the CMU training split {train:?} (test split {test:?} held out)");
+        training_windows(&clips, &train, &protocol, a.stride)?
+    };
+    let base = match a.preset.as_str() {
+        "quick" => TrainOptions::quick(),
+        "paper" => TrainOptions::paper(),
+        other => bail!("unknown preset '{other}'; expected quick or paper"),
+    };
+    if let Some(dir) = a.output.parent() {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir)?;
+        }
+    }
+    let opts = TrainOptions { episodes: a.episodes, seed: a.seed, checkpoint: Some(a.output.clone()), ..base };
+    println!("{} windows; {:?}", windows.len(), opts);
+    let (_, report) = inbetween_mocap::dqn::train(&windows, &DqnConfig::paper(), &opts)?;
+    println!(
+        "trained {} episodes, {} updates in {:.0} s; loss per 50 episodes {:?}; return per episode {:?}",
+        report.episodes,
+        report.updates,
+        report.seconds,
+        report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>(),
+        report.return_curve.iter().map(|r| format!("{r:.3}")).collect::<Vec<_>>()
+    );
+    println!("wrote {}", a.output.display());
+    Ok(())
+}
+
+fn stream_send(a: SendArgs) -> anyhow::Result<()> {
+    let m = inbetween_io::load_motion(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
+    let m = if a.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
+    let opts = inbetween_mocap::stream::SendOptions {
+        max_cm: codec::parse_length_cm(&a.max_error)?,
+        lookahead: a.lookahead,
+        realtime: !a.fast,
+        retries: a.retries,
+    };
+    let r = inbetween_mocap::stream::send(&a.addr, &m, &opts)?;
+    let secs = m.duration().max(1e-9);
+    println!(
+        "sent {} keys for {} frames in {:.2} s: {} bytes ({:.0} B/s) vs {} raw bytes ({:.0} B/s), {:.1}x less; added latency mean {:.0} ms, max {:.0} ms; {} reconnects",
+        r.keys,
+        r.frames,
+        r.seconds,
+        r.bytes_sent,
+        r.bytes_sent as f64 / secs,
+        r.raw_bytes,
+        r.raw_bytes as f64 / secs,
+        r.raw_bytes as f64 / r.bytes_sent as f64,
+        r.mean_latency_ms,
+        r.max_latency_ms,
+        r.reconnects
+    );
+    Ok(())
+}
+
+fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
+    let listener = std::net::TcpListener::bind(&a.addr).with_context(|| format!("listening on {}", a.addr))?;
+    let opts = inbetween_mocap::stream::RecvOptions { max_sessions: 8, accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s) };
+    let got = inbetween_mocap::stream::recv(&listener, &opts)?;
+    for w in &got.warnings {
+        eprintln!("warning: {w}");
+    }
+    inbetween_io::write_bvh(&a.output, &got.motion)?;
+    println!(
+        "received {} keys ({} bytes, {} sessions, {}), emitted {} frames; wrote {}",
+        got.keys,
+        got.bytes,
+        got.sessions,
+        if got.complete { "complete" } else { "incomplete" },
+        got.motion.num_frames(),
+        a.output.display()
+    );
+    if let Some(r) = &a.reference {
+        let m = inbetween_io::load_motion(r)?;
+        let m = if a.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
+        let n = m.num_frames().min(got.motion.num_frames());
+        let e = inbetween_core::position_error(&positions_clip(&m.crop(0, n)?), &positions_clip(&got.motion.crop(0, n)?));
+        let cm = inbetween_core::procedural::CM_PER_CMU_UNIT;
+        println!("error vs {}: mean {:.3} cm, max {:.3} cm over {n} frames", r.display(), e.mean * cm, e.max * cm);
+    }
+    Ok(())
 }

@@ -27,10 +27,11 @@ pub struct JointFilter {
 }
 
 impl JointFilter {
-    /// The paper's 23 major joints: drops fingers, thumbs and toes. Covers the cgspeed CMU names
-    /// (`LeftFingerBase`, `LThumb`, `LeftToeBase`) and Character Creator rigs (`CC_Base_L_Index1`, …).
+    /// The paper's 23 major joints: drops fingers, thumbs and toes. Covers both cgspeed CMU
+    /// releases (`LeftFingerBase`, `LThumb`, `LeftToeBase`; and `lhand`/`rhand`, the finger base
+    /// below `LeftWrist` in the 131_* files) and Character Creator rigs (`CC_Base_L_Index1`, …).
     pub fn paper() -> JointFilter {
-        let p = ["finger", "thumb", "toe", "handindex", "index", "mid", "ring", "pinky"];
+        let p = ["finger", "thumb", "toe", "handindex", "lhand", "rhand", "index", "mid", "ring", "pinky"];
         JointFilter { drop_patterns: p.iter().map(|s| s.to_string()).collect() }
     }
 
