@@ -1,5 +1,5 @@
 //! The quick training run behind the committed weights, runnable without the CLI:
-//! `cargo run -p inbetween-camera --example train_quick -- MINUTES OUT.bpk CHECKPOINT_DIR [ITERS_PER_EPOCH] [BATCH]`.
+//! `cargo run -p inbetween-camera --example train_quick -- MINUTES OUT.bpk CHECKPOINT_DIR [ITERS_PER_EPOCH] [BATCH] [STATIC_START]`.
 //! (`inbetween camera train` is the full-featured front end.)
 
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
@@ -16,6 +16,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(b) = args.get(4) {
         cfg.batch = b.parse()?;
+    }
+    if let Some(p) = args.get(5) {
+        cfg.static_start = p.parse()?;
     }
     let t0 = std::time::Instant::now();
     let mut report = |e: TrainEvent| match e {

@@ -5,6 +5,7 @@
 //! the synthetic [`dataset`] (scenes + four behaviours), the three networks in [`model`], [`train`],
 //! inference with keyframes in [`infer`], and exports ([`gltf`], [`preview`]) and the [`bench`].
 
+pub mod bench;
 pub mod dataset;
 pub mod features;
 pub mod infer;

@@ -2,6 +2,7 @@
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
+use inbetween_camera::bench;
 use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
 use inbetween_camera::infer::{self, FastModel, GenerateOptions, Keys, NamedStyle, ReferenceClip};
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
@@ -15,6 +16,21 @@ pub enum CameraCommand {
     Scene(SceneArgs),
     /// Train extractor, generator and mapping end to end on the synthetic dataset (resumable).
     Train(TrainArgs),
+    /// Benchmark: Table 1, Table 2 (SD/TD/KD), §6.3 spline comparison, style PCA, frames/s.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Reduced run (under a minute on 2 cores).
+    #[arg(long)]
+    pub quick: bool,
+    /// Folder for CSV tables, PNG charts and the JSON report.
+    #[arg(short, long, default_value = "out/camera-bench")]
+    pub out: PathBuf,
+    /// Weights (default: the committed quick-training weights).
+    #[arg(long)]
+    pub weights: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -91,6 +107,7 @@ pub fn run(c: CameraCommand) -> anyhow::Result<()> {
         CameraCommand::Generate(a) => run_generate(a),
         CameraCommand::Scene(a) => run_scene(a),
         CameraCommand::Train(a) => run_train(a),
+        CameraCommand::Bench(a) => run_bench(a),
     }
 }
 
@@ -161,6 +178,17 @@ fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
         inbetween_camera::write_json(&a.out.join(format!("reference-{}.json", b.name())), &seq)?;
     }
     println!("wrote scene.json, keys.json and reference-{{direct,relative,side,orbit}}.json to {}", a.out.display());
+    Ok(())
+}
+
+fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
+    let model = load_model(a.weights.as_deref())?;
+    let cfg = if a.quick { bench::BenchConfig::quick() } else { bench::BenchConfig::full() };
+    let t0 = std::time::Instant::now();
+    let report = bench::run(&model, &cfg);
+    print!("{}", report.text());
+    let files = report.write(&a.out)?;
+    println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t0.elapsed().as_secs_f64());
     Ok(())
 }
 

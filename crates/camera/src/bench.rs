@@ -1,0 +1,598 @@
+//! The benchmark of the issue: Table 1 (hidden-state initialisation), Table 2 (SD / TD / KD under
+//! keyframe displacement), the §6.3 spline comparison, the style-space PCA (Fig. 4) and generation
+//! speed. Everything runs on a held-out seeded evaluation set (a seed the training never uses).
+//!
+//! Protocols (in downsampled steps of 5 frames; errors are ‖Δx^c‖₂ over the 6 Toric values):
+//! - **Table 1**: a 45-step window per sequence: 5 ground-truth steps of context, then 40 generated
+//!   steps (200 frames) to a keyframe on the last one; z from the extractor on the 60 steps from
+//!   the window's start. The hidden state starts at zero, as N(0, 1) noise, warm-started (zero, then
+//!   the generator reads the 5 ground-truth steps) or mapped by H (Eq. 6). Error = mean over the
+//!   generated steps. The paper trains a separate network for the warm start; we reuse ours.
+//! - **Table 2**: 60-step segments with keys at both ends; the end key's θ is displaced by δ
+//!   (random sign, kept inside the valid arc). *Ours*: generate with z and the displaced key
+//!   (KD = miss at that key), correct onto it (Eq. 9), re-extract z_r, regenerate with z_r and the
+//!   true keys: TD = mean error to the ground truth, SD (Eq. 8) = S(Z_r, Z)/S(Z, Z) per behaviour.
+//!   *Only style*: generate with the true keys, then bend onto the displaced key by Eq. 9 alone.
+//!   *Toric interpolation*: straight lines in Toric space between the keys (no network).
+//! - **§6.3**: our track with 3 keys (start, middle, end) vs a Catmull-Rom spline through n evenly
+//!   spaced ground-truth keys: the smallest n whose spline error is at most ours.
+
+use crate::dataset::{Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE};
+use crate::features::{CAM_DIM, CHAR_ENC};
+use crate::infer::{cubic_fill, FastModel, State, StepIn};
+use crate::model::{MAP_FRAMES, STYLE_STEPS};
+use crate::toric::Lens;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+type Cam = [f32; CAM_DIM];
+type Chr = [f32; CHAR_ENC];
+
+/// Which benchmark size to run.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BenchConfig {
+    pub seed: u64,
+    pub scenes: usize,
+    pub windows_per_sequence: usize,
+    pub displacements: Vec<f64>,
+    pub max_spline_keys: usize,
+    pub speed_seconds: f64,
+}
+
+impl BenchConfig {
+    pub fn full() -> BenchConfig {
+        BenchConfig {
+            seed: 9001,
+            scenes: 12,
+            windows_per_sequence: 3,
+            displacements: vec![0.0, 0.1, 0.3, 0.5, 0.9, 1.2, 1.4, 1.6, 1.8, 2.0],
+            max_spline_keys: 40,
+            speed_seconds: 2.0,
+        }
+    }
+
+    /// Under a minute on 2 cores.
+    pub fn quick() -> BenchConfig {
+        BenchConfig { scenes: 3, windows_per_sequence: 1, displacements: vec![0.0, 0.5, 1.0, 2.0], speed_seconds: 0.7, ..BenchConfig::full() }
+    }
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Table1Row {
+    pub behaviour: String,
+    pub zero: f64,
+    pub gaussian: f64,
+    pub warm_start: f64,
+    pub mapped: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Table2Row {
+    pub displacement: f64,
+    pub sd_ours: f64,
+    pub sd_only_style: f64,
+    pub sd_interpolation: f64,
+    pub td_ours: f64,
+    pub td_only_style: f64,
+    pub td_interpolation: f64,
+    pub kd_ours: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RailsRow {
+    pub behaviour: String,
+    pub ours_error: f64,
+    /// Mean smallest key count for the spline to match us (capped cases count as the cap).
+    pub spline_keys: f64,
+    pub capped: usize,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Speed {
+    /// End to end (network every 5th frame, cubic fill, world poses), one 900-frame track.
+    pub single_frames_per_s: f64,
+    /// Network only, 16 trajectories in lockstep, output frames (5 per step).
+    pub batched_frames_per_s: f64,
+    pub batch: usize,
+}
+
+/// Everything the bench prints and writes.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BenchReport {
+    pub config: BenchConfig,
+    pub sequences: usize,
+    pub table1: Vec<Table1Row>,
+    pub table2: Vec<Table2Row>,
+    pub rails: Vec<RailsRow>,
+    pub speed: Speed,
+    /// (behaviour, main is A, z) of every evaluation sequence, for the PCA plot.
+    pub styles: Vec<(Behaviour, bool, Vec<f32>)>,
+}
+
+/// An evaluation sequence at the network rate.
+struct EvalSeq {
+    behaviour: Behaviour,
+    main_is_a: bool,
+    chars: Vec<Chr>,
+    cams: Vec<Cam>,
+}
+
+fn err(a: &Cam, b: &Cam) -> f64 {
+    a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()
+}
+
+fn mean_err(a: &[Cam], b: &[Cam]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| err(x, y)).sum::<f64>() / a.len().max(1) as f64
+}
+
+fn key_vec(cam: &Cam, ch: &Chr) -> [f32; CAM_DIM + CHAR_ENC] {
+    let mut v = [0.0; CAM_DIM + CHAR_ENC];
+    v[..CAM_DIM].copy_from_slice(cam);
+    v[CAM_DIM..].copy_from_slice(ch);
+    v
+}
+
+/// Generates steps 1..=last from `start` (index 0) with keys at the given indices (the last one is
+/// `last`); returns all `last + 1` steps, index 0 being `start`.
+fn roll(model: &FastModel, z: &[f32], mut state: State, start: Cam, chars: &[Chr], keys: &[(usize, Cam)]) -> Vec<Cam> {
+    let last = keys.last().map_or(0, |k| k.0);
+    let mut out = vec![start];
+    let mut prev = start;
+    for t in 1..=last {
+        let &(ki, kc) = keys.iter().find(|(i, _)| *i >= t).expect("a key at the end");
+        let input = StepIn { style: z, prev, character: chars[t], key: key_vec(&kc, &chars[ki]), tta_frames: (ki - t) * DOWNSAMPLE };
+        prev = model.step(&[input], &mut state)[0];
+        out.push(prev);
+    }
+    out
+}
+
+fn style_of(model: &FastModel, chars: &[Chr], cams: &[Cam]) -> Vec<f32> {
+    model.extract_style(chars, cams)
+}
+
+/// Bends `track` onto `keys` (index, value) by linearly blended residuals (Eq. 9).
+fn bend(track: &mut [Cam], keys: &[(usize, Cam)]) {
+    let mut t64: Vec<[f64; 6]> = track.iter().map(|c| c.map(|v| v as f64)).collect();
+    let k64: Vec<(usize, [f64; 6])> = keys.iter().map(|(i, c)| (*i, c.map(|v| v as f64))).collect();
+    crate::infer::correct_to_keys(&mut t64, &k64);
+    for (d, s) in track.iter_mut().zip(t64) {
+        *d = s.map(|v| v as f32);
+    }
+}
+
+fn mapped_state(model: &FastModel, z: &[f32], context: &[Cam]) -> State {
+    let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| context[i]);
+    model.map_state(z, &frames)
+}
+
+fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng) -> Vec<Table1Row> {
+    let gap = 40;
+    let hd = model.config.hidden;
+    let mut sums = vec![[0.0f64; 4]; BEHAVIOURS.len()];
+    let mut counts = vec![0usize; BEHAVIOURS.len()];
+    for s in seqs {
+        for _ in 0..cfg.windows_per_sequence {
+            let s0 = rng.random_range(0..=s.cams.len() - STYLE_STEPS.max(MAP_FRAMES + gap));
+            let z = style_of(model, &s.chars[s0..s0 + STYLE_STEPS], &s.cams[s0..s0 + STYLE_STEPS]);
+            let base = s0 + MAP_FRAMES - 1;
+            let chars = &s.chars[base..=base + gap];
+            let truth = &s.cams[base..=base + gap];
+            let keys = [(gap, truth[gap])];
+            let gaussian = State { h: (0..hd).map(|_| normal(rng)).collect(), c: (0..hd).map(|_| normal(rng)).collect() };
+            let mut warm = State::zeros(1, hd);
+            for t in s0 + 1..=base {
+                let input = StepIn { style: &z, prev: s.cams[t - 1], character: s.chars[t], key: key_vec(&truth[gap], &chars[gap]), tta_frames: (base + gap - t) * DOWNSAMPLE };
+                model.step(&[input], &mut warm);
+            }
+            let states = [State::zeros(1, hd), gaussian, warm, mapped_state(model, &z, &s.cams[s0..s0 + MAP_FRAMES])];
+            let b = s.behaviour.index();
+            for (m, st) in states.into_iter().enumerate() {
+                let out = roll(model, &z, st, truth[0], chars, &keys);
+                sums[b][m] += mean_err(&out[1..], &truth[1..]);
+            }
+            counts[b] += 1;
+        }
+    }
+    BEHAVIOURS
+        .iter()
+        .map(|b| {
+            let i = b.index();
+            let n = counts[i].max(1) as f64;
+            Table1Row { behaviour: b.name().into(), zero: sums[i][0] / n, gaussian: sums[i][1] / n, warm_start: sums[i][2] / n, mapped: sums[i][3] / n }
+        })
+        .collect()
+}
+
+/// Standard normal by Box–Muller (seeded through `rng`).
+fn normal(rng: &mut ChaCha8Rng) -> f32 {
+    let u1: f64 = rng.random_range(1e-12..1.0);
+    let u2: f64 = rng.random_range(0.0..1.0);
+    ((-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()) as f32
+}
+
+/// θ displaced by δ with a random sign, kept inside the valid arc (the other sign when needed).
+fn displaced(key: &Cam, delta: f64, lens: &Lens, rng: &mut ChaCha8Rng) -> Cam {
+    let toric = crate::features::decode_camera(key);
+    let max = toric.theta_max(lens) - 0.05;
+    let th = toric.theta;
+    let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let first = th + sign * delta;
+    let theta = if first > 0.05 && first < max { first } else { (th - sign * delta).clamp(0.05, max) };
+    let mut out = *key;
+    out[4] = theta as f32;
+    out
+}
+
+fn set_distance(u: &[Vec<f32>], v: &[Vec<f32>]) -> f64 {
+    let mut total = 0.0;
+    for a in u {
+        for b in v {
+            total += a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt();
+        }
+    }
+    total / (u.len() * v.len()).max(1) as f64
+}
+
+/// SD (Eq. 8) averaged over behaviours.
+fn silhouette(pairs: &[(Behaviour, Vec<f32>, Vec<f32>)]) -> f64 {
+    let mut sds = Vec::new();
+    for b in BEHAVIOURS {
+        let z: Vec<Vec<f32>> = pairs.iter().filter(|p| p.0 == b).map(|p| p.1.clone()).collect();
+        let zr: Vec<Vec<f32>> = pairs.iter().filter(|p| p.0 == b).map(|p| p.2.clone()).collect();
+        if z.len() > 1 {
+            sds.push(set_distance(&zr, &z) / set_distance(&z, &z).max(1e-12));
+        }
+    }
+    sds.iter().sum::<f64>() / sds.len().max(1) as f64
+}
+
+fn lerp_track(a: &Cam, b: &Cam, n: usize) -> Vec<Cam> {
+    (0..=n).map(|t| std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t as f32 / n as f32)).collect()
+}
+
+fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, rng: &mut ChaCha8Rng) -> Vec<Table2Row> {
+    let len = STYLE_STEPS;
+    // One segment per sequence, shared by every δ.
+    let segs: Vec<(usize, Vec<f32>)> = seqs
+        .iter()
+        .map(|s| {
+            let s0 = rng.random_range(0..=s.cams.len() - (len + MAP_FRAMES));
+            let base = s0 + MAP_FRAMES - 1;
+            (s0, style_of(model, &s.chars[base + 1..=base + len], &s.cams[base + 1..=base + len]))
+        })
+        .collect();
+    let mut rows = Vec::new();
+    for &delta in &cfg.displacements {
+        let (mut ours, mut only, mut interp) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut td, mut kd) = ([0.0f64; 3], 0.0);
+        for (s, (s0, z)) in seqs.iter().zip(&segs) {
+            let base = s0 + MAP_FRAMES - 1;
+            let chars = &s.chars[base..=base + len];
+            let truth = &s.cams[base..=base + len];
+            let true_keys = [(len, truth[len])];
+            let key_d = displaced(&truth[len], delta, lens, rng);
+            let disp_keys = [(0, truth[0]), (len, key_d)];
+            let ctx = &s.cams[*s0..s0 + MAP_FRAMES];
+            let regenerate = |zr: &[f32]| roll(model, zr, mapped_state(model, zr, ctx), truth[0], chars, &true_keys);
+            // Ours.
+            let mut x1 = roll(model, z, mapped_state(model, z, ctx), truth[0], chars, &[(len, key_d)]);
+            kd += err(&x1[len], &key_d);
+            bend(&mut x1, &disp_keys);
+            let zr = style_of(model, &chars[1..], &x1[1..]);
+            td[0] += mean_err(&regenerate(&zr)[1..], &truth[1..]);
+            ours.push((s.behaviour, z.clone(), zr));
+            // Only style.
+            let mut x2 = roll(model, z, mapped_state(model, z, ctx), truth[0], chars, &true_keys);
+            bend(&mut x2, &disp_keys);
+            let zr = style_of(model, &chars[1..], &x2[1..]);
+            td[1] += mean_err(&regenerate(&zr)[1..], &truth[1..]);
+            only.push((s.behaviour, z.clone(), zr));
+            // Plain Toric interpolation.
+            let x3 = lerp_track(&truth[0], &key_d, len);
+            let zr = style_of(model, &chars[1..], &x3[1..]);
+            td[2] += mean_err(&lerp_track(&truth[0], &truth[len], len)[1..], &truth[1..]);
+            interp.push((s.behaviour, z.clone(), zr));
+        }
+        let n = seqs.len().max(1) as f64;
+        rows.push(Table2Row {
+            displacement: delta,
+            sd_ours: silhouette(&ours),
+            sd_only_style: silhouette(&only),
+            sd_interpolation: silhouette(&interp),
+            td_ours: td[0] / n,
+            td_only_style: td[1] / n,
+            td_interpolation: td[2] / n,
+            kd_ours: kd / n,
+        });
+    }
+    rows
+}
+
+fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng) -> Vec<RailsRow> {
+    let len = STYLE_STEPS;
+    let mut acc = vec![(0.0f64, 0.0f64, 0usize, 0usize); BEHAVIOURS.len()];
+    for s in seqs {
+        let s0 = rng.random_range(0..=s.cams.len() - (len + MAP_FRAMES));
+        let base = s0 + MAP_FRAMES - 1;
+        let chars = &s.chars[base..=base + len];
+        let truth = &s.cams[base..=base + len];
+        let z = style_of(model, &chars[1..], &truth[1..]);
+        let keys = [(len / 2, truth[len / 2]), (len, truth[len])];
+        let mut ours = roll(model, &z, mapped_state(model, &z, &s.cams[s0..s0 + MAP_FRAMES]), truth[0], chars, &keys);
+        bend(&mut ours, &[(0, truth[0]), keys[0], keys[1]]);
+        let e_ours = mean_err(&ours, truth);
+        let mut needed = cfg.max_spline_keys;
+        let mut capped = 1;
+        for n in 2..=cfg.max_spline_keys {
+            let idx: Vec<usize> = (0..n).map(|i| (i * len + (n - 1) / 2) / (n - 1)).collect();
+            let samples: Vec<(usize, [f64; 6])> = idx.iter().map(|&i| (i, truth[i].map(|v| v as f64))).collect();
+            let spline: Vec<Cam> = cubic_fill(&samples).into_iter().map(|x| x.map(|v| v as f32)).collect();
+            if mean_err(&spline, truth) <= e_ours {
+                needed = n;
+                capped = 0;
+                break;
+            }
+        }
+        let a = &mut acc[s.behaviour.index()];
+        a.0 += e_ours;
+        a.1 += needed as f64;
+        a.2 += 1;
+        a.3 += capped;
+    }
+    BEHAVIOURS
+        .iter()
+        .map(|b| {
+            let a = acc[b.index()];
+            let n = a.2.max(1) as f64;
+            RailsRow { behaviour: b.name().into(), ours_error: a.0 / n, spline_keys: a.1 / n, capped: a.3 }
+        })
+        .collect()
+}
+
+fn speed(model: &FastModel, seconds: f64) -> Speed {
+    let scene = crate::dataset::Scene::procedural(42, 900, 30.0);
+    let keys = crate::infer::example_keys(&scene, &[0, 299, 599, 899]);
+    let z = vec![0.0; model.config.style_dim];
+    let opts = crate::infer::GenerateOptions::default();
+    let origin = std::path::Path::new("bench");
+    let t0 = Instant::now();
+    let mut frames = 0usize;
+    while t0.elapsed().as_secs_f64() < seconds * 0.5 || frames == 0 {
+        let track = crate::infer::generate(model, &scene, &keys, &z, "bench", &opts, origin).expect("bench generation");
+        frames += track.frames.len();
+    }
+    let single = frames as f64 / t0.elapsed().as_secs_f64();
+    let batch = 16;
+    let mut state = State::zeros(batch, model.config.hidden);
+    let input = StepIn { style: &z, prev: [-0.3, 0.1, 0.3, 0.1, 1.5, 0.2], character: [0.4, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 1.0], key: [0.1; 14], tta_frames: 100 };
+    let inputs = vec![input; batch];
+    let t1 = Instant::now();
+    let mut steps = 0usize;
+    while t1.elapsed().as_secs_f64() < seconds * 0.5 || steps == 0 {
+        for _ in 0..20 {
+            model.step(&inputs, &mut state);
+        }
+        steps += 20;
+    }
+    let batched = (steps * batch * DOWNSAMPLE) as f64 / t1.elapsed().as_secs_f64();
+    Speed { single_frames_per_s: single, batched_frames_per_s: batched, batch }
+}
+
+/// Runs the whole benchmark.
+pub fn run(model: &FastModel, cfg: &BenchConfig) -> BenchReport {
+    let lens = Lens::default();
+    let data = Dataset::generate(cfg.seed, cfg.scenes, crate::dataset::SCENE_FRAMES);
+    let seqs: Vec<EvalSeq> = data
+        .sequences
+        .iter()
+        .map(|s| {
+            let (chars, cams) = s.encoded(DOWNSAMPLE);
+            EvalSeq { behaviour: s.behaviour, main_is_a: s.main_is_a, chars, cams }
+        })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let styles = seqs.iter().map(|s| (s.behaviour, s.main_is_a, style_of(model, &s.chars[..STYLE_STEPS], &s.cams[..STYLE_STEPS]))).collect();
+    BenchReport {
+        config: cfg.clone(),
+        sequences: seqs.len(),
+        table1: table1(model, &seqs, cfg, &mut rng),
+        table2: table2(model, &seqs, cfg, &lens, &mut rng),
+        rails: rails(model, &seqs, cfg, &mut rng),
+        speed: speed(model, cfg.speed_seconds),
+        styles,
+    }
+}
+
+/// The first two principal components of the style codes (power iteration on the covariance).
+pub fn pca2(codes: &[Vec<f32>]) -> Vec<(f64, f64)> {
+    let d = codes.first().map_or(0, |c| c.len());
+    let n = codes.len().max(1) as f64;
+    let mean: Vec<f64> = (0..d).map(|k| codes.iter().map(|c| c[k] as f64).sum::<f64>() / n).collect();
+    let centred: Vec<Vec<f64>> = codes.iter().map(|c| (0..d).map(|k| c[k] as f64 - mean[k]).collect()).collect();
+    let mut cov = vec![vec![0.0; d]; d];
+    for c in &centred {
+        for i in 0..d {
+            for j in 0..d {
+                cov[i][j] += c[i] * c[j] / n;
+            }
+        }
+    }
+    let mut axes: Vec<Vec<f64>> = Vec::new();
+    for _ in 0..2.min(d) {
+        let mut v: Vec<f64> = (0..d).map(|k| 1.0 + k as f64 * 0.1).collect();
+        for _ in 0..200 {
+            let mut w: Vec<f64> = (0..d).map(|i| (0..d).map(|j| cov[i][j] * v[j]).sum()).collect();
+            for a in &axes {
+                let p: f64 = w.iter().zip(a).map(|(x, y)| x * y).sum();
+                for (wi, ai) in w.iter_mut().zip(a) {
+                    *wi -= p * ai;
+                }
+            }
+            let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-12);
+            v = w.iter().map(|x| x / norm).collect();
+        }
+        axes.push(v);
+    }
+    let proj = |c: &Vec<f64>, a: Option<&Vec<f64>>| a.map_or(0.0, |a| c.iter().zip(a).map(|(x, y)| x * y).sum());
+    centred.iter().map(|c| (proj(c, axes.first()), proj(c, axes.get(1)))).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pca_finds_the_dominant_axis() {
+        let codes: Vec<Vec<f32>> = (0..20).map(|i| vec![i as f32, 0.5 * i as f32, 0.01 * ((i * 7) % 3) as f32, 0.0]).collect();
+        let p = pca2(&codes);
+        let spread1 = p.iter().map(|x| x.0.abs()).fold(0.0, f64::max);
+        let spread2 = p.iter().map(|x| x.1.abs()).fold(0.0, f64::max);
+        assert!(spread1 > 10.0 && spread2 < 0.1, "{spread1} {spread2}");
+    }
+
+    #[test]
+    fn displaced_keys_stay_valid_and_move_by_delta() {
+        let lens = Lens::default();
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let key: Cam = [-0.3, 0.1, 0.3, 0.1, 2.0, 0.2];
+        for delta in [0.0, 0.5, 1.0] {
+            let d = displaced(&key, delta, &lens, &mut rng);
+            assert!(((d[4] - key[4]).abs() as f64 - delta).abs() < 1e-6);
+            assert!((d[4] as f64) < crate::features::decode_camera(&key).theta_max(&lens));
+        }
+    }
+
+    #[test]
+    fn bench_runs_on_a_tiny_model() {
+        let device = inbetween_nn::backend::cpu();
+        let cfg = crate::model::ModelConfig { hidden: 8, tta_dim: 8, ..Default::default() };
+        let model = FastModel::from_burn(&cfg.init(&device), cfg);
+        let bc = BenchConfig { scenes: 1, displacements: vec![0.0, 1.0], max_spline_keys: 6, speed_seconds: 0.05, ..BenchConfig::quick() };
+        let r = run(&model, &bc);
+        assert_eq!(r.table1.len(), 4);
+        assert_eq!(r.table2.len(), 2);
+        assert!(r.table1.iter().all(|row| row.mapped.is_finite() && row.zero > 0.0));
+        assert!(r.speed.single_frames_per_s > 0.0);
+        // TD of plain interpolation does not depend on the displaced key.
+        assert!((r.table2[0].td_interpolation - r.table2[1].td_interpolation).abs() < 1e-12);
+    }
+}
+
+/// The paper's numbers for the README and the printed comparison.
+pub const PAPER_TABLE1: [(&str, f64, f64, f64, f64); 4] = [
+    ("direct", 0.162, 0.146, 0.173, 0.107),
+    ("relative", 0.081, 0.074, 0.088, 0.050),
+    ("side", 0.045, 0.045, 0.071, 0.025),
+    ("orbit", 0.263, 0.263, 0.116, 0.049),
+];
+
+impl BenchReport {
+    /// The tables as text, ours beside the paper's where it has them.
+    pub fn text(&self) -> String {
+        let mut s = format!("camera bench: {} held-out sequences (seed {})\n", self.sequences, self.config.seed);
+        s += "\nTable 1: trajectory error (Toric units) by hidden-state initialisation   [paper: zero / gaussian / warm / mapped]\n";
+        s += &format!("{:<10}{:>9}{:>10}{:>9}{:>9}   {}\n", "behaviour", "zero", "gaussian", "warm", "mapped", "paper");
+        let mut avg = [0.0; 4];
+        for r in &self.table1 {
+            let p = PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).expect("paper row");
+            s += &format!("{:<10}{:>9.3}{:>10.3}{:>9.3}{:>9.3}   {:.3} / {:.3} / {:.3} / {:.3}\n", r.behaviour, r.zero, r.gaussian, r.warm_start, r.mapped, p.1, p.2, p.3, p.4);
+            for (a, v) in avg.iter_mut().zip([r.zero, r.gaussian, r.warm_start, r.mapped]) {
+                *a += v / self.table1.len() as f64;
+            }
+        }
+        s += &format!("{:<10}{:>9.3}{:>10.3}{:>9.3}{:>9.3}   0.138 / 0.132 / 0.112 / 0.057\n", "average", avg[0], avg[1], avg[2], avg[3]);
+        s += "\nTable 2: keyframe displacement δ (rad on θ): SD (Eq. 8), TD, KD\n";
+        s += &format!("{:>6}{:>9}{:>10}{:>10}{:>9}{:>10}{:>10}{:>9}\n", "δ", "SD ours", "SD style", "SD lerp", "TD ours", "TD style", "TD lerp", "KD ours");
+        for r in &self.table2 {
+            s += &format!(
+                "{:>6.1}{:>9.3}{:>10.3}{:>10.3}{:>9.3}{:>10.3}{:>10.3}{:>9.3}\n",
+                r.displacement, r.sd_ours, r.sd_only_style, r.sd_interpolation, r.td_ours, r.td_only_style, r.td_interpolation, r.kd_ours
+            );
+        }
+        s += "\n§6.3: keys a Catmull-Rom spline through ground truth needs to match our 3-key track\n";
+        for r in &self.rails {
+            s += &format!("{:<10} ours {:.3}  spline keys {:.1}{}\n", r.behaviour, r.ours_error, r.spline_keys, if r.capped > 0 { format!(" ({} capped at {})", r.capped, self.config.max_spline_keys) } else { String::new() });
+        }
+        s += &format!(
+            "\nspeed: {:.0} frames/s end to end (one 900-frame track, one thread); {:.0} frames/s network, {} trajectories batched   [paper: > 2000]\n",
+            self.speed.single_frames_per_s, self.speed.batched_frames_per_s, self.speed.batch
+        );
+        s
+    }
+
+    /// CSV tables, PNG charts, the style PCA (Fig. 4) and the JSON report under `dir`.
+    pub fn write(&self, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, crate::CameraError> {
+        use inbetween_render::plot::{grouped_bar_chart, line_plot, scatter_plot, Series};
+        let io = |p: &std::path::Path, e: std::io::Error| crate::CameraError::Io { path: p.into(), source: e };
+        let render = |p: &std::path::Path, e: inbetween_render::RenderError| crate::CameraError::invalid(p, e.to_string());
+        std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+        let mut written = Vec::new();
+        let put = |name: &str, text: String| -> Result<std::path::PathBuf, crate::CameraError> {
+            let p = dir.join(name);
+            inbetween_io::write_atomic(&p, text.as_bytes()).map_err(|e| io(&p, e))?;
+            Ok(p)
+        };
+        let mut t1 = String::from("behaviour,zero,gaussian,warm_start,mapped,paper_zero,paper_gaussian,paper_warm_start,paper_mapped\n");
+        for r in &self.table1 {
+            let p = PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).expect("paper row");
+            t1 += &format!("{},{:.4},{:.4},{:.4},{:.4},{},{},{},{}\n", r.behaviour, r.zero, r.gaussian, r.warm_start, r.mapped, p.1, p.2, p.3, p.4);
+        }
+        written.push(put("table1.csv", t1)?);
+        let mut t2 = String::from("displacement,sd_ours,sd_only_style,sd_interpolation,td_ours,td_only_style,td_interpolation,kd_ours\n");
+        for r in &self.table2 {
+            t2 += &format!("{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}\n", r.displacement, r.sd_ours, r.sd_only_style, r.sd_interpolation, r.td_ours, r.td_only_style, r.td_interpolation, r.kd_ours);
+        }
+        written.push(put("table2.csv", t2)?);
+        let mut rl = String::from("behaviour,ours_error,spline_keys,capped\n");
+        for r in &self.rails {
+            rl += &format!("{},{:.4},{:.2},{}\n", r.behaviour, r.ours_error, r.spline_keys, r.capped);
+        }
+        written.push(put("rails.csv", rl)?);
+        written.push(put("report.json", serde_json::to_string_pretty(self).unwrap_or_default())?);
+        written.push(put("report.txt", self.text())?);
+
+        let groups: Vec<String> = self.table1.iter().map(|r| r.behaviour.clone()).collect();
+        let col = |f: fn(&Table1Row) -> f64| self.table1.iter().map(f).collect::<Vec<f64>>();
+        let p = dir.join("table1.png");
+        grouped_bar_chart(
+            &p,
+            "Table 1: trajectory error by hidden-state initialisation",
+            "error (Toric units)",
+            &groups,
+            &[
+                ("zero".into(), col(|r| r.zero)),
+                ("gaussian".into(), col(|r| r.gaussian)),
+                ("warm start".into(), col(|r| r.warm_start)),
+                ("mapped (H)".into(), col(|r| r.mapped)),
+                ("paper mapped".into(), PAPER_TABLE1.iter().map(|p| p.4).collect()),
+            ],
+        )
+        .map_err(|e| render(&p, e))?;
+        written.push(p);
+        let series = |name: &str, f: fn(&Table2Row) -> f64| Series::new(name, self.table2.iter().map(|r| (r.displacement, f(r))).collect());
+        let p = dir.join("table2_td.png");
+        line_plot(&p, "Table 2: TD vs keyframe displacement", "δ (rad)", "TD", &[series("ours", |r| r.td_ours), series("only style", |r| r.td_only_style), series("Toric lerp", |r| r.td_interpolation), series("KD ours", |r| r.kd_ours)])
+            .map_err(|e| render(&p, e))?;
+        written.push(p);
+        let p = dir.join("table2_sd.png");
+        line_plot(&p, "Table 2: SD vs keyframe displacement", "δ (rad)", "SD", &[series("ours", |r| r.sd_ours), series("only style", |r| r.sd_only_style), series("Toric lerp", |r| r.sd_interpolation)])
+            .map_err(|e| render(&p, e))?;
+        written.push(p);
+        let codes: Vec<Vec<f32>> = self.styles.iter().map(|s| s.2.clone()).collect();
+        let pts = pca2(&codes);
+        let mut series = Vec::new();
+        for b in BEHAVIOURS {
+            for main_is_a in [true, false] {
+                let points = self.styles.iter().zip(&pts).filter(|(s, _)| s.0 == b && s.1 == main_is_a).map(|(_, p)| *p).collect();
+                series.push(Series::new(format!("{} ({} main)", b.name(), if main_is_a { "left" } else { "right" }), points));
+            }
+        }
+        let p = dir.join("style_pca.png");
+        scatter_plot(&p, "Style codes z, PCA (Fig. 4)", "PC 1", "PC 2", &series).map_err(|e| render(&p, e))?;
+        written.push(p);
+        Ok(written)
+    }
+}
