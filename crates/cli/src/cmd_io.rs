@@ -3,6 +3,7 @@
 use anyhow::Context;
 use clap::Args;
 use inbetween_core::{Motion, Skeleton};
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -45,19 +46,29 @@ fn load(file: &Path, asf: Option<&Path>) -> anyhow::Result<Motion> {
 
 pub fn info(a: InfoArgs) -> anyhow::Result<()> {
     let m = load(&a.file, a.asf.as_deref())?;
-    println!("file:      {}", a.file.display());
-    println!("joints:    {}", m.skeleton.len());
-    println!("channels:  {}", m.num_channels());
-    println!("frames:    {}", m.num_frames());
-    println!("fps:       {:.3} (frame time {} s)", m.fps(), m.frame_time);
-    println!("duration:  {:.3} s", m.duration());
-    println!("skeleton:");
-    print_tree(&m.skeleton);
-    Ok(())
+    let mut out = String::new();
+    writeln!(out, "file:      {}", a.file.display())?;
+    writeln!(out, "joints:    {}", m.skeleton.len())?;
+    writeln!(out, "channels:  {}", m.num_channels())?;
+    writeln!(out, "frames:    {}", m.num_frames())?;
+    writeln!(out, "fps:       {:.3} (frame time {} s)", m.fps(), m.frame_time)?;
+    writeln!(out, "duration:  {:.3} s", m.duration())?;
+    writeln!(out, "skeleton:")?;
+    write_tree(&mut out, &m.skeleton)?;
+    print_tolerating_closed_pipe(&out)
+}
+
+/// Prints `text`; a reader that stops early (`| head`) is not an error.
+fn print_tolerating_closed_pipe(text: &str) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }
 
 /// One line per joint, indented by depth: name, offset, channels.
-fn print_tree(s: &Skeleton) {
+fn write_tree(out: &mut String, s: &Skeleton) -> std::fmt::Result {
     let mut depth = vec![0usize; s.len()];
     let mut stack = vec![0usize];
     while let Some(j) = stack.pop() {
@@ -67,7 +78,8 @@ fn print_tree(s: &Skeleton) {
         }
         let channels: Vec<&str> = joint.channels.iter().map(|c| c.name()).collect();
         let end = joint.end_site.map(|e| format!("  end site ({:.3}, {:.3}, {:.3})", e.x, e.y, e.z)).unwrap_or_default();
-        println!(
+        writeln!(
+            out,
             "  {}{}  offset ({:.3}, {:.3}, {:.3})  [{}] {}{end}",
             "  ".repeat(depth[j]),
             joint.name,
@@ -76,10 +88,11 @@ fn print_tree(s: &Skeleton) {
             joint.offset.z,
             channels.len(),
             channels.join(" "),
-        );
+        )?;
         let children: Vec<usize> = s.children(j).collect();
         stack.extend(children.into_iter().rev());
     }
+    Ok(())
 }
 
 pub fn convert(a: ConvertArgs) -> anyhow::Result<()> {
