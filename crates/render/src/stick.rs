@@ -296,35 +296,50 @@ fn text_size(opts: &StickOptions) -> f32 {
     (opts.height as f32 / 24.0).clamp(10.0, 28.0)
 }
 
+/// Where the title and legend go: the title at the top left, the legend box at the top right, or
+/// below the title when both do not fit side by side.
+struct Header {
+    size: f32,
+    pad: f32,
+    /// Legend box: x, y, width, height (None without labels).
+    legend: Option<(f32, f32, f32, f32)>,
+    /// Pixels at the top that figures keep clear of.
+    height: f32,
+}
+
+fn header(opts: &StickOptions, figure_count: usize) -> Header {
+    let size = text_size(opts);
+    let pad = size * 0.5;
+    let title_w = opts.title.as_deref().map_or(0.0, |t| text_width(t, size * 1.1) + pad);
+    let title_h = if opts.title.is_some() { size * 1.9 } else { 0.0 };
+    let labels = &opts.labels[..opts.labels.len().min(figure_count)];
+    if labels.is_empty() {
+        return Header { size, pad, legend: None, height: title_h };
+    }
+    let swatch = size * 0.9;
+    let box_w = labels.iter().map(|l| text_width(l, size)).fold(0.0, f32::max) + swatch + 3.0 * pad;
+    let box_h = labels.len() as f32 * size * 1.35 + pad;
+    let side_by_side = title_w + box_w + 2.0 * pad <= opts.width as f32;
+    let y = if side_by_side { pad } else { title_h };
+    Header { size, pad, legend: Some((opts.width as f32 - box_w - pad, y, box_w, box_h)), height: title_h.max(y + box_h + pad) }
+}
+
 /// Pixel heights of the bands at the top (title, legend) and bottom (caption) that figures keep clear of.
 fn reserved_bands(opts: &StickOptions, figure_count: usize) -> (f64, f64) {
-    let size = text_size(opts);
-    let title = if opts.title.is_some() { size * 1.9 } else { 0.0 };
-    let legend = match opts.labels.len().min(figure_count) {
-        0 => 0.0,
-        n => n as f32 * size * 1.35 + size * 1.5,
-    };
-    let caption = if opts.show_frame_number { size * 1.8 } else { 0.0 };
-    (title.max(legend) as f64, caption as f64)
+    let caption = if opts.show_frame_number { text_size(opts) * 1.8 } else { 0.0 };
+    (header(opts, figure_count).height as f64, caption as f64)
 }
 
 fn draw_title_and_legend(canvas: &mut Canvas, opts: &StickOptions, figure_count: usize) {
-    let size = text_size(opts);
-    let pad = size * 0.5;
+    let Header { size, pad, legend, .. } = header(opts, figure_count);
     if let Some(title) = &opts.title {
         canvas.text((pad, pad * 0.6), title, size * 1.1, TEXT_COLOR);
     }
-    let entries: Vec<(usize, &String)> = opts.labels.iter().enumerate().take(figure_count).collect();
-    if entries.is_empty() {
-        return;
-    }
+    let Some((x, y0, box_w, box_h)) = legend else { return };
     let swatch = size * 0.9;
-    let box_w = entries.iter().map(|(_, l)| text_width(l, size)).fold(0.0, f32::max) + swatch + 3.0 * pad;
-    let box_h = entries.len() as f32 * size * 1.35 + pad;
-    let x = opts.width as f32 - box_w - pad;
-    canvas.rect_alpha(x, pad, box_w, box_h, [255, 255, 255], 0.8);
-    for (row, (i, label)) in entries.into_iter().enumerate() {
-        let y = pad + pad * 0.5 + row as f32 * size * 1.35;
+    canvas.rect_alpha(x, y0, box_w, box_h, [255, 255, 255], 0.8);
+    for (i, label) in opts.labels.iter().take(figure_count).enumerate() {
+        let y = y0 + pad * 0.5 + i as f32 * size * 1.35;
         canvas.rect(x + pad, y + (size * 1.3 - swatch) * 0.5, swatch, swatch, opts.color(i));
         canvas.text((x + 2.0 * pad + swatch, y), label, size, TEXT_COLOR);
     }
@@ -632,6 +647,19 @@ mod tests {
         assert!(err.contains("frame 4") && err.contains("joint 2"), "{err}");
         let err = render_positions_gif(&path, &parents[..2], &[frames], &opts).unwrap_err().to_string();
         assert!(err.contains("expected 2"), "{err}");
+    }
+
+    #[test]
+    fn legend_moves_below_a_title_too_long_to_share_the_row() {
+        let labels = vec!["original".to_string(), "reconstructed".to_string()];
+        let short = StickOptions { title: Some("walk".into()), labels: labels.clone(), ..StickOptions::default() };
+        let (_, y, _, _) = header(&short, 2).legend.unwrap();
+        assert!(y < 10.0, "short title: legend on the first row");
+        let long = StickOptions { title: Some("a title long enough to run across most of the image".into()), labels, ..short };
+        let h = header(&long, 2);
+        let (_, y, _, bh) = h.legend.unwrap();
+        assert!(y >= text_size(&long) * 1.5, "legend below the title, got y = {y}");
+        assert!(h.height >= y + bh, "figures keep clear of the legend");
     }
 
     #[test]
