@@ -67,6 +67,35 @@ pub fn seeded<T>(device: &Device, seed: u64, f: impl FnOnce() -> T) -> T {
 /// separate threads, not from a thread-count knob.
 pub const FLEX_THREADS_PER_OP: usize = 1;
 
+/// Visitor that reads every float parameter once, which runs burn's lazy initialisers.
+struct InitializeParams;
+
+impl burn::module::ModuleVisitor for InitializeParams {
+    fn visit_float<const D: usize>(&mut self, param: &burn::module::Param<Tensor<D>>) {
+        if !param.is_initialized() {
+            let _ = param.val();
+        }
+    }
+}
+
+/// Build a module with `build` inside [`seeded`] and run all its parameter initialisers before
+/// the lock is released.
+///
+/// burn initialises parameters lazily, on first use: a model built inside `seeded` but first
+/// used outside it would draw its weights later, from whatever state the shared generator is in
+/// then. This forces the draws to happen under the seed.
+pub fn seeded_module<M: burn::module::Module>(
+    device: &Device,
+    seed: u64,
+    build: impl FnOnce(&Device) -> M,
+) -> M {
+    seeded(device, seed, || {
+        let module = build(device);
+        module.visit(&mut InitializeParams);
+        module
+    })
+}
+
 /// The CUDA device at `index` (only with the crate feature `cuda`, which does not build offline).
 #[cfg(feature = "cuda")]
 pub fn cuda(index: usize) -> Device {
@@ -89,4 +118,36 @@ pub fn describe(device: &Device) -> String {
             ""
         }
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use burn::nn::LinearConfig;
+    use burn::tensor::Distribution;
+
+    fn weights(linear: &burn::nn::Linear) -> Vec<f32> {
+        linear.weight.val().into_data().try_to_vec::<f32>().unwrap()
+    }
+
+    #[test]
+    fn seeded_module_draws_weights_under_the_seed() {
+        let device = cpu();
+        let a = seeded_module(&device, 5, |d| LinearConfig::new(4, 3).init(d));
+        // Random draws between the builds must not leak into `a`'s (lazy) initialisation.
+        let _noise = Tensor::<1>::random([100], Distribution::Default, &device);
+        let b = seeded_module(&device, 5, |d| LinearConfig::new(4, 3).init(d));
+        assert_eq!(weights(&a), weights(&b));
+        let c = seeded_module(&device, 6, |d| LinearConfig::new(4, 3).init(d));
+        assert_ne!(weights(&a), weights(&c));
+    }
+
+    #[test]
+    fn autodiff_helpers_toggle_the_device() {
+        let device = cpu();
+        assert!(!device.is_autodiff());
+        assert!(with_autodiff(&device).is_autodiff());
+        assert!(!without_autodiff(&cpu_autodiff()).is_autodiff());
+        assert!(describe(&cpu_autodiff()).ends_with("(autodiff)"));
+    }
 }

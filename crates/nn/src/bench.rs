@@ -104,12 +104,11 @@ fn random_frames(frames: usize, batch: usize, features: usize, device: &Device) 
 /// Frames per second of a `hidden`-unit FusedLstm stepping `batch` trajectories of `frames`
 /// frames (inference device, inputs generated up front).
 fn lstm_inference_fps(opts: &LstmBenchOptions, batch: usize, device: &Device) -> f64 {
-    let (lstm, xs) = backend::seeded(device, 0, || {
-        let lstm = FusedLstmConfig::new(opts.d_input, opts.hidden).init(device);
-        (
-            lstm,
-            random_frames(opts.frames, batch, opts.d_input, device),
-        )
+    let lstm = backend::seeded_module(device, 0, |d| {
+        FusedLstmConfig::new(opts.d_input, opts.hidden).init(d)
+    });
+    let xs = backend::seeded(device, 1, || {
+        random_frames(opts.frames, batch, opts.d_input, device)
     });
     let secs = seconds_per_call(1, opts.repeats, || {
         let mut state: Option<LstmState> = None;
@@ -125,13 +124,10 @@ fn lstm_inference_fps(opts: &LstmBenchOptions, batch: usize, device: &Device) ->
 /// Seconds per BiLSTM training step: forward over the sequence, mean-square loss, backward,
 /// Adam update.
 fn bilstm_train_step_seconds(opts: &LstmBenchOptions, device: &Device) -> f64 {
-    let (model, xs) = backend::seeded(device, 0, || {
-        let config =
-            BiLstmConfig::new(opts.d_input, opts.bi_hidden).with_num_layers(opts.bi_layers);
-        (
-            config.init(device),
-            random_frames(opts.bi_frames, opts.bi_batch, opts.d_input, device),
-        )
+    let config = BiLstmConfig::new(opts.d_input, opts.bi_hidden).with_num_layers(opts.bi_layers);
+    let model = backend::seeded_module(device, 0, |d| config.init(d));
+    let xs = backend::seeded(device, 1, || {
+        random_frames(opts.bi_frames, opts.bi_batch, opts.d_input, device)
     });
     let mut model = Some(model);
     let mut optim = AdamConfig::new().init();

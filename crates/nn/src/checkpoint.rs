@@ -110,6 +110,12 @@ pub struct CheckpointMeta {
     pub optimizer_steps: u64,
     /// Mean loss of every completed epoch, in order.
     pub loss_history: Vec<f64>,
+    /// Bit patterns (`f64::to_bits`) of `loss_history`, filled by [`save`](Self::save).
+    /// serde_json (without its `float_roundtrip` feature) can parse a float back one ulp off,
+    /// which would make a resumed run's history differ from an uninterrupted one; integers
+    /// round-trip exactly, so [`load`](Self::load) restores the history from these.
+    #[serde(default)]
+    pub loss_history_bits: Vec<u64>,
     /// Learning rate used in the last completed epoch.
     pub lr: f64,
     /// The run's configuration (free-form, e.g. a serialised `TrainConfig` and model config).
@@ -119,7 +125,11 @@ pub struct CheckpointMeta {
 impl CheckpointMeta {
     /// Write the sidecar as pretty JSON, atomically.
     pub fn save(&self, path: &Path) -> Result<(), NnError> {
-        let json = serde_json::to_vec_pretty(self).map_err(|e| NnError::Metadata {
+        let exact = Self {
+            loss_history_bits: self.loss_history.iter().map(|l| l.to_bits()).collect(),
+            ..self.clone()
+        };
+        let json = serde_json::to_vec_pretty(&exact).map_err(|e| NnError::Metadata {
             path: path.to_path_buf(),
             line: 0,
             column: 0,
@@ -131,12 +141,20 @@ impl CheckpointMeta {
     /// Read a sidecar; malformed JSON is an error naming the file, line and column.
     pub fn load(path: &Path) -> Result<Self, NnError> {
         let bytes = read_file(path)?;
-        serde_json::from_slice(&bytes).map_err(|e| NnError::Metadata {
+        let mut meta: Self = serde_json::from_slice(&bytes).map_err(|e| NnError::Metadata {
             path: path.to_path_buf(),
             line: e.line(),
             column: e.column(),
             message: e.to_string(),
-        })
+        })?;
+        if meta.loss_history_bits.len() == meta.loss_history.len() {
+            meta.loss_history = meta
+                .loss_history_bits
+                .iter()
+                .map(|&b| f64::from_bits(b))
+                .collect();
+        }
+        Ok(meta)
     }
 }
 
@@ -222,4 +240,32 @@ pub fn load_checkpoint<M: Module>(
     let model = load_module(model, &files.model)?;
     let optim = load_optimizer(optim, &files.optimizer)?;
     Ok((model, optim, meta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sidecar_round_trips_losses_bit_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("epoch-000002.json");
+        // A value serde_json's default float parser reads back one ulp off.
+        let tricky = 0.40024039149284363_f64;
+        let meta = CheckpointMeta {
+            epoch: 2,
+            optimizer_steps: 10,
+            loss_history: vec![tricky, 0.1, 1.0 / 3.0],
+            loss_history_bits: Vec::new(),
+            lr: 0.01,
+            config: serde_json::json!({"seed": 1}),
+        };
+        meta.save(&path).unwrap();
+        let back = CheckpointMeta::load(&path).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back.loss_history), bits(&meta.loss_history));
+        assert_eq!(back.epoch, 2);
+        assert_eq!(latest_checkpoint(dir.path()).unwrap().unwrap().epoch, 2);
+        assert_eq!(latest_checkpoint(&dir.path().join("absent")).unwrap(), None);
+    }
 }

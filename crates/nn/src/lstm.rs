@@ -270,7 +270,7 @@ mod tests {
     #[test]
     fn step_by_step_matches_forward_seq() {
         let device = backend::cpu();
-        let lstm = backend::seeded(&device, 1, || FusedLstmConfig::new(3, 8).init(&device));
+        let lstm = backend::seeded_module(&device, 1, |d| FusedLstmConfig::new(3, 8).init(d));
         let xs = random_seq(12, 4, 3, &device);
         let (outputs, last) = lstm.forward_seq(&xs, None);
         let mut state = None;
@@ -289,7 +289,7 @@ mod tests {
     fn cell_matches_hand_computed_lstm_equations() {
         // One step of a 1-input, 1-unit cell checked against the scalar equations in f64.
         let device = backend::cpu();
-        let lstm = backend::seeded(&device, 2, || FusedLstmConfig::new(1, 1).init(&device));
+        let lstm = backend::seeded_module(&device, 2, |d| FusedLstmConfig::new(1, 1).init(d));
         let w: Vec<f32> = lstm
             .gates
             .weight
@@ -328,8 +328,8 @@ mod tests {
     #[test]
     fn bilstm_shape_and_backward_half_sees_the_future() {
         let device = backend::cpu();
-        let bilstm = backend::seeded(&device, 3, || {
-            BiLstmConfig::new(5, 6).with_num_layers(2).init(&device)
+        let bilstm = backend::seeded_module(&device, 3, |d| {
+            BiLstmConfig::new(5, 6).with_num_layers(2).init(d)
         });
         let mut xs = random_seq(10, 2, 5, &device);
         let out = bilstm.forward_seq(&xs);
@@ -344,7 +344,7 @@ mod tests {
         assert!(max_abs_diff(&out[0], &perturbed[0]) > 1e-4);
 
         // In a single layer the forward half of the first output must not change.
-        let single = backend::seeded(&device, 30, || BiLstmConfig::new(5, 6).init(&device));
+        let single = backend::seeded_module(&device, 30, |d| BiLstmConfig::new(5, 6).init(d));
         let a = single.forward_seq(&xs[..]);
         xs[9] = xs[9].clone() - 2.0;
         let b = single.forward_seq(&xs);

@@ -316,9 +316,8 @@ mod tests {
     #[test]
     fn spectral_linear_brings_largest_singular_value_to_one() {
         let device = backend::cpu();
-        let layer = backend::seeded(&device, 11, || {
-            SpectralLinearConfig::new(6, 4).init(&device)
-        });
+        let layer =
+            backend::seeded_module(&device, 11, |d| SpectralLinearConfig::new(6, 4).init(d));
         let raw = to_f64(layer.linear.weight.val());
         let sigma_ref = largest_singular_value(&raw, 6, 4);
         // The persistent u converges over successive forward passes.
@@ -345,11 +344,11 @@ mod tests {
     #[test]
     fn spectral_conv1d_normalises_the_reshaped_kernel() {
         let device = backend::cpu();
-        let conv = backend::seeded(&device, 12, || {
+        let conv = backend::seeded_module(&device, 12, |d| {
             SpectralConv1dConfig::new(3, 5, 3)
                 .with_padding(1)
                 .with_n_power_iterations(20)
-                .init(&device)
+                .init(d)
         });
         let x = backend::seeded(&device, 14, || {
             Tensor::<3>::random([2, 3, 9], Distribution::Normal(0.0, 1.0), &device)
@@ -367,9 +366,8 @@ mod tests {
     #[test]
     fn gradient_flows_to_the_raw_weight() {
         let device = backend::cpu_autodiff();
-        let layer = backend::seeded(&device, 13, || {
-            SpectralLinearConfig::new(3, 2).init(&device)
-        });
+        let layer =
+            backend::seeded_module(&device, 13, |d| SpectralLinearConfig::new(3, 2).init(d));
         let loss = layer
             .forward(Tensor::<2>::ones([4, 3], &device))
             .square()

@@ -2,7 +2,7 @@
 //! bar, periodic checkpoints and resume from the latest checkpoint.
 //!
 //! The caller supplies two closures: one that builds the model on a device (called once, right
-//! after seeding, inside [`backend::seeded`](crate::backend::seeded), so the initial weights
+//! after seeding, inside [`backend::seeded_module`](crate::backend::seeded_module), so the initial weights
 //! depend only on [`TrainConfig::seed`]) and one that
 //! returns the loss of one optimisation step. The loss closure gets a [`Step`] whose
 //! [`Step::seed`] depends only on (seed, epoch, step): draw batches from an RNG seeded with it and
@@ -208,7 +208,7 @@ where
             "fit needs an autodiff device (e.g. backend::cpu_autodiff())".into(),
         ));
     }
-    let mut model = crate::backend::seeded(device, config.seed, || build(device));
+    let mut model = crate::backend::seeded_module(device, config.seed, build);
     let mut optim = new_optimizer(config);
     let mut loss_history = Vec::new();
     let mut optimizer_steps = 0u64;
@@ -269,6 +269,7 @@ where
                     epoch: done,
                     optimizer_steps,
                     loss_history: loss_history.clone(),
+                    loss_history_bits: Vec::new(),
                     lr,
                     config: serde_json::to_value(config).unwrap_or(serde_json::Value::Null),
                 };
@@ -507,7 +508,7 @@ mod tests {
         let path = dir.path().join("sine.bpk");
         checkpoint::save_module(&report.model, &path).unwrap();
         // A differently seeded fresh model, then loaded: must reproduce the trained outputs.
-        let fresh = backend::seeded(&device, 999, || build(&device));
+        let fresh = backend::seeded_module(&device, 999, build);
         let loaded = checkpoint::load_module(fresh, &path).unwrap();
         let (inputs, _) = sine_batch(5, &device);
         let expected = predict(&report.model, &inputs)

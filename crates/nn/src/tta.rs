@@ -31,7 +31,7 @@ impl TtaEmbedding {
     /// If `dim` is odd or zero: sin/cos pairs need an even size.
     pub fn new(dim: usize, max_tta: f32) -> Self {
         assert!(
-            dim > 0 && dim % 2 == 0,
+            dim > 0 && dim.is_multiple_of(2),
             "TtaEmbedding: dim must be even and > 0, got {dim}"
         );
         Self {
@@ -44,7 +44,7 @@ impl TtaEmbedding {
     /// Like [`new`](Self::new) but returns an error instead of panicking on a bad `dim` or cap
     /// (for sizes read from files or the command line).
     pub fn try_new(dim: usize, max_tta: f32) -> Result<Self, crate::NnError> {
-        if dim == 0 || dim % 2 != 0 {
+        if dim == 0 || !dim.is_multiple_of(2) {
             return Err(crate::NnError::Config(format!(
                 "TTA embedding size must be even and > 0 (sin/cos pairs), got {dim}"
             )));
