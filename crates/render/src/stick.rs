@@ -655,7 +655,7 @@ mod tests {
         let short = StickOptions { title: Some("walk".into()), labels: labels.clone(), ..StickOptions::default() };
         let (_, y, _, _) = header(&short, 2).legend.unwrap();
         assert!(y < 10.0, "short title: legend on the first row");
-        let long = StickOptions { title: Some("a title long enough to run across most of the image".into()), labels, ..short };
+        let long = StickOptions { title: Some("a title long enough to run across most of the image, and then some more".into()), labels, ..short };
         let h = header(&long, 2);
         let (_, y, _, bh) = h.legend.unwrap();
         assert!(y >= text_size(&long) * 1.5, "legend below the title, got y = {y}");
