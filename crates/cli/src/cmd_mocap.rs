@@ -7,10 +7,10 @@ use inbetween_core::{positions_clip, KeyframeSet, Motion};
 use inbetween_io::fsutil::write_atomic;
 use inbetween_mocap::bench::{self, Method, Protocol};
 use inbetween_mocap::codec::{self, Budget};
+use inbetween_mocap::dqn::{train::SidqlPolicy, DqnConfig, TrainOptions};
 use inbetween_mocap::error::{Objective, SegmentModel, SegmentTable};
 use inbetween_mocap::representation::{JointFilter, SphericalMotion};
 use inbetween_mocap::rotations::RotationMotion;
-use inbetween_mocap::dqn::{train::SidqlPolicy, DqnConfig, TrainOptions};
 use inbetween_render::StickOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -248,7 +248,13 @@ fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
     let d = codec::decode(&bytes).with_context(|| format!("decoding {}", a.input.display()))?;
     let m = d.reconstruct()?;
     inbetween_io::write_bvh(&a.output, &m)?;
-    println!("{} keys → {} frames at {:.1} fps; wrote {}", d.key_frames.len(), m.num_frames(), m.fps(), a.output.display());
+    println!(
+        "{} keys → {} frames at {:.1} fps; wrote {}",
+        d.key_frames.len(),
+        m.num_frames(),
+        m.fps(),
+        a.output.display()
+    );
     Ok(())
 }
 
@@ -259,7 +265,11 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
             let d = codec::decode(&std::fs::read(p).with_context(|| format!("reading {}", p.display()))?)
                 .with_context(|| format!("decoding {}", p.display()))?;
             if d.skeleton != m.skeleton || d.num_frames != m.num_frames() {
-                bail!("{} does not match {} (skeleton or frame count differ; use the same --joints/--skip-first)", p.display(), a.input.display());
+                bail!(
+                    "{} does not match {} (skeleton or frame count differ; use the same --joints/--skip-first)",
+                    p.display(),
+                    a.input.display()
+                );
             }
             (d.reconstruct()?, d.key_frames.len())
         }
@@ -341,9 +351,17 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
         (None, episodes) => {
             let train_windows = training_windows(&clips, &train, &protocol, 10)?;
             let opts = TrainOptions { episodes, seed: a.seed, ..TrainOptions::quick() };
-            println!("SIDQL: training {episodes} episodes on {} windows of the training split (stride 10)…", train_windows.len());
+            println!(
+                "SIDQL: training {episodes} episodes on {} windows of the training split (stride 10)…",
+                train_windows.len()
+            );
             let (policy, report) = inbetween_mocap::dqn::train(&train_windows, &DqnConfig::paper(), &opts)?;
-            println!("SIDQL: trained in {:.0} s, {} updates, loss per 50 episodes {:?}", report.seconds, report.updates, report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>());
+            println!(
+                "SIDQL: trained in {:.0} s, {} updates, loss per 50 episodes {:?}",
+                report.seconds,
+                report.updates,
+                report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
+            );
             let path = PathBuf::from("out/sidql_cmu.bpk");
             std::fs::create_dir_all("out").ok();
             policy.save(&path)?;
@@ -378,13 +396,21 @@ fn bench_plot(path: &Path, rows: &[bench::Row]) -> anyhow::Result<()> {
     for m in Method::ALL {
         let vals: Vec<f64> = [5, 10, 15]
             .iter()
-            .filter_map(|&k| rows.iter().find(|r| r.split == "test" && r.method == m && r.k == k).map(|r| r.mean_angle_error))
+            .filter_map(|&k| {
+                rows.iter().find(|r| r.split == "test" && r.method == m && r.k == k).map(|r| r.mean_angle_error)
+            })
             .collect();
         if vals.len() == 3 {
             series.push((m.name().to_string(), vals));
         }
     }
-    inbetween_render::plot::grouped_bar_chart(path, "Mean angle error, CMU test-split 60-frame windows", "mean angle error (rad)", &groups, &series)?;
+    inbetween_render::plot::grouped_bar_chart(
+        path,
+        "Mean angle error, CMU test-split 60-frame windows",
+        "mean angle error (rad)",
+        &groups,
+        &series,
+    )?;
     Ok(())
 }
 
@@ -400,7 +426,11 @@ fn reconstruction_throughput(windows: &[bench::Window]) {
         }
     }
     let secs = t.elapsed().as_secs_f64();
-    println!("reconstruction throughput (spherical, positions of {} joints): {:.0} frames/s", windows.first().map(|w| w.rep.num_joints).unwrap_or(0), frames as f64 / secs);
+    println!(
+        "reconstruction throughput (spherical, positions of {} joints): {:.0} frames/s",
+        windows.first().map(|w| w.rep.num_joints).unwrap_or(0),
+        frames as f64 / secs
+    );
 }
 
 /// Codec size at an error bound over the full-rate, full-skeleton clips (T-pose frame dropped).
@@ -468,13 +498,28 @@ pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
     // The rotation model is the one the codec uses; say how it compares to the spherical one.
     let rm = RotationMotion::from_motion(&paper)?;
     let k10 = inbetween_mocap::select::optimal(&table, 10, Objective::Angle)?;
-    lines.push(format!("  K=10 on 23 joints: rotation reconstruction mean {:.2} cm vs spherical {:.2} cm", rm.error(&k10).mean_cm, rep.error(&k10).mean_cm));
-    lines.push(format!("  wrote {}, {}, {} ({:.1} s)", ibk.display(), bvh.display(), gif.display(), t.elapsed().as_secs_f64()));
+    lines.push(format!(
+        "  K=10 on 23 joints: rotation reconstruction mean {:.2} cm vs spherical {:.2} cm",
+        rm.error(&k10).mean_cm,
+        rep.error(&k10).mean_cm
+    ));
+    lines.push(format!(
+        "  wrote {}, {}, {} ({:.1} s)",
+        ibk.display(),
+        bvh.display(),
+        gif.display(),
+        t.elapsed().as_secs_f64()
+    ));
     Ok(lines)
 }
 
 /// Windows of the named clips with the given stride (overlapping windows for training).
-fn training_windows(clips: &[(String, Motion)], names: &[String], protocol: &Protocol, stride: usize) -> anyhow::Result<Vec<SphericalMotion>> {
+fn training_windows(
+    clips: &[(String, Motion)],
+    names: &[String],
+    protocol: &Protocol,
+    stride: usize,
+) -> anyhow::Result<Vec<SphericalMotion>> {
     let p = Protocol { stride, ..protocol.clone() };
     let mut out = Vec::new();
     for (name, m) in clips.iter().filter(|(n, _)| names.contains(n)) {
@@ -498,7 +543,8 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
     } else {
         let dir = match a.data.clone() {
             Some(d) => d,
-            None => inbetween_io::data::shared_data_dir().map_err(|p| anyhow::anyhow!("no data at {} (give --data DIR or --procedural)", p.display()))?,
+            None => inbetween_io::data::shared_data_dir()
+                .map_err(|p| anyhow::anyhow!("no data at {} (give --data DIR or --procedural)", p.display()))?,
         };
         let clips = cmu_clips(&dir)?;
         let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
@@ -561,7 +607,10 @@ fn stream_send(a: SendArgs) -> anyhow::Result<()> {
 
 fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
     let listener = std::net::TcpListener::bind(&a.addr).with_context(|| format!("listening on {}", a.addr))?;
-    let opts = inbetween_mocap::stream::RecvOptions { max_sessions: 8, accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s) };
+    let opts = inbetween_mocap::stream::RecvOptions {
+        max_sessions: 8,
+        accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s),
+    };
     let got = inbetween_mocap::stream::recv(&listener, &opts)?;
     for w in &got.warnings {
         eprintln!("warning: {w}");
@@ -580,7 +629,8 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
         let m = inbetween_io::load_motion(r)?;
         let m = if a.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
         let n = m.num_frames().min(got.motion.num_frames());
-        let e = inbetween_core::position_error(&positions_clip(&m.crop(0, n)?), &positions_clip(&got.motion.crop(0, n)?));
+        let e =
+            inbetween_core::position_error(&positions_clip(&m.crop(0, n)?), &positions_clip(&got.motion.crop(0, n)?));
         let cm = inbetween_core::procedural::CM_PER_CMU_UNIT;
         println!("error vs {}: mean {:.3} cm, max {:.3} cm over {n} frames", r.display(), e.mean * cm, e.max * cm);
     }

@@ -4,7 +4,11 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn inbetween(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_inbetween")).args(args).env("RUST_BACKTRACE", "0").output().expect("runs the binary")
+    Command::new(env!("CARGO_BIN_EXE_inbetween"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("runs the binary")
 }
 
 fn text(o: &Output) -> String {
@@ -58,7 +62,21 @@ fn stream_over_loopback() {
     let out = dir.path().join("streamed.bvh").to_string_lossy().into_owned();
     let recv = {
         let (addr, out, bvh) = (addr.clone(), out.clone(), bvh.clone());
-        std::thread::spawn(move || inbetween(&["mocap", "stream", "recv", "--addr", &addr, "-o", &out, "--reference", &bvh, "--timeout-s", "20"]))
+        std::thread::spawn(move || {
+            inbetween(&[
+                "mocap",
+                "stream",
+                "recv",
+                "--addr",
+                &addr,
+                "-o",
+                &out,
+                "--reference",
+                &bvh,
+                "--timeout-s",
+                "20",
+            ])
+        })
     };
     std::thread::sleep(std::time::Duration::from_millis(300));
     let o = inbetween(&["mocap", "stream", "send", &bvh, "--addr", &addr, "--fast", "--max-error", "1cm"]);

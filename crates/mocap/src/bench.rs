@@ -28,7 +28,15 @@ pub struct Protocol {
 
 impl Protocol {
     pub fn paper() -> Protocol {
-        Protocol { fps: 30.0, window: 60, stride: 60, filter: JointFilter::paper(), skip_first_frame: true, train_fraction: 0.8, seed: 0 }
+        Protocol {
+            fps: 30.0,
+            window: 60,
+            stride: 60,
+            filter: JointFilter::paper(),
+            skip_first_frame: true,
+            train_fraction: 0.8,
+            seed: 0,
+        }
     }
 }
 
@@ -42,7 +50,11 @@ pub struct Window {
 
 /// Resamples, filters and windows one clip.
 pub fn clip_windows(name: &str, motion: &Motion, p: &Protocol) -> Result<Vec<Window>> {
-    let m = if p.skip_first_frame && motion.num_frames() > 1 { motion.crop(1, motion.num_frames())? } else { motion.clone() };
+    let m = if p.skip_first_frame && motion.num_frames() > 1 {
+        motion.crop(1, motion.num_frames())?
+    } else {
+        motion.clone()
+    };
     let m = p.filter.apply(&m.resample(p.fps)?);
     let mut out = Vec::new();
     let stride = p.stride.max(1);
@@ -93,7 +105,13 @@ impl Method {
 pub type PolicyFn<'a> = &'a dyn Fn(&SphericalMotion, usize) -> Result<KeyframeSet>;
 
 /// Selects `k` keys of one window with a method; `seed` drives RC.
-pub fn select_keys(method: Method, rep: &SphericalMotion, k: usize, seed: u64, policy: Option<PolicyFn>) -> Result<KeyframeSet> {
+pub fn select_keys(
+    method: Method,
+    rep: &SphericalMotion,
+    k: usize,
+    seed: u64,
+    policy: Option<PolicyFn>,
+) -> Result<KeyframeSet> {
     let n = rep.num_frames;
     match method {
         Method::Rc => select::random(n, k, &mut ChaCha8Rng::seed_from_u64(seed)),
@@ -122,7 +140,14 @@ pub struct Row {
 
 /// Scores `methods` for every `k` over `windows` (serially, so decision times are not skewed by
 /// other windows running alongside).
-pub fn evaluate(split: &str, windows: &[Window], methods: &[Method], ks: &[usize], seed: u64, policy: Option<PolicyFn>) -> Result<Vec<Row>> {
+pub fn evaluate(
+    split: &str,
+    windows: &[Window],
+    methods: &[Method],
+    ks: &[usize],
+    seed: u64,
+    policy: Option<PolicyFn>,
+) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for &method in methods {
         if method == Method::Sidql && policy.is_none() {
@@ -175,7 +200,8 @@ pub fn paper_value(method: Method, k: usize) -> Option<f64> {
 
 /// The table as CSV: `split,method,k,mean_angle_error,mean_cm,max_cm,decision_ms,windows,paper_mean_angle_error`.
 pub fn to_csv(rows: &[Row]) -> String {
-    let mut s = String::from("method,k,mean_angle_error,mean_cm,max_cm,decision_ms,split,windows,paper_mean_angle_error\n");
+    let mut s =
+        String::from("method,k,mean_angle_error,mean_cm,max_cm,decision_ms,split,windows,paper_mean_angle_error\n");
     for r in rows {
         let paper = paper_value(r.method, r.k).map(|v| format!("{v}")).unwrap_or_default();
         s.push_str(&format!(

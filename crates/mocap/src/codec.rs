@@ -46,7 +46,11 @@ impl Decoded {
 
 /// Bytes one key takes on a skeleton.
 pub fn bytes_per_key(skeleton: &Skeleton) -> usize {
-    skeleton.joints().iter().map(|j| if j.rotation_order().is_some() { 12 } else { 0 } + if j.has_translation() { 24 } else { 0 }).sum()
+    skeleton
+        .joints()
+        .iter()
+        .map(|j| if j.rotation_order().is_some() { 12 } else { 0 } + if j.has_translation() { 24 } else { 0 })
+        .sum()
 }
 
 fn channel_code(c: Channel) -> u8 {
@@ -84,7 +88,8 @@ fn dequantize(q: i16, scale: f64) -> f64 {
 pub fn encode(model: &RotationMotion, keys: &KeyframeSet) -> Vec<u8> {
     let sk = &model.skeleton;
     let poses = model.key_poses(keys);
-    let max_w = poses.iter().flat_map(|p| p.angular_velocities.iter()).map(|w| w.abs().max_element()).fold(1e-6, f64::max);
+    let max_w =
+        poses.iter().flat_map(|p| p.angular_velocities.iter()).map(|w| w.abs().max_element()).fold(1e-6, f64::max);
     let mut out = Vec::new();
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
@@ -107,7 +112,6 @@ pub fn encode(model: &RotationMotion, keys: &KeyframeSet) -> Vec<u8> {
     out.extend_from_slice(&crc.to_le_bytes());
     out
 }
-
 
 /// Appends the skeleton section (joint count, then each joint).
 pub fn write_skeleton(out: &mut Vec<u8>, sk: &Skeleton) {
@@ -239,7 +243,8 @@ pub fn read_skeleton_joints(r: &mut Reader, nj: usize) -> Result<Skeleton> {
         let channels = (0..nch)
             .map(|_| {
                 let c = r.u8("channel code")?;
-                channel_from_code(c).ok_or_else(|| MocapError::Codec(format!("joint {i} '{name}': unknown channel code {c}")))
+                channel_from_code(c)
+                    .ok_or_else(|| MocapError::Codec(format!("joint {i} '{name}': unknown channel code {c}")))
             })
             .collect::<Result<Vec<_>>>()?;
         let end_site = if r.u8("end site flag")? == 1 { Some(r.vec3_f64("end site")?) } else { None };
@@ -269,21 +274,21 @@ pub fn read_key(r: &mut Reader, skeleton: &Skeleton, w_scale: f64) -> Result<Key
     };
     for (j, joint) in skeleton.joints().iter().enumerate() {
         if joint.rotation_order().is_some() {
-        let mut v = [0.0; 6];
-        for (i, x) in v.iter_mut().enumerate() {
-            let q = r.i16("key rotation")?;
-            *x = if i < 3 { dequantize(q, PI) } else { dequantize(q, w_scale) };
-        }
-        p.rotations[j] = rotvec_to_quat(DVec3::new(v[0], v[1], v[2]));
-        p.angular_velocities[j] = DVec3::new(v[3], v[4], v[5]);
+            let mut v = [0.0; 6];
+            for (i, x) in v.iter_mut().enumerate() {
+                let q = r.i16("key rotation")?;
+                *x = if i < 3 { dequantize(q, PI) } else { dequantize(q, w_scale) };
+            }
+            p.rotations[j] = rotvec_to_quat(DVec3::new(v[0], v[1], v[2]));
+            p.angular_velocities[j] = DVec3::new(v[3], v[4], v[5]);
         }
         if joint.has_translation() {
-        let mut v = [0.0; 6];
-        for x in &mut v {
-            *x = r.f32("key translation")?;
-        }
-        p.translations[j] = DVec3::new(v[0], v[1], v[2]);
-        p.velocities[j] = DVec3::new(v[3], v[4], v[5]);
+            let mut v = [0.0; 6];
+            for x in &mut v {
+                *x = r.f32("key translation")?;
+            }
+            p.translations[j] = DVec3::new(v[0], v[1], v[2]);
+            p.velocities[j] = DVec3::new(v[3], v[4], v[5]);
         }
     }
     Ok(p)
@@ -302,7 +307,9 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
     let mut r = Reader { bytes: body, pos: 4 };
     let version = r.u16("version")?;
     if version != VERSION {
-        return Err(MocapError::Codec(format!("unsupported .ibk version {version}; this build reads version {VERSION}")));
+        return Err(MocapError::Codec(format!(
+            "unsupported .ibk version {version}; this build reads version {VERSION}"
+        )));
     }
     if crc32fast::hash(body) != stored {
         return Err(MocapError::Codec(format!(
@@ -333,7 +340,11 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
         key_frames.push(f as usize);
     }
     if key_frames[num_keys - 1] != num_frames - 1 {
-        return Err(MocapError::Codec(format!("the last key is frame {}, expected the clip's last frame {}", key_frames[num_keys - 1], num_frames - 1)));
+        return Err(MocapError::Codec(format!(
+            "the last key is frame {}, expected the clip's last frame {}",
+            key_frames[num_keys - 1],
+            num_frames - 1
+        )));
     }
     let mut keys = Vec::with_capacity(num_keys);
     for _ in 0..num_keys {
@@ -341,7 +352,11 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
         keys.push(p);
     }
     if r.pos != body.len() {
-        return Err(MocapError::Codec(format!("{} unexpected bytes after the key values at byte {}", body.len() - r.pos, r.pos)));
+        return Err(MocapError::Codec(format!(
+            "{} unexpected bytes after the key values at byte {}",
+            body.len() - r.pos,
+            r.pos
+        )));
     }
     Ok(Decoded { skeleton, frame_time, num_frames, key_frames, keys })
 }
@@ -371,7 +386,19 @@ mod tests {
     fn round_trip_matches_the_unquantised_reconstruction() {
         let (m, rm, keys) = clip();
         let bytes = encode(&rm, &keys);
-        assert_eq!(bytes.len(), 4 + 4 + 8 + 4 + 4 + 4 + 2 + skeleton_bytes(&m.skeleton) + keys.len() + keys.len() * bytes_per_key(&m.skeleton) + 4);
+        assert_eq!(
+            bytes.len(),
+            4 + 4
+                + 8
+                + 4
+                + 4
+                + 4
+                + 2
+                + skeleton_bytes(&m.skeleton)
+                + keys.len()
+                + keys.len() * bytes_per_key(&m.skeleton)
+                + 4
+        );
         let d = decode(&bytes).unwrap();
         assert_eq!(d.key_frames, keys.frames());
         assert_eq!(d.skeleton, m.skeleton);
@@ -384,7 +411,10 @@ mod tests {
     }
 
     fn skeleton_bytes(s: &Skeleton) -> usize {
-        s.joints().iter().map(|j| 2 + j.name.len() + 2 + 24 + 1 + j.channels.len() + 1 + if j.end_site.is_some() { 24 } else { 0 }).sum()
+        s.joints()
+            .iter()
+            .map(|j| 2 + j.name.len() + 2 + 24 + 1 + j.channels.len() + 1 + if j.end_site.is_some() { 24 } else { 0 })
+            .sum()
     }
 
     #[test]
@@ -455,8 +485,17 @@ pub fn compress(motion: &Motion, budget: Budget, max_gap: usize) -> Result<Compr
     let planned = model.error(&keys);
     let bytes = encode(&model, &keys);
     let decoded = decode(&bytes)?.reconstruct()?;
-    let e = inbetween_core::position_error(&inbetween_core::positions_clip(motion), &inbetween_core::positions_clip(&decoded));
-    Ok(Compressed { keys, bytes, planned, decoded_mean_cm: e.mean * model.cm_per_unit, decoded_max_cm: e.max * model.cm_per_unit })
+    let e = inbetween_core::position_error(
+        &inbetween_core::positions_clip(motion),
+        &inbetween_core::positions_clip(&decoded),
+    );
+    Ok(Compressed {
+        keys,
+        bytes,
+        planned,
+        decoded_mean_cm: e.mean * model.cm_per_unit,
+        decoded_max_cm: e.max * model.cm_per_unit,
+    })
 }
 
 /// Parses an error bound such as `1cm`, `0.5 cm`, `10mm` or `0.01m` (a bare number is cm).
@@ -471,7 +510,10 @@ pub fn parse_length_cm(s: &str) -> Result<f64> {
     } else {
         (t.as_str(), 1.0)
     };
-    let v: f64 = num.trim().parse().map_err(|_| MocapError::Invalid(format!("'{s}' is not a length; expected e.g. 1cm, 5mm or 0.01m")))?;
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| MocapError::Invalid(format!("'{s}' is not a length; expected e.g. 1cm, 5mm or 0.01m")))?;
     if !(v.is_finite() && v >= 0.0) {
         return Err(MocapError::Invalid(format!("'{s}': a length must be non-negative")));
     }

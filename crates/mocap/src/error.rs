@@ -29,7 +29,11 @@ pub struct SegmentCost {
 
 impl SegmentCost {
     pub fn add(self, o: SegmentCost) -> SegmentCost {
-        SegmentCost { angle_sum: self.angle_sum + o.angle_sum, cm_sum: self.cm_sum + o.cm_sum, cm_max: self.cm_max.max(o.cm_max) }
+        SegmentCost {
+            angle_sum: self.angle_sum + o.angle_sum,
+            cm_sum: self.cm_sum + o.cm_sum,
+            cm_max: self.cm_max.max(o.cm_max),
+        }
     }
 }
 
@@ -101,7 +105,10 @@ pub trait SegmentModel: Sync {
     /// Error of a whole keyframe set, as the sum of its segments.
     fn error(&self, keys: &KeyframeSet) -> ReconstructionError {
         let mut s = self.scratch();
-        let total = keys.segments().map(|(a, b)| self.segment_cost(a, b, &mut s)).fold(SegmentCost::default(), SegmentCost::add);
+        let total = keys
+            .segments()
+            .map(|(a, b)| self.segment_cost(a, b, &mut s))
+            .fold(SegmentCost::default(), SegmentCost::add);
         ReconstructionError::from_total(total, self.num_frames(), self.num_joints(), self.angle_terms_per_frame())
     }
 }
@@ -139,7 +146,11 @@ impl SegmentModel for SphericalMotion {
     }
 
     fn scratch(&self) -> Scratch {
-        Scratch { angles: vec![0.0; 2 * self.num_joints], positions: vec![DVec3::ZERO; self.num_joints], ..Scratch::default() }
+        Scratch {
+            angles: vec![0.0; 2 * self.num_joints],
+            positions: vec![DVec3::ZERO; self.num_joints],
+            ..Scratch::default()
+        }
     }
 
     fn frame_cost(&self, a: usize, b: usize, f: usize, s: &mut Scratch) -> SegmentCost {
@@ -149,8 +160,8 @@ impl SegmentModel for SphericalMotion {
         for j in 0..nj {
             if self.has_angles[j] {
                 let i = j * n + f;
-                cost.angle_sum +=
-                    (s.angles[2 * j] - self.theta[i]).abs() + wrapped_angle_difference(s.angles[2 * j + 1], self.phi[i]);
+                cost.angle_sum += (s.angles[2 * j] - self.theta[i]).abs()
+                    + wrapped_angle_difference(s.angles[2 * j + 1], self.phi[i]);
             }
             let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
             cost.cm_sum += d;
@@ -169,7 +180,8 @@ pub fn spherical_error(rep: &SphericalMotion, rec: &SphericalReconstruction) -> 
         if rep.has_angles[j] {
             for f in 0..n {
                 let i = j * n + f;
-                total.angle_sum += (rec.theta[i] - rep.theta[i]).abs() + wrapped_angle_difference(rec.phi[i], rep.phi[i]);
+                total.angle_sum +=
+                    (rec.theta[i] - rep.theta[i]).abs() + wrapped_angle_difference(rec.phi[i], rep.phi[i]);
             }
         }
     }

@@ -43,7 +43,8 @@ pub fn segment_frame(rep: &SphericalMotion, a: usize, b: usize, f: usize, angles
 /// Reconstructs the whole clip from `keys` (Eq. 14: each section from its own two keys).
 pub fn reconstruct_spherical(rep: &SphericalMotion, keys: &KeyframeSet) -> SphericalReconstruction {
     let (n, nj) = (rep.num_frames, rep.num_joints);
-    let mut out = SphericalReconstruction { theta: rep.theta.clone(), phi: rep.phi.clone(), positions: rep.positions.clone() };
+    let mut out =
+        SphericalReconstruction { theta: rep.theta.clone(), phi: rep.phi.clone(), positions: rep.positions.clone() };
     let mut angles = vec![0.0; 2 * nj];
     let mut frame = vec![DVec3::ZERO; nj];
     for (a, b) in keys.segments() {
@@ -83,7 +84,11 @@ mod tests {
             for j in 1..nj {
                 let p = rep.parents[j].unwrap();
                 let len = (rec.positions[f * nj + j] - rec.positions[f * nj + p]).length();
-                assert!((len - rep.bone_length[j]).abs() < 1e-9, "frame {f} joint {j}: {len} vs {}", rep.bone_length[j]);
+                assert!(
+                    (len - rep.bone_length[j]).abs() < 1e-9,
+                    "frame {f} joint {j}: {len} vs {}",
+                    rep.bone_length[j]
+                );
             }
         }
     }

@@ -47,7 +47,11 @@ impl JointFilter {
             "" | "all" => JointFilter::all(),
             "paper" => JointFilter::paper(),
             list => JointFilter {
-                drop_patterns: list.split(',').map(|p| p.trim().to_ascii_lowercase()).filter(|p| !p.is_empty()).collect(),
+                drop_patterns: list
+                    .split(',')
+                    .map(|p| p.trim().to_ascii_lowercase())
+                    .filter(|p| !p.is_empty())
+                    .collect(),
             },
         }
     }
@@ -153,10 +157,16 @@ impl SphericalMotion {
     pub fn from_motion(motion: &Motion) -> Result<SphericalMotion> {
         let n = motion.num_frames();
         if n < 2 {
-            return Err(MocapError::Invalid(format!("a clip of {n} frames has nothing to reconstruct; need at least 2")));
+            return Err(MocapError::Invalid(format!(
+                "a clip of {n} frames has nothing to reconstruct; need at least 2"
+            )));
         }
         let global = inbetween_core::positions_clip(motion);
-        Ok(Self::from_positions(&motion.skeleton.joints().iter().map(|j| j.parent).collect::<Vec<_>>(), &global, motion.frame_time))
+        Ok(Self::from_positions(
+            &motion.skeleton.joints().iter().map(|j| j.parent).collect::<Vec<_>>(),
+            &global,
+            motion.frame_time,
+        ))
     }
 
     /// Builds the representation from global positions `[frame][joint]` and the joint parents.

@@ -42,7 +42,9 @@ impl RotationMotion {
     pub fn from_motion(motion: &Motion) -> Result<RotationMotion> {
         let n = motion.num_frames();
         if n < 2 {
-            return Err(MocapError::Invalid(format!("a clip of {n} frames has nothing to reconstruct; need at least 2")));
+            return Err(MocapError::Invalid(format!(
+                "a clip of {n} frames has nothing to reconstruct; need at least 2"
+            )));
         }
         let nj = motion.skeleton.len();
         let dt = motion.frame_time;
@@ -66,7 +68,9 @@ impl RotationMotion {
                         })
                         .collect(),
                     translations: poses[f].translations.clone(),
-                    velocities: (0..nj).map(|j| (poses[hi].translations[j] - poses[lo].translations[j]) / span).collect(),
+                    velocities: (0..nj)
+                        .map(|j| (poses[hi].translations[j] - poses[lo].translations[j]) / span)
+                        .collect(),
                 }
             })
             .collect();
@@ -74,7 +78,13 @@ impl RotationMotion {
         for g in inbetween_core::forward_clip(motion) {
             positions.extend(g.positions);
         }
-        Ok(RotationMotion { skeleton: motion.skeleton.clone(), frame_time: dt, frames, positions, cm_per_unit: CM_PER_CMU_UNIT })
+        Ok(RotationMotion {
+            skeleton: motion.skeleton.clone(),
+            frame_time: dt,
+            frames,
+            positions,
+            cm_per_unit: CM_PER_CMU_UNIT,
+        })
     }
 
     pub fn num_frames(&self) -> usize {
@@ -95,7 +105,8 @@ impl RotationMotion {
 /// Local pose at fraction `u` of a segment `h` seconds long between key poses `k0` and `k1`.
 pub fn interpolate_pose_into(k0: &KeyPose, k1: &KeyPose, h: f64, u: f64, rot: &mut [DQuat], trans: &mut [DVec3]) {
     for j in 0..rot.len() {
-        rot[j] = hermite_quat(k0.rotations[j], k0.angular_velocities[j], k1.rotations[j], k1.angular_velocities[j], h, u);
+        rot[j] =
+            hermite_quat(k0.rotations[j], k0.angular_velocities[j], k1.rotations[j], k1.angular_velocities[j], h, u);
         trans[j] = hermite_vec3(k0.translations[j], k0.velocities[j], k1.translations[j], k1.velocities[j], h, u);
     }
 }
@@ -117,9 +128,16 @@ pub fn forward_into(skeleton: &Skeleton, local_r: &[DQuat], local_t: &[DVec3], p
 }
 
 /// Rebuilds a clip of `frames[last] + 1` frames from keys at `frames` (sorted, first = 0).
-pub fn reconstruct_from_keys(skeleton: &Skeleton, frame_time: f64, frames: &[usize], keys: &[KeyPose]) -> Result<Motion> {
+pub fn reconstruct_from_keys(
+    skeleton: &Skeleton,
+    frame_time: f64,
+    frames: &[usize],
+    keys: &[KeyPose],
+) -> Result<Motion> {
     if frames.len() < 2 || frames.len() != keys.len() || frames[0] != 0 || frames.windows(2).any(|w| w[0] >= w[1]) {
-        return Err(MocapError::Invalid(format!("keyframes {frames:?} must start at 0, increase and number at least 2")));
+        return Err(MocapError::Invalid(format!(
+            "keyframes {frames:?} must start at 0, increase and number at least 2"
+        )));
     }
     let nj = skeleton.len();
     let n = frames[frames.len() - 1] + 1;
@@ -214,7 +232,12 @@ mod tests {
         // The error of the written clip equals the sum of the segment costs.
         let err = rm.error(&keys);
         let direct = inbetween_core::position_error(&a, &b);
-        assert!((direct.mean * rm.cm_per_unit - err.mean_cm).abs() < 1e-6, "{} vs {}", direct.mean * rm.cm_per_unit, err.mean_cm);
+        assert!(
+            (direct.mean * rm.cm_per_unit - err.mean_cm).abs() < 1e-6,
+            "{} vs {}",
+            direct.mean * rm.cm_per_unit,
+            err.mean_cm
+        );
         assert!(err.mean_cm > 0.0);
         // Bone lengths are exact: FK of local rotations with fixed offsets.
         let s = &m.skeleton;

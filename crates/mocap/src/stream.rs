@@ -62,7 +62,10 @@ pub fn online_keys(model: &dyn SegmentModel, max_cm: f64, lookahead: usize) -> V
     }
     // End of the clip: the last frame is known (one-sided velocity); close with feasible keys.
     while a != n - 1 {
-        let b = (a + 1..n).rev().find(|&b| b == a + 1 || model.segment_cost_within(a, b, max_cm, &mut scratch).is_some()).expect("a + 1 always fits");
+        let b = (a + 1..n)
+            .rev()
+            .find(|&b| b == a + 1 || model.segment_cost_within(a, b, max_cm, &mut scratch).is_some())
+            .expect("a + 1 always fits");
         events.push(KeyEvent { key: b, at: n - 1 });
         a = b;
     }
@@ -148,7 +151,11 @@ fn connect(addr: &str, retries: usize) -> Result<TcpStream> {
             }
         }
     }
-    Err(MocapError::Stream(format!("cannot connect to {addr} after {} attempts: {}", retries + 1, last.map(|e| e.to_string()).unwrap_or_default())))
+    Err(MocapError::Stream(format!(
+        "cannot connect to {addr} after {} attempts: {}",
+        retries + 1,
+        last.map(|e| e.to_string()).unwrap_or_default()
+    )))
 }
 
 /// Streams `motion` to a receiver at `addr`.
@@ -157,7 +164,12 @@ pub fn send(addr: &str, motion: &Motion, opts: &SendOptions) -> Result<SendRepor
     let events = online_keys(&model, opts.max_cm, opts.lookahead);
     let sk = &model.skeleton;
     let hello = frame_message(HELLO, &hello_payload(sk, model.frame_time, model.num_frames()));
-    let mut report = SendReport { frames: model.num_frames(), keys: events.len(), raw_bytes: inbetween_core::Motion::num_channels(motion) * 4 * model.num_frames(), ..Default::default() };
+    let mut report = SendReport {
+        frames: model.num_frames(),
+        keys: events.len(),
+        raw_bytes: inbetween_core::Motion::num_channels(motion) * 4 * model.num_frames(),
+        ..Default::default()
+    };
     let start = Instant::now();
     let mut conn = connect(addr, opts.retries)?;
     conn.write_all(&hello).map_err(|e| MocapError::Stream(format!("sending hello: {e}")))?;
@@ -207,13 +219,15 @@ enum Message {
 
 fn read_message(conn: &mut impl Read, skeleton: Option<&Skeleton>) -> Result<(Message, usize)> {
     let mut head = [0u8; 5];
-    conn.read_exact(&mut head).map_err(|e| MocapError::Stream(format!("connection closed while waiting for a message: {e}")))?;
+    conn.read_exact(&mut head)
+        .map_err(|e| MocapError::Stream(format!("connection closed while waiting for a message: {e}")))?;
     let len = u32::from_le_bytes(head[1..5].try_into().expect("4 bytes")) as usize;
     if len > MAX_MESSAGE {
         return Err(MocapError::Stream(format!("message of {len} bytes exceeds the {MAX_MESSAGE}-byte limit")));
     }
     let mut body = vec![0u8; len + 4];
-    conn.read_exact(&mut body).map_err(|e| MocapError::Stream(format!("connection closed inside a {len}-byte message: {e}")))?;
+    conn.read_exact(&mut body)
+        .map_err(|e| MocapError::Stream(format!("connection closed inside a {len}-byte message: {e}")))?;
     let mut check = head.to_vec();
     check.extend_from_slice(&body[..len]);
     if crc32fast::hash(&check).to_le_bytes() != body[len..] {
@@ -284,7 +298,14 @@ impl Rebuild {
                 let (a, h) = (*a, (frame - a) as f64 * self.frame_time);
                 for f in a + 1..frame {
                     let mut p = Pose { rotations: vec![DQuat::IDENTITY; nj], translations: vec![DVec3::ZERO; nj] };
-                    interpolate_pose_into(k0, &key, h, (f - a) as f64 / (frame - a) as f64, &mut p.rotations, &mut p.translations);
+                    interpolate_pose_into(
+                        k0,
+                        &key,
+                        h,
+                        (f - a) as f64 / (frame - a) as f64,
+                        &mut p.rotations,
+                        &mut p.translations,
+                    );
                     self.poses.push(p);
                 }
             }
@@ -360,7 +381,10 @@ fn accept_with_timeout(listener: &TcpListener, timeout: Duration) -> Result<TcpS
             }
             Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
                 if start.elapsed() > timeout {
-                    return Err(MocapError::Stream(format!("no sender connected within {:.1} s", timeout.as_secs_f64())));
+                    return Err(MocapError::Stream(format!(
+                        "no sender connected within {:.1} s",
+                        timeout.as_secs_f64()
+                    )));
                 }
                 std::thread::sleep(Duration::from_millis(10));
             }
@@ -372,8 +396,8 @@ fn accept_with_timeout(listener: &TcpListener, timeout: Duration) -> Result<TcpS
 #[cfg(test)]
 mod tests {
     use super::*;
-    use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
     use inbetween_core::positions_clip;
+    use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
 
     fn walk() -> Motion {
         let mut p = GaitParams::walk();

@@ -17,7 +17,12 @@ fn cmu_windows_have_23_joints_and_optimal_never_loses() {
             let rows = evaluate("t", few, &[Method::Uc, Method::Greedy, Method::Optimal], &[5], 0, None).unwrap();
             let opt = rows.iter().find(|r| r.method == Method::Optimal).unwrap().mean_angle_error;
             for r in &rows {
-                assert!(opt <= r.mean_angle_error + 1e-12, "{name}: optimal {opt} vs {:?} {}", r.method, r.mean_angle_error);
+                assert!(
+                    opt <= r.mean_angle_error + 1e-12,
+                    "{name}: optimal {opt} vs {:?} {}",
+                    r.method,
+                    r.mean_angle_error
+                );
             }
         }
     });

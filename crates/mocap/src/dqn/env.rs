@@ -20,7 +20,10 @@ pub struct EnvWindow {
 impl EnvWindow {
     pub fn new(rep: SphericalMotion, frames: usize, features_per_frame: usize) -> Result<EnvWindow> {
         if rep.num_frames != frames || rep.num_frames > 64 {
-            return Err(MocapError::Model(format!("the network takes {frames}-frame windows (≤ 64), got {}", rep.num_frames)));
+            return Err(MocapError::Model(format!(
+                "the network takes {frames}-frame windows (≤ 64), got {}",
+                rep.num_frames
+            )));
         }
         let mut features = Vec::with_capacity(frames * features_per_frame);
         for f in 0..frames {

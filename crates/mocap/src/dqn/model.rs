@@ -2,11 +2,11 @@
 //! per-frame current error) and two hidden layers, one Q-value per frame (action = make that frame
 //! a keyframe), as in §5.2.
 
-use inbetween_nn::burn;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::activation::relu;
 use burn::tensor::{Device, Tensor};
+use inbetween_nn::burn;
 use serde::{Deserialize, Serialize};
 
 /// Shape of the network; stored beside the weights so a checkpoint says what it fits.

@@ -12,12 +12,12 @@ use super::replay::{Replay, Transition};
 use crate::error::SegmentModel;
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
-use inbetween_core::KeyframeSet;
-use inbetween_nn::burn;
 use burn::module::Module;
 use burn::nn::loss::{HuberLossConfig, Reduction};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Int, Tensor, TensorData};
+use inbetween_core::KeyframeSet;
+use inbetween_nn::burn;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::{Path, PathBuf};
@@ -112,14 +112,17 @@ impl SidqlPolicy {
     pub fn save(&self, path: &Path) -> Result<()> {
         inbetween_nn::checkpoint::save_module(&self.net, path).map_err(model_err)?;
         let json = serde_json::to_vec_pretty(&self.config).map_err(model_err)?;
-        inbetween_io::write_atomic(&sidecar(path), &json).map_err(|source| MocapError::Io { path: sidecar(path).display().to_string(), source })
+        inbetween_io::write_atomic(&sidecar(path), &json)
+            .map_err(|source| MocapError::Io { path: sidecar(path).display().to_string(), source })
     }
 
     /// Loads a policy saved by [`SidqlPolicy::save`].
     pub fn load(path: &Path) -> Result<SidqlPolicy> {
         let side = sidecar(path);
-        let text = std::fs::read(&side).map_err(|source| MocapError::Io { path: side.display().to_string(), source })?;
-        let config: DqnConfig = serde_json::from_slice(&text).map_err(|e| MocapError::Model(format!("{}: {e}", side.display())))?;
+        let text =
+            std::fs::read(&side).map_err(|source| MocapError::Io { path: side.display().to_string(), source })?;
+        let config: DqnConfig =
+            serde_json::from_slice(&text).map_err(|e| MocapError::Model(format!("{}: {e}", side.display())))?;
         let device = inbetween_nn::backend::cpu();
         let net = inbetween_nn::checkpoint::load_module(config.init(&device), path).map_err(model_err)?;
         Ok(SidqlPolicy { config, net, device })
@@ -154,15 +157,21 @@ fn best_action(q: &[f32], mask: u64, frames: usize) -> usize {
 }
 
 /// Trains a policy on `windows` (all of the shape `config` expects).
-pub fn train(windows: &[SphericalMotion], config: &DqnConfig, opts: &TrainOptions) -> Result<(SidqlPolicy, TrainReport)> {
+pub fn train(
+    windows: &[SphericalMotion],
+    config: &DqnConfig,
+    opts: &TrainOptions,
+) -> Result<(SidqlPolicy, TrainReport)> {
     if windows.is_empty() {
         return Err(MocapError::Model("no training windows".into()));
     }
     if opts.max_keys < 3 || opts.max_keys > config.frames {
         return Err(MocapError::Model(format!("max_keys {} must lie in 3..={}", opts.max_keys, config.frames)));
     }
-    let env: Vec<EnvWindow> =
-        windows.iter().map(|r| EnvWindow::new(r.clone(), config.frames, config.features_per_frame)).collect::<Result<_>>()?;
+    let env: Vec<EnvWindow> = windows
+        .iter()
+        .map(|r| EnvWindow::new(r.clone(), config.frames, config.features_per_frame))
+        .collect::<Result<_>>()?;
     let t0 = std::time::Instant::now();
     let ad = inbetween_nn::backend::cpu_autodiff();
     let plain = inbetween_nn::backend::cpu();
@@ -180,7 +189,13 @@ pub fn train(windows: &[SphericalMotion], config: &DqnConfig, opts: &TrainOption
     let mut scratch = env[0].rep.scratch();
     let (mut env_steps, mut updates) = (0usize, 0usize);
     let (mut loss_sum, mut loss_n, mut ret_sum) = (0.0, 0usize, 0.0);
-    let mut report = TrainReport { episodes: opts.episodes, updates: 0, loss_curve: Vec::new(), return_curve: Vec::new(), seconds: 0.0 };
+    let mut report = TrainReport {
+        episodes: opts.episodes,
+        updates: 0,
+        loss_curve: Vec::new(),
+        return_curve: Vec::new(),
+        seconds: 0.0,
+    };
     let mut state = Vec::with_capacity(input);
     for episode in 0..opts.episodes {
         let eps = epsilon(opts, episode);
@@ -202,13 +217,21 @@ pub fn train(windows: &[SphericalMotion], config: &DqnConfig, opts: &TrainOption
             let next_err = w.frame_errors(next, &mut scratch, &mut errs);
             let reward = w.reward(err, next_err);
             ret_sum += reward as f64;
-            replay.push(Transition { window: wi, mask, action, reward, next_mask: next, done: t + 1 == steps_per_episode });
+            replay.push(Transition {
+                window: wi,
+                mask,
+                action,
+                reward,
+                next_mask: next,
+                done: t + 1 == steps_per_episode,
+            });
             mask = next;
             err = next_err;
             env_steps += 1;
             if replay.len() >= opts.batch && env_steps % opts.train_every.max(1) == 0 {
                 let batch = replay.sample(opts.batch, &mut rng);
-                let (m, loss) = update(main, &target, &mut optim, &huber, &env, &batch, opts, config, &ad, &plain, &mut scratch);
+                let (m, loss) =
+                    update(main, &target, &mut optim, &huber, &env, &batch, opts, config, &ad, &plain, &mut scratch);
                 main = m;
                 loss_sum += loss;
                 loss_n += 1;
@@ -224,7 +247,11 @@ pub fn train(windows: &[SphericalMotion], config: &DqnConfig, opts: &TrainOption
         if (episode + 1) % 50 == 0 || episode + 1 == opts.episodes {
             report.loss_curve.push(if loss_n > 0 { loss_sum / loss_n as f64 } else { f64::NAN });
             report.return_curve.push(ret_sum / 50.0);
-            bar.set_message(format!("loss {:.5} return {:.3} ε {eps:.2}", report.loss_curve.last().unwrap(), ret_sum / 50.0));
+            bar.set_message(format!(
+                "loss {:.5} return {:.3} ε {eps:.2}",
+                report.loss_curve.last().unwrap(),
+                ret_sum / 50.0
+            ));
             (loss_sum, loss_n, ret_sum) = (0.0, 0, 0.0);
         }
         if let Some(path) = &opts.checkpoint {
@@ -256,7 +283,9 @@ fn progress_bar(opts: &TrainOptions) -> indicatif::ProgressBar {
         return indicatif::ProgressBar::hidden();
     }
     let bar = indicatif::ProgressBar::new(opts.episodes as u64);
-    if let Ok(style) = indicatif::ProgressStyle::with_template("SIDQL {bar:30} {pos}/{len} episodes, {elapsed} < {eta} {msg}") {
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("SIDQL {bar:30} {pos}/{len} episodes, {elapsed} < {eta} {msg}")
+    {
         bar.set_style(style);
     }
     bar
@@ -297,7 +326,10 @@ fn update(
         })
         .collect();
     let x = Tensor::<2>::from_data(TensorData::new(states, [b, input]), ad);
-    let actions = Tensor::<2, Int>::from_data(TensorData::new(batch.iter().map(|t| t.action as i64).collect::<Vec<_>>(), [b, 1]), ad);
+    let actions = Tensor::<2, Int>::from_data(
+        TensorData::new(batch.iter().map(|t| t.action as i64).collect::<Vec<_>>(), [b, 1]),
+        ad,
+    );
     let q = main.forward(x).gather(1, actions);
     let y = Tensor::<2>::from_data(TensorData::new(y, [b, 1]), ad);
     let loss = huber.forward(q, y, Reduction::Mean);
@@ -320,7 +352,8 @@ mod tests {
             .map(|m| SphericalMotion::from_motion(&JointFilter::paper().apply(m)).unwrap())
             .collect();
         let config = DqnConfig { frames: 12, features_per_frame: 92, hidden: [32, 32, 16] };
-        let opts = TrainOptions { episodes: 150, max_keys: 5, batch: 16, lr: 1e-3, progress: false, ..TrainOptions::paper() };
+        let opts =
+            TrainOptions { episodes: 150, max_keys: 5, batch: 16, lr: 1e-3, progress: false, ..TrainOptions::paper() };
         let (policy, report) = train(&reps, &config, &opts).unwrap();
         assert!(report.updates > 100);
         assert!(report.loss_curve.iter().all(|l| l.is_finite()));

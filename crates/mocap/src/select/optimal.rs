@@ -155,7 +155,11 @@ mod tests {
                 assert!(e.max_cm <= bound + 1e-9);
                 // No smaller set meets the bound.
                 let fewest = (0..=10)
-                    .find(|&m| subsets(12, m).iter().any(|s| spherical_error(&rep, &reconstruct_spherical(&rep, s)).max_cm <= bound))
+                    .find(|&m| {
+                        subsets(12, m)
+                            .iter()
+                            .any(|s| spherical_error(&rep, &reconstruct_spherical(&rep, s)).max_cm <= bound)
+                    })
                     .unwrap();
                 assert_eq!(keys.len(), fewest + 2, "bound {bound}");
             }

@@ -8,7 +8,8 @@ use rand::Rng;
 
 pub fn random(n: usize, k: usize, rng: &mut impl Rng) -> Result<KeyframeSet> {
     check_k(n, k)?;
-    let interior: Vec<usize> = if n > 2 { sample(rng, n - 2, k - 2).into_iter().map(|i| i + 1).collect() } else { Vec::new() };
+    let interior: Vec<usize> =
+        if n > 2 { sample(rng, n - 2, k - 2).into_iter().map(|i| i + 1).collect() } else { Vec::new() };
     Ok(KeyframeSet::new(interior, n)?)
 }
 
