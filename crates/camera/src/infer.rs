@@ -574,6 +574,116 @@ pub fn example_keys(scene: &Scene, frames: &[usize]) -> Keys {
     }
 }
 
+/// Causal, one-frame-at-a-time generation for live use (beyond the paper): character features
+/// arrive frame by frame and a camera comes back at once. The network runs on every 5th frame with
+/// the features of that frame; frames in between extrapolate the last network step linearly, so
+/// nothing waits for the future. Keys (placed ahead by the user) can be set at any time.
+pub struct CausalCamera<'a> {
+    model: &'a FastModel,
+    style: Vec<f32>,
+    state: State,
+    frame: usize,
+    last: [f32; CAM_DIM],
+    velocity: [f32; CAM_DIM],
+    key: Option<(usize, [f32; CAM_DIM + CHAR_ENC])>,
+}
+
+impl<'a> CausalCamera<'a> {
+    /// Starts at `start` (frame 0) with an optional velocity (x^c per second) through H.
+    pub fn new(model: &'a FastModel, style: &[f32], start: &Toric, velocity: Option<[f64; 6]>, fps: f64) -> CausalCamera<'a> {
+        let v = velocity.unwrap_or([0.0; 6]);
+        let dt = DOWNSAMPLE as f64 / fps;
+        let frames: [[f32; CAM_DIM]; MAP_FRAMES] = std::array::from_fn(|i| {
+            let back = (MAP_FRAMES - 1 - i) as f64 * dt;
+            std::array::from_fn(|j| (start.to_array()[j] - v[j] * back) as f32)
+        });
+        CausalCamera {
+            model,
+            style: style.to_vec(),
+            state: model.map_state(style, &frames),
+            frame: 0,
+            last: encode_camera(start),
+            velocity: std::array::from_fn(|j| (v[j] * dt) as f32),
+            key: None,
+        }
+    }
+
+    /// The next keyframe: its frame, camera and the character features expected there.
+    pub fn set_key(&mut self, frame: usize, camera: &Toric, character: &CharacterFeatures) {
+        let mut v = [0.0; CAM_DIM + CHAR_ENC];
+        v[..CAM_DIM].copy_from_slice(&encode_camera(camera));
+        v[CAM_DIM..].copy_from_slice(&encode_character(character));
+        self.key = Some((frame, v));
+    }
+
+    /// Consumes the next frame's character features and returns that frame's camera.
+    pub fn push(&mut self, character: &CharacterFeatures) -> Toric {
+        self.frame += 1;
+        let phase = self.frame % DOWNSAMPLE;
+        if phase == 0 {
+            let cap = self.model.config.tta_max as usize;
+            let (tta_frames, key) = match self.key {
+                Some((kf, v)) if kf >= self.frame => ((kf - self.frame).min(cap), v),
+                Some((_, v)) => (0, v),
+                None => {
+                    let mut v = [0.0; CAM_DIM + CHAR_ENC];
+                    v[..CAM_DIM].copy_from_slice(&self.last);
+                    v[CAM_DIM..].copy_from_slice(&encode_character(character));
+                    (cap, v)
+                }
+            };
+            let input = StepIn { style: &self.style, prev: self.last, character: encode_character(character), key, tta_frames };
+            let next = self.model.step(&[input], &mut self.state)[0];
+            self.velocity = std::array::from_fn(|j| next[j] - self.last[j]);
+            self.last = next;
+            return decode_camera(&next);
+        }
+        let u = phase as f32 / DOWNSAMPLE as f32;
+        decode_camera(&std::array::from_fn::<f32, CAM_DIM, _>(|j| self.last[j] + self.velocity[j] * u))
+    }
+}
+
+/// A whole track through [`CausalCamera`]: frame by frame, each key announced once the previous one
+/// has passed, no correction (a live camera cannot go back). Key residuals report the misses.
+pub fn generate_causal(model: &FastModel, scene: &Scene, keys: &Keys, style: &[f32], style_name: &str, lens: &Lens, origin: &Path) -> Result<CameraTrack, CameraError> {
+    let (keys, main) = keys.resolve(scene, lens, origin)?;
+    let first = keys[0].frame;
+    let last = if keys.len() == 1 { scene.num_frames() - 1 } else { keys[keys.len() - 1].frame };
+    let feats = |f: usize, pair: (usize, usize)| {
+        let main_is_a = main.is_none_or(|m| m == pair.0);
+        CharacterFeatures::compute(&scene.characters[pair.0].frame(f), &scene.characters[pair.1].frame(f), main_is_a)
+    };
+    let mut live = CausalCamera::new(model, style, &keys[0].camera, keys[0].velocity, scene.fps);
+    let mut next = 1;
+    let mut frames = Vec::with_capacity(last - first + 1);
+    let mut residuals = vec![KeyResidual { frame: first, residual: 0.0 }];
+    let mut toric = keys[0].camera;
+    for frame in first..=last {
+        let target = keys.get(next).unwrap_or(&keys[keys.len() - 1]);
+        if frame > first {
+            // The live clock counts from the first key.
+            if let Some(k) = keys.get(next) {
+                live.set_key(k.frame - first, &k.camera, &feats(k.frame, k.pair));
+            }
+            toric = live.push(&feats(frame, target.pair));
+        }
+        if let Some(k) = keys.get(next) {
+            if k.frame == frame {
+                let r = (0..6).map(|i| (toric.to_array()[i] - k.camera.to_array()[i]).powi(2)).sum::<f64>().sqrt();
+                residuals.push(KeyResidual { frame, residual: r });
+                next += 1;
+            }
+        }
+        let pair = target.pair;
+        let (a, b) = (scene.characters[pair.0].frame(frame).target(), scene.characters[pair.1].frame(frame).target());
+        let t = toric.clamped(lens, 0.02);
+        let pose = to_pose(&t, a, b, lens).map_err(|e| CameraError::Model(format!("frame {frame}: {e}")))?;
+        frames.push(CameraFrame { frame, toric: t, targets: [pair.0, pair.1], pose });
+    }
+    let max_corrected_residual = residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+    Ok(CameraTrack { fps: scene.fps, style: style_name.to_string(), style_code: style.to_vec(), lens: *lens, frames, key_residuals: residuals, max_corrected_residual })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -649,6 +759,45 @@ mod tests {
         keys.keys[0].targets = Some(["A".into(), "Zed".into()]);
         let e = generate(&fast, &scene, &keys, &[0.0; 4], "t", &GenerateOptions::default(), Path::new("keys.json")).unwrap_err().to_string();
         assert!(e.contains("key 0") && e.contains("Zed"), "{e}");
+    }
+
+    #[test]
+    fn causal_mode_runs_the_network_every_fifth_frame_without_lookahead() {
+        let (_, fast) = small();
+        let scene = Scene::procedural(6, 60, 30.0);
+        let feats = scene.character_features(0, 1, true);
+        let keys = example_keys(&scene, &[0, 59]);
+        let style = [0.1f32, 0.0, -0.2, 0.3];
+        let mut live = CausalCamera::new(&fast, &style, &keys.keys[0].camera, None, 30.0);
+        live.set_key(59, &keys.keys[1].camera, &feats[59]);
+        let out: Vec<Toric> = (1..60).map(|f| live.push(&feats[f])).collect();
+        // The same steps by hand.
+        let mut state = fast.map_state(&style, &[encode_camera(&keys.keys[0].camera); MAP_FRAMES]);
+        let mut prev = encode_camera(&keys.keys[0].camera);
+        let mut key = [0.0; 14];
+        key[..6].copy_from_slice(&encode_camera(&keys.keys[1].camera));
+        key[6..].copy_from_slice(&encode_character(&feats[59]));
+        for f in (5..60).step_by(5) {
+            let input = StepIn { style: &style, prev, character: encode_character(&feats[f]), key, tta_frames: 59 - f };
+            prev = fast.step(&[input], &mut state)[0];
+            let got = encode_camera(&out[f - 1]);
+            assert!((0..6).all(|j| (got[j] - prev[j]).abs() < 1e-6), "frame {f}");
+        }
+        assert!(out.iter().all(|t| t.theta.is_finite()));
+    }
+
+    #[test]
+    fn velocity_at_a_key_changes_the_departure() {
+        let (_, fast) = small();
+        let scene = Scene::procedural(2, 120, 30.0);
+        let keys = example_keys(&scene, &[0, 119]);
+        let mut fast_start = keys.clone();
+        fast_start.keys[0].velocity = Some([0.0, 0.0, 0.0, 0.0, 1.5, 0.0]);
+        let o = GenerateOptions::default();
+        let a = generate(&fast, &scene, &keys, &[0.0; 4], "t", &o, Path::new("k")).unwrap();
+        let b = generate(&fast, &scene, &fast_start, &[0.0; 4], "t", &o, Path::new("k")).unwrap();
+        assert_ne!(a.frames[10].toric, b.frames[10].toric, "H sees the velocity");
+        assert_eq!(b.frames[0].toric, keys.keys[0].camera, "the key itself stays put");
     }
 
     #[test]

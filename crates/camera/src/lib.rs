@@ -8,8 +8,10 @@
 pub mod bench;
 pub mod dataset;
 pub mod features;
+pub mod gltf;
 pub mod infer;
 pub mod model;
+pub mod preview;
 pub mod toric;
 pub mod train;
 

@@ -53,6 +53,15 @@ pub struct GenerateArgs {
     /// Output JSON (per-frame toric coordinates, targets, camera position and rotation).
     #[arg(short, long)]
     pub out: PathBuf,
+    /// Also write the camera animation as glTF 2.0 (default: OUT with .gltf).
+    #[arg(long)]
+    pub gltf: Option<PathBuf>,
+    /// Also write a top-down preview GIF with a picture-in-picture camera view.
+    #[arg(long)]
+    pub gif: Option<PathBuf>,
+    /// Causal live mode: one frame at a time, no look-ahead, no correction (beyond the paper).
+    #[arg(long)]
+    pub causal: bool,
     /// Keep the network's own keyframe misses instead of correcting them away.
     #[arg(long)]
     pub no_exact_keys: bool,
@@ -152,8 +161,23 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
         vec![(name, style_code(&styles, b), a.out.clone())]
     };
     for (name, code, out) in jobs {
-        let track = infer::generate(&model, &scene, &keys, &code, &name, &opts, &a.keys)?;
+        let track = if a.causal {
+            infer::generate_causal(&model, &scene, &keys, &code, &name, &opts.lens, &a.keys)?
+        } else {
+            infer::generate(&model, &scene, &keys, &code, &name, &opts, &a.keys)?
+        };
         inbetween_camera::write_json(&out, &track)?;
+        let gltf = match &a.gltf {
+            Some(g) if a.all_styles => with_suffix(g, &name),
+            Some(g) => g.clone(),
+            None => out.with_extension("gltf"),
+        };
+        inbetween_camera::gltf::write_gltf(&gltf, &track, &scene)?;
+        if let Some(g) = &a.gif {
+            let g = if a.all_styles { with_suffix(g, &name) } else { g.clone() };
+            inbetween_camera::preview::write_preview(&g, &track, &scene, 3)?;
+            println!("  preview {}", g.display());
+        }
         let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
         println!(
             "{name}: {} frames -> {} (network keyframe miss max {worst:.4}, after correction {:.1e})",
@@ -232,7 +256,7 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 }
 
 /// The camera part of `inbetween demo`: a built-in scene, keyframes, the committed weights, one
-/// track per style; writes cam.json (orbit style) and one JSON per style under `out`.
+/// track per style; writes cam.json, cam.gltf and cam.gif (orbit style) and one JSON per style.
 pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
     let t0 = std::time::Instant::now();
     let model = load_model(None)?;
@@ -250,9 +274,16 @@ pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
         inbetween_camera::write_json(&dir.join(format!("cam-{}.json", b.name())), &track)?;
         if b == Behaviour::Orbit {
             inbetween_camera::write_json(&out.join("cam.json"), &track)?;
+            inbetween_camera::gltf::write_gltf(&out.join("cam.gltf"), &track, &scene)?;
+            inbetween_camera::preview::write_preview(&out.join("cam.gif"), &track, &scene, 3)?;
         }
         lines.push(format!("camera {:<8} {} frames, network key miss {worst:.3} (corrected to {:.0e})", b.name(), track.frames.len(), track.max_corrected_residual));
     }
-    lines.push(format!("camera demo: {} in {:.1} s", out.join("cam.json").display(), t0.elapsed().as_secs_f64()));
+    lines.push(format!(
+        "camera demo: {}, cam.gltf, cam.gif (orbit style; per-style tracks in {}) in {:.1} s",
+        out.join("cam.json").display(),
+        dir.display(),
+        t0.elapsed().as_secs_f64()
+    ));
     Ok(lines)
 }
