@@ -1,0 +1,51 @@
+//! End-to-end checks of `inbetween camera …` with the committed weights.
+
+use std::path::Path;
+use std::process::Command;
+
+fn inbetween(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_inbetween")).args(args).output().expect("run inbetween")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn scene_then_generate_writes_track_gltf_and_preview() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = inbetween(&["camera", "scene", "-o", s(d), "--frames", "120"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cam = d.join("cam.json");
+    let gif = d.join("cam.gif");
+    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--style", "side", "-o", s(&cam), "--gif", s(&gif)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let track: serde_json::Value = serde_json::from_slice(&std::fs::read(&cam).unwrap()).unwrap();
+    assert_eq!(track["frames"].as_array().unwrap().len(), 120);
+    assert_eq!(track["style"], "side");
+    assert!(track["max_corrected_residual"].as_f64().unwrap() < 1e-9, "keys are hit exactly");
+    let gltf: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("cam.gltf")).unwrap()).unwrap();
+    assert_eq!(gltf["asset"]["version"], "2.0");
+    assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
+
+    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--all-styles", "-o", s(&cam)]);
+    assert!(out.status.success());
+    for b in ["direct", "relative", "side", "orbit"] {
+        assert!(d.join(format!("cam-{b}.json")).exists(), "{b}");
+    }
+}
+
+#[test]
+fn bad_inputs_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert!(inbetween(&["camera", "scene", "-o", s(d), "--frames", "60"]).status.success());
+    std::fs::write(d.join("bad.json"), "{\"keys\": [ {\"frame\": 0,\n \"camera\": 7} ]}").unwrap();
+    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("bad.json")), "-o", s(&d.join("c.json"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("bad.json:2"), "{err}");
+    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--style", "dolly", "-o", s(&d.join("c.json"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("unknown style `dolly`"), "{err}");
+}
