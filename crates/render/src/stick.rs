@@ -230,7 +230,9 @@ pub fn auto_camera(points: &[DVec3], heading: DVec3, width: u32, height: u32, to
     // Where the centre of the framed points should land on screen.
     let (want_x, want_y) = (w * 0.5, top + avail * 0.5);
     let mut target = (lo + hi) * 0.5;
-    let mut cam = Camera3::new(target + to_eye, target, DVec3::Y, AUTO_FOV_Y).with_viewport(width, height);
+    // Coincident points fit at any distance; keep the eye well beyond the near plane.
+    let min_dist = ((hi - lo).length() * 0.5).max(1.0);
+    let mut cam = Camera3::new(target + to_eye * min_dist, target, DVec3::Y, AUTO_FOV_Y).with_viewport(width, height);
     for _ in 0..4 {
         let (right, up, _) = cam.basis();
         let dist = points
@@ -239,10 +241,14 @@ pub fn auto_camera(points: &[DVec3], heading: DVec3, width: u32, height: u32, to
                 let q = p - target;
                 (q.dot(right).abs() / tx).max(q.dot(up).abs() / ty) + q.dot(to_eye)
             })
-            .fold(1e-3, f64::max);
+            .fold(f64::MIN, f64::max);
+        let dist = if dist > 1e-9 { dist } else { min_dist };
         cam = Camera3::new(target + to_eye * dist, target, DVec3::Y, AUTO_FOV_Y).with_viewport(width, height);
         // Re-aim so that the projected bounding box is centred in the free area.
         let proj: Vec<(f32, f32, f32)> = points.iter().filter_map(|&p| cam.project(p)).collect();
+        if proj.is_empty() {
+            break;
+        }
         let (x0, x1) = proj.iter().fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
         let (y0, y1) = proj.iter().fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
         let (dx, dy) = ((x0 + x1) as f64 * 0.5 - want_x, (y0 + y1) as f64 * 0.5 - want_y);
@@ -660,6 +666,20 @@ mod tests {
         let (_, y, _, bh) = h.legend.unwrap();
         assert!(y >= text_size(&long) * 1.5, "legend below the title, got y = {y}");
         assert!(h.height >= y + bh, "figures keep clear of the legend");
+    }
+
+    #[test]
+    fn degenerate_figures_render_without_panicking() {
+        let opts = StickOptions { width: 64, height: 48, ..StickOptions::default() };
+        // One joint, one frame: a single dot in the middle.
+        let img = render_positions_frame(&[None], &[vec![vec![DVec3::new(5.0, 1.0, -2.0)]]], 0, &opts).unwrap();
+        let dots = img.pixels().filter(|p| p.0 != opts.background && p.0 != GRID_COLOR).count();
+        assert!(dots > 0);
+        // All joints at one place, and a huge unit scale.
+        let same = vec![vec![DVec3::splat(3.0); 3]; 4];
+        render_positions_frame(&[None, Some(0), Some(1)], &[same], 2, &opts).unwrap();
+        let far: Vec<Vec<DVec3>> = (0..3).map(|f| vec![DVec3::new(1e6, 0.0, f as f64 * 1e5), DVec3::new(1e6, 2e5, 0.0)]).collect();
+        render_positions_frame(&[None, Some(0)], &[far], 1, &opts).unwrap();
     }
 
     #[test]
