@@ -6,7 +6,10 @@
 //! autodiff ([`backend::cpu_autodiff`]) or, behind the opt-in `cuda` crate feature, on a GPU.
 //!
 //! Modules:
-//! - [`backend`]: device helpers (flex CPU, autodiff, seeding, thread count, optional CUDA).
+//! - [`backend`]: device helpers (flex CPU, autodiff, optional CUDA) and seeding. flex has one
+//!   random generator per process and burn initialises parameters lazily, so build models with
+//!   [`backend::seeded_module`] to get the same weights for the same seed even when other threads
+//!   (parallel tests) draw random numbers.
 //! - [`lstm`]: fused LSTM cell ([`lstm::FusedLstm`]) and stacked bidirectional LSTM
 //!   ([`lstm::BiLstm`]) over sequences kept as `Vec` of per-step `[batch, features]` tensors.
 //! - [`tta`]: time-to-arrival sinusoidal embedding (Harvey et al. 2020).
