@@ -148,3 +148,13 @@ fn motion_new_is_what_the_reader_builds() {
     let again = Motion::new(m.skeleton.clone(), m.frame_time, m.data().to_vec()).unwrap();
     assert_eq!(again, m);
 }
+
+#[test]
+fn bom_lowercase_keywords_spaced_names_and_inline_braces() {
+    let text = "\u{feff}hierarchy\nroot Root Bone {\n  offset 0 0 0\n  channels 3 xrotation yrotation zrotation\n  end site {\n    offset 0 1 0\n  }\n}\nmotion\nframes: 1\nframe time: 0.5\n1 2 3\n";
+    let m = parse_bvh(text, "t.bvh").unwrap();
+    assert_eq!(m.skeleton.joint(0).name, "Root Bone");
+    assert_eq!(m.skeleton.joint(0).end_site, Some(glam::DVec3::Y));
+    assert_eq!(m.frame(0), &[1.0, 2.0, 3.0]);
+    assert_eq!(parse_bvh(&to_bvh_string(&m), "w.bvh").unwrap(), m);
+}
