@@ -16,6 +16,9 @@ pub struct BenchRow {
     pub bytes: u64,
 }
 
+/// Writes one benchmark output file.
+type Task<'a> = Box<dyn Fn(&Path) -> Result<(), RenderError> + 'a>;
+
 /// Times each preview task `repeats` times (best time kept), writing the files under `dir`.
 pub fn render_bench(dir: &Path, repeats: usize) -> Result<Vec<BenchRow>, RenderError> {
     let walk = gait(&GaitParams { frames: 120, ..GaitParams::walk() });
@@ -24,7 +27,7 @@ pub fn render_bench(dir: &Path, repeats: usize) -> Result<Vec<BenchRow>, RenderE
     let curve: Vec<(f64, f64)> = (0..1000).map(|i| (i as f64 / 120.0, (i as f64 * 0.05).sin())).collect();
     let groups: Vec<String> = (1..=6).map(|i| format!("clip {i}")).collect();
     let bars = vec![("a".to_string(), vec![1.0; 6]), ("b".to_string(), vec![2.0; 6]), ("c".to_string(), vec![1.5; 6])];
-    let mut tasks: Vec<(&str, &str, Box<dyn Fn(&Path) -> Result<(), RenderError> + '_>)> = vec![
+    let tasks: Vec<(&str, &str, Task)> = vec![
         ("GIF, 1 figure, 120 frames, 480x360", "walk.gif", Box::new(|p| render_motion_gif(p, &[&walk], &opts))),
         ("GIF, 2 figures, 120 frames, 480x360", "compare.gif", Box::new(|p| render_motion_gif(p, &[&walk, &other], &opts))),
         ("PNG, 2 figures, 1 frame, 480x360", "compare.png", Box::new(|p| render_motion_png(p, &[&walk, &other], 60, &opts))),
@@ -32,7 +35,7 @@ pub fn render_bench(dir: &Path, repeats: usize) -> Result<Vec<BenchRow>, RenderE
         ("bar chart, 6 groups x 3, 900x560", "bars.png", Box::new(|p| grouped_bar_chart(p, "bench", "y", &groups, &bars))),
     ];
     let mut rows = Vec::new();
-    for (task, file, run) in tasks.drain(..) {
+    for (task, file, run) in tasks {
         let path = dir.join(file);
         let mut best = f64::INFINITY;
         for _ in 0..repeats.max(1) {

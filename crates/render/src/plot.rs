@@ -32,8 +32,16 @@ impl Series {
 pub const PLOT_WIDTH: u32 = 900;
 pub const PLOT_HEIGHT: u32 = 560;
 const FONT: &str = "sans-serif";
-const TITLE_SIZE: i32 = 26;
-const LABEL_SIZE: i32 = 17;
+/// Charts are drawn at this multiple of the output size and averaged down, which anti-aliases the
+/// lines, markers and text that plotters' bitmap backend draws with hard edges.
+const SUPERSAMPLE: i32 = 2;
+const TITLE_SIZE: i32 = 26 * SUPERSAMPLE;
+const LABEL_SIZE: i32 = 17 * SUPERSAMPLE;
+
+/// A length in output pixels, in the supersampled drawing.
+const fn px(v: i32) -> i32 {
+    v * SUPERSAMPLE
+}
 
 /// Registers the bundled font with plotters once per process.
 fn ensure_fonts() -> Result<(), RenderError> {
@@ -98,15 +106,16 @@ fn render_png(
     draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), RenderError>,
 ) -> Result<(), RenderError> {
     ensure_fonts()?;
-    let mut buf = vec![255u8; (PLOT_WIDTH * PLOT_HEIGHT * 3) as usize];
+    let (w, h) = (PLOT_WIDTH * SUPERSAMPLE as u32, PLOT_HEIGHT * SUPERSAMPLE as u32);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
     {
-        let root = BitMapBackend::with_buffer(&mut buf, (PLOT_WIDTH, PLOT_HEIGHT)).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(title, e))?;
         draw(&root)?;
         root.present().map_err(|e| plot_err(title, e))?;
     }
-    let img = image::RgbImage::from_raw(PLOT_WIDTH, PLOT_HEIGHT, buf).expect("buffer has the chart's size");
-    crate::write_png(path, &img)
+    let big = image::RgbImage::from_raw(w, h, buf).expect("buffer has the chart's size");
+    crate::write_png(path, &downsample(&big, SUPERSAMPLE as u32))
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -121,9 +130,9 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
         let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
         let mut chart = ChartBuilder::on(root)
             .caption(title, (FONT, TITLE_SIZE).into_font())
-            .margin(18)
-            .x_label_area_size(52)
-            .y_label_area_size(78)
+            .margin(px(18))
+            .x_label_area_size(px(52))
+            .y_label_area_size(px(78))
             .build_cartesian_2d(xr, yr)
             .map_err(e)?;
         chart
@@ -133,21 +142,23 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
             .label_style((FONT, LABEL_SIZE))
             .axis_desc_style((FONT, LABEL_SIZE + 1))
             .max_light_lines(4)
-            .light_line_style(RGBColor(238, 238, 238))
-            .bold_line_style(RGBColor(214, 214, 214))
+            .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
+            .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
+            .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
+            .set_all_tick_mark_size(px(5))
             .draw()
             .map_err(e)?;
         for (i, s) in series.iter().enumerate() {
             let color = series_color(s, i);
             let anno = match style {
-                Style::Lines => chart.draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(2))),
-                Style::Points => chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, color.filled()))),
+                Style::Lines => chart.draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(px(2) as u32))),
+                Style::Points => chart.draw_series(s.points.iter().map(|&p| Circle::new(p, px(3), color.filled()))),
             }
             .map_err(e)?;
             if !s.name.is_empty() {
                 anno.label(s.name.as_str()).legend(move |(x, y)| match style {
-                    Style::Lines => Rectangle::new([(x, y - 1), (x + 22, y + 1)], color.filled()),
-                    Style::Points => Rectangle::new([(x + 7, y - 4), (x + 15, y + 4)], color.filled()),
+                    Style::Lines => Rectangle::new([(x, y - px(1)), (x + px(22), y + px(1))], color.filled()),
+                    Style::Points => Rectangle::new([(x + px(7), y - px(4)), (x + px(15), y + px(4))], color.filled()),
                 });
             }
         }
@@ -156,7 +167,9 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
                 .configure_series_labels()
                 .label_font((FONT, LABEL_SIZE))
                 .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
+                .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
+                .margin(px(8))
+                .legend_area_size(px(30))
                 .position(SeriesLabelPosition::UpperRight)
                 .draw()
                 .map_err(e)?;
@@ -206,9 +219,9 @@ pub fn grouped_bar_chart(
         let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
         let mut chart = ChartBuilder::on(root)
             .caption(title, (FONT, TITLE_SIZE).into_font())
-            .margin(18)
-            .x_label_area_size(40)
-            .y_label_area_size(78)
+            .margin(px(18))
+            .x_label_area_size(px(40))
+            .y_label_area_size(px(78))
             .build_cartesian_2d(0.0..n, yr.clone())
             .map_err(e)?;
         chart
@@ -219,8 +232,10 @@ pub fn grouped_bar_chart(
             .label_style((FONT, LABEL_SIZE))
             .axis_desc_style((FONT, LABEL_SIZE + 1))
             .max_light_lines(4)
-            .light_line_style(RGBColor(238, 238, 238))
-            .bold_line_style(RGBColor(214, 214, 214))
+            .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
+            .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
+            .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
+            .set_all_tick_mark_size(px(5))
             .draw()
             .map_err(e)?;
         for (s, (name, values)) in series.iter().enumerate() {
@@ -232,23 +247,43 @@ pub fn grouped_bar_chart(
                 }))
                 .map_err(e)?
                 .label(name.as_str())
-                .legend(move |(x, y)| Rectangle::new([(x + 4, y - 5), (x + 14, y + 5)], color.filled()));
+                .legend(move |(x, y)| Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled()));
         }
         chart
             .configure_series_labels()
             .label_font((FONT, LABEL_SIZE))
             .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
+            .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
+            .margin(px(8))
+            .legend_area_size(px(30))
             .position(SeriesLabelPosition::UpperRight)
             .draw()
             .map_err(e)?;
         // Group names centred under their bars, placed in pixels below the x axis.
         let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
         for (g, name) in groups.iter().enumerate() {
-            let (px, py) = chart.backend_coord(&(g as f64 + 0.5, yr.start));
-            root.draw(&Text::new(name.as_str(), (px, py + 8), style.clone())).map_err(e)?;
+            let (bx, by) = chart.backend_coord(&(g as f64 + 0.5, yr.start));
+            root.draw(&Text::new(name.as_str(), (bx, by + px(8)), style.clone())).map_err(e)?;
         }
         Ok(())
+    })
+}
+
+/// Averages each `factor` × `factor` block into one pixel.
+fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage {
+    let (w, h) = (big.width() / factor, big.height() / factor);
+    let n = factor * factor;
+    image::RgbImage::from_fn(w, h, |x, y| {
+        let mut sum = [0u32; 3];
+        for dy in 0..factor {
+            for dx in 0..factor {
+                let p = big.get_pixel(x * factor + dx, y * factor + dy).0;
+                for c in 0..3 {
+                    sum[c] += p[c] as u32;
+                }
+            }
+        }
+        image::Rgb(sum.map(|v| ((v + n / 2) / n) as u8))
     })
 }
 
