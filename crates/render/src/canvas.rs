@@ -193,6 +193,26 @@ impl Canvas {
     }
 }
 
+impl Canvas {
+    /// Copies `other` resized to `w` × `h` (smooth filter) with its top-left corner at (x, y), e.g. a
+    /// camera view inset in a corner.
+    pub fn blit_scaled(&mut self, other: &RgbImage, x: i64, y: i64, w: u32, h: u32) {
+        if w == 0 || h == 0 {
+            return;
+        }
+        let small = image::imageops::resize(other, w, h, image::imageops::FilterType::Triangle);
+        self.blit(&small, x, y);
+    }
+
+    /// A one-pixel frame around the rectangle at (x, y) of size w × h (for picture-in-picture).
+    pub fn rect_outline(&mut self, x: f32, y: f32, w: f32, h: f32, color: [u8; 3]) {
+        self.rect(x, y, w, 1.0, color);
+        self.rect(x, y + h - 1.0, w, 1.0, color);
+        self.rect(x, y, 1.0, h, color);
+        self.rect(x + w - 1.0, y, 1.0, h, color);
+    }
+}
+
 /// Width in pixels that [`Canvas::text`] would use for `text` at `size`.
 pub fn text_width(text: &str, size: f32) -> f32 {
     let font = font().as_scaled(PxScale::from(size));
@@ -373,6 +393,11 @@ mod tests {
         let small = RgbImage::from_pixel(4, 4, Rgb([9, 9, 9]));
         cv.blit(&small, 118, 58);
         assert_eq!(cv.pixel(119, 59), [9, 9, 9]);
+        cv.blit_scaled(&small, 100, 0, 10, 8);
+        assert_eq!(cv.pixel(109, 7), [9, 9, 9]);
+        cv.rect_outline(60.0, 40.0, 10.0, 10.0, [1, 2, 3]);
+        assert_eq!(cv.pixel(69, 45), [1, 2, 3]);
+        assert_eq!(cv.pixel(65, 45), [255, 255, 255]);
         let w = cv.text((30.0, 20.0), "Hello", 20.0, [0, 0, 0]);
         assert!((w - text_width("Hello", 20.0)).abs() < 1e-3 && w > 30.0);
         let dark = (30..30 + w as u32).flat_map(|x| (20..40).map(move |y| (x, y))).filter(|&(x, y)| cv.pixel(x, y)[0] < 100).count();

@@ -442,6 +442,9 @@ fn draw_frame(scene: &Scene, figs: &[Figure], frames: &[usize], opts: &StickOpti
     canvas.into_image()
 }
 
+/// Fastest GIF frame rate that plays at its nominal speed (2 cs per frame).
+const MAX_GIF_FPS: f64 = 50.0;
+
 /// The GIF timeline: for each GIF frame, the frame of every figure, plus the GIF frame rate.
 /// Time follows the first figure's rate; the animation lasts as long as the longest figure.
 fn timeline(figs: &[Figure], opts: &StickOptions) -> Result<(Vec<Vec<usize>>, f64), RenderError> {
@@ -456,6 +459,9 @@ fn timeline(figs: &[Figure], opts: &StickOptions) -> Result<(Vec<Vec<usize>>, f6
     let duration = figs.iter().map(Figure::duration).fold(0.0, f64::max);
     let source_frames = (duration * base_fps).round() as usize + 1;
     let mut step = (base_fps / wanted).round().max(1.0) as usize;
+    // GIF delays are whole hundredths of a second and viewers slow anything under 2 cs down, so
+    // faster sources are stepped to at most 50 frames per second to keep playback real-time.
+    step = step.max((base_fps / MAX_GIF_FPS - 1e-9).ceil() as usize);
     step = step.max(source_frames.div_ceil(opts.max_frames));
     let frames = (0..source_frames)
         .step_by(step)
@@ -633,8 +639,14 @@ mod tests {
         let long = walk(100);
         render_motion_gif(&path, &[&long], &StickOptions { max_frames: 30, ..opts.clone() }).unwrap();
         assert_eq!(decode(&path).len(), 25, "100 frames stepped by 4");
-        render_motion_gif(&path, &[&long], &StickOptions { fps: Some(10.0), ..opts }).unwrap();
+        render_motion_gif(&path, &[&long], &StickOptions { fps: Some(10.0), ..opts.clone() }).unwrap();
         assert_eq!(decode(&path).len(), 34, "30 fps source at 10 fps: every 3rd frame");
+        let fast = gait(&GaitParams { frames: 40, fps: 120.0, ..GaitParams::walk() });
+        render_motion_gif(&path, &[&fast], &opts).unwrap();
+        let frames = decode(&path);
+        assert_eq!(frames.len(), 14, "120 fps is stepped by 3 to 40 fps");
+        let (num, den) = frames[0].delay().numer_denom_ms();
+        assert!((num as f64 / den as f64 - 25.0).abs() <= 10.0, "about 25 ms per frame");
     }
 
     #[test]
