@@ -587,7 +587,11 @@ impl BenchReport {
         for b in BEHAVIOURS {
             for main_is_a in [true, false] {
                 let points = self.styles.iter().zip(&pts).filter(|(s, _)| s.0 == b && s.1 == main_is_a).map(|(_, p)| *p).collect();
-                series.push(Series::new(format!("{} ({} main)", b.name(), if main_is_a { "left" } else { "right" }), points));
+                let base = [[31, 119, 180], [44, 160, 44], [255, 127, 14], [214, 39, 40]][b.index()];
+                let color = if main_is_a { base } else { base.map(|c: u8| c / 2 + 100) };
+                let mut s = Series::new(format!("{} ({} main)", b.name(), if main_is_a { "left" } else { "right" }), points);
+                s.color = Some(color);
+                series.push(s);
             }
         }
         let p = dir.join("style_pca.png");
