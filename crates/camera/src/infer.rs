@@ -689,6 +689,7 @@ mod tests {
     use super::*;
     use crate::model::generator::StepInput;
     use crate::train::rows;
+    use glam::DVec3;
 
     fn small() -> (CameraModel, FastModel) {
         let device = inbetween_nn::backend::cpu();
@@ -745,6 +746,24 @@ mod tests {
         // Same inputs, same track.
         let again = generate(&fast, &scene, &keys, &[0.0; 4], "test", &GenerateOptions::default(), Path::new("k.json")).unwrap();
         assert_eq!(again, track);
+    }
+
+    #[test]
+    fn per_key_targets_switch_the_framed_pair() {
+        let (_, fast) = small();
+        let scene = Scene::procedural(4, 120, 30.0);
+        let mut keys = example_keys(&scene, &[0, 60, 119]);
+        // Second segment frames the pair the other way round: a transition at frame 60.
+        let lens = Lens::default();
+        let (a, b) = (scene.characters[1].frame(119).target(), scene.characters[0].frame(119).target());
+        let pose = CameraPose::look_at((a + b) * 0.5 + DVec3::new(0.0, 1.0, 0.0) + (b - a).cross(DVec3::Y).normalize() * 4.0, (a + b) * 0.5);
+        keys.keys[2].camera = crate::toric::from_pose(&pose, a, b, &lens).unwrap();
+        keys.keys[2].targets = Some(["B".into(), "A".into()]);
+        let track = generate(&fast, &scene, &keys, &[0.0; 4], "t", &GenerateOptions::default(), Path::new("k")).unwrap();
+        assert_eq!(track.frames[30].targets, [0, 1]);
+        assert_eq!(track.frames[90].targets, [1, 0]);
+        let end = &track.frames[119];
+        assert!((end.pose.position - pose.position).length() < 1e-6, "the transition key is met in world space too");
     }
 
     #[test]
