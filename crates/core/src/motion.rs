@@ -41,7 +41,7 @@ impl Motion {
             return Err(CoreError::InvalidMotion(format!("frame time {frame_time} must be a positive number")));
         }
         let nc = skeleton.num_channels();
-        if nc == 0 && !data.is_empty() || nc > 0 && data.len() % nc != 0 {
+        if (nc == 0 && !data.is_empty()) || (nc > 0 && !data.len().is_multiple_of(nc)) {
             return Err(CoreError::InvalidMotion(format!(
                 "{} values are not a whole number of frames of {nc} channels",
                 data.len()
@@ -69,12 +69,7 @@ impl Motion {
     }
 
     pub fn num_frames(&self) -> usize {
-        let nc = self.skeleton.num_channels();
-        if nc == 0 {
-            0
-        } else {
-            self.data.len() / nc
-        }
+        self.data.len().checked_div(self.skeleton.num_channels()).unwrap_or(0)
     }
 
     pub fn num_channels(&self) -> usize {

@@ -411,11 +411,14 @@ fn draw_frame(scene: &Scene, figs: &[Figure], frames: &[usize], opts: &StickOpti
     let mut prims: Vec<(f32, Prim)> = Vec::new();
     for (i, (fig, &f)) in figs.iter().zip(frames).enumerate() {
         let color = opts.color(i);
+        // Overlaid figures that coincide (a clip and its reconstruction) would otherwise swap
+        // places bone by bone on rounding noise; a small bias keeps later figures on top.
+        let layer_bias = i as f32 * scene.ref_depth * 2e-3;
         let pts = &fig.frames[f];
         for (j, parent) in fig.parents.iter().enumerate() {
             if let Some((a, b)) = parent.and_then(|p| cam.project_segment(pts[p], pts[j])) {
                 let depth = (a.2 + b.2) * 0.5;
-                prims.push((depth, Prim::Bone { a: (a.0, a.1), b: (b.0, b.1), width: scene.line_width * persp(depth), color }));
+                prims.push((depth - layer_bias, Prim::Bone { a: (a.0, a.1), b: (b.0, b.1), width: scene.line_width * persp(depth), color }));
             }
             if let Some((x, y, depth)) = cam.project(pts[j]) {
                 let full = scene.line_width * 0.95 * persp(depth);
@@ -424,7 +427,7 @@ fn draw_frame(scene: &Scene, figs: &[Figure], frames: &[usize], opts: &StickOpti
                 let bone_px = parent.and_then(|p| cam.project(pts[p])).map(|q| ((q.0 - x).powi(2) + (q.1 - y).powi(2)).sqrt());
                 let radius = bone_px.map_or(full, |l| full * (l / (4.0 * full)).clamp(0.3, 1.0));
                 // Dots sit just in front of the bones that meet at them.
-                prims.push((depth * 0.999, Prim::Dot { at: (x, y), radius, color: darken(color, 0.35) }));
+                prims.push((depth * 0.999 - layer_bias, Prim::Dot { at: (x, y), radius, color: darken(color, 0.35) }));
             }
         }
     }
