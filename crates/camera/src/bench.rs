@@ -440,47 +440,6 @@ pub fn pca2(codes: &[Vec<f32>]) -> Vec<(f64, f64)> {
     centred.iter().map(|c| (proj(c, axes.first()), proj(c, axes.get(1)))).collect()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn pca_finds_the_dominant_axis() {
-        let codes: Vec<Vec<f32>> = (0..20).map(|i| vec![i as f32, 0.5 * i as f32, 0.01 * ((i * 7) % 3) as f32, 0.0]).collect();
-        let p = pca2(&codes);
-        let spread1 = p.iter().map(|x| x.0.abs()).fold(0.0, f64::max);
-        let spread2 = p.iter().map(|x| x.1.abs()).fold(0.0, f64::max);
-        assert!(spread1 > 10.0 && spread2 < 0.1, "{spread1} {spread2}");
-    }
-
-    #[test]
-    fn displaced_keys_stay_valid_and_move_by_delta() {
-        let lens = Lens::default();
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let key: Cam = [-0.3, 0.1, 0.3, 0.1, 2.0, 0.2];
-        for delta in [0.0, 0.5, 1.0] {
-            let d = displaced(&key, delta, &lens, &mut rng);
-            assert!(((d[4] - key[4]).abs() as f64 - delta).abs() < 1e-6);
-            assert!((d[4] as f64) < crate::features::decode_camera(&key).theta_max(&lens));
-        }
-    }
-
-    #[test]
-    fn bench_runs_on_a_tiny_model() {
-        let device = inbetween_nn::backend::cpu();
-        let cfg = crate::model::ModelConfig { hidden: 8, tta_dim: 8, ..Default::default() };
-        let model = FastModel::from_burn(&cfg.init(&device), cfg);
-        let bc = BenchConfig { scenes: 1, displacements: vec![0.0, 1.0], max_spline_keys: 6, speed_seconds: 0.05, ..BenchConfig::quick() };
-        let r = run(&model, &bc);
-        assert_eq!(r.table1.len(), 4);
-        assert_eq!(r.table2.len(), 2);
-        assert!(r.table1.iter().all(|row| row.mapped.is_finite() && row.zero > 0.0));
-        assert!(r.speed.single_frames_per_s > 0.0);
-        // TD of plain interpolation does not depend on the displaced key.
-        assert!((r.table2[0].td_interpolation - r.table2[1].td_interpolation).abs() < 1e-12);
-    }
-}
-
 /// The paper's numbers for the README and the printed comparison.
 pub const PAPER_TABLE1: [(&str, f64, f64, f64, f64); 4] = [
     ("direct", 0.162, 0.146, 0.173, 0.107),
@@ -598,5 +557,46 @@ impl BenchReport {
         scatter_plot(&p, "Style codes z, PCA (Fig. 4)", "PC 1", "PC 2", &series).map_err(|e| render(&p, e))?;
         written.push(p);
         Ok(written)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pca_finds_the_dominant_axis() {
+        let codes: Vec<Vec<f32>> = (0..20).map(|i| vec![i as f32, 0.5 * i as f32, 0.01 * ((i * 7) % 3) as f32, 0.0]).collect();
+        let p = pca2(&codes);
+        let spread1 = p.iter().map(|x| x.0.abs()).fold(0.0, f64::max);
+        let spread2 = p.iter().map(|x| x.1.abs()).fold(0.0, f64::max);
+        assert!(spread1 > 10.0 && spread2 < 0.1, "{spread1} {spread2}");
+    }
+
+    #[test]
+    fn displaced_keys_stay_valid_and_move_by_delta() {
+        let lens = Lens::default();
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let key: Cam = [-0.3, 0.1, 0.3, 0.1, 2.0, 0.2];
+        for delta in [0.0, 0.5, 1.0] {
+            let d = displaced(&key, delta, &lens, &mut rng);
+            assert!(((d[4] - key[4]).abs() as f64 - delta).abs() < 1e-6);
+            assert!((d[4] as f64) < crate::features::decode_camera(&key).theta_max(&lens));
+        }
+    }
+
+    #[test]
+    fn bench_runs_on_a_tiny_model() {
+        let device = inbetween_nn::backend::cpu();
+        let cfg = crate::model::ModelConfig { hidden: 8, tta_dim: 8, ..Default::default() };
+        let model = FastModel::from_burn(&cfg.init(&device), cfg);
+        let bc = BenchConfig { scenes: 1, displacements: vec![0.0, 1.0], max_spline_keys: 6, speed_seconds: 0.05, ..BenchConfig::quick() };
+        let r = run(&model, &bc);
+        assert_eq!(r.table1.len(), 4);
+        assert_eq!(r.table2.len(), 2);
+        assert!(r.table1.iter().all(|row| row.mapped.is_finite() && row.zero > 0.0));
+        assert!(r.speed.single_frames_per_s > 0.0);
+        // TD of plain interpolation does not depend on the displaced key.
+        assert!((r.table2[0].td_interpolation - r.table2[1].td_interpolation).abs() < 1e-12);
     }
 }

@@ -154,7 +154,7 @@ mod tests {
         let b = standing(DVec3::new(2.0, 0.0, 0.0), -PI / 2.0);
         let x = CharacterFeatures::compute(&a, &b, false);
         assert!((x.s_a - 0.4).abs() < 1e-9, "s_A = {}", x.s_a);
-        assert_eq!(x.main_is_a, false);
+        assert!(!x.main_is_a);
     }
 
     #[test]

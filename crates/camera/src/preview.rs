@@ -148,7 +148,7 @@ mod tests {
         let frames = render_frames(&track, &scene, 30);
         assert_eq!(frames.len(), 3);
         let img = &frames[1];
-        let is_char = |p: &image::Rgb<u8>| CHAR.iter().any(|c| p.0 == *c);
+        let is_char = |p: &image::Rgb<u8>| CHAR.contains(&p.0);
         let in_pip = |x: u32, y: u32| x >= W - PIP_W - 8 && y >= H - PIP_H - 8;
         let top = img.enumerate_pixels().filter(|(x, y, p)| !in_pip(*x, *y) && is_char(p)).count();
         let pip = img.enumerate_pixels().filter(|(x, y, p)| in_pip(*x, *y) && is_char(p)).count();

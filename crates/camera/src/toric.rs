@@ -150,7 +150,7 @@ impl CameraPose {
 fn pair_frame(a: DVec3, b: DVec3) -> Result<(DVec3, DVec3, DVec3, f64), ToricError> {
     let ab = b - a;
     let d = ab.length();
-    if !(d > 1e-9) {
+    if d.is_nan() || d <= 1e-9 {
         return Err(ToricError::TargetsCoincide(d));
     }
     let t = ab / d;
@@ -174,7 +174,7 @@ pub fn to_pose(toric: &Toric, a: DVec3, b: DVec3, lens: &Lens) -> Result<CameraP
     let ra = lens.ray(toric.pa);
     let rb = lens.ray(toric.pb);
     let alpha = ra.angle_between(rb);
-    if !(alpha > 1e-7) {
+    if alpha.is_nan() || alpha <= 1e-7 {
         return Err(ToricError::ScreenPositionsCoincide(alpha));
     }
     let theta_max = 2.0 * (PI - alpha);

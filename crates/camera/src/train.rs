@@ -131,11 +131,11 @@ pub fn style_row<'a>(chars: &'a [[f32; CHAR_ENC]], cams: &'a [[f32; CAM_DIM]], t
 pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: usize, static_start: f64, rng: &mut impl Rng, device: &Device) -> Batch {
     let b = which.len();
     let tta = cfg.tta();
-    let mut style = vec![Vec::with_capacity(b * (CHAR_ENC + CAM_DIM)); STYLE_STEPS];
+    let mut style: Vec<Vec<f32>> = (0..STYLE_STEPS).map(|_| Vec::with_capacity(b * (CHAR_ENC + CAM_DIM))).collect();
     let mut map = Vec::with_capacity(b * MAP_FRAMES * CAM_DIM);
     let mut start = Vec::with_capacity(b * CAM_DIM);
-    let mut chars = vec![Vec::with_capacity(b * CHAR_ENC); gap];
-    let mut targets = vec![Vec::with_capacity(b * CAM_DIM); gap];
+    let mut chars: Vec<Vec<f32>> = (0..gap).map(|_| Vec::with_capacity(b * CHAR_ENC)).collect();
+    let mut targets: Vec<Vec<f32>> = (0..gap).map(|_| Vec::with_capacity(b * CAM_DIM)).collect();
     let mut key = Vec::with_capacity(b * (CAM_DIM + CHAR_ENC));
     for &s in which {
         let (c, x) = (&data.chars[s], &data.cams[s]);
