@@ -174,6 +174,18 @@ impl FastModel {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("weights").join("camera.bpk")
     }
 
+    /// The committed weights, compiled into the binary so tools and the demo run from anywhere.
+    pub fn committed() -> Result<FastModel, CameraError> {
+        const WEIGHTS: &[u8] = include_bytes!("../weights/camera.bpk");
+        const SUMMARY: &str = include_str!("../weights/camera.json");
+        let origin = Self::committed_weights_path();
+        let summary: crate::train::TrainSummary = serde_json::from_str(SUMMARY)
+            .map_err(|e| CameraError::Parse { path: origin.with_extension("json"), line: e.line(), column: e.column(), message: e.to_string() })?;
+        let device = inbetween_nn::backend::cpu();
+        let model = crate::train::load_model_bytes(&summary.config.model, WEIGHTS.to_vec(), &origin, &device)?;
+        Ok(FastModel::from_burn(&model, summary.config.model))
+    }
+
     /// Style code z of a reference clip (§4.1): `steps` are (encoded x^v, x^c) at the 5-frame rate;
     /// the extractor reads the last [`STYLE_STEPS`] of them.
     pub fn extract_style(&self, chars: &[[f32; CHAR_ENC]], cams: &[[f32; CAM_DIM]]) -> Vec<f32> {
@@ -817,6 +829,20 @@ mod tests {
         let b = generate(&fast, &scene, &fast_start, &[0.0; 4], "t", &o, Path::new("k")).unwrap();
         assert_ne!(a.frames[10].toric, b.frames[10].toric, "H sees the velocity");
         assert_eq!(b.frames[0].toric, keys.keys[0].camera, "the key itself stays put");
+    }
+
+    #[test]
+    fn committed_weights_load_and_hit_keys_closely() {
+        let model = FastModel::committed().unwrap();
+        assert_eq!(model.config.hidden, 256);
+        let scene = Scene::procedural(3, 300, 30.0);
+        let keys = example_keys(&scene, &[0, 150, 299]);
+        let styles = model.behaviour_styles(777, 1);
+        let opts = GenerateOptions { exact_keys: false, ..Default::default() };
+        let track = generate(&model, &scene, &keys, &styles[2].code, "relative", &opts, Path::new("k")).unwrap();
+        // Trained, the network alone lands near its keys (an untrained one misses by whole radians).
+        let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+        assert!(worst < 0.3, "network key miss {worst}");
     }
 
     #[test]

@@ -216,6 +216,11 @@ pub fn save_model(model: &CameraModel, path: &Path) -> Result<(), CameraError> {
 /// Loads parameters saved by [`save_model`] into a freshly built model.
 pub fn load_model(config: &ModelConfig, path: &Path, device: &Device) -> Result<CameraModel, CameraError> {
     let bytes = std::fs::read(path).map_err(|source| CameraError::Io { path: path.into(), source })?;
+    load_model_bytes(config, bytes, path, device)
+}
+
+/// [`load_model`] from bytes already in memory (`origin` names them in errors).
+pub fn load_model_bytes(config: &ModelConfig, bytes: Vec<u8>, path: &Path, device: &Device) -> Result<CameraModel, CameraError> {
     let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_error(path, e))?;
     config.init(device).try_load_record(record).map_err(|e| record_error(path, e))
 }

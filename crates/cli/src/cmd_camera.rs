@@ -121,8 +121,10 @@ pub fn run(c: CameraCommand) -> anyhow::Result<()> {
 }
 
 fn load_model(weights: Option<&Path>) -> anyhow::Result<FastModel> {
-    let path = weights.map(Path::to_path_buf).unwrap_or_else(FastModel::committed_weights_path);
-    FastModel::load(&path).with_context(|| format!("loading camera weights {}", path.display()))
+    match weights {
+        Some(path) => FastModel::load(path).with_context(|| format!("loading camera weights {}", path.display())),
+        None => FastModel::committed().context("loading the committed camera weights"),
+    }
 }
 
 /// Style codes per behaviour, seeded so every run names the same codes.
