@@ -28,7 +28,7 @@ pub struct SegmentCost {
 }
 
 impl SegmentCost {
-    pub fn add(self, o: SegmentCost) -> SegmentCost {
+    pub fn combine(self, o: SegmentCost) -> SegmentCost {
         SegmentCost {
             angle_sum: self.angle_sum + o.angle_sum,
             cm_sum: self.cm_sum + o.cm_sum,
@@ -79,7 +79,7 @@ pub trait SegmentModel: Sync {
 
     /// The error of the frames strictly between keys `a < b`.
     fn segment_cost(&self, a: usize, b: usize, scratch: &mut Scratch) -> SegmentCost {
-        (a + 1..b).fold(SegmentCost::default(), |acc, f| acc.add(self.frame_cost(a, b, f, scratch)))
+        (a + 1..b).fold(SegmentCost::default(), |acc, f| acc.combine(self.frame_cost(a, b, f, scratch)))
     }
 
     /// Like [`SegmentModel::segment_cost`], but gives up with `None` as soon as one frame exceeds
@@ -96,7 +96,7 @@ pub trait SegmentModel: Sync {
                 if c.cm_max > max_cm {
                     return None;
                 }
-                acc = acc.add(c);
+                acc = acc.combine(c);
             }
         }
         Some(acc)
@@ -108,7 +108,7 @@ pub trait SegmentModel: Sync {
         let total = keys
             .segments()
             .map(|(a, b)| self.segment_cost(a, b, &mut s))
-            .fold(SegmentCost::default(), SegmentCost::add);
+            .fold(SegmentCost::default(), SegmentCost::combine);
         ReconstructionError::from_total(total, self.num_frames(), self.num_joints(), self.angle_terms_per_frame())
     }
 }
@@ -276,7 +276,7 @@ impl SegmentTable {
 
     /// Total cost of a keyframe set (None if a segment is outside the band).
     pub fn total(&self, keys: &KeyframeSet) -> Option<SegmentCost> {
-        keys.segments().try_fold(SegmentCost::default(), |acc, (a, b)| self.get(a, b).map(|c| acc.add(*c)))
+        keys.segments().try_fold(SegmentCost::default(), |acc, (a, b)| self.get(a, b).map(|c| acc.combine(*c)))
     }
 }
 

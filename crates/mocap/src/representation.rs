@@ -142,11 +142,11 @@ pub fn wrap_angle(a: f64) -> f64 {
 /// Central difference of a per-frame series (one-sided at the ends), per second.
 fn central_difference<T>(values: &[T], f: usize, dt: f64) -> T
 where
-    T: Copy + std::ops::Sub<Output = T> + std::ops::Div<f64, Output = T>,
+    T: Copy + Default + std::ops::Sub<Output = T> + std::ops::Div<f64, Output = T>,
 {
     let n = values.len();
     if n < 2 {
-        return values[f] - values[f];
+        return T::default();
     }
     let (lo, hi) = (f.saturating_sub(1), (f + 1).min(n - 1));
     (values[hi] - values[lo]) / ((hi - lo) as f64 * dt)

@@ -241,10 +241,10 @@ mod tests {
         assert!(err.mean_cm > 0.0);
         // Bone lengths are exact: FK of local rotations with fixed offsets.
         let s = &m.skeleton;
-        for f in 0..45 {
+        for frame in &b {
             for j in 1..s.len() {
                 let par = s.parent(j).unwrap();
-                assert!(((b[f][j] - b[f][par]).length() - s.joint(j).offset.length()).abs() < 1e-9);
+                assert!(((frame[j] - frame[par]).length() - s.joint(j).offset.length()).abs() < 1e-9);
             }
         }
     }

@@ -59,9 +59,9 @@ impl EnvWindow {
         out.iter_mut().for_each(|e| *e = 0.0);
         let mut total = 0.0;
         for w in keys.windows(2) {
-            for f in w[0] + 1..w[1] {
-                out[f] = self.rep.frame_cost(w[0], w[1], f, scratch).angle_sum;
-                total += out[f];
+            for (f, slot) in out.iter_mut().enumerate().take(w[1]).skip(w[0] + 1) {
+                *slot = self.rep.frame_cost(w[0], w[1], f, scratch).angle_sum;
+                total += *slot;
             }
         }
         total
