@@ -107,6 +107,9 @@ pub struct BenchReport {
     pub table2: Vec<Table2Row>,
     pub rails: Vec<RailsRow>,
     pub speed: Speed,
+    /// How much the style code changes a track: mean distance between the tracks generated through
+    /// the same keys with each behaviour's mean style code (0 = style ignored).
+    pub style_spread: f64,
     /// (behaviour, main is A, z) of every evaluation sequence, for the PCA plot.
     pub styles: Vec<(Behaviour, bool, Vec<f32>)>,
 }
@@ -352,6 +355,34 @@ fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCh
         .collect()
 }
 
+/// Mean pairwise distance between tracks through the same two keys (60 steps) generated with each
+/// behaviour's mean style code.
+fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool, Vec<f32>)], rng: &mut ChaCha8Rng) -> f64 {
+    let len = STYLE_STEPS;
+    let codes: Vec<Vec<f32>> = BEHAVIOURS
+        .iter()
+        .map(|b| {
+            let zs: Vec<&Vec<f32>> = styles.iter().filter(|s| s.0 == *b).map(|s| &s.2).collect();
+            (0..model.config.style_dim).map(|k| zs.iter().map(|z| z[k]).sum::<f32>() / zs.len().max(1) as f32).collect()
+        })
+        .collect();
+    let (mut total, mut n) = (0.0, 0usize);
+    for s in seqs {
+        let s0 = rng.random_range(0..=s.cams.len() - (len + MAP_FRAMES));
+        let base = s0 + MAP_FRAMES - 1;
+        let chars = &s.chars[base..=base + len];
+        let truth = &s.cams[base..=base + len];
+        let tracks: Vec<Vec<Cam>> = codes.iter().map(|z| roll(model, z, mapped_state(model, z, &[truth[0]; MAP_FRAMES]), truth[0], chars, &[(len, truth[len])])).collect();
+        for i in 0..tracks.len() {
+            for j in i + 1..tracks.len() {
+                total += mean_err(&tracks[i], &tracks[j]);
+                n += 1;
+            }
+        }
+    }
+    total / n.max(1) as f64
+}
+
 fn speed(model: &FastModel, seconds: f64) -> Speed {
     let scene = crate::dataset::Scene::procedural(42, 900, 30.0);
     let keys = crate::infer::example_keys(&scene, &[0, 299, 599, 899]);
@@ -394,8 +425,10 @@ pub fn run(model: &FastModel, cfg: &BenchConfig) -> BenchReport {
         })
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let styles = seqs.iter().map(|s| (s.behaviour, s.main_is_a, style_of(model, &s.chars[..STYLE_STEPS], &s.cams[..STYLE_STEPS]))).collect();
+    let styles: Vec<(Behaviour, bool, Vec<f32>)> = seqs.iter().map(|s| (s.behaviour, s.main_is_a, style_of(model, &s.chars[..STYLE_STEPS], &s.cams[..STYLE_STEPS]))).collect();
+    let spread = style_spread(model, &seqs, &styles, &mut ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x51));
     BenchReport {
+        style_spread: spread,
         config: cfg.clone(),
         sequences: seqs.len(),
         table1: table1(model, &seqs, cfg, &mut rng),
@@ -475,6 +508,7 @@ impl BenchReport {
         for r in &self.rails {
             s += &format!("{:<10} ours {:.3}  spline keys {:.1}{}\n", r.behaviour, r.ours_error, r.spline_keys, if r.capped > 0 { format!(" ({} capped at {})", r.capped, self.config.max_spline_keys) } else { String::new() });
         }
+        s += &format!("\nstyle effect: tracks through the same keys with the 4 behaviour codes differ by {:.4} on average\n", self.style_spread);
         s += &format!(
             "\nspeed: {:.0} frames/s end to end (one 900-frame track, one thread); {:.0} frames/s network, {} trajectories batched   [paper: > 2000]\n",
             self.speed.single_frames_per_s, self.speed.batched_frames_per_s, self.speed.batch
