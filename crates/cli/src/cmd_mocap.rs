@@ -384,6 +384,7 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
         println!("wrote {}", p.display());
     }
     reconstruction_throughput(&all);
+    both_reconstructions(&all)?;
     for &bound in &a.codec_bounds {
         codec_ratio(&clips, bound)?;
     }
@@ -431,6 +432,33 @@ fn reconstruction_throughput(windows: &[bench::Window]) {
         windows.first().map(|w| w.rep.num_joints).unwrap_or(0),
         frames as f64 / secs
     );
+}
+
+/// The paper's spherical reconstruction vs our rotation (quaternion Hermite) one, same optimal keys.
+fn both_reconstructions(windows: &[bench::Window]) -> anyhow::Result<()> {
+    for k in [5, 10, 15] {
+        let (mut sph, mut rot, mut rot_deg, mut sph_max, mut rot_max) = (0.0, 0.0, 0.0, 0.0f64, 0.0f64);
+        for w in windows {
+            let keys = inbetween_mocap::select::optimal(&SegmentTable::full(&w.rep), k, Objective::Angle)?;
+            let es = w.rep.error(&keys);
+            let er = RotationMotion::from_motion(&w.motion)?.error(&keys);
+            sph += es.mean_cm;
+            rot += er.mean_cm;
+            rot_deg += er.mean_angle.to_degrees();
+            sph_max = sph_max.max(es.max_cm);
+            rot_max = rot_max.max(er.max_cm);
+        }
+        let n = windows.len().max(1) as f64;
+        println!(
+            "K={k:<2} optimal keys, all windows: spherical (paper) mean {:.3} cm / max {:.2} cm; rotation (BVH) mean {:.3} cm / max {:.2} cm, local rotation error {:.2} deg",
+            sph / n,
+            sph_max,
+            rot / n,
+            rot_max,
+            rot_deg / n
+        );
+    }
+    Ok(())
 }
 
 /// Codec size at an error bound over the full-rate, full-skeleton clips (T-pose frame dropped).

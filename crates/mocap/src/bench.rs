@@ -46,6 +46,8 @@ pub struct Window {
     pub clip: String,
     pub start: usize,
     pub rep: SphericalMotion,
+    /// The window as a clip (filtered joints, 30 fps), for the rotation reconstruction.
+    pub motion: Motion,
 }
 
 /// Resamples, filters and windows one clip.
@@ -59,7 +61,7 @@ pub fn clip_windows(name: &str, motion: &Motion, p: &Protocol) -> Result<Vec<Win
     let mut out = Vec::new();
     let stride = p.stride.max(1);
     for (i, w) in m.windows(p.window, stride).into_iter().enumerate() {
-        out.push(Window { clip: name.to_string(), start: i * stride, rep: SphericalMotion::from_motion(&w)? });
+        out.push(Window { clip: name.to_string(), start: i * stride, rep: SphericalMotion::from_motion(&w)?, motion: w });
     }
     Ok(out)
 }
