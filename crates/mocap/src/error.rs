@@ -210,30 +210,26 @@ impl SegmentTable {
 
     /// Segments up to `max_gap` frames long, computed in parallel over rows.
     pub fn banded(model: &dyn SegmentModel, max_gap: usize) -> SegmentTable {
-        let n = model.num_frames();
-        let g = max_gap.clamp(1, n.saturating_sub(1).max(1));
-        let mut costs = vec![SegmentCost::default(); n * g];
-        costs.par_chunks_mut(g).enumerate().for_each_init(
-            || model.scratch(),
-            |scratch, (a, row)| {
-                for (k, slot) in row.iter_mut().enumerate() {
-                    let b = a + k + 1;
-                    if b < n {
-                        *slot = model.segment_cost(a, b, scratch);
-                    }
-                }
-            },
-        );
-        SegmentTable { num_frames: n, max_gap: g, costs }
+        Self::fill(model, max_gap, |a, b, scratch| model.segment_cost(a, b, scratch))
     }
 
     /// Segments up to `max_gap` frames long whose every frame stays within `max_cm`; the others are
     /// stored with an infinite `cm_max` (not computed in full), which is all the error-bounded
     /// selector needs to know about them.
     pub fn bounded(model: &dyn SegmentModel, max_gap: usize, max_cm: f64) -> SegmentTable {
+        let infeasible = SegmentCost { angle_sum: f64::INFINITY, cm_sum: f64::INFINITY, cm_max: f64::INFINITY };
+        Self::fill(model, max_gap, |a, b, scratch| model.segment_cost_within(a, b, max_cm, scratch).unwrap_or(infeasible))
+    }
+
+    /// Rows of segment costs `(a, a + 1 ..= a + max_gap)`, computed in parallel over rows with one
+    /// scratch buffer per worker.
+    fn fill(
+        model: &dyn SegmentModel,
+        max_gap: usize,
+        cost: impl Fn(usize, usize, &mut Scratch) -> SegmentCost + Sync,
+    ) -> SegmentTable {
         let n = model.num_frames();
         let g = max_gap.clamp(1, n.saturating_sub(1).max(1));
-        let infeasible = SegmentCost { angle_sum: f64::INFINITY, cm_sum: f64::INFINITY, cm_max: f64::INFINITY };
         let mut costs = vec![SegmentCost::default(); n * g];
         costs.par_chunks_mut(g).enumerate().for_each_init(
             || model.scratch(),
@@ -241,7 +237,7 @@ impl SegmentTable {
                 for (k, slot) in row.iter_mut().enumerate() {
                     let b = a + k + 1;
                     if b < n {
-                        *slot = model.segment_cost_within(a, b, max_cm, scratch).unwrap_or(infeasible);
+                        *slot = cost(a, b, scratch);
                     }
                 }
             },
