@@ -344,7 +344,7 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
     let ks = [5, 10, 15];
     let policy = match (&a.model, a.train_episodes) {
         (Some(p), _) => {
-            println!("SIDQL: loaded {} (trained by `mocap train` on the CMU training split)", p.display());
+            println!("SIDQL: loaded {} (a policy written by `mocap train`; its training data is whatever that run used)", p.display());
             Some(SidqlPolicy::load(p)?)
         }
         (None, 0) => None,
