@@ -135,17 +135,7 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
             .y_label_area_size(px(78))
             .build_cartesian_2d(xr, yr)
             .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .label_style((FONT, LABEL_SIZE))
-            .axis_desc_style((FONT, LABEL_SIZE + 1))
-            .max_light_lines(4)
-            .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
-            .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
-            .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
-            .set_all_tick_mark_size(px(5))
+        house_mesh(chart.configure_mesh().x_desc(x_label).y_desc(y_label))
             .draw()
             .map_err(e)?;
         for (i, s) in series.iter().enumerate() {
@@ -224,18 +214,7 @@ pub fn grouped_bar_chart(
             .y_label_area_size(px(78))
             .build_cartesian_2d(0.0..n, yr.clone())
             .map_err(e)?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(0)
-            .y_desc(y_label)
-            .label_style((FONT, LABEL_SIZE))
-            .axis_desc_style((FONT, LABEL_SIZE + 1))
-            .max_light_lines(4)
-            .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
-            .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
-            .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
-            .set_all_tick_mark_size(px(5))
+        house_mesh(chart.configure_mesh().disable_x_mesh().x_labels(0).y_desc(y_label))
             .draw()
             .map_err(e)?;
         for (s, (name, values)) in series.iter().enumerate() {
@@ -346,4 +325,22 @@ mod tests {
         assert!(err.contains("2 values for 1 groups"), "{err}");
         assert!(!p.exists());
     }
+}
+
+/// The shared look of every chart's axes and grid: fonts, light grid lines, tick marks.
+fn house_mesh<'m, 'a, 'b, X, Y, DB>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: plotters::coord::ranged1d::Ranged,
+    Y: plotters::coord::ranged1d::Ranged,
+    DB: DrawingBackend,
+{
+    mesh.label_style((FONT, LABEL_SIZE))
+        .axis_desc_style((FONT, LABEL_SIZE + 1))
+        .max_light_lines(4)
+        .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
+        .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
+        .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
+        .set_all_tick_mark_size(px(5))
 }
