@@ -5,7 +5,7 @@ use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 use inbetween_core::{positions_clip, KeyframeSet, Motion};
 use inbetween_io::fsutil::write_atomic;
-use inbetween_mocap::bench::{self, Method, Protocol};
+use inbetween_mocap::bench::{self, Clip, Method, Protocol};
 use inbetween_mocap::codec::{self, Budget};
 use inbetween_mocap::dqn::{train::SidqlPolicy, DqnConfig, TrainOptions};
 use inbetween_mocap::error::{Objective, SegmentModel, SegmentTable};
@@ -43,11 +43,16 @@ pub struct TrainArgs {
     /// Data folder for the CMU clips (default: the shared corpus).
     #[arg(long)]
     pub data: Option<PathBuf>,
-    #[arg(long, default_value_t = 600)]
-    pub episodes: usize,
-    /// Hyper-parameters: `quick` (Adam 1e-3, batch 64) or `paper` (§5.2: lr 0.01, batch 256).
-    #[arg(long, default_value = "quick")]
+    /// Episodes (default: the preset's; `paper` runs 2000).
+    #[arg(long)]
+    pub episodes: Option<usize>,
+    /// Hyper-parameters: `paper` (§5.2: lr 0.01, batch 256, memory 10 000, γ = 0.5, target renewed
+    /// every 100 updates, 2000 episodes) or `quick` (the same with batch 64 and 300 episodes).
+    #[arg(long, default_value = "paper")]
     pub preset: String,
+    /// Learning rate (default: the preset's; `paper` uses 0.01).
+    #[arg(long)]
+    pub lr: Option<f64>,
     /// Stride of the training windows (overlapping windows give more training data).
     #[arg(long, default_value_t = 10)]
     pub stride: usize,
@@ -170,7 +175,8 @@ pub struct PreviewArgs {
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Data folder (default: the shared corpus); clips are read from <DIR>/mocap/cmu/cgspeed or DIR itself.
+    /// Data folder (default: the shared corpus); every CMU take under <DIR>/mocap/cmu (cgspeed BVH,
+    /// ASF/AMC, iClone BVH; one entry per take), or each .bvh in DIR itself.
     #[arg(long)]
     pub data: Option<PathBuf>,
     /// Write the table as CSV.
@@ -184,12 +190,13 @@ pub struct BenchArgs {
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// A SIDQL policy trained by `mocap train` (on the CMU training split); without it the bench
-    /// trains one on the training split first (see --train-episodes).
+    /// A SIDQL policy written by `mocap train`. Default: the committed policy (trained on our
+    /// procedural gaits), unless --train-episodes is given.
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Episodes for the inline SIDQL training when no --model is given (0 skips SIDQL).
-    #[arg(long, default_value_t = 600)]
+    /// Train SIDQL here first, on the CMU training split with the paper's settings, for this many
+    /// episodes (saved as out/sidql_cmu.bpk).
+    #[arg(long, default_value_t = 0, conflicts_with = "model")]
     pub train_episodes: usize,
     /// Also report codec compression at these max errors (cm), on the full-rate clips.
     #[arg(long, value_delimiter = ',', default_value = "1,0.1")]
@@ -290,26 +297,21 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The cgspeed BVH clips of a data folder, with their names.
-fn cmu_clips(dir: &Path) -> anyhow::Result<Vec<(String, Motion)>> {
-    let sub = dir.join("mocap/cmu/cgspeed");
-    let folder = if sub.is_dir() { sub } else { dir.to_path_buf() };
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&folder)
-        .with_context(|| format!("listing {}", folder.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")))
-        .collect();
-    paths.sort();
-    if paths.is_empty() {
-        bail!("no .bvh clips in {}", folder.display());
+/// The CMU takes of a data folder (see [`inbetween_mocap::corpus`]).
+fn cmu_clips(dir: &Path) -> anyhow::Result<Vec<Clip>> {
+    Ok(inbetween_mocap::corpus::cmu_corpus(dir)?)
+}
+
+/// One line per source: how many takes came from where.
+fn describe_sources(clips: &[Clip]) -> String {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for c in clips {
+        match counts.iter_mut().find(|(s, _)| *s == c.source) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((c.source, 1)),
+        }
     }
-    paths
-        .iter()
-        .map(|p| {
-            let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            Ok((name, inbetween_io::read_bvh(p)?))
-        })
-        .collect()
+    counts.iter().map(|(s, n)| format!("{n} {s}")).collect::<Vec<_>>().join(", ")
 }
 
 fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
@@ -322,57 +324,59 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
     };
     let clips = cmu_clips(&dir)?;
     let protocol = Protocol { stride: a.stride, seed: a.seed, ..Protocol::paper() };
-    let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
+    let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
     let (train, test) = bench::split_clips(&names, &protocol);
     let mut all = Vec::new();
-    for (name, m) in &clips {
-        all.extend(bench::clip_windows(name, m, &protocol)?);
+    for clip in &clips {
+        all.extend(bench::clip_windows(clip, &protocol)?);
     }
     let test_windows: Vec<_> = all.iter().filter(|w| test.contains(&w.clip)).cloned().collect();
+    let joints: std::collections::BTreeSet<usize> = all.iter().map(|w| w.rep.num_joints).collect();
     println!(
-        "{} clips ({}), {} windows of {} frames at {} fps, {} joints; test split: {:?} ({} windows), train: {:?}",
+        "{} takes ({}) from {}: {} windows of {} frames at {} fps, joints per skeleton {:?}",
         clips.len(),
+        describe_sources(&clips),
         dir.display(),
         all.len(),
         protocol.window,
         protocol.fps,
-        all.first().map(|w| w.rep.num_joints).unwrap_or(0),
-        test,
-        test_windows.len(),
-        train
+        joints,
     );
+    println!("test split ({} windows): {test:?}\ntraining split: {train:?}", test_windows.len());
     let ks = [5, 10, 15];
-    let policy = match (&a.model, a.train_episodes) {
-        (Some(p), _) => {
-            println!("SIDQL: loaded {} (a policy written by `mocap train`; its training data is whatever that run used)", p.display());
-            Some(SidqlPolicy::load(p)?)
-        }
-        (None, 0) => None,
-        (None, episodes) => {
-            let train_windows = training_windows(&clips, &train, &protocol, 10)?;
-            let opts = TrainOptions { episodes, seed: a.seed, ..TrainOptions::quick() };
-            println!(
-                "SIDQL: training {episodes} episodes on {} windows of the training split (stride 10)…",
-                train_windows.len()
-            );
-            let (policy, report) = inbetween_mocap::dqn::train(&train_windows, &DqnConfig::paper(), &opts)?;
-            println!(
-                "SIDQL: trained in {:.0} s, {} updates, loss per 50 episodes {:?}",
-                report.seconds,
-                report.updates,
-                report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
-            );
-            let path = PathBuf::from("out/sidql_cmu.bpk");
-            std::fs::create_dir_all("out").ok();
-            policy.save(&path)?;
-            println!("SIDQL: saved {} (weights trained on CMU data: keep out of the repository)", path.display());
-            Some(policy)
-        }
+    let policy = if let Some(p) = &a.model {
+        let policy = SidqlPolicy::load(p)?;
+        println!("SIDQL: {} (trained on: {})", p.display(), policy.info.trained_on);
+        policy
+    } else if a.train_episodes > 0 {
+        let train_windows = training_windows(&clips, &train, &protocol, 10)?;
+        let opts = TrainOptions {
+            episodes: a.train_episodes,
+            seed: a.seed,
+            data: format!("CMU training split {train:?}, {} windows at stride 10", train_windows.len()),
+            ..TrainOptions::paper()
+        };
+        println!("SIDQL: training {} episodes on {} windows of the training split…", opts.episodes, train_windows.len());
+        let (policy, report) = inbetween_mocap::dqn::train(&train_windows, &DqnConfig::default(), &opts)?;
+        println!(
+            "SIDQL: trained in {:.0} s, {} updates, loss per 50 episodes {:?}",
+            report.seconds,
+            report.updates,
+            report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
+        );
+        let path = PathBuf::from("out/sidql_cmu.bpk");
+        std::fs::create_dir_all("out").ok();
+        policy.save(&path)?;
+        println!("SIDQL: saved {} (weights trained on CMU data: keep out of the repository)", path.display());
+        policy
+    } else {
+        let policy = SidqlPolicy::committed()?;
+        println!("SIDQL: the committed policy (trained on: {})", policy.info.trained_on);
+        policy
     };
-    let policy_fn = policy.as_ref().map(|p| move |rep: &SphericalMotion, k: usize| p.select(rep, k));
-    let pf: Option<bench::PolicyFn> = policy_fn.as_ref().map(|f| f as bench::PolicyFn);
-    let all_methods: Vec<Method> = Method::ALL.into_iter().filter(|m| *m != Method::Sidql).collect();
-    let mut rows = bench::evaluate("all", &all, &all_methods, &ks, a.seed, None)?;
+    let policy_fn = move |rep: &SphericalMotion, k: usize| policy.select(rep, k);
+    let pf: Option<bench::PolicyFn> = Some(&policy_fn);
+    let mut rows = bench::evaluate("all", &all, &Method::ALL, &ks, a.seed, pf)?;
     rows.extend(bench::evaluate("test", &test_windows, &Method::ALL, &ks, a.seed, pf)?);
     println!("{}", bench::to_table(&rows));
     if let Some(p) = &a.csv {
@@ -385,8 +389,10 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
     }
     reconstruction_throughput(&all);
     both_reconstructions(&all)?;
+    // The codec measures cm in CMU units: the cgspeed takes (or a plain folder, read as CMU units).
+    let cmu_units: Vec<&Clip> = clips.iter().filter(|c| c.source == "cgspeed" || c.source == "bvh").collect();
     for &bound in &a.codec_bounds {
-        codec_ratio(&clips, bound)?;
+        codec_ratio(&cmu_units, bound)?;
     }
     Ok(())
 }
@@ -441,7 +447,9 @@ fn both_reconstructions(windows: &[bench::Window]) -> anyhow::Result<()> {
         for w in windows {
             let keys = inbetween_mocap::select::optimal(&SegmentTable::full(&w.rep), k, Objective::Angle)?;
             let es = w.rep.error(&keys);
-            let er = RotationMotion::from_motion(&w.motion)?.error(&keys);
+            let mut rm = RotationMotion::from_motion(&w.motion)?;
+            rm.cm_per_unit = w.rep.cm_per_unit;
+            let er = rm.error(&keys);
             sph += es.mean_cm;
             rot += er.mean_cm;
             rot_deg += er.mean_angle.to_degrees();
@@ -461,12 +469,13 @@ fn both_reconstructions(windows: &[bench::Window]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Codec size at an error bound over the full-rate, full-skeleton clips (T-pose frame dropped).
-fn codec_ratio(clips: &[(String, Motion)], bound_cm: f64) -> anyhow::Result<()> {
+/// Codec size at an error bound over the full-rate, full-skeleton cgspeed clips (T-pose frame
+/// dropped; the codec measures cm in CMU units).
+fn codec_ratio(clips: &[&Clip], bound_cm: f64) -> anyhow::Result<()> {
     let (mut raw, mut packed, mut keys, mut frames, mut max_cm) = (0usize, 0usize, 0usize, 0usize, 0.0f64);
     let t = Instant::now();
-    for (_, m) in clips {
-        let m = m.crop(1, m.num_frames())?;
+    for clip in clips {
+        let m = clip.motion.crop(1, clip.motion.num_frames())?;
         let gap = ((0.5 / m.frame_time).round() as usize).max(1);
         let c = codec::compress(&m, Budget::MaxErrorCm(bound_cm), gap)?;
         raw += codec::raw_bytes(&m);
@@ -543,31 +552,48 @@ pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
 
 /// Windows of the named clips with the given stride (overlapping windows for training).
 fn training_windows(
-    clips: &[(String, Motion)],
+    clips: &[Clip],
     names: &[String],
     protocol: &Protocol,
     stride: usize,
 ) -> anyhow::Result<Vec<SphericalMotion>> {
     let p = Protocol { stride, ..protocol.clone() };
     let mut out = Vec::new();
-    for (name, m) in clips.iter().filter(|(n, _)| names.contains(n)) {
-        out.extend(bench::clip_windows(name, m, &p)?.into_iter().map(|w| w.rep));
+    for clip in clips.iter().filter(|c| names.contains(&c.name)) {
+        out.extend(bench::clip_windows(clip, &p)?.into_iter().map(|w| w.rep));
     }
     Ok(out)
 }
 
+/// Procedural gaits (our own data) as clips in CMU units.
+fn procedural_clips(seed: u64, count: usize) -> Vec<Clip> {
+    inbetween_core::procedural::gait_library(seed, count, 241, 30.0)
+        .into_iter()
+        .enumerate()
+        .map(|(i, m)| Clip {
+            name: format!("gait{i}"),
+            source: "procedural",
+            motion: m,
+            cm_per_unit: inbetween_core::procedural::CM_PER_CMU_UNIT,
+        })
+        .collect()
+}
+
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
     let protocol = Protocol { seed: a.seed, ..Protocol::paper() };
-    let windows = if a.procedural {
-        let clips: Vec<(String, Motion)> = inbetween_core::procedural::gait_library(a.seed, 24, 241, 30.0)
-            .into_iter()
-            .enumerate()
-            .map(|(i, m)| (format!("gait{i}"), m))
-            .collect();
-        let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
+    let (windows, data) = if a.procedural {
+        let clips = procedural_clips(a.seed, 24);
+        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
         let p = Protocol { skip_first_frame: false, ..protocol.clone() };
-        println!("training on {} procedural gaits (seed {})", clips.len(), a.seed);
-        training_windows(&clips, &names, &p, a.stride)?
+        let windows = training_windows(&clips, &names, &p, a.stride)?;
+        let data = format!(
+            "{} procedural gaits (seed {}), {} windows of 60 frames at stride {}",
+            clips.len(),
+            a.seed,
+            windows.len(),
+            a.stride
+        );
+        (windows, data)
     } else {
         let dir = match a.data.clone() {
             Some(d) => d,
@@ -575,24 +601,37 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
                 .map_err(|p| anyhow::anyhow!("no data at {} (give --data DIR or --procedural)", p.display()))?,
         };
         let clips = cmu_clips(&dir)?;
-        let names: Vec<String> = clips.iter().map(|c| c.0.clone()).collect();
+        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
         let (train, test) = bench::split_clips(&names, &protocol);
-        println!("training on the CMU training split {train:?} (test split {test:?} held out)");
-        training_windows(&clips, &train, &protocol, a.stride)?
+        let windows = training_windows(&clips, &train, &protocol, a.stride)?;
+        let data = format!(
+            "CMU training split (seed {}) {train:?}, {} windows of 60 frames at stride {}; test split {test:?} held out",
+            a.seed,
+            windows.len(),
+            a.stride
+        );
+        (windows, data)
     };
     let base = match a.preset.as_str() {
         "quick" => TrainOptions::quick(),
         "paper" => TrainOptions::paper(),
-        other => bail!("unknown preset '{other}'; expected quick or paper"),
+        other => bail!("unknown preset '{other}'; expected paper or quick"),
     };
     if let Some(dir) = a.output.parent() {
         if !dir.as_os_str().is_empty() {
             std::fs::create_dir_all(dir)?;
         }
     }
-    let opts = TrainOptions { episodes: a.episodes, seed: a.seed, checkpoint: Some(a.output.clone()), ..base };
-    println!("{} windows; {:?}", windows.len(), opts);
-    let (_, report) = inbetween_mocap::dqn::train(&windows, &DqnConfig::paper(), &opts)?;
+    println!("training on {data}");
+    let opts = TrainOptions {
+        episodes: a.episodes.unwrap_or(base.episodes),
+        lr: a.lr.unwrap_or(base.lr),
+        seed: a.seed,
+        checkpoint: Some(a.output.clone()),
+        data,
+        ..base
+    };
+    let (_, report) = inbetween_mocap::dqn::train(&windows, &DqnConfig::default(), &opts)?;
     println!(
         "trained {} episodes, {} updates in {:.0} s; loss per 50 episodes {:?}; return per episode {:?}",
         report.episodes,

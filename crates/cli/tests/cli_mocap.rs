@@ -86,3 +86,39 @@ fn stream_over_loopback() {
     assert!(r.status.success(), "{}", text(&r));
     assert!(text(&r).contains("complete") && text(&r).contains("emitted 90 frames"), "{}", text(&r));
 }
+
+#[test]
+fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
+    let dir = tempfile::tempdir().unwrap();
+    let policy = dir.path().join("p.bpk").to_string_lossy().into_owned();
+    let o = inbetween(&[
+        "mocap", "train", "--procedural", "--preset", "quick", "--episodes", "8", "--stride", "60", "-o", &policy,
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let info = std::fs::read_to_string(dir.path().join("p.json")).unwrap();
+    assert!(info.contains("procedural gaits"), "the sidecar says what it was trained on: {info}");
+    // A plain folder of clips: two procedural walks, different lengths and speeds.
+    let data = dir.path().join("clips");
+    std::fs::create_dir_all(&data).unwrap();
+    for (i, frames) in [(0, 250), (1, 190)] {
+        let mut p = inbetween_core::procedural::GaitParams::walk();
+        p.frames = frames;
+        p.speed *= 1.0 + 0.2 * i as f64;
+        inbetween_io::write_bvh(&data.join(format!("walk{i}.bvh")), &inbetween_core::procedural::gait(&p)).unwrap();
+    }
+    let csv = dir.path().join("bench.csv").to_string_lossy().into_owned();
+    let o = inbetween(&[
+        "mocap", "bench", "--data", data.to_str().unwrap(), "--model", &policy, "--csv", &csv, "--codec-bounds", "1",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let table = std::fs::read_to_string(&csv).unwrap();
+    for method in ["rc", "uc", "greedy", "sidql", "optimal"] {
+        assert!(table.lines().any(|l| l.starts_with(&format!("{method},5,"))), "{method} missing:\n{table}");
+    }
+    // Without --model the bench uses the committed policy (trained on our procedural gaits).
+    let o = inbetween(&["mocap", "bench", "--data", data.to_str().unwrap(), "--codec-bounds", "1"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("committed policy (trained on: 24 procedural gaits"), "{}", text(&o));
+    let o = inbetween(&["mocap", "bench", "--data", dir.path().join("none").to_str().unwrap()]);
+    assert!(!o.status.success(), "{}", text(&o));
+}

@@ -3,6 +3,7 @@
 //! K = 5, 10, 15 with the mean angle error (Eq. 24), the mean and max position error in cm and the
 //! decision time per window.
 
+pub use crate::corpus::Clip;
 use crate::error::{Objective, SegmentModel, SegmentTable};
 use crate::representation::{JointFilter, SphericalMotion};
 use crate::select;
@@ -51,7 +52,8 @@ pub struct Window {
 }
 
 /// Resamples, filters and windows one clip.
-pub fn clip_windows(name: &str, motion: &Motion, p: &Protocol) -> Result<Vec<Window>> {
+pub fn clip_windows(clip: &Clip, p: &Protocol) -> Result<Vec<Window>> {
+    let (name, motion) = (&clip.name, &clip.motion);
     let m = if p.skip_first_frame && motion.num_frames() > 1 {
         motion.crop(1, motion.num_frames())?
     } else {
@@ -61,7 +63,9 @@ pub fn clip_windows(name: &str, motion: &Motion, p: &Protocol) -> Result<Vec<Win
     let mut out = Vec::new();
     let stride = p.stride.max(1);
     for (i, w) in m.windows(p.window, stride).into_iter().enumerate() {
-        out.push(Window { clip: name.to_string(), start: i * stride, rep: SphericalMotion::from_motion(&w)?, motion: w });
+        let mut rep = SphericalMotion::from_motion(&w)?;
+        rep.cm_per_unit = clip.cm_per_unit;
+        out.push(Window { clip: name.to_string(), start: i * stride, rep, motion: w });
     }
     Ok(out)
 }
@@ -256,8 +260,9 @@ mod tests {
         let p = Protocol { fps: 30.0, ..Protocol::paper() };
         let clips = gait_library(5, 2, 121, 30.0);
         let mut windows = Vec::new();
-        for (i, c) in clips.iter().enumerate() {
-            windows.extend(clip_windows(&format!("c{i}"), c, &p).unwrap());
+        for (i, c) in clips.into_iter().enumerate() {
+            let clip = Clip { name: format!("c{i}"), source: "bvh", motion: c, cm_per_unit: 5.6444 };
+            windows.extend(clip_windows(&clip, &p).unwrap());
         }
         assert_eq!(windows.len(), 4);
         assert_eq!(windows[0].rep.num_joints, 23);

@@ -8,6 +8,7 @@
 
 pub mod bench;
 pub mod codec;
+pub mod corpus;
 pub mod dqn;
 pub mod error;
 pub mod reconstruct;
@@ -32,6 +33,8 @@ pub enum MocapError {
     Codec(String),
     #[error("i/o error on {path}: {source}")]
     Io { path: String, source: std::io::Error },
+    #[error(transparent)]
+    Format(#[from] inbetween_io::IoError),
     #[error("model: {0}")]
     Model(String),
     #[error("stream: {0}")]

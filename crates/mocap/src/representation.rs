@@ -29,9 +29,14 @@ pub struct JointFilter {
 impl JointFilter {
     /// The paper's 23 major joints: drops fingers, thumbs and toes. Covers both cgspeed CMU
     /// releases (`LeftFingerBase`, `LThumb`, `LeftToeBase`; and `lhand`/`rhand`, the finger base
-    /// below `LeftWrist` in the 131_* files) and Character Creator rigs (`CC_Base_L_Index1`, …).
+    /// below `LeftWrist` in the 131_* files), CMU ASF (`lhand`, `ltoes`: 23 joints too) and
+    /// Character Creator rigs, where it also drops the helper bones (`CC_Base_L_Index1`, twist and
+    /// share bones, face, breasts: 22 joints, 23 under an `RL_BoneRoot`).
     pub fn paper() -> JointFilter {
-        let p = ["finger", "thumb", "toe", "handindex", "lhand", "rhand", "index", "mid", "ring", "pinky"];
+        let p = [
+            "finger", "thumb", "toe", "handindex", "lhand", "rhand", "index", "mid", "ring", "pinky",
+            "thightwist", "calftwist", "armtwist", "ribstwist", "sharebone", "facialbone", "breast",
+        ];
         JointFilter { drop_patterns: p.iter().map(|s| s.to_string()).collect() }
     }
 
@@ -248,24 +253,6 @@ impl SphericalMotion {
         for j in 1..self.num_joints {
             let p = self.parents[j].expect("non-root joints have parents");
             out[j] = out[p] + direction(self.theta[j * n + f], self.phi[j * n + f]) * self.bone_length[j];
-        }
-    }
-
-    /// Per-frame feature vector for learning: for every joint, (θ, φ, θ̇, φ̇) scaled to about unit
-    /// range (φ as its wrapped value); for the root, its velocity and height, relative to the window.
-    pub fn frame_features(&self, f: usize, out: &mut Vec<f32>) {
-        let n = self.num_frames;
-        let v = self.root_vel[f];
-        let h = self.root_pos[f].y - self.root_pos[0].y;
-        out.extend_from_slice(&[(v.x / 50.0) as f32, (v.y / 50.0) as f32, (v.z / 50.0) as f32, (h / 10.0) as f32]);
-        for j in 1..self.num_joints {
-            let i = j * n + f;
-            out.extend_from_slice(&[
-                (self.theta[i] / PI) as f32,
-                (wrap_angle(self.phi[i]) / PI) as f32,
-                (self.dtheta[i] / 10.0).clamp(-5.0, 5.0) as f32,
-                (self.dphi[i] / 10.0).clamp(-5.0, 5.0) as f32,
-            ]);
         }
     }
 }

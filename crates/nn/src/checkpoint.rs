@@ -76,12 +76,17 @@ pub fn save_module<M: Module>(module: &M, path: &Path) -> Result<(), NnError> {
 /// Load parameters saved by [`save_module`] into `module` (which fixes the architecture and the
 /// device). Shape mismatches and missing parameters are errors naming the file and parameter.
 pub fn load_module<M: Module>(module: M, path: &Path) -> Result<M, NnError> {
-    let bytes = read_file(path)?;
+    load_module_bytes(module, read_file(path)?, path)
+}
+
+/// Like [`load_module`], from bytes already in memory (weights compiled into a binary); `origin`
+/// names them in errors.
+pub fn load_module_bytes<M: Module>(module: M, bytes: Vec<u8>, origin: &Path) -> Result<M, NnError> {
     let record =
-        ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))?;
+        ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(origin, e))?;
     module
         .try_load_record(record)
-        .map_err(|e| record_err(path, e))
+        .map_err(|e| record_err(origin, e))
 }
 
 /// Save an optimizer's state (Adam moments and step counts, keyed by parameter id).

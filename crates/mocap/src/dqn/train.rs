@@ -4,9 +4,11 @@
 //! ε-greedy; transitions go to the replay memory; every `train_every` environment steps one
 //! minibatch updates the main network towards `y = r + γ · max_a' Q_target(s', a')` (Eq. 23; 0 after
 //! the last step) under the Huber loss, and every `target_every` updates the target network copies
-//! the main one. Actions that are already keys are never chosen (their Q-values are masked).
+//! the main one. Actions that are already keys are never chosen (their Q-values are masked). The
+//! Huber loss compares Q and y both divided by E(s)/E(s₀) (see [`super::model`]), so the small
+//! rewards of late steps are learnt as precisely as the large early ones.
 
-use super::env::EnvWindow;
+use super::env::{EnvWindow, INPUTS};
 use super::model::{DqnConfig, QNet};
 use super::replay::{Replay, Transition};
 use crate::error::SegmentModel;
@@ -47,6 +49,9 @@ pub struct TrainOptions {
     pub checkpoint: Option<PathBuf>,
     pub checkpoint_every: usize,
     pub progress: bool,
+    /// What the policy was trained on, in words; written beside the weights.
+    #[serde(default)]
+    pub data: String,
 }
 
 impl TrainOptions {
@@ -70,13 +75,13 @@ impl TrainOptions {
             checkpoint: None,
             checkpoint_every: 200,
             progress: true,
+            data: String::new(),
         }
     }
 
-    /// What fits a few CPU minutes: Adam at 1e-3 (0.01 diverged in our runs), batch 64, the rest as
-    /// the paper.
+    /// A short run for smoke tests and quick looks: 300 episodes at batch 64, the rest as the paper.
     pub fn quick() -> TrainOptions {
-        TrainOptions { lr: 1e-3, batch: 64, episodes: 600, ..TrainOptions::paper() }
+        TrainOptions { batch: 64, episodes: 300, ..TrainOptions::paper() }
     }
 }
 
@@ -92,9 +97,21 @@ pub struct TrainReport {
     pub seconds: f64,
 }
 
+/// What is written beside a policy's weights: the network shape and how it was trained.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct PolicyInfo {
+    pub config: DqnConfig,
+    /// The training data, in words (clips, split, windows).
+    pub trained_on: String,
+    pub episodes: usize,
+    pub updates: usize,
+    pub seconds: f64,
+    pub options: Option<TrainOptions>,
+}
+
 /// A trained SIDQL policy on the plain (inference) CPU device.
 pub struct SidqlPolicy {
-    pub config: DqnConfig,
+    pub info: PolicyInfo,
     net: QNet,
     device: Device,
 }
@@ -108,10 +125,10 @@ fn sidecar(path: &Path) -> PathBuf {
 }
 
 impl SidqlPolicy {
-    /// Writes the weights (`path`, burnpack) and the network shape (`path` with `.json`).
+    /// Writes the weights (`path`, burnpack) and [`PolicyInfo`] (`path` with `.json`).
     pub fn save(&self, path: &Path) -> Result<()> {
         inbetween_nn::checkpoint::save_module(&self.net, path).map_err(model_err)?;
-        let json = serde_json::to_vec_pretty(&self.config).map_err(model_err)?;
+        let json = serde_json::to_vec_pretty(&self.info).map_err(model_err)?;
         inbetween_io::write_atomic(&sidecar(path), &json)
             .map_err(|source| MocapError::Io { path: sidecar(path).display().to_string(), source })
     }
@@ -121,33 +138,68 @@ impl SidqlPolicy {
         let side = sidecar(path);
         let text =
             std::fs::read(&side).map_err(|source| MocapError::Io { path: side.display().to_string(), source })?;
-        let config: DqnConfig =
-            serde_json::from_slice(&text).map_err(|e| MocapError::Model(format!("{}: {e}", side.display())))?;
+        let info: PolicyInfo = serde_json::from_slice(&text).map_err(|e| {
+            MocapError::Model(format!("{}: {e} (a policy written by an older version? retrain it)", side.display()))
+        })?;
+        let weights =
+            std::fs::read(path).map_err(|source| MocapError::Io { path: path.display().to_string(), source })?;
+        Self::from_info(info, weights, path)
+    }
+
+    /// The committed policy (`crates/mocap/weights/sidql.bpk`, trained by `inbetween mocap train
+    /// --procedural` on our own gaits), compiled into the binary so the bench and the tools run from
+    /// any folder.
+    pub fn committed() -> Result<SidqlPolicy> {
+        const WEIGHTS: &[u8] = include_bytes!("../../weights/sidql.bpk");
+        const INFO: &[u8] = include_bytes!("../../weights/sidql.json");
+        let origin = Path::new(env!("CARGO_MANIFEST_DIR")).join("weights/sidql.bpk");
+        Self::from_bytes(WEIGHTS, INFO, &origin)
+    }
+
+    /// A policy from weights and [`PolicyInfo`] JSON already in memory; `origin` names them in errors.
+    pub fn from_bytes(weights: &[u8], info_json: &[u8], origin: &Path) -> Result<SidqlPolicy> {
+        let info: PolicyInfo = serde_json::from_slice(info_json)
+            .map_err(|e| MocapError::Model(format!("{}: {e}", sidecar(origin).display())))?;
+        Self::from_info(info, weights.to_vec(), origin)
+    }
+
+    fn from_info(info: PolicyInfo, weights: Vec<u8>, origin: &Path) -> Result<SidqlPolicy> {
+        if info.config.inputs_per_frame != INPUTS {
+            return Err(MocapError::Model(format!(
+                "{}: the policy reads {} inputs per frame, this version builds {INPUTS}; retrain it",
+                origin.display(),
+                info.config.inputs_per_frame
+            )));
+        }
         let device = inbetween_nn::backend::cpu();
-        let net = inbetween_nn::checkpoint::load_module(config.init(&device), path).map_err(model_err)?;
-        Ok(SidqlPolicy { config, net, device })
+        let net = inbetween_nn::checkpoint::load_module_bytes(info.config.init(&device), weights, origin)
+            .map_err(model_err)?;
+        Ok(SidqlPolicy { info, net, device })
     }
 
     /// Chooses `k` keys for a window: starting from the end keys, repeatedly the frame with the
     /// highest Q-value among the non-keys.
     pub fn select(&self, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
         crate::select::check_k(rep.num_frames, k)?;
-        let w = EnvWindow::new(rep.clone(), self.config.frames, self.config.features_per_frame)?;
+        if k <= 2 {
+            return Ok(KeyframeSet::new(vec![0, rep.num_frames - 1], rep.num_frames)?);
+        }
+        let w = EnvWindow::new(rep.clone())?;
         let mut mask = w.initial_mask();
         let mut scratch = rep.scratch();
-        let mut state = Vec::with_capacity(self.config.input_size());
+        let mut state = Vec::with_capacity(w.frames() * INPUTS);
         while (mask.count_ones() as usize) < k {
             state.clear();
             w.state(mask, &mut scratch, &mut state);
-            let q = q_values(&self.net, &state, 1, self.config.input_size(), &self.device);
+            let q = q_values(&self.net, &state, 1, w.frames(), &self.device);
             mask |= 1 << best_action(&q, mask, w.frames());
         }
         Ok(KeyframeSet::new((0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect(), w.frames())?)
     }
 }
 
-fn q_values(net: &QNet, states: &[f32], batch: usize, input: usize, device: &Device) -> Vec<f32> {
-    let x = Tensor::<2>::from_data(TensorData::new(states.to_vec(), [batch, input]), device);
+fn q_values(net: &QNet, states: &[f32], batch: usize, frames: usize, device: &Device) -> Vec<f32> {
+    let x = Tensor::<3>::from_data(TensorData::new(states.to_vec(), [batch, frames, INPUTS]), device);
     net.forward(x).into_data().try_to_vec::<f32>().expect("f32 Q-values")
 }
 
@@ -156,37 +208,44 @@ fn best_action(q: &[f32], mask: u64, frames: usize) -> usize {
     (0..frames).filter(|&f| mask >> f & 1 == 0).max_by(|&a, &b| q[a].total_cmp(&q[b])).expect("a non-key frame remains")
 }
 
-/// Trains a policy on `windows` (all of the shape `config` expects).
+/// Trains a policy on `windows` (all of one length, ≤ 64 frames; any skeleton).
 pub fn train(
     windows: &[SphericalMotion],
     config: &DqnConfig,
     opts: &TrainOptions,
 ) -> Result<(SidqlPolicy, TrainReport)> {
-    if windows.is_empty() {
+    let Some(first) = windows.first() else {
         return Err(MocapError::Model("no training windows".into()));
+    };
+    let frames = first.num_frames;
+    if let Some(w) = windows.iter().find(|w| w.num_frames != frames) {
+        return Err(MocapError::Model(format!(
+            "training windows must share one length: {frames} and {} frames",
+            w.num_frames
+        )));
     }
-    if opts.max_keys < 3 || opts.max_keys > config.frames {
-        return Err(MocapError::Model(format!("max_keys {} must lie in 3..={}", opts.max_keys, config.frames)));
+    if opts.max_keys < 3 || opts.max_keys > frames {
+        return Err(MocapError::Model(format!("max_keys {} must lie in 3..={frames}", opts.max_keys)));
     }
-    let env: Vec<EnvWindow> = windows
-        .iter()
-        .map(|r| EnvWindow::new(r.clone(), config.frames, config.features_per_frame))
-        .collect::<Result<_>>()?;
+    if config.inputs_per_frame != INPUTS {
+        return Err(MocapError::Model(format!("the state has {INPUTS} inputs per frame, not {}", config.inputs_per_frame)));
+    }
+    let env: Vec<EnvWindow> = windows.iter().map(|r| EnvWindow::new(r.clone())).collect::<Result<_>>()?;
     let t0 = std::time::Instant::now();
     let ad = inbetween_nn::backend::cpu_autodiff();
     let plain = inbetween_nn::backend::cpu();
-    ad.seed(opts.seed);
-    let mut main = config.init(&ad);
+    let mut main = inbetween_nn::backend::seeded_module(&ad, opts.seed, |d| config.init(d));
     let mut target = main.valid();
     let mut acting = main.valid();
     let mut optim = AdamConfig::new().init();
     let huber = HuberLossConfig::new(1.0).init();
     let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
     let mut replay = Replay::new(opts.memory);
-    let input = config.input_size();
+    let input = frames * INPUTS;
     let steps_per_episode = opts.max_keys - 2;
     let bar = progress_bar(opts);
-    let mut scratch = env[0].rep.scratch();
+    // Windows may come from different skeletons; the widest one's buffers serve them all.
+    let mut scratch = env.iter().max_by_key(|w| w.rep.num_joints).map(|w| w.rep.scratch()).unwrap_or_default();
     let (mut env_steps, mut updates) = (0usize, 0usize);
     let (mut loss_sum, mut loss_n, mut ret_sum) = (0.0, 0usize, 0.0);
     let mut report = TrainReport {
@@ -210,7 +269,7 @@ pub fn train(
             } else {
                 state.clear();
                 w.state(mask, &mut scratch, &mut state);
-                best_action(&q_values(&acting, &state, 1, input, &plain), mask, w.frames())
+                best_action(&q_values(&acting, &state, 1, frames, &plain), mask, frames)
             };
             let next = mask | 1 << action;
             let mut errs = vec![0.0; w.frames()];
@@ -231,7 +290,7 @@ pub fn train(
             if replay.len() >= opts.batch && env_steps % opts.train_every.max(1) == 0 {
                 let batch = replay.sample(opts.batch, &mut rng);
                 let (m, loss) =
-                    update(main, &target, &mut optim, &huber, &env, &batch, opts, config, &ad, &plain, &mut scratch);
+                    update(main, &target, &mut optim, &huber, &env, &batch, opts, &ad, &plain, &mut scratch);
                 main = m;
                 loss_sum += loss;
                 loss_n += 1;
@@ -256,7 +315,8 @@ pub fn train(
         }
         if let Some(path) = &opts.checkpoint {
             if (episode + 1) % opts.checkpoint_every.max(1) == 0 {
-                SidqlPolicy { config: config.clone(), net: main.valid(), device: plain.clone() }.save(path)?;
+                let info = policy_info(config, opts, episode + 1, updates, t0.elapsed().as_secs_f64());
+                SidqlPolicy { info, net: main.valid(), device: plain.clone() }.save(path)?;
             }
         }
         bar.inc(1);
@@ -264,11 +324,23 @@ pub fn train(
     bar.finish();
     report.updates = updates;
     report.seconds = t0.elapsed().as_secs_f64();
-    let policy = SidqlPolicy { config: config.clone(), net: main.valid(), device: plain };
+    let info = policy_info(config, opts, opts.episodes, updates, report.seconds);
+    let policy = SidqlPolicy { info, net: main.valid(), device: plain };
     if let Some(path) = &opts.checkpoint {
         policy.save(path)?;
     }
     Ok((policy, report))
+}
+
+fn policy_info(config: &DqnConfig, opts: &TrainOptions, episodes: usize, updates: usize, seconds: f64) -> PolicyInfo {
+    PolicyInfo {
+        config: config.clone(),
+        trained_on: opts.data.clone(),
+        episodes,
+        updates,
+        seconds,
+        options: Some(TrainOptions { checkpoint: None, data: String::new(), ..opts.clone() }),
+    }
 }
 
 fn epsilon(opts: &TrainOptions, episode: usize) -> f64 {
@@ -301,19 +373,21 @@ fn update(
     env: &[EnvWindow],
     batch: &[Transition],
     opts: &TrainOptions,
-    config: &DqnConfig,
     ad: &Device,
     plain: &Device,
     scratch: &mut crate::error::Scratch,
 ) -> (QNet, f64) {
-    let input = config.input_size();
+    let frames = env[batch[0].window].frames();
+    let input = frames * INPUTS;
     let b = batch.len();
     let (mut states, mut nexts) = (Vec::with_capacity(b * input), Vec::with_capacity(b * input));
+    let mut scales = Vec::with_capacity(b);
     for t in batch {
-        env[t.window].state(t.mask, scratch, &mut states);
-        env[t.window].state(t.next_mask, scratch, &mut nexts);
+        let w = &env[t.window];
+        scales.push((w.state(t.mask, scratch, &mut states) / w.e0.max(1e-12)).max(1e-6) as f32);
+        w.state(t.next_mask, scratch, &mut nexts);
     }
-    let q_next = q_values(target, &nexts, b, input, plain);
+    let q_next = q_values(target, &nexts, b, frames, plain);
     let y: Vec<f32> = batch
         .iter()
         .enumerate()
@@ -321,16 +395,19 @@ fn update(
             if t.done {
                 return t.reward;
             }
-            let row = &q_next[i * config.frames..(i + 1) * config.frames];
-            t.reward + opts.gamma as f32 * row[best_action(row, t.next_mask, config.frames)]
+            let row = &q_next[i * frames..(i + 1) * frames];
+            t.reward + opts.gamma as f32 * row[best_action(row, t.next_mask, frames)]
         })
+        .zip(&scales)
+        .map(|(y, scale)| y / scale)
         .collect();
-    let x = Tensor::<2>::from_data(TensorData::new(states, [b, input]), ad);
+    let x = Tensor::<3>::from_data(TensorData::new(states, [b, frames, INPUTS]), ad);
     let actions = Tensor::<2, Int>::from_data(
         TensorData::new(batch.iter().map(|t| t.action as i64).collect::<Vec<_>>(), [b, 1]),
         ad,
     );
-    let q = main.forward(x).gather(1, actions);
+    // Both sides divided by E(s)/E(s₀) (see `QNet::forward_unscaled`).
+    let q = main.forward_unscaled(x).gather(1, actions);
     let y = Tensor::<2>::from_data(TensorData::new(y, [b, 1]), ad);
     let loss = huber.forward(q, y, Reduction::Mean);
     let value = f64::from(loss.clone().into_scalar::<f32>());
@@ -351,9 +428,9 @@ mod tests {
             .iter()
             .map(|m| SphericalMotion::from_motion(&JointFilter::paper().apply(m)).unwrap())
             .collect();
-        let config = DqnConfig { frames: 12, features_per_frame: 92, hidden: [32, 32, 16] };
+        let config = DqnConfig { hidden: [32, 32, 16], ..DqnConfig::default() };
         let opts =
-            TrainOptions { episodes: 150, max_keys: 5, batch: 16, lr: 1e-3, progress: false, ..TrainOptions::paper() };
+            TrainOptions { episodes: 150, max_keys: 5, batch: 16, progress: false, ..TrainOptions::paper() };
         let (policy, report) = train(&reps, &config, &opts).unwrap();
         assert!(report.updates > 100);
         assert!(report.loss_curve.iter().all(|l| l.is_finite()));
@@ -365,7 +442,25 @@ mod tests {
         let loaded = SidqlPolicy::load(&path).unwrap();
         assert_eq!(loaded.select(&reps[0], 4).unwrap(), keys);
         assert!(SidqlPolicy::load(&dir.path().join("missing.bpk")).is_err());
+        assert!(SidqlPolicy::from_bytes(b"not burnpack", b"{}", &path).is_err());
         // Its keys lower the error below the two-key start state.
         assert!(reps[0].error(&keys).mean_angle < reps[0].error(&KeyframeSet::new(vec![], 12).unwrap()).mean_angle);
+    }
+
+    #[test]
+    fn committed_policy_serves_any_skeleton_and_window_length() {
+        let policy = SidqlPolicy::committed().unwrap();
+        assert!(policy.info.trained_on.contains("procedural"), "{}", policy.info.trained_on);
+        let m = inbetween_core::procedural::gait(&inbetween_core::procedural::GaitParams {
+            frames: 40,
+            fps: 30.0,
+            ..inbetween_core::procedural::GaitParams::walk()
+        });
+        // All 31 joints (the policy was trained on 23) and 40 frames (trained on 60).
+        let rep = SphericalMotion::from_motion(&m).unwrap();
+        let keys = policy.select(&rep, 6).unwrap();
+        assert_eq!(keys.len(), 6);
+        let two = KeyframeSet::new(vec![], 40).unwrap();
+        assert!(rep.error(&keys).mean_angle < 0.5 * rep.error(&two).mean_angle);
     }
 }
