@@ -1,5 +1,6 @@
 //! The quick training run behind the committed weights, runnable without the CLI:
-//! `cargo run -p inbetween-camera --example train_quick -- MINUTES OUT.bpk CHECKPOINT_DIR [ITERS_PER_EPOCH] [BATCH] [STATIC_START]`.
+//! `cargo run -p inbetween-camera --example train_quick -- MINUTES OUT.bpk CHECKPOINT_DIR [ITERS_PER_EPOCH] [BATCH] [STATIC_START] [SCENES]`
+//! (`CAMERA_MAX_GAP` overrides the longest generated gap).
 //! (`inbetween camera train` is the full-featured front end.)
 
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
@@ -19,6 +20,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(p) = args.get(5) {
         cfg.static_start = p.parse()?;
+    }
+    if let Some(n) = args.get(6) {
+        cfg.scenes = n.parse()?;
+    }
+    if let Ok(g) = std::env::var("CAMERA_MAX_GAP") {
+        cfg.max_gap = g.parse()?;
     }
     let t0 = std::time::Instant::now();
     let mut report = |e: TrainEvent| match e {

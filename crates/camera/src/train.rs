@@ -1,11 +1,13 @@
 //! End-to-end training of extractor, generator and mapping (§4.4–4.5) with L = L_rec + L_K (Eq. 7),
-//! Adam, learning rate 1e-3 × 0.97 per epoch, checkpoints every epoch and resume.
+//! Adam, learning rate 1e-3 × 0.97 per epoch, checkpoints every epoch and resume. The norm of Eq. 7
+//! is smoothed at zero ([`LOSS_SMOOTHING`]) and each parameter's gradient is clipped to norm 1.
 //!
 //! Sampling (§4.5): every batch element draws a sequence of the synthetic dataset (downsampled ×5).
 //! The extractor reads a random 60-step (300-frame) window of it; the generator gets a random
 //! segment: five steps of ground-truth camera for H, then `gap` generated steps ending on the
-//! keyframe K (the segment's last step). `gap` is drawn per batch, so keyframe distances from 5 to
-//! 200+ frames are all trained. With probability `static_start` the five H frames are replaced by
+//! keyframe K (the segment's last step). `gap` is drawn per batch (4–60 steps by default), so
+//! keyframe distances from 20 to 300 frames are all trained, past the 200-frame tta cap and as long
+//! as the benchmark's 60-step segments. With probability `static_start` the five H frames are replaced by
 //! the start pose repeated (zero velocity): that is what inference feeds H when the user gives no
 //! velocity, so the generator learns to start from rest too.
 
@@ -15,6 +17,7 @@ use crate::model::generator::StepInput;
 use crate::model::{CameraModel, ModelConfig, MAP_FRAMES, STYLE_STEPS};
 use crate::CameraError;
 use burn::module::Module;
+use burn::optim::grad_clipping::GradientClippingConfig;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::store::ModuleRecord;
 use burn::tensor::{Bytes, Device, Tensor, TensorData};
@@ -39,6 +42,9 @@ pub struct TrainConfig {
     pub min_gap: usize,
     pub max_gap: usize,
     pub static_start: f64,
+    /// Clip each parameter's gradient to this L2 norm (none when absent; older summaries have none).
+    #[serde(default)]
+    pub grad_clip: Option<f32>,
     /// Stop after this many seconds (the epoch in progress is finished and saved).
     pub time_limit_s: Option<f64>,
     pub model: ModelConfig,
@@ -55,8 +61,9 @@ impl Default for TrainConfig {
             lr: 1e-3,
             lr_decay: 0.97,
             min_gap: 4,
-            max_gap: 40,
+            max_gap: 60,
             static_start: 0.3,
+            grad_clip: Some(1.0),
             time_limit_s: None,
             model: ModelConfig::default(),
         }
@@ -119,6 +126,7 @@ pub struct Batch {
     pub characters: Vec<Tensor<2>>,
     pub key: Tensor<2>,
     pub tta: Vec<Tensor<2>>,
+    pub arrival: Vec<Tensor<2>>,
     pub targets: Vec<Tensor<2>>,
 }
 
@@ -165,7 +173,9 @@ pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: u
             tta.embed_batch(&vec![frames; b], device)
         })
         .collect();
+    let arrival = (0..gap).map(|k| rows(vec![cfg.arrival_weight(((gap - 1 - k) * DOWNSAMPLE) as f32); b], 1, device)).collect();
     Batch {
+        arrival,
         style_steps: style.into_iter().map(|v| rows(v, CHAR_ENC + CAM_DIM, device)).collect(),
         map_frames: rows(map, MAP_FRAMES * CAM_DIM, device),
         start_camera: rows(start, CAM_DIM, device),
@@ -176,9 +186,17 @@ pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: u
     }
 }
 
-/// Mean over the batch of the per-row L2 norm (the ‖·‖₂ of Eq. 7).
+/// Smoothing scale ε of the training norm (x^c units), see [`mean_l2`].
+pub const LOSS_SMOOTHING: f32 = 0.05;
+
+/// Mean over the batch of the per-row L2 norm (the ‖·‖₂ of Eq. 7), smoothed at zero:
+/// √(‖e‖² + ε²) − ε, which is ‖e‖ − ε for errors well above ε = [`LOSS_SMOOTHING`] and ‖e‖²/2ε
+/// below. The plain norm's gradient has length 1 however small the error, so rows that are already
+/// right (a still camera, a track on the straight line) kept pushing every weight in random
+/// directions as hard as the rows that were wrong; smoothed, a row's push fades as it is learnt.
 fn mean_l2(a: Tensor<2>, b: Tensor<2>) -> Tensor<1> {
-    (a - b).powf_scalar(2.0).sum_dim(1).add_scalar(1e-8).sqrt().mean()
+    let eps = LOSS_SMOOTHING;
+    (a - b).powf_scalar(2.0).sum_dim(1).add_scalar(eps * eps).sqrt().sub_scalar(eps).mean()
 }
 
 /// Eq. 7 on one batch: returns (L, L_rec, L_K) with L differentiable.
@@ -189,8 +207,8 @@ pub fn batch_loss(model: &CameraModel, batch: Batch) -> (Tensor<1>, Tensor<1>, T
     let gap = batch.targets.len();
     let mut rec = Vec::with_capacity(gap);
     let mut last = None;
-    for ((ch, tta), target) in batch.characters.into_iter().zip(batch.tta).zip(batch.targets) {
-        let input = StepInput { style: z.clone(), prev_camera: prev, character: ch, key: batch.key.clone(), tta };
+    for (((ch, tta), arrival), target) in batch.characters.into_iter().zip(batch.tta).zip(batch.arrival).zip(batch.targets) {
+        let input = StepInput { style: z.clone(), prev_camera: prev, character: ch, key: batch.key.clone(), tta, arrival };
         let (cam, next) = model.generator.step(input, Some(state));
         state = next;
         rec.push(mean_l2(cam.clone(), target.clone()));
@@ -254,7 +272,7 @@ pub fn train(cfg: &TrainConfig, checkpoint_dir: Option<&Path>, progress: Progres
     let dataset = Dataset::generate(cfg.seed, cfg.scenes, crate::dataset::SCENE_FRAMES);
     let data = TrainData::from_dataset(&dataset);
     let mut model = cfg.model.init(&device);
-    let mut optim: ModuleOptimizer = AdamConfig::new().init();
+    let mut optim: ModuleOptimizer = AdamConfig::new().with_grad_clipping(cfg.grad_clip.map(GradientClippingConfig::Norm)).init();
     let mut summary = TrainSummary { config: cfg.clone(), epochs_done: 0, iterations: 0, seconds: 0.0, loss_history: vec![], final_loss: f64::NAN, lr: cfg.lr };
     if let Some(dir) = checkpoint_dir {
         std::fs::create_dir_all(dir).map_err(|source| CameraError::Io { path: dir.into(), source })?;
@@ -330,6 +348,8 @@ mod tests {
                 v
             })
             .collect();
-        assert!(losses[14] < losses[0] * 0.7, "loss {:?}", losses);
+        // The generator starts on the straight line to the key (arrival base), so the first loss
+        // is already that of Toric interpolation; training must still improve on it.
+        assert!(losses[14] < losses[0] * 0.85, "loss {:?}", losses);
     }
 }

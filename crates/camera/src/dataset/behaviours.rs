@@ -12,7 +12,10 @@
 //! - **Direct track**: the camera stays in front of the main character: seen from the main
 //!   character, the camera sits `offset` radians from the other character towards the camera side,
 //!   plus however far the main character's torso turns towards that side (σ, clamped to the arc).
-//!   Turning the torso swings the camera round to keep the face in view.
+//!   Turning the torso swings the camera round to keep the face in view. σ is folded,
+//!   σ' = atan2(sin σ, |cos σ|), so a character turning its back (σ through ±π) brings the camera
+//!   back towards its rest offset instead of flipping it across the arc (a discontinuity no
+//!   network can predict from the character features).
 //! - **Side track**: the camera sits on the bisector of AB (β = (π − α)/2, a profile two-shot) at a
 //!   constant world distance `distance` from their midpoint and does not zoom: the screen separation
 //!   w follows the characters' distance (α = 2·atan(d_AB / 2·distance)) instead of the camera.
@@ -156,7 +159,11 @@ pub fn film(
             Behaviour::Relative => p.arc,
             Behaviour::Direct => {
                 let (front, towards_other) = if main_is_a { (fa.front(), t) } else { (fb.front(), -t) };
-                let sigma = front.dot(s).atan2(front.dot(towards_other));
+                // Torso yaw towards the camera side, folded so that a character turning its back
+                // (σ through ±π) does not flip the camera from one end of the arc to the other:
+                // σ' = atan2(sin σ, |cos σ|) equals σ while the torso faces the other character
+                // (|σ| ≤ π/2) and returns to 0 as it turns fully away, continuously.
+                let sigma = front.dot(s).atan2(front.dot(towards_other).abs());
                 let arc = arc_of(w);
                 let beta_main = (p.offset + sigma).clamp(0.15, arc - 0.15);
                 let frac_main = beta_main / arc;
@@ -190,6 +197,9 @@ mod tests {
     use super::*;
     use crate::toric::to_pose;
     use rand::SeedableRng;
+
+    /// Bound on the direct track's θ change per frame with the shortest lag (radians).
+    const DIRECT_MAX_STEP: f64 = 0.25;
 
     fn params(seed: u64) -> BehaviourParams {
         BehaviourParams::sample(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed))
@@ -233,6 +243,23 @@ mod tests {
         let th: Vec<f64> = direct.iter().map(|x| x.theta).collect();
         let s_a: Vec<f64> = scene.character_features(0, 1, true).iter().map(|x| x.s_a).collect();
         assert!(correlation(&th, &s_a).abs() > 0.3, "direct track follows the main character's torso");
+    }
+
+    #[test]
+    fn direct_track_does_not_flip_when_the_main_character_turns_away() {
+        // Before σ was folded, a torso turning through ±π threw the camera across the whole arc
+        // within a few frames; now θ moves only as fast as the torso turns (plus the lag).
+        let lens = Lens::default();
+        let mut worst: f64 = 0.0;
+        for seed in 0..6 {
+            let scene = Scene::procedural(seed, 900, 30.0);
+            let p = BehaviourParams { lag: 0.2, ..params(seed) };
+            for main_is_a in [true, false] {
+                let th: Vec<f64> = film(&scene, 0, 1, main_is_a, Behaviour::Direct, &p, &lens).iter().map(|x| x.theta).collect();
+                worst = th.windows(2).map(|w| (w[1] - w[0]).abs()).fold(worst, f64::max);
+            }
+        }
+        assert!(worst < DIRECT_MAX_STEP, "largest θ change in one frame {worst}");
     }
 
     #[test]

@@ -6,8 +6,9 @@
 use super::ModelConfig;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
-use burn::tensor::activation::relu;
-use burn::tensor::{Device, Tensor};
+use burn::tensor::activation::leaky_relu;
+use burn::module::Param;
+use burn::tensor::{Device, Tensor, TensorData};
 use inbetween_nn::lstm::{FusedLstm, FusedLstmConfig, LstmState};
 
 #[derive(Module, Debug)]
@@ -17,6 +18,8 @@ pub struct Generator {
     pub lstm: FusedLstm,
     pub dec1: Linear,
     pub dec2: Linear,
+    /// Negative slope of the ReLUs (0: plain ReLU).
+    pub slope: f64,
 }
 
 /// Everything but the recurrent state that one generator step reads, each `[batch, ·]`.
@@ -27,6 +30,8 @@ pub struct StepInput {
     /// Next keyframe: x^c_K (6) then encoded x^v_K (8).
     pub key: Tensor<2>,
     pub tta: Tensor<2>,
+    /// `[batch, 1]`: [`ModelConfig::arrival_weight`] of this step's tta (zeros: plain residual).
+    pub arrival: Tensor<2>,
 }
 
 impl Generator {
@@ -37,17 +42,34 @@ impl Generator {
             enc2: LinearConfig::new(h, h).init(device),
             lstm: FusedLstmConfig::new(h, h).init(device),
             dec1: LinearConfig::new(h, h).init(device),
-            dec2: LinearConfig::new(h, crate::features::CAM_DIM).init(device),
+            dec2: small_output(LinearConfig::new(h, crate::features::CAM_DIM).init(device), device),
+            slope: c.leaky_slope as f64,
         }
     }
 
     /// One step: returns x̂^c_i (`[batch, 6]`) and the new LSTM state.
     pub fn step(&self, x: StepInput, state: Option<LstmState>) -> (Tensor<2>, LstmState) {
         let prev = x.prev_camera.clone();
+        let toward = (x.key.clone().narrow(1, 0, crate::features::CAM_DIM) - prev.clone()) * x.arrival;
         let input = Tensor::cat(vec![x.style, x.prev_camera, x.character, x.key, x.tta], 1);
-        let e = relu(self.enc2.forward(relu(self.enc1.forward(input))));
+        let act = |t: Tensor<2>| leaky_relu(t, self.slope);
+        let e = act(self.enc2.forward(act(self.enc1.forward(input))));
         let state = self.lstm.step(e, state);
-        let delta = self.dec2.forward(relu(self.dec1.forward(state.h.clone())));
-        (prev + delta, state)
+        let delta = self.dec2.forward(act(self.dec1.forward(state.h.clone())));
+        (prev + toward + delta, state)
     }
+}
+
+/// The output layer starts 10× smaller than burn's default, so the untrained generator stays near
+/// its base (the previous pose, or the straight line to the key) instead of drifting by ±0.1 a step.
+fn small_output(mut l: Linear, device: &Device) -> Linear {
+    // Rebuilt from plain data so the parameters stay leaves under autodiff.
+    let w = l.weight.val();
+    let dims = w.dims();
+    let values: Vec<f32> = w.into_data().try_to_vec::<f32>().unwrap_or_default().into_iter().map(|v| v * 0.1).collect();
+    l.weight = Param::from_data(TensorData::new(values, dims), device);
+    if let Some(b) = l.bias.take() {
+        l.bias = Some(Param::from_data(TensorData::new(vec![0.0f32; b.dims()[0]], [b.dims()[0]]), device));
+    }
+    l
 }

@@ -6,7 +6,7 @@ use super::{ModelConfig, MAP_FRAMES};
 use crate::features::CAM_DIM;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
-use burn::tensor::activation::relu;
+use burn::tensor::activation::leaky_relu;
 use burn::tensor::{Device, Tensor};
 use inbetween_nn::lstm::LstmState;
 
@@ -15,6 +15,8 @@ pub struct Mapping {
     pub fc1: Linear,
     pub fc2: Linear,
     pub hidden: usize,
+    /// Negative slope of the ReLU (0: plain ReLU).
+    pub slope: f64,
 }
 
 impl Mapping {
@@ -23,13 +25,14 @@ impl Mapping {
             fc1: LinearConfig::new(c.mapping_input(), c.hidden).init(device),
             fc2: LinearConfig::new(c.hidden, 2 * c.hidden).init(device),
             hidden: c.hidden,
+            slope: c.leaky_slope as f64,
         }
     }
 
     /// `z` is `[batch, 4]`, `frames` is `[batch, 5·6]` (x^c_0 … x^c_4 concatenated).
     pub fn forward(&self, z: Tensor<2>, frames: Tensor<2>) -> LstmState {
         debug_assert_eq!(frames.dims()[1], MAP_FRAMES * CAM_DIM);
-        let y = self.fc2.forward(relu(self.fc1.forward(Tensor::cat(vec![z, frames], 1))));
+        let y = self.fc2.forward(leaky_relu(self.fc1.forward(Tensor::cat(vec![z, frames], 1)), self.slope));
         LstmState { h: y.clone().narrow(1, 0, self.hidden), c: y.narrow(1, self.hidden, self.hidden) }
     }
 }

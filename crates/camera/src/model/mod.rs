@@ -8,7 +8,10 @@
 //! angles), x^c has the 6 values of Eq. 2, so the extractor sees 8 + 6 = 14 values per step and the
 //! generator z (4) + x^c_{i−1} (6) + x^v_i (8) + K (6 + 8) + z_tta (128) = 160, as in the paper.
 //! The generator predicts the change of x^c from the previous step (a residual): the same
-//! function as Eq. 3, easier to learn in a short CPU training.
+//! function as Eq. 3, easier to learn in a short CPU training. With `arrival_base` (default) the
+//! residual is taken from the straight Toric line to the next key instead (one step of it, a fixed
+//! function of x^c_{i−1}, K and tta, all inputs of Eq. 3), so an untrained correction gives plain
+//! Toric interpolation and the network only learns how the style departs from a line.
 
 pub mod extractor;
 pub mod generator;
@@ -36,11 +39,22 @@ pub struct ModelConfig {
     pub tta_dim: usize,
     /// tta cap in frames (§4.2: 200).
     pub tta_max: f32,
+    /// The generator's residual starts from the straight Toric line to the next key: x^c_i =
+    /// x^c_{i−1} + w·(x^c_K − x^c_{i−1}) + Δ with w = 5 / (min(tta, tta_max) + 5) (see
+    /// [`ModelConfig::arrival_weight`]); without it x^c_i = x^c_{i−1} + Δ. Weights saved before this
+    /// option existed read as `false`.
+    #[serde(default)]
+    pub arrival_base: bool,
+    /// Negative slope of the encoder / decoder / H activations: 0 is the paper's ReLU; a leaky
+    /// ReLU keeps a gradient through units that a short small-batch training would otherwise
+    /// switch off for good (see the README). Older summaries read as 0.
+    #[serde(default)]
+    pub leaky_slope: f32,
 }
 
 impl Default for ModelConfig {
     fn default() -> Self {
-        ModelConfig { hidden: 256, style_dim: 4, tta_dim: 128, tta_max: 200.0 }
+        ModelConfig { hidden: 256, style_dim: 4, tta_dim: 128, tta_max: 200.0, arrival_base: true, leaky_slope: 0.01 }
     }
 }
 
@@ -61,6 +75,17 @@ impl ModelConfig {
         inbetween_nn::tta::TtaEmbedding::new(self.tta_dim, self.tta_max)
     }
 
+    /// Share of the remaining way to the key that the straight line covers in this step:
+    /// `tta_frames` frames are left after it, so 1 at the key and 5 / (tta + 5) before (tta capped
+    /// like its embedding); 0 when [`ModelConfig::arrival_base`] is off.
+    pub fn arrival_weight(&self, tta_frames: f32) -> f32 {
+        if !self.arrival_base {
+            return 0.0;
+        }
+        let step = crate::dataset::DOWNSAMPLE as f32;
+        step / (tta_frames.clamp(0.0, self.tta_max) + step)
+    }
+
     pub fn init(&self, device: &Device) -> CameraModel {
         CameraModel {
             extractor: Extractor::new(self, device),
@@ -76,4 +101,22 @@ pub struct CameraModel {
     pub extractor: Extractor,
     pub generator: Generator,
     pub mapping: Mapping,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arrival_weight_reaches_one_at_the_key_and_is_off_for_old_configs() {
+        let c = ModelConfig::default();
+        assert_eq!(c.arrival_weight(0.0), 1.0);
+        assert!((c.arrival_weight(5.0) - 0.5).abs() < 1e-6);
+        assert!((c.arrival_weight(195.0) - 5.0 / 200.0).abs() < 1e-6);
+        assert_eq!(c.arrival_weight(400.0), c.arrival_weight(200.0), "capped like the tta embedding");
+        // Summaries written before the option existed load with the plain residual.
+        let old: ModelConfig = serde_json::from_str(r#"{"hidden":256,"style_dim":4,"tta_dim":128,"tta_max":200.0}"#).unwrap();
+        assert!(!old.arrival_base);
+        assert_eq!(old.arrival_weight(0.0), 0.0);
+    }
 }
