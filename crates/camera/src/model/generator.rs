@@ -1,7 +1,9 @@
 //! The autoregressive camera motion generator (§4.2, Eq. 3):
 //! x^c_i = f(z, x^c_{i−1}, x^v_i, K, z_tta, h_{i−1}) with an encoder of two FC+ReLU layers, a 256-unit
 //! LSTM and a decoder FC+ReLU, FC. K is the next keyframe's camera and character features and
-//! z_tta the time-to-arrival embedding (Eq. 4–5, tta capped at 200 frames).
+//! z_tta the time-to-arrival embedding (Eq. 4–5, tta capped at 200 frames). The ReLUs are leaky
+//! when `ModelConfig::leaky_slope` > 0, and the output is a residual on the previous pose, or on
+//! one step of the straight line to the key (`ModelConfig::arrival_base`).
 
 use super::ModelConfig;
 use burn::module::Module;

@@ -4,7 +4,7 @@
 //!
 //! Sizes follow Appendix A.1: extractor LSTM(14 → 256) + FC(256 → 4); generator FC+ReLU(160 → 256),
 //! FC+ReLU(256 → 256), LSTM(256 → 256), FC+ReLU(256 → 256), FC(256 → 6); mapping FC+ReLU(34 → 256),
-//! FC(256 → 2·256). Our inputs: x^v is encoded in 8 values (`features::CHAR_ENC`, sin/cos of the
+//! FC(256 → 2·256), each ReLU leaky with slope `leaky_slope` (0.01 by default, 0 = ReLU). Our inputs: x^v is encoded in 8 values (`features::CHAR_ENC`, sin/cos of the
 //! angles), x^c has the 6 values of Eq. 2, so the extractor sees 8 + 6 = 14 values per step and the
 //! generator z (4) + x^c_{i−1} (6) + x^v_i (8) + K (6 + 8) + z_tta (128) = 160, as in the paper.
 //! The generator predicts the change of x^c from the previous step (a residual): the same
