@@ -417,18 +417,22 @@ fn speed(model: &FastModel, seconds: f64) -> Speed {
     Speed { single_frames_per_s: single, batched_frames_per_s: batched, batch }
 }
 
-/// Runs the whole benchmark.
-pub fn run(model: &FastModel, cfg: &BenchConfig) -> BenchReport {
-    let lens = Lens::default();
-    let data = Dataset::generate(cfg.seed, cfg.scenes, crate::dataset::SCENE_FRAMES);
-    let seqs: Vec<EvalSeq> = data
+/// The held-out sequences of `scenes` procedural scenes (seed `seed`), downsampled and encoded.
+fn eval_sequences(seed: u64, scenes: usize) -> Vec<EvalSeq> {
+    Dataset::generate(seed, scenes, crate::dataset::SCENE_FRAMES)
         .sequences
         .iter()
         .map(|s| {
             let (chars, cams) = s.encoded(DOWNSAMPLE);
             EvalSeq { behaviour: s.behaviour, main_is_a: s.main_is_a, chars, cams }
         })
-        .collect();
+        .collect()
+}
+
+/// Runs the whole benchmark.
+pub fn run(model: &FastModel, cfg: &BenchConfig) -> BenchReport {
+    let lens = Lens::default();
+    let seqs = eval_sequences(cfg.seed, cfg.scenes);
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
     let styles: Vec<(Behaviour, bool, Vec<f32>)> = seqs.iter().map(|s| (s.behaviour, s.main_is_a, style_of(model, &s.chars[..STYLE_STEPS], &s.cams[..STYLE_STEPS]))).collect();
     let spread = style_spread(model, &seqs, &styles, &mut ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x51));
@@ -631,14 +635,7 @@ mod tests {
         // straight line to the key, overall and on orbit tracks (which a line cannot follow).
         let model = FastModel::committed().unwrap();
         let cfg = BenchConfig { seed: 4242, scenes: 1, windows_per_sequence: 2, ..BenchConfig::quick() };
-        let seqs: Vec<EvalSeq> = Dataset::generate(cfg.seed, cfg.scenes, crate::dataset::SCENE_FRAMES)
-            .sequences
-            .iter()
-            .map(|s| {
-                let (chars, cams) = s.encoded(DOWNSAMPLE);
-                EvalSeq { behaviour: s.behaviour, main_is_a: s.main_is_a, chars, cams }
-            })
-            .collect();
+        let seqs = eval_sequences(cfg.seed, cfg.scenes);
         let rows = table1(&model, &seqs, &cfg, &mut ChaCha8Rng::seed_from_u64(1));
         let mapped = rows.iter().map(|r| r.mapped).sum::<f64>() / rows.len() as f64;
         let lerp = rows.iter().map(|r| r.lerp).sum::<f64>() / rows.len() as f64;
