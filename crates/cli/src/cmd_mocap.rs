@@ -502,19 +502,24 @@ pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
     let rep = SphericalMotion::from_motion(&paper)?;
     let table = SegmentTable::full(&rep);
     let mut lines = vec!["mocap: procedural walk, 60 frames at 30 fps, 23 joints (paper representation)".to_string()];
+    let sidql = SidqlPolicy::committed()?;
     for k in [5, 10] {
         let opt = inbetween_mocap::select::optimal(&table, k, Objective::Angle)?;
         let uc = inbetween_mocap::select::uniform(60, k)?;
-        let (eo, eu) = (rep.error(&opt), rep.error(&uc));
+        let sq = sidql.select(&rep, k)?;
+        let (eo, eu, es) = (rep.error(&opt), rep.error(&uc), rep.error(&sq));
         lines.push(format!(
-            "  K={k:<2} optimal keys {:?}: angle err {:.4}, mean {:.2} cm, max {:.2} cm | uniform: {:.4}, {:.2} cm, {:.2} cm",
+            "  K={k:<2} optimal keys {:?}: angle err {:.4}, mean {:.2} cm, max {:.2} cm | uniform: {:.4}, {:.2} cm, {:.2} cm | SIDQL (committed policy): {:.4}, {:.2} cm, {:.2} cm",
             opt.frames(),
             eo.mean_angle,
             eo.mean_cm,
             eo.max_cm,
             eu.mean_angle,
             eu.mean_cm,
-            eu.max_cm
+            eu.max_cm,
+            es.mean_angle,
+            es.mean_cm,
+            es.max_cm
         ));
     }
     let c = codec::compress(&walk, Budget::MaxErrorCm(1.0), 15)?;
