@@ -121,4 +121,17 @@ fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
     assert!(text(&o).contains("committed policy (trained on: 24 procedural gaits"), "{}", text(&o));
     let o = inbetween(&["mocap", "bench", "--data", dir.path().join("none").to_str().unwrap()]);
     assert!(!o.status.success(), "{}", text(&o));
+    // One clip: no test split, so the table and the chart use all windows.
+    std::fs::remove_file(data.join("walk1.bvh")).unwrap();
+    let png = dir.path().join("bench.png").to_string_lossy().into_owned();
+    let o = inbetween(&["mocap", "bench", "--data", data.to_str().unwrap(), "--plot", &png, "--codec-bounds", "1"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("test split has no windows"), "{}", text(&o));
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    // A clip shorter than one window is refused with a reason, not a table of zeros.
+    let mut p = inbetween_core::procedural::GaitParams::walk();
+    p.frames = 40;
+    inbetween_io::write_bvh(&data.join("walk0.bvh"), &inbetween_core::procedural::gait(&p)).unwrap();
+    let o = inbetween(&["mocap", "bench", "--data", data.to_str().unwrap()]);
+    assert!(!o.status.success() && text(&o).contains("long enough"), "{}", text(&o));
 }
