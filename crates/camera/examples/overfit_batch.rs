@@ -8,7 +8,7 @@
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use inbetween_camera::dataset::{Dataset, Behaviour};
 use inbetween_camera::model::ModelConfig;
-use inbetween_camera::train::{batch_loss, sample_batch, TrainData};
+use inbetween_camera::train::{batch_loss, sample_batch, TrainData, LOSS_SMOOTHING};
 use rand::SeedableRng;
 
 fn main() {
@@ -48,7 +48,7 @@ fn main() {
             }
             avg_lerp += tot / gap as f32;
         }
-        let (loss, rec, lk) = if std::env::var("TF").is_ok() { tf_loss(&model, batch) } else { batch_loss(&model, batch) };
+        let (loss, rec, lk) = if std::env::var("TF").is_ok() { tf_loss(&model, batch) } else { batch_loss(&model, batch, LOSS_SMOOTHING) };
         let v = [loss.clone(), rec, lk].map(|t| t.into_scalar::<f32>());
         avg_net += v[1];
         let grads = GradientsParams::from_grads(loss.backward(), &model);

@@ -1,6 +1,8 @@
 //! The quick training run behind the committed weights, runnable without the CLI:
 //! `cargo run -p inbetween-camera --example train_quick -- MINUTES OUT.bpk CHECKPOINT_DIR [ITERS_PER_EPOCH] [BATCH] [STATIC_START] [SCENES]`
-//! (`CAMERA_MAX_GAP` overrides the longest generated gap).
+//! (`CAMERA_MAX_GAP` overrides the longest generated gap; `CAMERA_LR` the learning rate; `CAMERA_EPOCHS` the epoch count; `CAMERA_LOSS_EPS` the loss's ε;
+//! `CAMERA_LR_RESTART=1` restarts the decay schedule at the checkpoint's epoch, `CAMERA_LR_DECAY_FROM=N`
+//! at epoch N.)
 //! (`inbetween camera train` is the full-featured front end.)
 
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
@@ -26,6 +28,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Ok(g) = std::env::var("CAMERA_MAX_GAP") {
         cfg.max_gap = g.parse()?;
+    }
+    if let Ok(e) = std::env::var("CAMERA_LOSS_EPS") {
+        cfg.loss_smoothing = e.parse()?;
+    }
+    if let Ok(e) = std::env::var("CAMERA_EPOCHS") {
+        cfg.epochs = e.parse()?;
+    }
+    if let Ok(lr) = std::env::var("CAMERA_LR") {
+        cfg.lr = lr.parse()?;
+    }
+    if std::env::var("CAMERA_LR_RESTART").is_ok_and(|v| v == "1") {
+        cfg.lr_decay_from = train::epochs_done(&ckpt)?;
+    }
+    if let Ok(e) = std::env::var("CAMERA_LR_DECAY_FROM") {
+        cfg.lr_decay_from = e.parse()?;
     }
     let t0 = std::time::Instant::now();
     let mut report = |e: TrainEvent| match e {

@@ -38,6 +38,10 @@ pub struct TrainConfig {
     pub batch: usize,
     pub lr: f64,
     pub lr_decay: f64,
+    /// Epoch the ×`lr_decay` schedule counts from: 0 for a fresh run; a resumed run that sets it to
+    /// its first epoch restarts at `lr` (a warm restart) instead of where the old schedule had decayed to.
+    #[serde(default)]
+    pub lr_decay_from: usize,
     /// Generated steps between the start and the keyframe, drawn in this range per batch.
     pub min_gap: usize,
     pub max_gap: usize,
@@ -47,6 +51,9 @@ pub struct TrainConfig {
     pub grad_clip: Option<f32>,
     /// Stop after this many seconds (the epoch in progress is finished and saved).
     pub time_limit_s: Option<f64>,
+    /// ε of the smoothed training norm (see [`mean_l2`]); older summaries used [`LOSS_SMOOTHING`].
+    #[serde(default = "default_loss_smoothing")]
+    pub loss_smoothing: f32,
     pub model: ModelConfig,
 }
 
@@ -60,13 +67,22 @@ impl Default for TrainConfig {
             batch: 64,
             lr: 1e-3,
             lr_decay: 0.97,
+            lr_decay_from: 0,
             min_gap: 4,
             max_gap: 60,
             static_start: 0.3,
             grad_clip: Some(1.0),
             time_limit_s: None,
+            loss_smoothing: LOSS_SMOOTHING,
             model: ModelConfig::default(),
         }
+    }
+}
+
+impl TrainConfig {
+    /// Learning rate of `epoch`: `lr` × `lr_decay`^(epochs since `lr_decay_from`).
+    pub fn lr_at(&self, epoch: usize) -> f64 {
+        self.lr * self.lr_decay.powi(epoch.saturating_sub(self.lr_decay_from) as i32)
     }
 }
 
@@ -186,21 +202,24 @@ pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: u
     }
 }
 
-/// Smoothing scale ε of the training norm (x^c units), see [`mean_l2`].
+/// Default smoothing scale ε of the training norm (x^c units), see [`mean_l2`].
 pub const LOSS_SMOOTHING: f32 = 0.05;
 
+fn default_loss_smoothing() -> f32 {
+    LOSS_SMOOTHING
+}
+
 /// Mean over the batch of the per-row L2 norm (the ‖·‖₂ of Eq. 7), smoothed at zero:
-/// √(‖e‖² + ε²) − ε, which is ‖e‖ − ε for errors well above ε = [`LOSS_SMOOTHING`] and ‖e‖²/2ε
+/// √(‖e‖² + ε²) − ε, which is ‖e‖ − ε for errors well above ε (default [`LOSS_SMOOTHING`]) and ‖e‖²/2ε
 /// below. The plain norm's gradient has length 1 however small the error, so rows that are already
 /// right (a still camera, a track on the straight line) kept pushing every weight in random
 /// directions as hard as the rows that were wrong; smoothed, a row's push fades as it is learnt.
-fn mean_l2(a: Tensor<2>, b: Tensor<2>) -> Tensor<1> {
-    let eps = LOSS_SMOOTHING;
+fn mean_l2(a: Tensor<2>, b: Tensor<2>, eps: f32) -> Tensor<1> {
     (a - b).powf_scalar(2.0).sum_dim(1).add_scalar(eps * eps).sqrt().sub_scalar(eps).mean()
 }
 
 /// Eq. 7 on one batch: returns (L, L_rec, L_K) with L differentiable.
-pub fn batch_loss(model: &CameraModel, batch: Batch) -> (Tensor<1>, Tensor<1>, Tensor<1>) {
+pub fn batch_loss(model: &CameraModel, batch: Batch, eps: f32) -> (Tensor<1>, Tensor<1>, Tensor<1>) {
     let z = model.extractor.forward(&batch.style_steps);
     let mut state = model.mapping.forward(z.clone(), batch.map_frames);
     let mut prev = batch.start_camera;
@@ -211,13 +230,13 @@ pub fn batch_loss(model: &CameraModel, batch: Batch) -> (Tensor<1>, Tensor<1>, T
         let input = StepInput { style: z.clone(), prev_camera: prev, character: ch, key: batch.key.clone(), tta, arrival };
         let (cam, next) = model.generator.step(input, Some(state));
         state = next;
-        rec.push(mean_l2(cam.clone(), target.clone()));
+        rec.push(mean_l2(cam.clone(), target.clone(), eps));
         last = Some((cam.clone(), target));
         prev = cam;
     }
     let l_rec = Tensor::cat(rec, 0).mean();
     let (cam, target) = last.expect("gap ≥ 1");
-    let l_k = mean_l2(cam, target);
+    let l_k = mean_l2(cam, target, eps);
     (l_rec.clone() + l_k.clone(), l_rec, l_k)
 }
 
@@ -256,6 +275,17 @@ impl CheckpointPaths {
     }
 }
 
+/// Epochs already done by the checkpoint in `dir` (0 when it holds none): where a warm restart
+/// of the learning-rate schedule starts.
+pub fn epochs_done(dir: &Path) -> Result<usize, CameraError> {
+    let p = CheckpointPaths::in_dir(dir);
+    if !p.summary.exists() {
+        return Ok(0);
+    }
+    let summary: TrainSummary = crate::read_json(&p.summary)?;
+    Ok(summary.epochs_done)
+}
+
 /// Progress callback: (epoch, iteration in epoch, running loss).
 pub type Progress<'a> = &'a mut dyn FnMut(TrainEvent);
 
@@ -289,13 +319,13 @@ pub fn train(cfg: &TrainConfig, checkpoint_dir: Option<&Path>, progress: Progres
     let already = summary.seconds;
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed ^ (summary.epochs_done as u64).wrapping_mul(0x9e37_79b9));
     for epoch in summary.epochs_done..cfg.epochs {
-        let lr = cfg.lr * cfg.lr_decay.powi(epoch as i32);
+        let lr = cfg.lr_at(epoch);
         let mut total = 0.0;
         for iter in 0..cfg.iters_per_epoch {
             let gap = rng.random_range(cfg.min_gap..=cfg.max_gap);
             let which: Vec<usize> = (0..cfg.batch).map(|_| rng.random_range(0..data.len())).collect();
             let batch = sample_batch(&data, &cfg.model, &which, gap, cfg.static_start, &mut rng, &device);
-            let (loss, _, _) = batch_loss(&model, batch);
+            let (loss, _, _) = batch_loss(&model, batch, cfg.loss_smoothing);
             let value = loss.clone().into_scalar::<f32>() as f64;
             let grads = GradientsParams::from_grads(loss.backward(), &model);
             model = optim.step(lr, model, grads);
@@ -329,6 +359,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_warm_restart_starts_the_decay_again_at_the_resumed_epoch() {
+        let fresh = TrainConfig::default();
+        assert!((fresh.lr_at(0) - 1e-3).abs() < 1e-12);
+        assert!((fresh.lr_at(2) - 1e-3 * 0.97 * 0.97).abs() < 1e-12);
+        let restarted = TrainConfig { lr: 5e-4, lr_decay_from: 95, ..TrainConfig::default() };
+        assert!((restarted.lr_at(95) - 5e-4).abs() < 1e-12);
+        assert!((restarted.lr_at(96) - 5e-4 * 0.97).abs() < 1e-12);
+    }
+
+    #[test]
+    fn summaries_written_before_the_restart_and_smoothing_settings_read_with_their_old_meaning() {
+        let old = r#"{"seed":1,"scenes":96,"epochs":200,"iters_per_epoch":50,"batch":64,"lr":0.001,
+            "lr_decay":0.97,"min_gap":4,"max_gap":60,"static_start":0.3,"grad_clip":1.0,"time_limit_s":null,
+            "model":{"hidden":256,"style_dim":4,"tta_dim":128,"tta_max":200.0,"arrival_base":true,"leaky_slope":0.01}}"#;
+        let cfg: TrainConfig = serde_json::from_str(old).expect("old config parses");
+        assert_eq!(cfg.lr_decay_from, 0);
+        assert_eq!(cfg.loss_smoothing, LOSS_SMOOTHING);
+    }
+
+    #[test]
     fn a_few_steps_reduce_the_loss_on_a_fixed_batch() {
         let device = inbetween_nn::backend::cpu_autodiff();
         inbetween_nn::backend::seed(&device, 3);
@@ -341,7 +391,7 @@ mod tests {
             .map(|_| {
                 let mut rng = ChaCha8Rng::seed_from_u64(9);
                 let batch = sample_batch(&data, &cfg, &which, 6, 0.3, &mut rng, &device);
-                let (loss, _, _) = batch_loss(&model, batch);
+                let (loss, _, _) = batch_loss(&model, batch, LOSS_SMOOTHING);
                 let v = loss.clone().into_scalar::<f32>() as f64;
                 let grads = GradientsParams::from_grads(loss.backward(), &model);
                 model = optim.step(3e-3, model.clone(), grads);

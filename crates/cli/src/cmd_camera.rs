@@ -104,6 +104,12 @@ pub struct TrainArgs {
     /// Stop after this many minutes (the running epoch is finished and saved).
     #[arg(long)]
     pub minutes: Option<f64>,
+    /// Initial learning rate (decays ×0.97 per epoch).
+    #[arg(long, default_value_t = 1e-3)]
+    pub lr: f64,
+    /// When resuming, restart the learning-rate schedule at --lr instead of where it had decayed to.
+    #[arg(long)]
+    pub restart_lr: bool,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// LSTM / FC width (the paper: 256).
@@ -226,8 +232,12 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         iters_per_epoch: a.iters_per_epoch,
         batch: a.batch,
         time_limit_s: a.minutes.map(|m| m * 60.0),
+        lr: a.lr,
         ..TrainConfig::default()
     };
+    if a.restart_lr {
+        cfg.lr_decay_from = train::epochs_done(&a.checkpoints)?;
+    }
     cfg.model.hidden = a.hidden;
     let bar = crate::progress::bar((cfg.epochs * cfg.iters_per_epoch) as u64, "training");
     let mut report = |e: TrainEvent| match e {
