@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let data = Dataset::generate(seed, scenes, inbetween_camera::dataset::SCENE_FRAMES);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     // [net, lerp, hold, net with other z, net last-step miss, gt per-step motion]
-    let mut acc = vec![[0.0f64; 6]; 4];
+    let mut acc = [[0.0f64; 6]; 4];
     let mut n = [0usize; 4];
     let mut zs: Vec<Vec<f32>> = vec![];
     for s in &data.sequences {

@@ -126,6 +126,7 @@ enum Style {
 
 fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series], style: Style) -> Result<(), RenderError> {
     let (xr, yr) = data_ranges(title, series)?;
+    let legend_corner = emptiest_corner(series, &xr, &yr);
     render_png(path, title, |root| {
         let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
         let mut chart = ChartBuilder::on(root)
@@ -160,12 +161,34 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
                 .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
                 .margin(px(8))
                 .legend_area_size(px(30))
-                .position(SeriesLabelPosition::UpperRight)
+                .position(legend_corner)
                 .draw()
                 .map_err(e)?;
         }
         Ok(())
     })
+}
+
+/// The corner of the plot whose box (45% of the width, 40% of the height) covers the fewest data
+/// points, so the legend hides as little as possible (ties go to the upper right).
+fn emptiest_corner(series: &[Series], xr: &std::ops::Range<f64>, yr: &std::ops::Range<f64>) -> SeriesLabelPosition {
+    let (w, h) = ((xr.end - xr.start).max(1e-12), (yr.end - yr.start).max(1e-12));
+    let count = |right: bool, upper: bool| {
+        let points = series.iter().flat_map(|s| s.points.iter());
+        points
+            .filter(|&&(x, y)| {
+                let (fx, fy) = ((x - xr.start) / w, (y - yr.start) / h);
+                (if right { fx >= 0.55 } else { fx <= 0.45 }) && (if upper { fy >= 0.6 } else { fy <= 0.4 })
+            })
+            .count()
+    };
+    let corners = [
+        (SeriesLabelPosition::UpperRight, count(true, true)),
+        (SeriesLabelPosition::UpperLeft, count(false, true)),
+        (SeriesLabelPosition::LowerRight, count(true, false)),
+        (SeriesLabelPosition::LowerLeft, count(false, false)),
+    ];
+    corners.into_iter().min_by_key(|c| c.1).map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 /// Line chart of one or more curves (points joined in the given order).
@@ -269,6 +292,16 @@ fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_legend_goes_to_the_corner_without_data() {
+        let crowded_upper_right = Series { name: "a".into(), points: vec![(0.0, 0.0), (0.9, 0.9), (1.0, 1.0), (0.95, 0.8)], color: None };
+        let (xr, yr) = (0.0..1.0, 0.0..1.0);
+        let corner = emptiest_corner(std::slice::from_ref(&crowded_upper_right), &xr, &yr);
+        assert!(matches!(corner, SeriesLabelPosition::UpperLeft), "upper right holds 3 points, upper left none");
+        let empty = Series { name: "b".into(), points: vec![], color: None };
+        assert!(matches!(emptiest_corner(&[empty], &xr, &yr), SeriesLabelPosition::UpperRight));
+    }
 
     fn dark_pixels(img: &image::RgbImage, region: (u32, u32, u32, u32)) -> usize {
         let (x0, y0, x1, y1) = region;
