@@ -49,3 +49,26 @@ fn bad_inputs_are_clear_errors() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("unknown style `dolly`"), "{err}");
 }
+
+#[test]
+fn train_resumes_from_its_checkpoint_and_can_restart_the_learning_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    let (weights, ckpt) = (dir.path().join("w.bpk"), dir.path().join("ck"));
+    let small = ["--iters-per-epoch", "2", "--batch", "4", "--scenes", "1", "--hidden", "16"];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["camera", "train", "-o", s(&weights), "--checkpoints", s(&ckpt)];
+        args.extend_from_slice(&small);
+        args.extend_from_slice(extra);
+        let out = inbetween(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = std::fs::read_to_string(weights.with_extension("json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+    };
+    let first = run(&["--epochs", "1"]);
+    assert_eq!(first["epochs_done"], 1);
+    let resumed = run(&["--epochs", "2", "--lr", "5e-4", "--restart-lr"]);
+    assert_eq!(resumed["epochs_done"], 2, "the second run continues the first");
+    assert_eq!(resumed["iterations"], 4);
+    assert_eq!(resumed["config"]["lr_decay_from"], 1);
+    assert_eq!(resumed["lr"], 5e-4, "epoch 2 runs at the restarted rate, not 5e-4 × 0.97");
+}
