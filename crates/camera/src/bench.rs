@@ -152,6 +152,11 @@ fn roll(model: &FastModel, z: &[f32], mut state: State, start: Cam, chars: &[Chr
         let input = StepIn { style: z, prev, character: chars[t], key: key_vec(&kc, &chars[ki]), tta_frames: (ki - t) * DOWNSAMPLE };
         prev = model.step(&[input], &mut state)[0];
         out.push(prev);
+        // As in `infer::generate`: at an interior key H restarts the generator from the motion arriving there.
+        if t == ki && t < last {
+            let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| out[(out.len() + i).saturating_sub(MAP_FRAMES)]);
+            state = model.map_state(z, &frames);
+        }
     }
     out
 }

@@ -377,11 +377,14 @@ pub struct GenerateOptions {
     /// Add the blended key residuals so every keyframe is hit exactly (beyond the paper).
     pub exact_keys: bool,
     pub lens: Lens,
+    /// At a key with no user velocity, restart the generator through H from the motion arriving
+    /// there (otherwise the LSTM state runs on from the arrival).
+    pub remap_at_keys: bool,
 }
 
 impl Default for GenerateOptions {
     fn default() -> Self {
-        GenerateOptions { exact_keys: true, lens: Lens::default() }
+        GenerateOptions { exact_keys: true, lens: Lens::default(), remap_at_keys: true }
     }
 }
 
@@ -469,6 +472,13 @@ pub fn correct_to_keys(track: &mut [[f64; 6]], keys: &[(usize, [f64; 6])]) {
 /// Generates the camera between the first and last keyframe (to the scene's end with a single key)
 /// with style code `style`: the network runs every 5th frame (§4.5), cubic fill in between, keys
 /// snapped to that grid for the network and then hit exactly by correction.
+/// The last [`MAP_FRAMES`] steps of `history` (x^c every 5th frame; it starts with H's first input,
+/// so it is never shorter), H's input for the motion arriving at a key.
+fn arriving_frames(history: &[[f32; CAM_DIM]]) -> [[f32; CAM_DIM]; MAP_FRAMES] {
+    let start = history.len().saturating_sub(MAP_FRAMES);
+    std::array::from_fn(|i| history[(start + i).min(history.len().saturating_sub(1))])
+}
+
 pub fn generate(model: &FastModel, scene: &Scene, keys: &Keys, style: &[f32], style_name: &str, opts: &GenerateOptions, origin: &Path) -> Result<CameraTrack, CameraError> {
     let lens = opts.lens;
     let (keys, main) = keys.resolve(scene, &lens, origin)?;
@@ -497,6 +507,7 @@ pub fn generate(model: &FastModel, scene: &Scene, keys: &Keys, style: &[f32], st
     };
     let mut state = model.map_state(style, &map_frames(&keys[0]));
     let mut prev = start;
+    let mut history: Vec<[f32; CAM_DIM]> = map_frames(&keys[0]).to_vec();
     let mut samples: Vec<(usize, [f64; 6])> = vec![(first, keys[0].camera.to_array())];
     let mut pairs: Vec<(usize, (usize, usize))> = vec![(first, keys[0].pair)];
     let mut residuals = vec![KeyResidual { frame: first, residual: 0.0 }];
@@ -512,6 +523,7 @@ pub fn generate(model: &FastModel, scene: &Scene, keys: &Keys, style: &[f32], st
             let tta_frames = if keys.len() == 1 { model.config.tta_max as usize } else { end - f };
             let input = StepIn { style, prev, character: enc_char(f.min(last), target.pair), key: kv, tta_frames };
             prev = model.step(&[input], &mut state)[0];
+            history.push(prev);
             samples.push((f.min(last), decode_camera(&prev).to_array()));
         }
         if keys.len() > 1 {
@@ -521,9 +533,16 @@ pub fn generate(model: &FastModel, scene: &Scene, keys: &Keys, style: &[f32], st
             // The key frame itself carries the network's value; exact correction moves it onto the key.
             let lastf = samples.len() - 1;
             samples[lastf].0 = target.frame.min(last).max(samples[lastf.saturating_sub(1)].0 + 1);
-            if target.velocity.is_some() && ti + 1 < targets.len() {
-                state = model.map_state(style, &map_frames(target));
-                prev = encode_camera(&target.camera);
+            if ti + 1 < targets.len() {
+                if target.velocity.is_some() {
+                    state = model.map_state(style, &map_frames(target));
+                    prev = encode_camera(&target.camera);
+                } else if opts.remap_at_keys {
+                    // Training starts every segment from H, never from a state that has just arrived
+                    // at a key (tta = 0); re-mapping the motion that arrives keeps the camera moving
+                    // through the key instead of stopping and starting again.
+                    state = model.map_state(style, &arriving_frames(&history));
+                }
             }
         }
     }
@@ -851,6 +870,26 @@ mod tests {
         // the key at tta 0 and the trained correction must not throw it off.
         let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
         assert!(worst < 0.3, "network key miss {worst}");
+    }
+
+    #[test]
+    fn an_interior_key_restarts_the_generator_from_the_motion_arriving_there() {
+        let model = FastModel::committed().unwrap();
+        let scene = Scene::procedural(3, 300, 30.0);
+        let keys = example_keys(&scene, &[0, 150, 299]);
+        let orbit = &model.behaviour_styles(777, 1)[3].code;
+        let run = |remap_at_keys| {
+            let opts = GenerateOptions { exact_keys: false, remap_at_keys, ..Default::default() };
+            generate(&model, &scene, &keys, orbit, "orbit", &opts, Path::new("k")).unwrap()
+        };
+        let (remapped, ran_on) = (run(true), run(false));
+        // Up to the middle key nothing differs; after it only the state differs, and it must matter.
+        assert_eq!(remapped.frames[..=145], ran_on.frames[..=145]);
+        let after = |t: &CameraTrack| t.frames[200].toric.to_array();
+        let moved = (0..6).map(|i| (after(&remapped)[i] - after(&ran_on)[i]).abs()).fold(0.0, f64::max);
+        assert!(moved > 1e-4, "H's restart changes the second segment (by {moved})");
+        let worst = remapped.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+        assert!(worst < 0.3, "the restarted segment still lands near its key: miss {worst}");
     }
 
     #[test]
