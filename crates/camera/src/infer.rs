@@ -623,6 +623,8 @@ pub struct CausalCamera<'a> {
     last: [f32; CAM_DIM],
     velocity: [f32; CAM_DIM],
     key: Option<(usize, [f32; CAM_DIM + CHAR_ENC])>,
+    /// The last [`MAP_FRAMES`] network steps, H's input when the next key is announced.
+    recent: [[f32; CAM_DIM]; MAP_FRAMES],
 }
 
 impl<'a> CausalCamera<'a> {
@@ -642,11 +644,16 @@ impl<'a> CausalCamera<'a> {
             last: encode_camera(start),
             velocity: std::array::from_fn(|j| (v[j] * dt) as f32),
             key: None,
+            recent: frames,
         }
     }
 
-    /// The next keyframe: its frame, camera and the character features expected there.
+    /// The next keyframe: its frame, camera and the character features expected there. Replacing a
+    /// key restarts the generator through H from the motion so far, as `generate` does at its keys.
     pub fn set_key(&mut self, frame: usize, camera: &Toric, character: &CharacterFeatures) {
+        if self.key.is_some() {
+            self.state = self.model.map_state(&self.style, &self.recent);
+        }
         let mut v = [0.0; CAM_DIM + CHAR_ENC];
         v[..CAM_DIM].copy_from_slice(&encode_camera(camera));
         v[CAM_DIM..].copy_from_slice(&encode_character(character));
@@ -673,6 +680,8 @@ impl<'a> CausalCamera<'a> {
             let next = self.model.step(&[input], &mut self.state)[0];
             self.velocity = std::array::from_fn(|j| next[j] - self.last[j]);
             self.last = next;
+            self.recent.rotate_left(1);
+            self.recent[MAP_FRAMES - 1] = next;
             return decode_camera(&next);
         }
         let u = phase as f32 / DOWNSAMPLE as f32;
@@ -841,6 +850,23 @@ mod tests {
             assert!((0..6).all(|j| (got[j] - prev[j]).abs() < 1e-6), "frame {f}");
         }
         assert!(out.iter().all(|t| t.theta.is_finite()));
+    }
+
+    #[test]
+    fn causal_mode_restarts_through_h_from_its_last_steps_when_the_next_key_is_announced() {
+        let (_, fast) = small();
+        let scene = Scene::procedural(6, 60, 30.0);
+        let feats = scene.character_features(0, 1, true);
+        let keys = example_keys(&scene, &[0, 30, 59]);
+        let style = [0.1f32, 0.0, -0.2, 0.3];
+        let mut live = CausalCamera::new(&fast, &style, &keys.keys[0].camera, None, 30.0);
+        live.set_key(30, &keys.keys[1].camera, &feats[30]);
+        let out: Vec<Toric> = (1..=30).map(|f| live.push(&feats[f])).collect();
+        let steps: [[f32; CAM_DIM]; MAP_FRAMES] = std::array::from_fn(|i| encode_camera(&out[10 + 5 * i - 1]));
+        live.set_key(59, &keys.keys[2].camera, &feats[59]);
+        let expected = fast.map_state(&style, &steps);
+        let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
+        assert!(close(&live.state.h, &expected.h) && close(&live.state.c, &expected.c), "H re-mapped the last five network steps");
     }
 
     #[test]
