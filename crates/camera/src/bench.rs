@@ -154,8 +154,7 @@ fn roll(model: &FastModel, z: &[f32], mut state: State, start: Cam, chars: &[Chr
         out.push(prev);
         // As in `infer::generate`: at an interior key H restarts the generator from the motion arriving there.
         if t == ki && t < last {
-            let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| out[(out.len() + i).saturating_sub(MAP_FRAMES)]);
-            state = model.map_state(z, &frames);
+            state = model.map_state(z, &crate::infer::arriving_frames(&out));
         }
     }
     out

@@ -469,16 +469,15 @@ pub fn correct_to_keys(track: &mut [[f64; 6]], keys: &[(usize, [f64; 6])]) {
     }
 }
 
+/// H's input for the motion arriving at a key: the last [`MAP_FRAMES`] network steps of a non-empty
+/// `history` (x^c every 5th frame), padded at the front with its first step when it is shorter.
+pub(crate) fn arriving_frames(history: &[[f32; CAM_DIM]]) -> [[f32; CAM_DIM]; MAP_FRAMES] {
+    std::array::from_fn(|i| history[(history.len() + i).saturating_sub(MAP_FRAMES)])
+}
+
 /// Generates the camera between the first and last keyframe (to the scene's end with a single key)
 /// with style code `style`: the network runs every 5th frame (§4.5), cubic fill in between, keys
 /// snapped to that grid for the network and then hit exactly by correction.
-/// The last [`MAP_FRAMES`] steps of `history` (x^c every 5th frame; it starts with H's first input,
-/// so it is never shorter), H's input for the motion arriving at a key.
-fn arriving_frames(history: &[[f32; CAM_DIM]]) -> [[f32; CAM_DIM]; MAP_FRAMES] {
-    let start = history.len().saturating_sub(MAP_FRAMES);
-    std::array::from_fn(|i| history[(start + i).min(history.len().saturating_sub(1))])
-}
-
 pub fn generate(model: &FastModel, scene: &Scene, keys: &Keys, style: &[f32], style_name: &str, opts: &GenerateOptions, origin: &Path) -> Result<CameraTrack, CameraError> {
     let lens = opts.lens;
     let (keys, main) = keys.resolve(scene, &lens, origin)?;
@@ -916,6 +915,14 @@ mod tests {
         assert!(moved > 1e-4, "H's restart changes the second segment (by {moved})");
         let worst = remapped.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
         assert!(worst < 0.3, "the restarted segment still lands near its key: miss {worst}");
+    }
+
+    #[test]
+    fn arriving_frames_are_the_last_five_steps_padded_at_the_front() {
+        let steps: Vec<[f32; CAM_DIM]> = (0..7).map(|i| [i as f32; CAM_DIM]).collect();
+        let firsts = |h: &[[f32; CAM_DIM]]| arriving_frames(h).map(|x| x[0]);
+        assert_eq!(firsts(&steps), [2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(firsts(&steps[..2]), [0.0, 0.0, 0.0, 0.0, 1.0]);
     }
 
     #[test]
