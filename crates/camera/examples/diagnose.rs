@@ -1,20 +1,13 @@
 //! Diagnostics of a trained model against trivial baselines on the training-loss scale:
-//! `cargo run -p inbetween-camera --example diagnose -- [WEIGHTS.bpk] [SEED] [SCENES]`.
+//! `cargo run -p inbetween-camera --example diagnose -- [WEIGHTS.bpk|committed] [SEED] [SCENES] [GAP]`.
 //! Per behaviour: mean per-step ‖Δx^c‖₂ of the network (mapped H from the 5 real frames, z from a
 //! window of the same sequence), of Toric lerp to the key, and of holding the start pose; plus the
 //! spread of the per-step ground-truth change and how much z changes the output.
 
 use inbetween_camera::dataset::{Dataset, BEHAVIOURS, DOWNSAMPLE};
-use inbetween_camera::features::{CAM_DIM, CHAR_ENC};
-use inbetween_camera::infer::{FastModel, StepIn};
+use inbetween_camera::infer::{cam_distance as err, Cam, FastModel, Rollout};
 use inbetween_camera::model::{MAP_FRAMES, STYLE_STEPS};
 use rand::{Rng, SeedableRng};
-
-type Cam = [f32; CAM_DIM];
-
-fn err(a: &Cam, b: &Cam) -> f64 {
-    a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -44,22 +37,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let s0 = rng.random_range(0..=x.len() - MAP_FRAMES - gap);
             let last = s0 + MAP_FRAMES - 1;
             let kf = last + gap;
-            let mut key = [0.0; CAM_DIM + CHAR_ENC];
-            key[..CAM_DIM].copy_from_slice(&x[kf]);
-            key[CAM_DIM..].copy_from_slice(&c[kf]);
             let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| x[s0 + i]);
-            let run = |zz: &[f32]| {
-                let mut st = model.map_state(zz, &frames);
-                let mut prev = x[last];
-                let mut out = vec![];
-                for k in 0..gap {
-                    let t = last + 1 + k;
-                    let inp = StepIn { style: zz, prev, character: c[t], key, tta_frames: (kf - t) * DOWNSAMPLE };
-                    prev = model.step(&[inp], &mut st)[0];
-                    out.push(prev);
-                }
-                out
-            };
+            // Steps 1..=gap after `last`, the key at the end; drop the start.
+            let run = |zz: &[f32]| Rollout::mapped(&model, zz, &frames).through_keys(&c[last..=kf], &[(gap, x[kf])])[1..].to_vec();
             let net = run(&z);
             let alt = run(other);
             let b = s.behaviour.index();

@@ -19,17 +19,15 @@
 //!   spaced ground-truth keys: the smallest n whose spline error is at most ours.
 
 use crate::dataset::{Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE};
-use crate::features::{CAM_DIM, CHAR_ENC};
-use crate::infer::{cubic_fill, FastModel, State, StepIn};
+use crate::infer::{cam_distance as err, key_vector, Cam, Chr, FastModel, Rollout, Scratch, StepIn};
 use crate::model::{MAP_FRAMES, STYLE_STEPS};
 use crate::toric::Lens;
+use inbetween_core::curve::{Curve, Samples, Track};
+use inbetween_nn::runtime::LstmState;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
-
-type Cam = [f32; CAM_DIM];
-type Chr = [f32; CHAR_ENC];
 
 /// Which benchmark size to run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -126,38 +124,15 @@ struct EvalSeq {
     cams: Vec<Cam>,
 }
 
-fn err(a: &Cam, b: &Cam) -> f64 {
-    a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()
-}
-
 fn mean_err(a: &[Cam], b: &[Cam]) -> f64 {
     a.iter().zip(b).map(|(x, y)| err(x, y)).sum::<f64>() / a.len().max(1) as f64
 }
 
-fn key_vec(cam: &Cam, ch: &Chr) -> [f32; CAM_DIM + CHAR_ENC] {
-    let mut v = [0.0; CAM_DIM + CHAR_ENC];
-    v[..CAM_DIM].copy_from_slice(cam);
-    v[CAM_DIM..].copy_from_slice(ch);
-    v
-}
-
-/// Generates steps 1..=last from `start` (index 0) with keys at the given indices (the last one is
-/// `last`); returns all `last + 1` steps, index 0 being `start`.
-fn roll(model: &FastModel, z: &[f32], mut state: State, start: Cam, chars: &[Chr], keys: &[(usize, Cam)]) -> Vec<Cam> {
-    let last = keys.last().map_or(0, |k| k.0);
-    let mut out = vec![start];
-    let mut prev = start;
-    for t in 1..=last {
-        let &(ki, kc) = keys.iter().find(|(i, _)| *i >= t).expect("a key at the end");
-        let input = StepIn { style: z, prev, character: chars[t], key: key_vec(&kc, &chars[ki]), tta_frames: (ki - t) * DOWNSAMPLE };
-        prev = model.step(&[input], &mut state)[0];
-        out.push(prev);
-        // As in `infer::generate`: at an interior key H restarts the generator from the motion arriving there.
-        if t == ki && t < last {
-            state = model.map_state(z, &crate::infer::arriving_frames(&out));
-        }
-    }
-    out
+/// Generates from the last of the five `context` steps (H's input) through `keys` (step indices
+/// into `chars`, the last key last); returns all steps, the start first.
+fn roll(model: &FastModel, z: &[f32], context: &[Cam], chars: &[Chr], keys: &[(usize, Cam)]) -> Vec<Cam> {
+    let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| context[i]);
+    Rollout::mapped(model, z, &frames).through_keys(chars, keys)
 }
 
 fn style_of(model: &FastModel, chars: &[Chr], cams: &[Cam]) -> Vec<f32> {
@@ -166,17 +141,13 @@ fn style_of(model: &FastModel, chars: &[Chr], cams: &[Cam]) -> Vec<f32> {
 
 /// Bends `track` onto `keys` (index, value) by linearly blended residuals (Eq. 9).
 fn bend(track: &mut [Cam], keys: &[(usize, Cam)]) {
-    let mut t64: Vec<[f64; 6]> = track.iter().map(|c| c.map(|v| v as f64)).collect();
-    let k64: Vec<(usize, [f64; 6])> = keys.iter().map(|(i, c)| (*i, c.map(|v| v as f64))).collect();
-    crate::infer::correct_to_keys(&mut t64, &k64);
-    for (d, s) in track.iter_mut().zip(t64) {
-        *d = s.map(|v| v as f32);
+    let values = track.iter().map(|c| c.map(|v| v as f64)).collect();
+    let Ok(samples) = Samples::new(0.0, 1.0, values) else { return };
+    let k64: Vec<(f64, [f64; 6])> = keys.iter().map(|(i, c)| (*i as f64, c.map(|v| v as f64))).collect();
+    let bent = samples.corrected_to_keys(&k64);
+    for (i, d) in track.iter_mut().enumerate() {
+        *d = bent.sample(i as f64).map(|v| v as f32);
     }
-}
-
-fn mapped_state(model: &FastModel, z: &[f32], context: &[Cam]) -> State {
-    let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| context[i]);
-    model.map_state(z, &frames)
 }
 
 fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng) -> Vec<Table1Row> {
@@ -192,18 +163,22 @@ fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaC
             let chars = &s.chars[base..=base + gap];
             let truth = &s.cams[base..=base + gap];
             let keys = [(gap, truth[gap])];
-            let gaussian = State { h: (0..hd).map(|_| normal(rng)).collect(), c: (0..hd).map(|_| normal(rng)).collect() };
-            let mut warm = State::zeros(1, hd);
+            let gaussian = LstmState { h: (0..hd).map(|_| normal(rng)).collect(), c: (0..hd).map(|_| normal(rng)).collect() };
+            // Warm start: from a zero state the generator reads the context steps (teacher forced).
+            let mut warm = Rollout::with_state(model, &z, LstmState::zeros(1, hd), s.cams[s0]);
+            let key = key_vector(&truth[gap], &chars[gap]);
             for t in s0 + 1..=base {
-                let input = StepIn { style: &z, prev: s.cams[t - 1], character: s.chars[t], key: key_vec(&truth[gap], &chars[gap]), tta_frames: (base + gap - t) * DOWNSAMPLE };
-                model.step(&[input], &mut warm);
+                warm.set_prev(s.cams[t - 1]);
+                warm.step(&s.chars[t], &key, (base + gap - t) * DOWNSAMPLE);
             }
-            let states = [State::zeros(1, hd), gaussian, warm, mapped_state(model, &z, &s.cams[s0..s0 + MAP_FRAMES])];
             let b = s.behaviour.index();
-            for (m, st) in states.into_iter().enumerate() {
-                let out = roll(model, &z, st, truth[0], chars, &keys);
+            let starts = [LstmState::zeros(1, hd), gaussian, warm.state().clone()];
+            for (m, st) in starts.into_iter().enumerate() {
+                let out = Rollout::with_state(model, &z, st, truth[0]).through_keys(chars, &keys);
                 sums[b][m] += mean_err(&out[1..], &truth[1..]);
             }
+            let out = roll(model, &z, &s.cams[s0..s0 + MAP_FRAMES], chars, &keys);
+            sums[b][3] += mean_err(&out[1..], &truth[1..]);
             sums[b][4] += mean_err(&lerp_track(&truth[0], &truth[gap], gap)[1..], &truth[1..]);
             counts[b] += 1;
         }
@@ -288,16 +263,16 @@ fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, r
             let key_d = displaced(&truth[len], delta, lens, rng);
             let disp_keys = [(0, truth[0]), (len, key_d)];
             let ctx = &s.cams[*s0..s0 + MAP_FRAMES];
-            let regenerate = |zr: &[f32]| roll(model, zr, mapped_state(model, zr, ctx), truth[0], chars, &true_keys);
+            let regenerate = |zr: &[f32]| roll(model, zr, ctx, chars, &true_keys);
             // Ours.
-            let mut x1 = roll(model, z, mapped_state(model, z, ctx), truth[0], chars, &[(len, key_d)]);
+            let mut x1 = roll(model, z, ctx, chars, &[(len, key_d)]);
             kd += err(&x1[len], &key_d);
             bend(&mut x1, &disp_keys);
             let zr = style_of(model, &chars[1..], &x1[1..]);
             td[0] += mean_err(&regenerate(&zr)[1..], &truth[1..]);
             ours.push((s.behaviour, z.clone(), zr));
             // Only style.
-            let mut x2 = roll(model, z, mapped_state(model, z, ctx), truth[0], chars, &true_keys);
+            let mut x2 = roll(model, z, ctx, chars, &true_keys);
             bend(&mut x2, &disp_keys);
             let zr = style_of(model, &chars[1..], &x2[1..]);
             td[1] += mean_err(&regenerate(&zr)[1..], &truth[1..]);
@@ -333,15 +308,17 @@ fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCh
         let truth = &s.cams[base..=base + len];
         let z = style_of(model, &chars[1..], &truth[1..]);
         let keys = [(len / 2, truth[len / 2]), (len, truth[len])];
-        let mut ours = roll(model, &z, mapped_state(model, &z, &s.cams[s0..s0 + MAP_FRAMES]), truth[0], chars, &keys);
+        let mut ours = roll(model, &z, &s.cams[s0..s0 + MAP_FRAMES], chars, &keys);
         bend(&mut ours, &[(0, truth[0]), keys[0], keys[1]]);
         let e_ours = mean_err(&ours, truth);
         let mut needed = cfg.max_spline_keys;
         let mut capped = 1;
         for n in 2..=cfg.max_spline_keys {
             let idx: Vec<usize> = (0..n).map(|i| (i * len + (n - 1) / 2) / (n - 1)).collect();
-            let samples: Vec<(usize, [f64; 6])> = idx.iter().map(|&i| (i, truth[i].map(|v| v as f64))).collect();
-            let spline: Vec<Cam> = cubic_fill(&samples).into_iter().map(|x| x.map(|v| v as f32)).collect();
+            let times: Vec<f64> = idx.iter().map(|&i| i as f64).collect();
+            let values: Vec<[f64; 6]> = idx.iter().map(|&i| truth[i].map(|v| v as f64)).collect();
+            let Ok(curve) = Track::catmull_rom(&times, &values) else { continue };
+            let spline: Vec<Cam> = (0..=len).map(|t| curve.sample(t as f64).map(|v| v as f32)).collect();
             if mean_err(&spline, truth) <= e_ours {
                 needed = n;
                 capped = 0;
@@ -381,7 +358,7 @@ fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool,
         let base = s0 + MAP_FRAMES - 1;
         let chars = &s.chars[base..=base + len];
         let truth = &s.cams[base..=base + len];
-        let tracks: Vec<Vec<Cam>> = codes.iter().map(|z| roll(model, z, mapped_state(model, z, &[truth[0]; MAP_FRAMES]), truth[0], chars, &[(len, truth[len])])).collect();
+        let tracks: Vec<Vec<Cam>> = codes.iter().map(|z| roll(model, z, &[truth[0]; MAP_FRAMES], chars, &[(len, truth[len])])).collect();
         for i in 0..tracks.len() {
             for j in i + 1..tracks.len() {
                 total += mean_err(&tracks[i], &tracks[j]);
@@ -395,25 +372,26 @@ fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool,
 fn speed(model: &FastModel, seconds: f64) -> Speed {
     let scene = crate::dataset::Scene::procedural(42, 900, 30.0);
     let keys = crate::infer::example_keys(&scene, &[0, 299, 599, 899]);
-    let z = vec![0.0; model.config.style_dim];
-    let opts = crate::infer::GenerateOptions::default();
-    let origin = std::path::Path::new("bench");
+    let style = crate::infer::Style { name: "bench".into(), code: vec![0.0; model.config.style_dim] };
+    let job = crate::infer::GenerateJob { model, scene: &scene, keys: &keys, style: &style, options: Default::default(), origin: std::path::Path::new("bench") };
     let t0 = Instant::now();
     let mut frames = 0usize;
     while t0.elapsed().as_secs_f64() < seconds * 0.5 || frames == 0 {
-        let track = crate::infer::generate(model, &scene, &keys, &z, "bench", &opts, origin).expect("bench generation");
+        // The built-in scene and keys are valid; a failure would leave the count at 0 and stop.
+        let Ok(track) = job.run() else { break };
         frames += track.frames.len();
     }
     let single = frames as f64 / t0.elapsed().as_secs_f64();
     let batch = 16;
-    let mut state = State::zeros(batch, model.config.hidden);
-    let input = StepIn { style: &z, prev: [-0.3, 0.1, 0.3, 0.1, 1.5, 0.2], character: [0.4, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 1.0], key: [0.1; 14], tta_frames: 100 };
+    let mut state = LstmState::zeros(batch, model.config.hidden);
+    let input = StepIn { style: &style.code, prev: [-0.3, 0.1, 0.3, 0.1, 1.5, 0.2], character: [0.4, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 1.0], key: [0.1; 14], tta_frames: 100 };
     let inputs = vec![input; batch];
+    let mut scratch = Scratch::for_rows(model, batch);
     let t1 = Instant::now();
     let mut steps = 0usize;
     while t1.elapsed().as_secs_f64() < seconds * 0.5 || steps == 0 {
         for _ in 0..20 {
-            model.step(&inputs, &mut state);
+            model.step_into(&inputs, &mut state, &mut scratch);
         }
         steps += 20;
     }
@@ -648,18 +626,45 @@ mod tests {
         assert!(orbit.mapped < 0.6 * orbit.lerp, "orbit: mapped {} vs lerp {}", orbit.mapped, orbit.lerp);
     }
 
-    #[test]
-    fn bench_runs_on_a_tiny_model() {
+    fn tiny_model() -> FastModel {
         let device = inbetween_nn::backend::cpu();
         let cfg = crate::model::ModelConfig { hidden: 8, tta_dim: 8, ..Default::default() };
-        let model = FastModel::from_burn(&cfg.init(&device), cfg);
-        let bc = BenchConfig { scenes: 1, displacements: vec![0.0, 1.0], max_spline_keys: 6, speed_seconds: 0.05, ..BenchConfig::quick() };
-        let r = run(&model, &bc);
-        assert_eq!(r.table1.len(), 4);
-        assert_eq!(r.table2.len(), 2);
-        assert!(r.table1.iter().all(|row| row.mapped.is_finite() && row.zero > 0.0 && row.lerp.is_finite()));
-        assert!(r.speed.single_frames_per_s > 0.0);
-        // TD of plain interpolation does not depend on the displaced key.
-        assert!((r.table2[0].td_interpolation - r.table2[1].td_interpolation).abs() < 1e-12);
+        FastModel::from_burn(&inbetween_nn::backend::seeded_module(&device, 8, |d| cfg.init(d)), cfg)
+    }
+
+    fn tiny_config() -> BenchConfig {
+        BenchConfig { scenes: 1, displacements: vec![0.0, 1.0], max_spline_keys: 6, speed_seconds: 0.05, ..BenchConfig::quick() }
+    }
+
+    #[test]
+    fn a_generator_that_predicts_no_correction_scores_exactly_as_toric_interpolation() {
+        // With the arrival base and a zero decoder output, every step is one step of the straight
+        // Toric line to the key (within the tta cap), whatever the state or style: each Table 1
+        // column (40 steps = 200 frames) must equal the lerp column, the network must land on
+        // displaced keys (KD 0) and the style must have no effect. Any misaligned window, key,
+        // tta or restart in the bench's bookkeeping breaks these equalities.
+        let mut model = tiny_model();
+        model.dec2.w.iter_mut().for_each(|w| *w = 0.0);
+        model.dec2.b.iter_mut().for_each(|b| *b = 0.0);
+        let r = run(&model, &tiny_config());
+        for row in &r.table1 {
+            for (name, v) in [("zero", row.zero), ("gaussian", row.gaussian), ("warm", row.warm_start), ("mapped", row.mapped)] {
+                assert!((v - row.lerp).abs() < 1e-5, "{} {name}: {v} vs lerp {}", row.behaviour, row.lerp);
+            }
+        }
+        assert!(r.table1.iter().any(|row| row.lerp > 0.01), "the windows move: the check is not 0 = 0");
+        // Table 2's 60-step segments start beyond the 200-frame tta cap, where one step of the
+        // arrival base is shorter than the line's: only the landing (KD) is exact there, and the
+        // style, having no effect, cannot separate ours from only-style.
+        for row in &r.table2 {
+            assert!(row.kd_ours < 1e-5, "δ {}: KD {}", row.displacement, row.kd_ours);
+            assert_eq!(row.td_ours, row.td_only_style, "{row:?}");
+        }
+        assert!(r.style_spread < 1e-6, "style spread {}", r.style_spread);
+        // The same tiny model with its (random) decoder departs from the line and styles differ.
+        let r = run(&tiny_model(), &tiny_config());
+        let departs = r.table1.iter().map(|row| (row.mapped - row.lerp).abs()).fold(0.0, f64::max);
+        assert!(departs > 1e-4 && r.style_spread > 1e-5, "departure {departs}, style spread {}", r.style_spread);
+        assert!(r.speed.single_frames_per_s > 0.0 && r.speed.batched_frames_per_s > 0.0);
     }
 }

@@ -124,7 +124,8 @@ mod tests {
         let cfg = crate::model::ModelConfig { hidden: 8, tta_dim: 8, ..Default::default() };
         let model = crate::infer::FastModel::from_burn(&cfg.init(&device), cfg);
         let keys = crate::infer::example_keys(&scene, &[0, 59]);
-        let track = crate::infer::generate(&model, &scene, &keys, &[0.0; 4], "t", &Default::default(), std::path::Path::new("k")).unwrap();
+        let style = crate::infer::Style { name: "t".into(), code: vec![0.0; 4] };
+        let track = crate::infer::GenerateJob::new(&model, &scene, &keys, &style).run().unwrap();
         let doc = camera_gltf(&track, &scene);
         let accessors = doc["accessors"].as_array().unwrap();
         assert_eq!(accessors[0]["count"], 60);

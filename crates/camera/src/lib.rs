@@ -3,7 +3,9 @@
 //!
 //! Pipeline (one module per stage): [`toric`] space ↔ camera poses, cinematic [`features`] (Eq. 1–2),
 //! the synthetic [`dataset`] (scenes + four behaviours), the three networks in [`model`], [`train`],
-//! inference with keyframes in [`infer`], and exports ([`gltf`], [`preview`]) and the [`bench`].
+//! loading trained [`weights`], inference with keyframes in [`infer`] (plain-Rust networks, one
+//! [`infer::Rollout`], [`infer::GenerateJob`], the causal mode), exports ([`gltf`], [`preview`]) and
+//! the [`bench`].
 
 pub mod bench;
 pub mod dataset;
@@ -14,6 +16,7 @@ pub mod model;
 pub mod preview;
 pub mod toric;
 pub mod train;
+pub mod weights;
 
 use std::path::{Path, PathBuf};
 
@@ -30,6 +33,8 @@ pub enum CameraError {
     Toric(#[from] toric::ToricError),
     #[error("model: {0}")]
     Model(String),
+    #[error("{0}")]
+    Weights(#[from] inbetween_nn::NnError),
 }
 
 impl CameraError {
@@ -49,7 +54,7 @@ pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Camer
     })
 }
 
-/// Writes pretty JSON atomically.
+/// Writes compact JSON atomically (temp file, then rename).
 pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<(), CameraError> {
     let bytes = serde_json::to_vec(value).map_err(|e| CameraError::invalid(path, e.to_string()))?;
     inbetween_io::write_atomic(path, &bytes).map_err(|source| CameraError::Io { path: path.into(), source })

@@ -4,8 +4,9 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_camera::bench;
 use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
-use inbetween_camera::infer::{self, FastModel, GenerateOptions, Keys, NamedStyle, ReferenceClip};
+use inbetween_camera::infer::{self, GenerateJob, GenerateOptions, Keys, ReferenceClip, Style};
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
+use inbetween_camera::weights::{self, CameraWeights};
 use std::path::{Path, PathBuf};
 
 #[derive(Subcommand)]
@@ -28,7 +29,7 @@ pub struct BenchArgs {
     /// Folder for CSV tables, PNG charts and the JSON report.
     #[arg(short, long, default_value = "out/camera-bench")]
     pub out: PathBuf,
-    /// Weights (default: the committed quick-training weights).
+    /// Weights (default: the committed weights).
     #[arg(long)]
     pub weights: Option<PathBuf>,
 }
@@ -65,7 +66,7 @@ pub struct GenerateArgs {
     /// Keep the network's own keyframe misses instead of correcting them away.
     #[arg(long)]
     pub no_exact_keys: bool,
-    /// Weights (default: the committed quick-training weights).
+    /// Weights (default: the committed weights).
     #[arg(long)]
     pub weights: Option<PathBuf>,
 }
@@ -83,9 +84,13 @@ pub struct SceneArgs {
 
 #[derive(Args)]
 pub struct TrainArgs {
-    /// Where the trained weights go (a JSON summary is written beside them).
-    #[arg(short, long, default_value = "crates/camera/weights/camera.bpk")]
+    /// Where the trained weights go (burnpack; its JSON card, with the style codes, is written
+    /// beside it). The committed weights folder is refused unless --overwrite-committed.
+    #[arg(short, long, default_value = "out/camera/camera.bpk")]
     pub out: PathBuf,
+    /// Allow OUT inside crates/camera/weights/ (replacing the committed weights on purpose).
+    #[arg(long)]
+    pub overwrite_committed: bool,
     /// Checkpoint folder: saved every epoch, and training resumes from it when it holds one.
     #[arg(long, default_value = "out/camera-train")]
     pub checkpoints: PathBuf,
@@ -126,25 +131,21 @@ pub fn run(c: CameraCommand) -> anyhow::Result<()> {
     }
 }
 
-fn load_model(weights: Option<&Path>) -> anyhow::Result<FastModel> {
-    match weights {
-        Some(path) => FastModel::load(path).with_context(|| format!("loading camera weights {}", path.display())),
-        None => FastModel::committed().context("loading the committed camera weights"),
+fn load_weights(path: Option<&Path>) -> anyhow::Result<CameraWeights> {
+    match path {
+        Some(path) => weights::load(path).with_context(|| format!("loading camera weights {}", path.display())),
+        None => weights::committed().context("loading the committed camera weights"),
     }
 }
 
-/// Style codes per behaviour, seeded so every run names the same codes.
-fn named_styles(model: &FastModel) -> Vec<NamedStyle> {
-    model.behaviour_styles(777, 2)
+/// A behaviour's style code, as stored in the weights card.
+fn behaviour_style(w: &CameraWeights, behaviour: Behaviour) -> anyhow::Result<Style> {
+    w.style(behaviour).with_context(|| format!("the weights card has no style code for `{}`", behaviour.name()))
 }
 
-fn style_code(styles: &[NamedStyle], behaviour: Behaviour) -> Vec<f32> {
-    styles.iter().find(|s| s.behaviour == behaviour && s.main_is_a).map(|s| s.code.clone()).unwrap_or_default()
-}
-
-fn reference_style(model: &FastModel, path: &Path) -> anyhow::Result<Vec<f32>> {
+fn reference_style(w: &CameraWeights, path: &Path) -> anyhow::Result<Style> {
     let clip: ReferenceClip = inbetween_camera::read_json(path)?;
-    Ok(clip.style(model, path)?)
+    Ok(Style { name: format!("reference:{}", path.display()), code: clip.style(&w.model, path)? })
 }
 
 fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
@@ -154,26 +155,22 @@ fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
 }
 
 fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
-    let model = load_model(a.weights.as_deref())?;
+    let w = load_weights(a.weights.as_deref())?;
     let scene = Scene::load(&a.scene)?;
     let keys = Keys::load(&a.keys)?;
-    let opts = GenerateOptions { exact_keys: !a.no_exact_keys, ..GenerateOptions::default() };
-    let styles = named_styles(&model);
-    let jobs: Vec<(String, Vec<f32>, PathBuf)> = if a.all_styles {
-        BEHAVIOURS.iter().map(|b| (b.name().to_string(), style_code(&styles, *b), with_suffix(&a.out, b.name()))).collect()
+    let options = GenerateOptions { exact_keys: !a.no_exact_keys, causal: a.causal, ..GenerateOptions::default() };
+    let runs: Vec<(Style, PathBuf)> = if a.all_styles {
+        BEHAVIOURS.iter().map(|b| Ok((behaviour_style(&w, *b)?, with_suffix(&a.out, b.name())))).collect::<anyhow::Result<_>>()?
     } else if let Some(r) = &a.reference {
-        vec![(format!("reference:{}", r.display()), reference_style(&model, r)?, a.out.clone())]
+        vec![(reference_style(&w, r)?, a.out.clone())]
     } else {
         let name = a.style.clone().unwrap_or_else(|| "relative".into());
         let b = Behaviour::parse(&name).with_context(|| format!("unknown style `{name}` (direct, relative, side, orbit)"))?;
-        vec![(name, style_code(&styles, b), a.out.clone())]
+        vec![(behaviour_style(&w, b)?, a.out.clone())]
     };
-    for (name, code, out) in jobs {
-        let track = if a.causal {
-            infer::generate_causal(&model, &scene, &keys, &code, &name, &opts.lens, &a.keys)?
-        } else {
-            infer::generate(&model, &scene, &keys, &code, &name, &opts, &a.keys)?
-        };
+    for (style, out) in runs {
+        let name = style.name.clone();
+        let track = GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin: &a.keys }.run()?;
         inbetween_camera::write_json(&out, &track)?;
         let gltf = match &a.gltf {
             Some(g) if a.all_styles => with_suffix(g, &name),
@@ -186,7 +183,7 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
             inbetween_camera::preview::write_preview(&g, &track, &scene, 3)?;
             println!("  preview {}", g.display());
         }
-        let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+        let worst = track.worst_key_miss();
         println!(
             "{name}: {} frames -> {} (network keyframe miss max {worst:.4}, after correction {:.1e})",
             track.frames.len(),
@@ -214,7 +211,7 @@ fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
 }
 
 fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
-    let model = load_model(a.weights.as_deref())?;
+    let model = load_weights(a.weights.as_deref())?.model;
     let cfg = if a.quick { bench::BenchConfig::quick() } else { bench::BenchConfig::full() };
     let t0 = std::time::Instant::now();
     let report = bench::run(&model, &cfg);
@@ -225,6 +222,8 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn run_train(a: TrainArgs) -> anyhow::Result<()> {
+    // Refuse before hours of training, not after.
+    weights::check_output(&a.out, a.overwrite_committed)?;
     let mut cfg = TrainConfig {
         seed: a.seed,
         scenes: a.scenes,
@@ -239,7 +238,7 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         cfg.lr_decay_from = train::epochs_done(&a.checkpoints)?;
     }
     cfg.model.hidden = a.hidden;
-    let bar = crate::progress::bar((cfg.epochs * cfg.iters_per_epoch) as u64, "training");
+    let bar = inbetween_io::Progress::new((cfg.epochs * cfg.iters_per_epoch) as u64, "training");
     let mut report = |e: TrainEvent| match e {
         TrainEvent::Iteration { epoch, iter, loss } => {
             bar.set_position((epoch * cfg.iters_per_epoch + iter + 1) as u64);
@@ -250,12 +249,11 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         }
     };
     let (model, summary) = train::train(&cfg, Some(&a.checkpoints), &mut report)?;
-    bar.finish_and_clear();
+    bar.finish();
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    train::save_model(&model, &a.out)?;
-    inbetween_camera::write_json(&a.out.with_extension("json"), &summary)?;
+    weights::save(&model, &summary, &a.out, a.overwrite_committed)?;
     println!(
         "trained {} epochs ({} iterations) in {:.1} min, final loss {:.4}; weights: {}",
         summary.epochs_done,
@@ -271,18 +269,19 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 /// track per style; writes cam.json, cam.gltf and cam.gif (orbit style) and one JSON per style.
 pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
     let t0 = std::time::Instant::now();
-    let model = load_model(None)?;
+    let w = load_weights(None)?;
     let scene = Scene::procedural(3, 300, 30.0);
     let keys = infer::example_keys(&scene, &[0, 150, 299]);
-    let styles = named_styles(&model);
     let dir = out.join("camera");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     scene.save(&dir.join("scene.json"))?;
     inbetween_camera::write_json(&dir.join("keys.json"), &keys)?;
     let mut lines = Vec::new();
     for b in BEHAVIOURS {
-        let track = infer::generate(&model, &scene, &keys, &style_code(&styles, b), b.name(), &GenerateOptions::default(), &dir.join("keys.json"))?;
-        let worst = track.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
+        let style = behaviour_style(&w, b)?;
+        let keys_path = dir.join("keys.json");
+        let track = GenerateJob { origin: &keys_path, ..GenerateJob::new(&w.model, &scene, &keys, &style) }.run()?;
+        let worst = track.worst_key_miss();
         inbetween_camera::write_json(&dir.join(format!("cam-{}.json", b.name())), &track)?;
         if b == Behaviour::Orbit {
             inbetween_camera::write_json(&out.join("cam.json"), &track)?;

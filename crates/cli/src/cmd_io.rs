@@ -2,6 +2,7 @@
 
 use anyhow::Context;
 use clap::Args;
+use inbetween_core::units::{rest_pose_extent, LengthUnit, UnitChoice};
 use inbetween_core::{Motion, Skeleton};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -13,6 +14,10 @@ pub struct InfoArgs {
     /// The ASF skeleton of an .amc file, when it is not beside it (`01_01.amc` → `01.asf`).
     #[arg(long)]
     pub asf: Option<PathBuf>,
+    /// Length unit of the file: cm, m, mm, in, cmu (CMU mocap units, 5.6444 cm) or cm per unit
+    /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (printed with the reason).
+    #[arg(long)]
+    pub unit: Option<LengthUnit>,
 }
 
 #[derive(Args)]
@@ -53,6 +58,10 @@ pub fn info(a: InfoArgs) -> anyhow::Result<()> {
     writeln!(out, "frames:    {}", m.num_frames())?;
     writeln!(out, "fps:       {:.3} (frame time {} s)", m.fps(), m.frame_time)?;
     writeln!(out, "duration:  {:.3} s", m.duration())?;
+    let unit = UnitChoice::resolve(a.unit, &m.skeleton);
+    writeln!(out, "unit:      {} ({})", unit.unit.describe(), unit.reason)?;
+    let size = rest_pose_extent(&m.skeleton);
+    writeln!(out, "rest pose: {size:.2} units = {:.1} cm tall (or wide)", size * unit.cm_per_unit())?;
     writeln!(out, "skeleton:")?;
     write_tree(&mut out, &m.skeleton)?;
     print_tolerating_closed_pipe(&out)
@@ -77,7 +86,8 @@ fn write_tree(out: &mut String, s: &Skeleton) -> std::fmt::Result {
             depth[j] = depth[p] + 1;
         }
         let channels: Vec<&str> = joint.channels.iter().map(|c| c.name()).collect();
-        let end = joint.end_site.map(|e| format!("  end site ({:.3}, {:.3}, {:.3})", e.x, e.y, e.z)).unwrap_or_default();
+        let end =
+            joint.end_site.map(|e| format!("  end site ({:.3}, {:.3}, {:.3})", e.x, e.y, e.z)).unwrap_or_default();
         writeln!(
             out,
             "  {}{}  offset ({:.3}, {:.3}, {:.3})  [{}] {}{end}",

@@ -3,14 +3,13 @@
 
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
-use inbetween_core::{positions_clip, KeyframeSet, Motion};
+use inbetween_core::units::{LengthUnit, UnitChoice};
+use inbetween_core::{positions_clip, Motion};
 use inbetween_io::fsutil::write_atomic;
-use inbetween_mocap::bench::{self, Clip, Method, Protocol};
+use inbetween_mocap::bench::{self, Clip, Protocol};
 use inbetween_mocap::codec::{self, Budget};
-use inbetween_mocap::dqn::{train::SidqlPolicy, DqnConfig, TrainOptions};
-use inbetween_mocap::error::{Objective, SegmentModel, SegmentTable};
+use inbetween_mocap::dqn::{DqnConfig, TrainOptions};
 use inbetween_mocap::representation::{JointFilter, SphericalMotion};
-use inbetween_mocap::rotations::RotationMotion;
 use inbetween_render::StickOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -40,9 +39,14 @@ pub struct TrainArgs {
     /// Train on procedural gaits (our own data, safe to commit) instead of the CMU training split.
     #[arg(long)]
     pub procedural: bool,
-    /// Data folder for the CMU clips (default: the shared corpus).
+    /// Data folder: the shared corpus (default), its mocap/cmu folder, or any folder of .bvh files
+    /// (searched recursively).
     #[arg(long)]
     pub data: Option<PathBuf>,
+    /// Length unit of the clips (overrides the corpus's known units): cm, m, mm, in, cmu (CMU mocap units, 5.6444 cm) or cm per unit
+    /// (e.g. 2.54). Default: known for the corpus folders, else inferred per clip from its rest pose (the report says which and why).
+    #[arg(long)]
+    pub unit: Option<LengthUnit>,
     /// Episodes (default: the preset's; `paper` runs 2000).
     #[arg(long)]
     pub episodes: Option<usize>,
@@ -58,6 +62,10 @@ pub struct TrainArgs {
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Stop after the episode during which this many minutes have passed; run the same command
+    /// again to resume (training state is checkpointed in `<output>.ckpt/`).
+    #[arg(long)]
+    pub time_limit_min: Option<f64>,
 }
 
 #[derive(Subcommand)]
@@ -85,6 +93,10 @@ pub struct SendArgs {
     pub skip_first: bool,
     #[arg(long, default_value_t = 10)]
     pub retries: usize,
+    /// Length unit of the clip: cm, m, mm, in, cmu (CMU mocap units, 5.6444 cm) or cm per unit
+    /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (the report says which and why).
+    #[arg(long)]
+    pub unit: Option<LengthUnit>,
 }
 
 #[derive(Args)]
@@ -93,11 +105,16 @@ pub struct RecvArgs {
     pub addr: String,
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Compare against this clip and print the error.
+    /// Compare against this clip and print the error (from the frame the stream starts at).
     #[arg(long)]
     pub reference: Option<PathBuf>,
     #[arg(long)]
     pub skip_first: bool,
+    /// Length unit of the reference clip, for errors in cm: cm, m, mm, in, cmu (CMU mocap units, 5.6444 cm) or cm per unit
+    /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (the report says which and why).
+    #[arg(long)]
+    pub unit: Option<LengthUnit>,
+
     /// Seconds to wait for a (re)connection.
     #[arg(long, default_value_t = 30.0)]
     pub timeout_s: f64,
@@ -120,9 +137,18 @@ pub struct BudgetArgs {
     /// Drop the first frame (the T-pose of CMU cgspeed files).
     #[arg(long)]
     pub skip_first: bool,
+    /// Length unit of the clip: cm, m, mm, in, cmu (CMU mocap units, 5.6444 cm) or cm per unit
+    /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (the report says which and why).
+    #[arg(long)]
+    pub unit: Option<LengthUnit>,
 }
 
 impl BudgetArgs {
+    /// The clip's unit: `--unit`, else inferred from its skeleton.
+    fn unit(&self, m: &Motion) -> UnitChoice {
+        UnitChoice::resolve(self.unit, &m.skeleton)
+    }
+
     fn budget(&self) -> anyhow::Result<Budget> {
         match (self.k, &self.max_error) {
             (Some(k), None) => Ok(Budget::Keys(k)),
@@ -179,12 +205,21 @@ pub struct BenchArgs {
     /// ASF/AMC, iClone BVH; one entry per take), or each .bvh in DIR itself.
     #[arg(long)]
     pub data: Option<PathBuf>,
-    /// Write the table as CSV.
+    /// Write the whole report into this folder: report.txt and report.md (every table), one CSV
+    /// per table (mocap_bench.csv holds every row) and table3.png.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Also write every row as CSV (the columns of mocap_bench.csv).
     #[arg(long)]
     pub csv: Option<PathBuf>,
-    /// Write a bar chart of the mean angle error (PNG).
+    /// Also write the bar chart of the mean angle error (PNG).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Length unit of the clips (overrides the corpus's known units): cm, m, mm, in, cmu (CMU mocap
+    /// units, 5.6444 cm) or cm per unit. Default: known for the corpus folders, else inferred per
+    /// clip from its rest pose (the report says which and why).
+    #[arg(long)]
+    pub unit: Option<LengthUnit>,
     /// Window stride in frames (60 = non-overlapping windows, as in the paper).
     #[arg(long, default_value_t = 60)]
     pub stride: usize,
@@ -218,7 +253,7 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
 fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
     let t = Instant::now();
-    let c = codec::compress(&m, a.budget.budget()?, a.budget.max_gap(&m))?;
+    let c = codec::compress_in(&m, a.budget.unit(&m), a.budget.budget()?, a.budget.max_gap(&m))?;
     let secs = t.elapsed().as_secs_f64();
     write_atomic(&a.output, &c.bytes).with_context(|| format!("writing {}", a.output.display()))?;
     for l in compress_report(&m, &c) {
@@ -231,6 +266,7 @@ fn compress(a: CompressArgs) -> anyhow::Result<()> {
 fn compress_report(m: &Motion, c: &codec::Compressed) -> Vec<String> {
     let raw = codec::raw_bytes(m);
     vec![
+        c.unit.to_string(),
         format!(
             "{} frames, {} joints, {} keys; {} bytes ({} bytes per key) vs {} raw f32 bytes: ratio {:.1}x",
             m.num_frames(),
@@ -255,6 +291,7 @@ fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
     let d = codec::decode(&bytes).with_context(|| format!("decoding {}", a.input.display()))?;
     let m = d.reconstruct()?;
     inbetween_io::write_bvh(&a.output, &m)?;
+    println!("{} (the file keeps the source's unit)", LengthUnit::infer(&d.skeleton));
     println!(
         "{} keys → {} frames at {:.1} fps; wrote {}",
         d.key_frames.len(),
@@ -267,6 +304,8 @@ fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
 
 fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
+    let unit = a.budget.unit(&m);
+    println!("{unit}");
     let (rec, keys) = match &a.ibk {
         Some(p) => {
             let d = codec::decode(&std::fs::read(p).with_context(|| format!("reading {}", p.display()))?)
@@ -281,12 +320,12 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
             (d.reconstruct()?, d.key_frames.len())
         }
         None => {
-            let c = codec::compress(&m, a.budget.budget()?, a.budget.max_gap(&m))?;
+            let c = codec::compress_in(&m, unit.clone(), a.budget.budget()?, a.budget.max_gap(&m))?;
             (codec::decode(&c.bytes)?.reconstruct()?, c.keys.len())
         }
     };
     let e = inbetween_core::position_error(&positions_clip(&m), &positions_clip(&rec));
-    let cm = inbetween_core::procedural::CM_PER_CMU_UNIT;
+    let cm = unit.cm_per_unit();
     let opts = StickOptions {
         labels: vec!["original".into(), format!("from {keys} keys")],
         title: Some(format!("{} keys: mean {:.2} cm, max {:.2} cm", keys, e.mean * cm, e.max * cm)),
@@ -297,301 +336,63 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The CMU takes of a data folder (see [`inbetween_mocap::corpus`]).
-fn cmu_clips(dir: &Path) -> anyhow::Result<Vec<Clip>> {
-    Ok(inbetween_mocap::corpus::cmu_corpus(dir)?)
+/// The CMU takes of a data folder, or every .bvh below it (see [`inbetween_mocap::corpus`]);
+/// prints the length unit each was read in and why.
+fn cmu_clips(dir: &Path, unit: Option<LengthUnit>) -> anyhow::Result<Vec<Clip>> {
+    let corpus = inbetween_mocap::corpus::load(dir, unit)?;
+    for note in corpus.unit_notes() {
+        println!("{note}");
+    }
+    Ok(corpus.clips)
 }
 
-/// One line per source: how many takes came from where.
-fn describe_sources(clips: &[Clip]) -> String {
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for c in clips {
-        match counts.iter_mut().find(|(s, _)| *s == c.source) {
-            Some((_, n)) => *n += 1,
-            None => counts.push((c.source, 1)),
+impl BenchArgs {
+    /// The library's bench configuration for these arguments.
+    fn config(&self) -> bench::BenchConfig {
+        let policy = match (&self.model, self.train_episodes) {
+            (Some(p), _) => bench::PolicyChoice::File(p.clone()),
+            (None, 0) => bench::PolicyChoice::Committed,
+            (None, episodes) => bench::PolicyChoice::Train { episodes, output: PathBuf::from("out/sidql_cmu.bpk") },
+        };
+        bench::BenchConfig {
+            data: self.data.clone(),
+            unit: self.unit,
+            protocol: Protocol { stride: self.stride, seed: self.seed, ..Protocol::paper() },
+            policy,
+            codec_bounds_cm: self.codec_bounds.clone(),
+            output_dir: self.output.clone(),
+            csv: self.csv.clone(),
+            plot: self.plot.clone(),
+            ..bench::BenchConfig::default()
         }
     }
-    counts.iter().map(|(s, n)| format!("{n} {s}")).collect::<Vec<_>>().join(", ")
 }
 
 fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
-    let dir = match a.data.clone() {
-        Some(d) => d,
-        None => match inbetween_io::data::shared_data_dir() {
-            Ok(d) => d,
-            Err(p) => bail!("no data at {} (give --data DIR)", p.display()),
-        },
-    };
-    let clips = cmu_clips(&dir)?;
-    let protocol = Protocol { stride: a.stride, seed: a.seed, ..Protocol::paper() };
-    let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-    let (train, test) = bench::split_clips(&names, &protocol);
-    let mut all = Vec::new();
-    for clip in &clips {
-        all.extend(bench::clip_windows(clip, &protocol)?);
-    }
-    if all.is_empty() {
-        bail!("no clip in {} is long enough for one {}-frame window at {} fps", dir.display(), protocol.window, protocol.fps);
-    }
-    let test_windows: Vec<_> = all.iter().filter(|w| test.contains(&w.clip)).cloned().collect();
-    let joints: std::collections::BTreeSet<usize> = all.iter().map(|w| w.rep.num_joints).collect();
-    println!(
-        "{} takes ({}) from {}: {} windows of {} frames at {} fps, joints per skeleton {:?}",
-        clips.len(),
-        describe_sources(&clips),
-        dir.display(),
-        all.len(),
-        protocol.window,
-        protocol.fps,
-        joints,
-    );
-    println!("test split ({} windows): {test:?}\ntraining split: {train:?}", test_windows.len());
-    let ks = [5, 10, 15];
-    let policy = if let Some(p) = &a.model {
-        let policy = SidqlPolicy::load(p)?;
-        println!("SIDQL: {} (trained on: {})", p.display(), policy.info.trained_on);
-        policy
-    } else if a.train_episodes > 0 {
-        let train_windows = training_windows(&clips, &train, &protocol, 10)?;
-        let opts = TrainOptions {
-            episodes: a.train_episodes,
-            seed: a.seed,
-            data: format!("CMU training split {train:?}, {} windows at stride 10", train_windows.len()),
-            ..TrainOptions::paper()
-        };
-        println!("SIDQL: training {} episodes on {} windows of the training split…", opts.episodes, train_windows.len());
-        let (policy, report) = inbetween_mocap::dqn::train(&train_windows, &DqnConfig::default(), &opts)?;
-        println!(
-            "SIDQL: trained in {:.0} s, {} updates, loss per 50 episodes {:?}",
-            report.seconds,
-            report.updates,
-            report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
-        );
-        let path = PathBuf::from("out/sidql_cmu.bpk");
-        std::fs::create_dir_all("out").ok();
-        policy.save(&path)?;
-        println!("SIDQL: saved {} (weights trained on CMU data: keep out of the repository)", path.display());
-        policy
-    } else {
-        let policy = SidqlPolicy::committed()?;
-        println!("SIDQL: the committed policy (trained on: {})", policy.info.trained_on);
-        policy
-    };
-    let policy_fn = move |rep: &SphericalMotion, k: usize| policy.select(rep, k);
-    let pf: Option<bench::PolicyFn> = Some(&policy_fn);
-    let mut rows = bench::evaluate("all", &all, &Method::ALL, &ks, a.seed, pf)?;
-    if test_windows.is_empty() {
-        println!("the test split has no windows (too few or too short clips): only the `all` rows are shown");
-    } else {
-        rows.extend(bench::evaluate("test", &test_windows, &Method::ALL, &ks, a.seed, pf)?);
-    }
-    println!("{}", bench::to_table(&rows));
-    if let Some(p) = &a.csv {
-        write_atomic(p, bench::to_csv(&rows).as_bytes()).with_context(|| format!("writing {}", p.display()))?;
+    let progress = inbetween_io::Progress::new(0, "mocap bench");
+    let out = bench::run(&a.config(), &progress);
+    progress.finish();
+    let out = out?;
+    print!("{}", out.report.to_text());
+    for p in &out.written {
         println!("wrote {}", p.display());
     }
-    if let Some(p) = &a.plot {
-        bench_plot(p, &rows)?;
-        println!("wrote {}", p.display());
-    }
-    reconstruction_throughput(&all)?;
-    both_reconstructions(&all)?;
-    // The codec measures cm in CMU units: the cgspeed takes (or a plain folder, read as CMU units).
-    let cmu_units: Vec<&Clip> = clips.iter().filter(|c| c.source == "cgspeed" || c.source == "bvh").collect();
-    for &bound in &a.codec_bounds {
-        codec_ratio(&cmu_units, bound)?;
-    }
     Ok(())
 }
 
-fn bench_plot(path: &Path, rows: &[bench::Row]) -> anyhow::Result<()> {
-    let groups: Vec<String> = [5, 10, 15].iter().map(|k| format!("K = {k}")).collect();
-    // The test split when there is one, else all windows.
-    let split = if rows.iter().any(|r| r.split == "test") { "test" } else { "all" };
-    let mut series = Vec::new();
-    for m in Method::ALL {
-        let vals: Vec<f64> = [5, 10, 15]
-            .iter()
-            .filter_map(|&k| {
-                rows.iter().find(|r| r.split == split && r.method == m && r.k == k).map(|r| r.mean_angle_error)
-            })
-            .collect();
-        if vals.len() == 3 {
-            series.push((m.name().to_string(), vals));
-        }
-    }
-    inbetween_render::plot::grouped_bar_chart(
-        path,
-        &format!("Mean angle error, {} 60-frame windows", if split == "test" { "test-split" } else { "all" }),
-        "mean angle error (rad)",
-        &groups,
-        &series,
-    )?;
-    Ok(())
-}
-
-/// Frames per second of the spherical reconstruction (all frames of all windows, K = 10, uniform).
-fn reconstruction_throughput(windows: &[bench::Window]) -> anyhow::Result<()> {
-    let t = Instant::now();
-    let mut frames = 0usize;
-    for _ in 0..5 {
-        for w in windows {
-            let keys = KeyframeSet::uniform(w.rep.num_frames, 10.min(w.rep.num_frames))?;
-            let rec = inbetween_mocap::reconstruct_spherical(&w.rep, &keys);
-            frames += rec.positions.len() / w.rep.num_joints;
-        }
-    }
-    let secs = t.elapsed().as_secs_f64();
-    let joints: std::collections::BTreeSet<usize> = windows.iter().map(|w| w.rep.num_joints).collect();
-    println!(
-        "reconstruction throughput (spherical, K = 10, skeletons of {joints:?} joints): {:.0} frames/s",
-        frames as f64 / secs
-    );
-    Ok(())
-}
-
-/// The paper's spherical reconstruction vs our rotation (quaternion Hermite) one, same optimal keys.
-fn both_reconstructions(windows: &[bench::Window]) -> anyhow::Result<()> {
-    for k in [5, 10, 15] {
-        let (mut sph, mut rot, mut rot_deg, mut sph_max, mut rot_max) = (0.0, 0.0, 0.0, 0.0f64, 0.0f64);
-        for w in windows {
-            let keys = inbetween_mocap::select::optimal(&SegmentTable::full(&w.rep), k, Objective::Angle)?;
-            let es = w.rep.error(&keys);
-            let mut rm = RotationMotion::from_motion(&w.motion)?;
-            rm.cm_per_unit = w.rep.cm_per_unit;
-            let er = rm.error(&keys);
-            sph += es.mean_cm;
-            rot += er.mean_cm;
-            rot_deg += er.mean_angle.to_degrees();
-            sph_max = sph_max.max(es.max_cm);
-            rot_max = rot_max.max(er.max_cm);
-        }
-        let n = windows.len().max(1) as f64;
-        println!(
-            "K={k:<2} optimal keys, all windows: spherical (paper) mean {:.3} cm / max {:.2} cm; rotation (BVH) mean {:.3} cm / max {:.2} cm, local rotation error {:.2} deg",
-            sph / n,
-            sph_max,
-            rot / n,
-            rot_max,
-            rot_deg / n
-        );
-    }
-    Ok(())
-}
-
-/// Codec size at an error bound over the full-rate, full-skeleton cgspeed clips (T-pose frame
-/// dropped; the codec measures cm in CMU units).
-fn codec_ratio(clips: &[&Clip], bound_cm: f64) -> anyhow::Result<()> {
-    let (mut raw, mut packed, mut keys, mut frames, mut max_cm) = (0usize, 0usize, 0usize, 0usize, 0.0f64);
-    let t = Instant::now();
-    for clip in clips {
-        let m = clip.motion.crop(1, clip.motion.num_frames())?;
-        let gap = ((0.5 / m.frame_time).round() as usize).max(1);
-        let c = codec::compress(&m, Budget::MaxErrorCm(bound_cm), gap)?;
-        raw += codec::raw_bytes(&m);
-        packed += c.bytes.len();
-        keys += c.keys.len();
-        frames += m.num_frames();
-        max_cm = max_cm.max(c.decoded_max_cm);
-    }
-    println!(
-        "codec at max error {bound_cm} cm: {keys} keys for {frames} frames, {packed} bytes vs {raw} raw f32 bytes = ratio {:.1}x (decoded max error {max_cm:.3} cm, {:.1} s)",
-        raw as f64 / packed as f64,
-        t.elapsed().as_secs_f64()
-    );
-    Ok(())
-}
-
-/// The mocap part of `inbetween demo`: writes its outputs under `out` and returns lines to print.
-pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
-    let t = Instant::now();
-    let mut p = inbetween_core::procedural::GaitParams::walk();
-    p.frames = 60;
-    let walk = inbetween_core::procedural::gait(&p);
-    let paper = JointFilter::paper().apply(&walk);
-    let rep = SphericalMotion::from_motion(&paper)?;
-    let table = SegmentTable::full(&rep);
-    let mut lines = vec!["mocap: procedural walk, 60 frames at 30 fps, 23 joints (paper representation)".to_string()];
-    let sidql = SidqlPolicy::committed()?;
-    for k in [5, 10] {
-        let opt = inbetween_mocap::select::optimal(&table, k, Objective::Angle)?;
-        let uc = inbetween_mocap::select::uniform(60, k)?;
-        let sq = sidql.select(&rep, k)?;
-        let (eo, eu, es) = (rep.error(&opt), rep.error(&uc), rep.error(&sq));
-        lines.push(format!(
-            "  K={k:<2} optimal keys {:?}: angle err {:.4}, mean {:.2} cm, max {:.2} cm | uniform: {:.4}, {:.2} cm, {:.2} cm | SIDQL (committed policy): {:.4}, {:.2} cm, {:.2} cm",
-            opt.frames(),
-            eo.mean_angle,
-            eo.mean_cm,
-            eo.max_cm,
-            eu.mean_angle,
-            eu.mean_cm,
-            eu.max_cm,
-            es.mean_angle,
-            es.mean_cm,
-            es.max_cm
-        ));
-    }
-    let c = codec::compress(&walk, Budget::MaxErrorCm(1.0), 15)?;
-    lines.extend(compress_report(&walk, &c).into_iter().map(|l| format!("  codec (31 joints, ≤ 1 cm): {l}")));
-    let ibk = out.join("mocap_walk.ibk");
-    write_atomic(&ibk, &c.bytes)?;
-    let rec = codec::decode(&c.bytes)?.reconstruct()?;
-    let bvh = out.join("mocap_walk_reconstructed.bvh");
-    inbetween_io::write_bvh(&bvh, &rec)?;
-    let gif = out.join("mocap_overlay.gif");
-    let opts = StickOptions {
-        labels: vec!["original".into(), format!("from {} keys", c.keys.len())],
-        title: Some(format!("mocap codec: {} keys, max {:.2} cm", c.keys.len(), c.decoded_max_cm)),
-        max_frames: 60,
-        ..StickOptions::default()
-    };
-    inbetween_render::render_motion_gif(&gif, &[&walk, &rec], &opts)?;
-    // The rotation model is the one the codec uses; say how it compares to the spherical one.
-    let rm = RotationMotion::from_motion(&paper)?;
-    let k10 = inbetween_mocap::select::optimal(&table, 10, Objective::Angle)?;
-    lines.push(format!(
-        "  K=10 on 23 joints: rotation reconstruction mean {:.2} cm vs spherical {:.2} cm",
-        rm.error(&k10).mean_cm,
-        rep.error(&k10).mean_cm
-    ));
-    lines.push(format!(
-        "  wrote {}, {}, {} ({:.1} s)",
-        ibk.display(),
-        bvh.display(),
-        gif.display(),
-        t.elapsed().as_secs_f64()
-    ));
-    Ok(lines)
-}
-
-/// Windows of the named clips with the given stride (overlapping windows for training).
+/// Windows of the named clips with the given stride (see [`bench::training_windows`]).
 fn training_windows(
     clips: &[Clip],
     names: &[String],
     protocol: &Protocol,
     stride: usize,
 ) -> anyhow::Result<Vec<SphericalMotion>> {
-    let p = Protocol { stride, ..protocol.clone() };
-    let mut out = Vec::new();
-    for clip in clips.iter().filter(|c| names.contains(&c.name)) {
-        out.extend(bench::clip_windows(clip, &p)?.into_iter().map(|w| w.rep));
-    }
-    Ok(out)
+    Ok(bench::training_windows(clips, names, protocol, stride)?)
 }
 
-/// Procedural gaits (our own data) as clips in CMU units.
+/// Procedural gaits (our own data) as clips in CMU units (see [`bench::procedural_clips`]).
 fn procedural_clips(seed: u64, count: usize) -> Vec<Clip> {
-    inbetween_core::procedural::gait_library(seed, count, 241, 30.0)
-        .into_iter()
-        .enumerate()
-        .map(|(i, m)| Clip {
-            name: format!("gait{i}"),
-            source: "procedural",
-            motion: m,
-            cm_per_unit: inbetween_core::procedural::CM_PER_CMU_UNIT,
-        })
-        .collect()
+    bench::procedural_clips(seed, count)
 }
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
@@ -615,7 +416,7 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
             None => inbetween_io::data::shared_data_dir()
                 .map_err(|p| anyhow::anyhow!("no data at {} (give --data DIR or --procedural)", p.display()))?,
         };
-        let clips = cmu_clips(&dir)?;
+        let clips = cmu_clips(&dir, a.unit)?;
         let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
         let (train, test) = bench::split_clips(&names, &protocol);
         let windows = training_windows(&clips, &train, &protocol, a.stride)?;
@@ -638,15 +439,29 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
         }
     }
     println!("training on {data}");
+    let checkpoint_dir = a.output.with_extension("ckpt");
     let opts = TrainOptions {
         episodes: a.episodes.unwrap_or(base.episodes),
         lr: a.lr.unwrap_or(base.lr),
         seed: a.seed,
         checkpoint: Some(a.output.clone()),
+        checkpoint_dir: Some(checkpoint_dir.clone()),
+        time_limit_s: a.time_limit_min.map(|m| m * 60.0),
         data,
         ..base
     };
     let (_, report) = inbetween_mocap::dqn::train(&windows, &DqnConfig::default(), &opts)?;
+    if let Some(from) = &report.resumed_from {
+        println!("resumed from {}", from.display());
+    }
+    if report.episodes < opts.episodes {
+        println!(
+            "stopped at the time limit after {} of {} episodes; run the same command again to resume from {}",
+            report.episodes,
+            opts.episodes,
+            checkpoint_dir.display()
+        );
+    }
     println!(
         "trained {} episodes, {} updates in {:.0} s; loss per 50 episodes {:?}; return per episode {:?}",
         report.episodes,
@@ -667,9 +482,11 @@ fn stream_send(a: SendArgs) -> anyhow::Result<()> {
         lookahead: a.lookahead,
         realtime: !a.fast,
         retries: a.retries,
+        unit: a.unit,
     };
     let r = inbetween_mocap::stream::send(&a.addr, &m, &opts)?;
     let secs = m.duration().max(1e-9);
+    println!("{}", r.unit);
     println!(
         "sent {} keys for {} frames in {:.2} s: {} bytes ({:.0} B/s) vs {} raw bytes ({:.0} B/s), {:.1}x less; added latency mean {:.0} ms, max {:.0} ms; {} reconnects",
         r.keys,
@@ -699,22 +516,36 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
     }
     inbetween_io::write_bvh(&a.output, &got.motion)?;
     println!(
-        "received {} keys ({} bytes, {} sessions, {}), emitted {} frames; wrote {}",
+        "received {} keys ({} bytes, {} sessions, {}), emitted {} frames (frames {}..{} of the sender's {}-frame clip); wrote {}",
         got.keys,
         got.bytes,
         got.sessions,
         if got.complete { "complete" } else { "incomplete" },
         got.motion.num_frames(),
+        got.start_frame,
+        got.start_frame + got.motion.num_frames(),
+        got.clip_frames,
         a.output.display()
     );
+    if got.start_frame > 0 {
+        println!("joined mid-stream: the output's frame 0 is frame {} of the sender's clip", got.start_frame);
+    }
     if let Some(r) = &a.reference {
-        let m = inbetween_io::load_motion(r)?;
+        let m = inbetween_io::load_motion(r).with_context(|| format!("reading {}", r.display()))?;
         let m = if a.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
-        let n = m.num_frames().min(got.motion.num_frames());
-        let e =
-            inbetween_core::position_error(&positions_clip(&m.crop(0, n)?), &positions_clip(&got.motion.crop(0, n)?));
-        let cm = inbetween_core::procedural::CM_PER_CMU_UNIT;
-        println!("error vs {}: mean {:.3} cm, max {:.3} cm over {n} frames", r.display(), e.mean * cm, e.max * cm);
+        let unit = UnitChoice::resolve(a.unit, &m.skeleton);
+        let e = inbetween_mocap::stream::compare(&got, &m, unit.cm_per_unit())
+            .with_context(|| format!("comparing with {}", r.display()))?;
+        println!("{unit}");
+        println!(
+            "error vs {} frames {}..{}: mean {:.3} cm, max {:.3} cm over {} frames",
+            r.display(),
+            e.start_frame,
+            e.start_frame + e.frames,
+            e.mean_cm,
+            e.max_cm,
+            e.frames
+        );
     }
     Ok(())
 }

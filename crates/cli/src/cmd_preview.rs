@@ -105,21 +105,14 @@ pub fn run(a: PreviewArgs) -> anyhow::Result<()> {
 /// Renders the GIF, showing a progress bar over the encoding once it has taken over a second.
 /// Returns the number of GIF frames.
 fn write_gif(path: &Path, motions: &[&inbetween_core::Motion], opts: &StickOptions) -> anyhow::Result<usize> {
-    let bar = crate::progress::bar(0, "encoding");
-    bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    let started = Instant::now();
-    let mut shown = false;
+    let bar = inbetween_io::Progress::after(PROGRESS_AFTER, 0, "encoding");
     let mut total = 0;
     stick::render_motion_gif_with_progress(path, motions, opts, &mut |done, all| {
         total = all;
-        if !shown && started.elapsed() > PROGRESS_AFTER {
-            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            shown = true;
-        }
         bar.set_length(all as u64);
         bar.set_position(done as u64);
     })
     .with_context(|| format!("writing {}", path.display()))?;
-    bar.finish_and_clear();
+    bar.finish();
     Ok(total)
 }

@@ -1,10 +1,10 @@
 //! `inbetween demo`: the main job. Runs on a fresh clone with no data: a procedural walk, written as
 //! BVH and previewed as a GIF, then each engine's own demo on built-in data.
 
-use crate::progress;
 use anyhow::Context;
 use clap::Args;
 use inbetween_core::procedural::{gait, GaitParams};
+use inbetween_io::Progress;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -19,7 +19,8 @@ pub struct DemoArgs {
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let steps = progress::bar(3, "demo");
+    // One step for the walk, four for the mocap demo, one for the camera demo.
+    let steps = Progress::new(6, "demo");
     let mut params = GaitParams::walk().jittered(a.seed, 0.15);
     params.frames = 150;
     params.turn_rate = 0.35;
@@ -42,10 +43,10 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         bvh.display(),
         gif.display()
     )];
-    lines.extend(crate::cmd_mocap::demo(&a.out)?);
-    steps.inc(1);
+    lines.extend(inbetween_mocap::demo::run(&a.out, &steps)?);
     lines.extend(crate::cmd_camera::demo(&a.out)?);
-    steps.finish_and_clear();
+    steps.inc(1);
+    steps.finish();
     for l in lines {
         println!("{l}");
     }

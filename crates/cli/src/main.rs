@@ -5,13 +5,18 @@ mod cmd_io;
 mod cmd_mocap;
 mod cmd_preview;
 mod demo;
-mod progress;
+mod errors;
+
+use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(name = "inbetween", version, about = "AI-assisted keyframe animation: in-betweening, keyframe extraction, previews")]
 struct Cli {
+    /// On an error, also print its backtrace (same as INBETWEEN_DEBUG=1).
+    #[arg(long, global = true)]
+    debug: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -34,9 +39,22 @@ enum Command {
     Camera(cmd_camera::CameraCommand),
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
+    let debug = cli.debug || std::env::var_os("INBETWEEN_DEBUG").is_some_and(|v| v != "0");
+    errors::install(debug);
+    match dispatch(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprint!("{}", errors::render(&e, debug));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The CLI only parses arguments (above) and calls the engines' library functions (below).
+fn dispatch(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Info(a) => cmd_io::info(a),
         Command::Convert(a) => cmd_io::convert(a),
         Command::Preview(a) => cmd_preview::run(a),

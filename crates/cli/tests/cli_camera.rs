@@ -62,7 +62,10 @@ fn train_resumes_from_its_checkpoint_and_can_restart_the_learning_rate() {
         let out = inbetween(&args);
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let text = std::fs::read_to_string(weights.with_extension("json")).unwrap();
-        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+        let card = serde_json::from_str::<serde_json::Value>(&text).unwrap();
+        assert_eq!(card["kind"], "camera");
+        assert_eq!(card["extra"]["style_codes"].as_array().unwrap().len(), 8, "4 behaviours × main left/right");
+        card["training"].clone()
     };
     let first = run(&["--epochs", "1"]);
     assert_eq!(first["epochs_done"], 1);
@@ -71,4 +74,19 @@ fn train_resumes_from_its_checkpoint_and_can_restart_the_learning_rate() {
     assert_eq!(resumed["iterations"], 4);
     assert_eq!(resumed["config"]["lr_decay_from"], 1);
     assert_eq!(resumed["lr"], 5e-4, "epoch 2 runs at the restarted rate, not 5e-4 × 0.97");
+    // The trained weights load back for generation.
+    let d = dir.path();
+    assert!(inbetween(&["camera", "scene", "-o", s(d), "--frames", "60"]).status.success());
+    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--weights", s(&weights), "-o", s(&d.join("c.json"))]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn train_refuses_to_overwrite_the_committed_weights() {
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../camera/weights/camera.bpk");
+    let before = std::fs::read(&committed).unwrap();
+    let out = inbetween(&["camera", "train", "-o", s(&committed), "--epochs", "1", "--iters-per-epoch", "1", "--batch", "2", "--scenes", "1", "--hidden", "8"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--overwrite-committed"), "{err}");
+    assert_eq!(std::fs::read(&committed).unwrap(), before, "the committed weights are untouched");
 }

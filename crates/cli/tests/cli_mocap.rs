@@ -31,6 +31,8 @@ fn compress_decompress_preview_and_corrupt_input() {
     let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "-o", &ibk]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("bytes per key"), "{}", text(&o));
+    assert!(text(&o).contains("length unit: CMU units (5.6444 cm) (rest-pose height 26.7 units"), "{}", text(&o));
+    assert!(max_cm(&text(&o)) <= 1.0, "{}", text(&o));
     let out = dir.path().join("rec.bvh").to_string_lossy().into_owned();
     let o = inbetween(&["mocap", "decompress", &ibk, "-o", &out]);
     assert!(o.status.success(), "{}", text(&o));
@@ -51,6 +53,101 @@ fn compress_decompress_preview_and_corrupt_input() {
     assert!(!Path::new(&none).exists());
     let o = inbetween(&["mocap", "compress", &bvh, "-o", &ibk]);
     assert!(!o.status.success() && text(&o).contains("-k"), "{}", text(&o));
+}
+
+/// The "max X cm" of a report line.
+fn max_cm(report: &str) -> f64 {
+    let at = report.find("max ").expect("a max error in the report") + 4;
+    report[at..].split_whitespace().next().unwrap().parse().unwrap()
+}
+
+/// Keys in a compress report ("…, 12 keys; …").
+fn keys(report: &str) -> usize {
+    let before = &report[..report.find(" keys;").expect("a key count")];
+    before.rsplit(' ').next().unwrap().parse().unwrap()
+}
+
+/// The same walk written in CMU units, centimetres and metres compresses to the same keys and the
+/// same cm error at the same bound; each report says which unit it inferred, and --unit overrides.
+#[test]
+fn compress_infers_the_unit_of_any_rig_and_accepts_an_override() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut p = inbetween_core::procedural::GaitParams::walk();
+    p.frames = 90;
+    let walk = inbetween_core::procedural::gait(&p);
+    let mut reports = Vec::new();
+    for (name, unit) in [("cmu", "CMU units (5.6444 cm)"), ("cm", "cm"), ("m", "m")] {
+        let u: inbetween_core::units::LengthUnit = name.parse().unwrap();
+        let scaled = inbetween_core::units::scale_motion(&walk, 5.6444 / u.cm_per_unit());
+        let bvh = dir.path().join(format!("{name}.bvh"));
+        inbetween_io::write_bvh(&bvh, &scaled).unwrap();
+        let ibk = dir.path().join(format!("{name}.ibk")).to_string_lossy().into_owned();
+        let o = inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "-o", &ibk]);
+        assert!(o.status.success(), "{}", text(&o));
+        assert!(text(&o).contains(&format!("length unit: {unit} (rest-pose height")), "{}", text(&o));
+        reports.push(text(&o));
+    }
+    for r in &reports[1..] {
+        assert_eq!(keys(r), keys(&reports[0]), "{r}");
+        assert!((max_cm(r) - max_cm(&reports[0])).abs() < 2e-3, "{r}");
+    }
+    // Told the CMU clip is in cm, the bound is 5.6 times looser: fewer keys.
+    let bvh = dir.path().join("cmu.bvh");
+    let out = dir.path().join("o.ibk").to_string_lossy().into_owned();
+    let o =
+        inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "--unit", "cm", "-o", &out]);
+    assert!(o.status.success() && text(&o).contains("length unit: cm (given with --unit)"), "{}", text(&o));
+    assert!(keys(&text(&o)) < keys(&reports[0]), "{}", text(&o));
+    let o =
+        inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "1cm", "--unit", "feet", "-o", &out]);
+    assert!(!o.status.success() && text(&o).contains("expected cm, m, mm, in, cmu"), "{}", text(&o));
+}
+
+/// A receiver is killed mid-stream and a new one started on the same address: the sender
+/// reconnects, and the new receiver says which frame it starts at and compares from there.
+#[test]
+fn stream_receiver_joining_mid_stream_compares_at_its_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    let bvh = walk_bvh(dir.path());
+    let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let addr = format!("127.0.0.1:{port}");
+    let first = dir.path().join("first.bvh").to_string_lossy().into_owned();
+    let out = dir.path().join("second.bvh").to_string_lossy().into_owned();
+    let exe = env!("CARGO_BIN_EXE_inbetween");
+    let mut recv1 = Command::new(exe)
+        .args(["mocap", "stream", "recv", "--addr", &addr, "-o", &first, "--timeout-s", "20"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    // Real time: 90 frames at 30 fps take 3 s.
+    let sender = Command::new(exe)
+        .args(["mocap", "stream", "send", &bvh, "--addr", &addr, "--max-error", "1cm", "--retries", "25"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1200));
+    recv1.kill().unwrap();
+    recv1.wait().unwrap();
+    let o =
+        inbetween(&["mocap", "stream", "recv", "--addr", &addr, "-o", &out, "--reference", &bvh, "--timeout-s", "20"]);
+    let s = sender.wait_with_output().unwrap();
+    assert!(s.status.success(), "{}", text(&s));
+    assert!(text(&s).contains("1 reconnects"), "{}", text(&s));
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("joined mid-stream"), "{t}");
+    let start: usize = t.split("frame 0 is frame ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+    assert!(start > 10 && start < 80, "{t}");
+    assert!(
+        t.contains(&format!("emitted {} frames (frames {start}..90 of the sender's 90-frame clip)", 90 - start)),
+        "{t}"
+    );
+    assert!(t.contains(&format!("frames {start}..90: mean")), "{t}");
+    assert!(max_cm(&t[t.find("error vs").unwrap()..]) <= 1.0, "{t}");
+    assert_eq!(inbetween_io::read_bvh(Path::new(&out)).unwrap().num_frames(), 90 - start);
 }
 
 #[test]
@@ -84,7 +181,8 @@ fn stream_over_loopback() {
     assert!(text(&o).contains("added latency"), "{}", text(&o));
     let r = recv.join().unwrap();
     assert!(r.status.success(), "{}", text(&r));
-    assert!(text(&r).contains("complete") && text(&r).contains("emitted 90 frames"), "{}", text(&r));
+    assert!(text(&r).contains("complete") && text(&r).contains("emitted 90 frames (frames 0..90"), "{}", text(&r));
+    assert!(max_cm(&text(&r)[text(&r).find("error vs").unwrap()..]) <= 1.0, "{}", text(&r));
 }
 
 #[test]
@@ -92,7 +190,17 @@ fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
     let dir = tempfile::tempdir().unwrap();
     let policy = dir.path().join("p.bpk").to_string_lossy().into_owned();
     let o = inbetween(&[
-        "mocap", "train", "--procedural", "--preset", "quick", "--episodes", "8", "--stride", "60", "-o", &policy,
+        "mocap",
+        "train",
+        "--procedural",
+        "--preset",
+        "quick",
+        "--episodes",
+        "8",
+        "--stride",
+        "60",
+        "-o",
+        &policy,
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let info = std::fs::read_to_string(dir.path().join("p.json")).unwrap();
@@ -100,15 +208,26 @@ fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
     // A plain folder of clips: two procedural walks, different lengths and speeds.
     let data = dir.path().join("clips");
     std::fs::create_dir_all(&data).unwrap();
-    for (i, frames) in [(0, 250), (1, 190)] {
+    // The second one in a sub-folder: --data searches below the folder too.
+    std::fs::create_dir_all(data.join("more")).unwrap();
+    for (i, frames, path) in [(0, 250, "walk0.bvh"), (1, 190, "more/walk1.bvh")] {
         let mut p = inbetween_core::procedural::GaitParams::walk();
         p.frames = frames;
         p.speed *= 1.0 + 0.2 * i as f64;
-        inbetween_io::write_bvh(&data.join(format!("walk{i}.bvh")), &inbetween_core::procedural::gait(&p)).unwrap();
+        inbetween_io::write_bvh(&data.join(path), &inbetween_core::procedural::gait(&p)).unwrap();
     }
     let csv = dir.path().join("bench.csv").to_string_lossy().into_owned();
     let o = inbetween(&[
-        "mocap", "bench", "--data", data.to_str().unwrap(), "--model", &policy, "--csv", &csv, "--codec-bounds", "1",
+        "mocap",
+        "bench",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        &policy,
+        "--csv",
+        &csv,
+        "--codec-bounds",
+        "1",
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let table = std::fs::read_to_string(&csv).unwrap();
@@ -122,7 +241,7 @@ fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
     let o = inbetween(&["mocap", "bench", "--data", dir.path().join("none").to_str().unwrap()]);
     assert!(!o.status.success(), "{}", text(&o));
     // One clip: no test split, so the table and the chart use all windows.
-    std::fs::remove_file(data.join("walk1.bvh")).unwrap();
+    std::fs::remove_file(data.join("more/walk1.bvh")).unwrap();
     let png = dir.path().join("bench.png").to_string_lossy().into_owned();
     let o = inbetween(&["mocap", "bench", "--data", data.to_str().unwrap(), "--plot", &png, "--codec-bounds", "1"]);
     assert!(o.status.success(), "{}", text(&o));

@@ -1,6 +1,8 @@
 //! Core types and math every inbetween engine speaks: skeletons, motion clips, rotations, forward
-//! kinematics, resampling and windowing, keyed curves, keyframe sets, interpolation and error metrics.
+//! kinematics, resampling and windowing, keyed curves, keyframe sets, interpolation, error metrics, length units,
+//! seeding ([`seed`]) and angle wrapping ([`angle`]).
 
+pub mod angle;
 pub mod curve;
 pub mod fk;
 pub mod interp;
@@ -9,9 +11,11 @@ pub mod metrics;
 pub mod motion;
 pub mod procedural;
 pub mod rotation;
+pub mod seed;
 pub mod skeleton;
+pub mod units;
 
-pub use curve::{Animatable, Curve, Interpolation, Key, ScalarTrack, Track};
+pub use curve::{Animatable, Curve, Interpolation, Key, KeyCorrected, Samples, ScalarTrack, Track};
 pub use fk::{forward, forward_clip, positions_clip, GlobalPose};
 pub use keyframes::KeyframeSet;
 pub use metrics::{position_error, rotation_error, ErrorStats};

@@ -134,7 +134,7 @@ impl GaitParams {
             lean: j(self.lean),
             ..self.clone()
         };
-        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x9e37_79b9_7f4a_7c15);
+        let mut rng = crate::seed::rng(seed ^ 0x9e37_79b9_7f4a_7c15);
         p.phase = rng.random_range(0.0..TAU);
         p.turn_rate = self.turn_rate + rng.random_range(-0.4..=0.4) * amount;
         p

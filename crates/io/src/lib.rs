@@ -1,4 +1,6 @@
-//! File formats: BVH, ASF/AMC, and the shared file helpers (atomic writes, locating shared data).
+//! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), locating
+//! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]) and the
+//! bench/report harness ([`report`]: tables, reports, timings).
 //!
 //! Every reader returns [`IoError`] on bad input (never panics); its message names the file, the
 //! 1-based line and what was expected there.
@@ -8,11 +10,14 @@ pub mod bvh;
 pub mod data;
 pub mod fsutil;
 mod lexer;
+pub mod progress;
+pub mod report;
 
 pub use asf::{parse_asf_amc, read_asf_amc};
 pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
 pub use data::shared_data_dir;
-pub use fsutil::write_atomic;
+pub use fsutil::{write_atomic, write_atomic_with};
+pub use progress::Progress;
 
 use inbetween_core::Motion;
 use std::path::{Path, PathBuf};

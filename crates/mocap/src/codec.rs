@@ -1,31 +1,45 @@
 //! The `.ibk` keyframe codec: a compact, versioned, checksummed binary of a clip's keyframes from
 //! which the whole clip is rebuilt by the rotation reconstruction ([`crate::rotations`]).
 //!
-//! Layout (little-endian):
+//! Layout (little-endian), version 2:
 //! ```text
 //! magic "IBK\0" | version u16 | reserved u16
-//! frame_time f64 | num_frames u32 | num_keys u32 | angvel_scale f32 | num_joints u16
+//! frame_time f64 | num_frames u32 | num_keys u32 | num_joints u16
 //! skeleton: per joint  name_len u16, name bytes, parent i16 (-1 root), offset 3×f64,
 //!                      channel count u8, channel codes u8…, end site flag u8 (+ 3×f64)
 //! key frames: num_keys × varint of the gap to the previous key (first key is frame 0)
-//! key values: per key, per joint with rotation channels
-//!                  rotation vector 3×i16 (scale π/32767) and angular velocity 3×i16 (scale angvel_scale/32767),
+//! key values: per key  angular velocity scale f32, then
+//!             per joint with rotation channels
+//!                  rotation vector 3×i16 (scale π/32767) and angular velocity 3×i16 (scale/32767),
 //!             per joint with position channels
 //!                  translation 3×f32 and velocity 3×f32
 //! crc32 of every byte before it, u32
 //! ```
-//! So a key costs 12 bytes per rotating joint plus 24 per translating joint: 396 bytes on the
-//! 31-joint CMU skeleton (31 × 12 + 24) against 384 bytes for one raw frame of 96 f32 channels.
+//! So a key costs 4 bytes plus 12 per rotating joint plus 24 per translating joint: 400 bytes on
+//! the 31-joint CMU skeleton (4 + 31 × 12 + 24) against 384 bytes for one raw frame of 96 f32
+//! channels. Version 1 (still read) had one angular velocity scale for the whole file, after
+//! `num_keys`, and none per key.
+//!
+//! Each key's scale depends on that key alone, so the value a decoder will see for any frame is
+//! known before keys are chosen ([`quantised_model`]): [`compress`] chooses keys against exactly
+//! what the decoder rebuilds, and its error bound holds for the decoded file.
 
 use crate::rotations::{reconstruct_from_keys, KeyPose, RotationMotion};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::rotation::{quat_to_rotvec, rotvec_to_quat};
+use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{Channel, Joint, KeyframeSet, Motion, Skeleton};
 use std::f64::consts::PI;
 
 pub const MAGIC: &[u8; 4] = b"IBK\0";
-pub const VERSION: u16 = 1;
+/// The version [`encode`] writes.
+pub const VERSION: u16 = 2;
+/// The oldest version [`decode`] reads.
+pub const OLDEST_VERSION: u16 = 1;
+/// Largest clip a file may describe (frames × joints), so a corrupt or hostile header cannot make
+/// the decoder's caller allocate without bound: 2²⁶ joint poses (~4.5 GB of f64 channels at most).
+pub const MAX_FRAME_JOINTS: u64 = 1 << 26;
 
 /// A decoded `.ibk` file.
 #[derive(Clone, Debug)]
@@ -44,13 +58,13 @@ impl Decoded {
     }
 }
 
-/// Bytes one key takes on a skeleton.
+/// Bytes one key takes on a skeleton (its angular velocity scale included).
 pub fn bytes_per_key(skeleton: &Skeleton) -> usize {
-    skeleton
+    4 + skeleton
         .joints()
         .iter()
         .map(|j| if j.rotation_order().is_some() { 12 } else { 0 } + if j.has_translation() { 24 } else { 0 })
-        .sum()
+        .sum::<usize>()
 }
 
 fn channel_code(c: Channel) -> u8 {
@@ -87,9 +101,6 @@ fn dequantize(q: i16, scale: f64) -> f64 {
 /// Encodes the keys `keys` of `model` (a [`RotationMotion`] of the clip to store).
 pub fn encode(model: &RotationMotion, keys: &KeyframeSet) -> Vec<u8> {
     let sk = &model.skeleton;
-    let poses = model.key_poses(keys);
-    let max_w =
-        poses.iter().flat_map(|p| p.angular_velocities.iter()).map(|w| w.abs().max_element()).fold(1e-6, f64::max);
     let mut out = Vec::new();
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
@@ -97,16 +108,14 @@ pub fn encode(model: &RotationMotion, keys: &KeyframeSet) -> Vec<u8> {
     out.extend_from_slice(&model.frame_time.to_le_bytes());
     out.extend_from_slice(&(model.num_frames() as u32).to_le_bytes());
     out.extend_from_slice(&(keys.len() as u32).to_le_bytes());
-    out.extend_from_slice(&(max_w as f32 * 1.0001).to_le_bytes());
-    let w_scale = f32::from_le_bytes(out[out.len() - 4..].try_into().expect("4 bytes")) as f64;
     write_skeleton(&mut out, sk);
     let mut prev = 0;
     for &f in keys.frames() {
         write_varint(&mut out, (f - prev) as u64);
         prev = f;
     }
-    for p in &poses {
-        write_key(&mut out, sk, p, w_scale);
+    for &f in keys.frames() {
+        write_scaled_key(&mut out, sk, &model.frames[f]);
     }
     let crc = crc32fast::hash(&out);
     out.extend_from_slice(&crc.to_le_bytes());
@@ -137,6 +146,20 @@ pub fn write_skeleton(out: &mut Vec<u8>, sk: &Skeleton) {
     }
 }
 
+/// The angular velocity scale of one key: its largest component (rad/s), a little over so that
+/// it quantises to ±32767 at most, as the f32 that is stored.
+pub fn key_scale(p: &KeyPose) -> f32 {
+    let max_w = p.angular_velocities.iter().map(|w| w.abs().max_element()).fold(1e-6, f64::max);
+    max_w as f32 * 1.0001
+}
+
+/// Appends one key: its angular velocity scale ([`key_scale`]) and its values ([`write_key`]).
+pub fn write_scaled_key(out: &mut Vec<u8>, sk: &Skeleton, p: &KeyPose) {
+    let scale = key_scale(p);
+    out.extend_from_slice(&scale.to_le_bytes());
+    write_key(out, sk, p, scale as f64);
+}
+
 /// Appends one key's values (quantised rotations and angular velocities, f32 translations).
 pub fn write_key(out: &mut Vec<u8>, sk: &Skeleton, p: &KeyPose, w_scale: f64) {
     for (j, joint) in sk.joints().iter().enumerate() {
@@ -154,6 +177,21 @@ pub fn write_key(out: &mut Vec<u8>, sk: &Skeleton, p: &KeyPose, w_scale: f64) {
             }
         }
     }
+}
+
+/// The key pose a decoder reads back for `p` (written by [`write_scaled_key`]).
+pub fn round_trip_key(sk: &Skeleton, p: &KeyPose) -> KeyPose {
+    let mut bytes = Vec::with_capacity(bytes_per_key(sk));
+    write_scaled_key(&mut bytes, sk, p);
+    read_scaled_key(&mut Reader::new(&bytes), sk).expect("a key written for this skeleton reads back")
+}
+
+/// `model` with every frame replaced by what a decoder reads back for it as a key (quantised
+/// rotations and angular velocities, f32 translations); positions stay the source's. Errors of
+/// this model's in-betweens are the errors of the decoded file.
+pub fn quantised_model(model: &RotationMotion) -> RotationMotion {
+    let frames = model.frames.iter().map(|p| round_trip_key(&model.skeleton, p)).collect();
+    RotationMotion { frames, ..model.clone() }
 }
 
 fn write_varint(out: &mut Vec<u8>, mut v: u64) {
@@ -263,7 +301,7 @@ pub fn read_skeleton(r: &mut Reader) -> Result<Skeleton> {
     read_skeleton_joints(r, nj)
 }
 
-/// Reads one key written by [`write_key`].
+/// Reads one key's values written by [`write_key`] with scale `w_scale`.
 pub fn read_key(r: &mut Reader, skeleton: &Skeleton, w_scale: f64) -> Result<KeyPose> {
     let nj = skeleton.len();
     let mut p = KeyPose {
@@ -294,7 +332,20 @@ pub fn read_key(r: &mut Reader, skeleton: &Skeleton, w_scale: f64) -> Result<Key
     Ok(p)
 }
 
-/// Decodes an `.ibk` file, checking magic, version, checksum and every length.
+/// Reads one key written by [`write_scaled_key`], refusing a scale that is not a finite,
+/// non-negative number.
+pub fn read_scaled_key(r: &mut Reader, skeleton: &Skeleton) -> Result<KeyPose> {
+    let at = r.pos;
+    let scale = r.f32("angular velocity scale")?;
+    if !(scale.is_finite() && scale >= 0.0) {
+        return Err(MocapError::Codec(format!(
+            "angular velocity scale {scale} at byte {at} is not a finite, non-negative number"
+        )));
+    }
+    read_key(r, skeleton, scale)
+}
+
+/// Decodes an `.ibk` file (version 1 or 2), checking magic, version, checksum and every length.
 pub fn decode(bytes: &[u8]) -> Result<Decoded> {
     if bytes.len() < 4 || &bytes[..4] != MAGIC {
         return Err(MocapError::Codec("not an .ibk file: expected the magic bytes \"IBK\\0\" at byte 0".into()));
@@ -306,9 +357,9 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
     let stored = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("4 bytes"));
     let mut r = Reader { bytes: body, pos: 4 };
     let version = r.u16("version")?;
-    if version != VERSION {
+    if !(OLDEST_VERSION..=VERSION).contains(&version) {
         return Err(MocapError::Codec(format!(
-            "unsupported .ibk version {version}; this build reads version {VERSION}"
+            "unsupported .ibk version {version}; this build reads versions {OLDEST_VERSION} to {VERSION}"
         )));
     }
     if crc32fast::hash(body) != stored {
@@ -321,19 +372,57 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
     let frame_time = r.f64("frame time")?;
     let num_frames = r.u32("frame count")? as usize;
     let num_keys = r.u32("key count")? as usize;
-    let w_scale = r.f32("angular velocity scale")?;
+    let file_scale = if version == 1 { Some(r.f32("angular velocity scale")?) } else { None };
     let nj = r.u16("joint count")? as usize;
     if !(frame_time.is_finite() && frame_time > 0.0) || num_keys < 2 || num_keys > num_frames || nj == 0 {
         return Err(MocapError::Codec(format!(
             "invalid header: frame time {frame_time}, {num_frames} frames, {num_keys} keys, {nj} joints"
         )));
     }
+    if num_frames as u64 * nj as u64 > MAX_FRAME_JOINTS {
+        return Err(MocapError::Codec(format!(
+            "invalid header: {num_frames} frames of {nj} joints exceed the {MAX_FRAME_JOINTS} joint poses a file may hold"
+        )));
+    }
+    if file_scale.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
+        return Err(MocapError::Codec(format!("invalid header: angular velocity scale {}", file_scale.unwrap_or(0.0))));
+    }
     let skeleton = read_skeleton_joints(&mut r, nj)?;
+    // Every key takes at least one byte of gap and one of values: a count beyond the bytes left
+    // is corrupt (and must not size an allocation).
+    if num_keys > r.remaining() {
+        return Err(MocapError::Codec(format!(
+            "truncated file: {num_keys} keys announced but only {} bytes remain at byte {}",
+            r.remaining(),
+            r.pos
+        )));
+    }
+    let key_frames = read_key_frames(&mut r, num_keys, num_frames)?;
+    let mut keys = Vec::with_capacity(num_keys);
+    for _ in 0..num_keys {
+        let p = match file_scale {
+            Some(s) => read_key(&mut r, &skeleton, s)?,
+            None => read_scaled_key(&mut r, &skeleton)?,
+        };
+        keys.push(p);
+    }
+    if r.pos != body.len() {
+        return Err(MocapError::Codec(format!(
+            "{} unexpected bytes after the key values at byte {}",
+            body.len() - r.pos,
+            r.pos
+        )));
+    }
+    Ok(Decoded { skeleton, frame_time, num_frames, key_frames, keys })
+}
+
+/// The varint gaps of the key frames: strictly increasing from frame 0 to the clip's last frame.
+fn read_key_frames(r: &mut Reader, num_keys: usize, num_frames: usize) -> Result<Vec<usize>> {
     let mut key_frames = Vec::with_capacity(num_keys);
     let mut f = 0u64;
     for k in 0..num_keys {
         let gap = r.varint("key frame gap")?;
-        f += gap;
+        f = f.saturating_add(gap);
         if (k > 0 && gap == 0) || (k == 0 && gap != 0) || f >= num_frames as u64 {
             return Err(MocapError::Codec(format!("key {k}: frame {f} is out of order or outside 0..{num_frames}")));
         }
@@ -346,19 +435,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
             num_frames - 1
         )));
     }
-    let mut keys = Vec::with_capacity(num_keys);
-    for _ in 0..num_keys {
-        let p = read_key(&mut r, &skeleton, w_scale)?;
-        keys.push(p);
-    }
-    if r.pos != body.len() {
-        return Err(MocapError::Codec(format!(
-            "{} unexpected bytes after the key values at byte {}",
-            body.len() - r.pos,
-            r.pos
-        )));
-    }
-    Ok(Decoded { skeleton, frame_time, num_frames, key_frames, keys })
+    Ok(key_frames)
 }
 
 /// Raw size of a clip as f32 channel values (the comparison baseline).
@@ -372,6 +449,7 @@ mod tests {
     use crate::error::SegmentModel;
     use inbetween_core::positions_clip;
     use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
+    use rand::{Rng, SeedableRng};
 
     fn clip() -> (Motion, RotationMotion, KeyframeSet) {
         let mut p = GaitParams::run();
@@ -382,39 +460,78 @@ mod tests {
         (m, rm, keys)
     }
 
-    #[test]
-    fn round_trip_matches_the_unquantised_reconstruction() {
-        let (m, rm, keys) = clip();
-        let bytes = encode(&rm, &keys);
-        assert_eq!(
-            bytes.len(),
-            4 + 4
-                + 8
-                + 4
-                + 4
-                + 4
-                + 2
-                + skeleton_bytes(&m.skeleton)
-                + keys.len()
-                + keys.len() * bytes_per_key(&m.skeleton)
-                + 4
-        );
-        let d = decode(&bytes).unwrap();
-        assert_eq!(d.key_frames, keys.frames());
-        assert_eq!(d.skeleton, m.skeleton);
-        let rec = d.reconstruct().unwrap();
-        assert_eq!(rec.num_frames(), 50);
-        let exact = rm.reconstruct(&keys).unwrap();
-        let e = inbetween_core::position_error(&positions_clip(&exact), &positions_clip(&rec));
-        assert!(e.max * CM_PER_CMU_UNIT < 0.1, "quantisation costs {} cm", e.max * CM_PER_CMU_UNIT);
-        assert!(rm.error(&keys).max_cm > 0.0);
-    }
-
     fn skeleton_bytes(s: &Skeleton) -> usize {
         s.joints()
             .iter()
             .map(|j| 2 + j.name.len() + 2 + 24 + 1 + j.channels.len() + 1 + if j.end_site.is_some() { 24 } else { 0 })
             .sum()
+    }
+
+    #[test]
+    fn round_trip_rebuilds_exactly_what_the_quantised_model_predicts() {
+        let (m, rm, keys) = clip();
+        let bytes = encode(&rm, &keys);
+        let header = 4 + 4 + 8 + 4 + 4 + 2;
+        let expected = header + skeleton_bytes(&m.skeleton) + keys.len() + keys.len() * bytes_per_key(&m.skeleton) + 4;
+        assert_eq!(bytes.len(), expected);
+        assert_eq!(bytes_per_key(&m.skeleton), 4 + 31 * 12 + 24);
+        let d = decode(&bytes).unwrap();
+        assert_eq!(d.key_frames, keys.frames());
+        assert_eq!(d.skeleton, m.skeleton);
+        let rec = d.reconstruct().unwrap();
+        assert_eq!(rec.num_frames(), 50);
+        // The quantised model predicts the decoded clip: same frames to rounding.
+        let q = quantised_model(&rm);
+        let predicted = q.reconstruct(&keys).unwrap();
+        let e = inbetween_core::position_error(&positions_clip(&predicted), &positions_clip(&rec));
+        assert!(e.max * CM_PER_CMU_UNIT < 1e-9, "prediction off by {} cm", e.max * CM_PER_CMU_UNIT);
+        // Quantisation moves the clip by well under a millimetre.
+        let exact = rm.reconstruct(&keys).unwrap();
+        let e = inbetween_core::position_error(&positions_clip(&exact), &positions_clip(&rec));
+        assert!(e.max * CM_PER_CMU_UNIT < 0.05, "quantisation costs {} cm", e.max * CM_PER_CMU_UNIT);
+        // Four interior keys over 50 frames of a run (gaps up to 14 frames) leave centimetres of
+        // error (41 cm at worst), and the model's segment sums say how much the decoded file has.
+        let source = positions_clip(&m);
+        let decoded = inbetween_core::position_error(&source, &positions_clip(&rec));
+        let planned = q.error(&keys);
+        assert!(planned.max_cm > 10.0 && planned.max_cm < 60.0, "{planned:?}");
+        assert!(planned.mean_cm > 1.0 && planned.mean_cm < 6.0, "{planned:?}");
+        assert!((decoded.max * CM_PER_CMU_UNIT - planned.max_cm).abs() < 0.05, "{} vs {planned:?}", decoded.max);
+    }
+
+    #[test]
+    fn version_1_files_still_decode() {
+        let (_, rm, keys) = clip();
+        let v2 = decode(&encode(&rm, &keys)).unwrap();
+        // Version 1: one file-wide scale after the key count, none per key.
+        let scale = keys.frames().iter().map(|&f| key_scale(&rm.frames[f])).fold(0.0f32, f32::max);
+        let mut v1 = Vec::new();
+        v1.extend_from_slice(MAGIC);
+        v1.extend_from_slice(&1u16.to_le_bytes());
+        v1.extend_from_slice(&0u16.to_le_bytes());
+        v1.extend_from_slice(&rm.frame_time.to_le_bytes());
+        v1.extend_from_slice(&(rm.num_frames() as u32).to_le_bytes());
+        v1.extend_from_slice(&(keys.len() as u32).to_le_bytes());
+        v1.extend_from_slice(&scale.to_le_bytes());
+        write_skeleton(&mut v1, &rm.skeleton);
+        let mut prev = 0;
+        for &f in keys.frames() {
+            write_varint(&mut v1, (f - prev) as u64);
+            prev = f;
+        }
+        for &f in keys.frames() {
+            write_key(&mut v1, &rm.skeleton, &rm.frames[f], scale as f64);
+        }
+        let crc = crc32fast::hash(&v1);
+        v1.extend_from_slice(&crc.to_le_bytes());
+        let old = decode(&v1).unwrap();
+        assert_eq!(old.key_frames, v2.key_frames);
+        for (a, b) in old.keys.iter().zip(&v2.keys) {
+            assert_eq!(a.rotations, b.rotations);
+            for (wa, wb) in a.angular_velocities.iter().zip(&b.angular_velocities) {
+                assert!((*wa - *wb).abs().max_element() <= 2.0 * scale as f64 / 32767.0);
+            }
+        }
     }
 
     #[test]
@@ -427,9 +544,9 @@ mod tests {
         let mut flipped = bytes.clone();
         flipped[100] ^= 0x40;
         assert!(msg(&flipped).contains("checksum"));
-        let mut v2 = bytes.clone();
-        v2[4] = 9;
-        assert!(msg(&v2).contains("version 9"));
+        let mut v9 = bytes.clone();
+        v9[4] = 9;
+        assert!(msg(&v9).contains("version 9"));
         // A truncated body with a valid checksum still fails on lengths, naming the byte.
         let mut cut = bytes[..bytes.len() - 40].to_vec();
         let crc = crc32fast::hash(&cut);
@@ -439,14 +556,69 @@ mod tests {
             assert!(decode(&bytes[..n]).is_err(), "prefix of {n} bytes decoded");
         }
     }
+
+    /// With its checksum fixed up, `body` reaches the structural checks.
+    fn with_crc(mut body: Vec<u8>) -> Vec<u8> {
+        let crc = crc32fast::hash(&body);
+        body.extend_from_slice(&crc.to_le_bytes());
+        body
+    }
+
+    /// What the fuzz target (`fuzz/fuzz_targets/ibk.rs`) does, on seeded random inputs, so that CI
+    /// runs it: random bytes, and valid files with random bytes changed, cut or a huge header
+    /// value, all behind a valid checksum. Decoding must return, never panic or allocate wildly.
+    #[test]
+    fn decoding_arbitrary_bytes_never_panics() {
+        let (_, rm, keys) = clip();
+        let good = encode(&rm, &keys);
+        let body = &good[..good.len() - 4];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let mut accepted = 0;
+        for case in 0..3000 {
+            let bytes = match case % 4 {
+                0 => {
+                    let n = rng.random_range(0..200);
+                    let mut b: Vec<u8> = (0..n).map(|_| rng.random()).collect();
+                    if n >= 6 && rng.random_bool(0.5) {
+                        b[..4].copy_from_slice(MAGIC);
+                        b[4] = 2;
+                        b[5] = 0;
+                    }
+                    with_crc(b)
+                }
+                1 => {
+                    let mut b = body.to_vec();
+                    for _ in 0..rng.random_range(1..6) {
+                        let i = rng.random_range(6..b.len());
+                        b[i] = rng.random();
+                    }
+                    with_crc(b)
+                }
+                2 => with_crc(body[..rng.random_range(0..body.len())].to_vec()),
+                _ => {
+                    let mut b = body.to_vec();
+                    let at = rng.random_range(8..24);
+                    b[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+                    with_crc(b)
+                }
+            };
+            if let Ok(d) = decode(&bytes) {
+                accepted += 1;
+                if d.num_frames * d.skeleton.len() <= 100_000 {
+                    let _ = d.reconstruct();
+                }
+            }
+        }
+        assert!(accepted > 0, "some single-byte changes (e.g. in key values) still decode");
+    }
 }
 
 /// How many keys a compression may use.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Budget {
-    /// Exactly this many keys, placed to minimise the mean position error.
+    /// Exactly this many keys, placed to minimise the mean position error of the decoded file.
     Keys(usize),
-    /// The fewest keys keeping every joint of every frame within this many cm (before quantisation).
+    /// The fewest keys keeping every joint of every frame of the decoded file within this many cm.
     MaxErrorCm(f64),
 }
 
@@ -455,46 +627,101 @@ pub enum Budget {
 pub struct Compressed {
     pub keys: KeyframeSet,
     pub bytes: Vec<u8>,
-    /// Error of the exact (unquantised) reconstruction, as the selector saw it.
+    /// Error of the in-between frames as the selector saw them (the decoder's quantised keys).
     pub planned: crate::ReconstructionError,
-    /// Mean and max position error in cm of the decoded file against the source.
+    /// Mean and max position error in cm of the decoded file against the source, key frames
+    /// (quantised) included.
     pub decoded_mean_cm: f64,
     pub decoded_max_cm: f64,
+    /// Frame of the largest decoded error.
+    pub worst_frame: usize,
+    /// The length unit errors were measured in, and why.
+    pub unit: UnitChoice,
+    /// Bound (cm) the keys were finally chosen with: the requested bound, or a tighter one when
+    /// rounding on the way through Euler angles pushed a frame over it. `None` for `Keys`.
+    pub selection_bound_cm: Option<f64>,
 }
 
-/// Picks keys with the exact selectors over segments of at most `max_gap` frames, encodes them and
-/// measures the decoded result. In `Keys(k)` mode the gap is widened to at least twice the average
-/// spacing so that `k` keys can cover the clip.
+/// [`compress_in`] with the length unit inferred from the clip's skeleton.
 pub fn compress(motion: &Motion, budget: Budget, max_gap: usize) -> Result<Compressed> {
-    use crate::error::{Objective, SegmentModel, SegmentTable};
-    let model = RotationMotion::from_motion(motion)?;
+    compress_in(motion, LengthUnit::infer(&motion.skeleton), budget, max_gap)
+}
+
+/// Picks keys with the exact selectors over segments of at most `max_gap` frames, against the
+/// clip as the decoder will rebuild it ([`quantised_model`]), encodes them and measures the decoded
+/// file. In `Keys(k)` mode the gap is widened to at least twice the average spacing so that `k`
+/// keys can cover the clip. In `MaxErrorCm` mode the decoded file is checked against the bound;
+/// should a frame still exceed it (rounding), the keys are chosen again with a tighter bound, and a
+/// bound below what the format stores (a key frame's own quantisation error) is an error.
+pub fn compress_in(motion: &Motion, unit: UnitChoice, budget: Budget, max_gap: usize) -> Result<Compressed> {
+    use crate::error::{Objective, SegmentTable};
+    let exact = RotationMotion::from_motion_in(motion, unit.cm_per_unit())?;
+    let model = quantised_model(&exact);
     let n = model.num_frames();
-    let keys = match budget {
+    let bound = match budget {
         Budget::Keys(k) => {
             crate::select::check_k(n, k)?;
             let gap = max_gap.max((2 * (n - 1)).div_ceil(k - 1));
-            crate::select::optimal(&SegmentTable::banded(&model, gap), k, Objective::Position)?
+            let keys = crate::select::optimal(&SegmentTable::banded(&model, gap), k, Objective::Position)?;
+            return finish(&exact, &model, keys, unit, None);
         }
-        Budget::MaxErrorCm(cm) => {
-            if !(cm.is_finite() && cm >= 0.0) {
-                return Err(MocapError::Invalid(format!("max error {cm} cm must be a non-negative number")));
-            }
-            crate::select::error_bounded(&SegmentTable::bounded(&model, max_gap, cm), cm, Objective::Position)?
-        }
+        Budget::MaxErrorCm(cm) => cm,
     };
-    let planned = model.error(&keys);
-    let bytes = encode(&model, &keys);
+    if !(bound.is_finite() && bound >= 0.0) {
+        return Err(MocapError::Invalid(format!("max error {bound} cm must be a non-negative number")));
+    }
+    let mut select_at = bound;
+    for _ in 0..6 {
+        let table = SegmentTable::bounded(&model, max_gap, select_at);
+        let keys = crate::select::error_bounded(&table, select_at, Objective::Position)?;
+        let c = finish(&exact, &model, keys, unit.clone(), Some(select_at))?;
+        if c.decoded_max_cm <= bound {
+            return Ok(c);
+        }
+        if c.keys.frames().contains(&c.worst_frame) {
+            return Err(MocapError::Invalid(format!(
+                "max error {bound} cm is below what the .ibk format stores: quantising key frame {} alone moves a joint by {:.4} cm",
+                c.worst_frame, c.decoded_max_cm
+            )));
+        }
+        select_at = (select_at - 2.0 * (c.decoded_max_cm - bound)).min(select_at * (1.0 - 1e-9));
+    }
+    Err(MocapError::Invalid(format!("could not keep the decoded file within {bound} cm")))
+}
+
+/// Encodes `keys` of `exact`, decodes the file and measures it against the source; `model` is
+/// `exact` quantised, for the planned error.
+fn finish(
+    exact: &RotationMotion,
+    model: &RotationMotion,
+    keys: KeyframeSet,
+    unit: UnitChoice,
+    selection_bound_cm: Option<f64>,
+) -> Result<Compressed> {
+    use crate::error::SegmentModel;
+    let bytes = encode(exact, &keys);
     let decoded = decode(&bytes)?.reconstruct()?;
-    let e = inbetween_core::position_error(
-        &inbetween_core::positions_clip(motion),
-        &inbetween_core::positions_clip(&decoded),
-    );
+    let nj = model.skeleton.len();
+    let (mut sum, mut max, mut worst_frame) = (0.0, 0.0f64, 0);
+    for (f, frame) in inbetween_core::positions_clip(&decoded).iter().enumerate() {
+        for (j, p) in frame.iter().enumerate() {
+            let d = p.distance(model.positions[f * nj + j]) * model.cm_per_unit;
+            sum += d;
+            if d > max {
+                (max, worst_frame) = (d, f);
+            }
+        }
+    }
+    let planned = model.error(&keys);
     Ok(Compressed {
         keys,
         bytes,
         planned,
-        decoded_mean_cm: e.mean * model.cm_per_unit,
-        decoded_max_cm: e.max * model.cm_per_unit,
+        decoded_mean_cm: sum / (model.num_frames() * nj) as f64,
+        decoded_max_cm: max,
+        worst_frame,
+        unit,
+        selection_bound_cm,
     })
 }
 
@@ -523,24 +750,88 @@ pub fn parse_length_cm(s: &str) -> Result<f64> {
 #[cfg(test)]
 mod compress_tests {
     use super::*;
-    use inbetween_core::procedural::{gait, GaitParams};
+    use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
+    use inbetween_core::units::{scale_motion, CANDIDATES};
+
+    fn clips() -> Vec<Motion> {
+        let mut walk = GaitParams::walk();
+        walk.frames = 60;
+        let mut run = GaitParams::run();
+        run.frames = 90;
+        run.fps = 60.0;
+        let mut turn = GaitParams::walk();
+        turn.frames = 80;
+        turn.turn_rate = 2.5;
+        vec![gait(&walk), gait(&run), gait(&turn)]
+    }
 
     #[test]
-    fn max_error_mode_meets_its_bound_and_k_mode_uses_k_keys() {
-        let mut p = GaitParams::walk();
-        p.frames = 60;
-        let m = gait(&p);
-        let c = compress(&m, Budget::MaxErrorCm(1.0), 30).unwrap();
-        assert!(c.planned.max_cm <= 1.0 + 1e-9);
-        assert!(c.decoded_max_cm < 1.1, "decoded max {}", c.decoded_max_cm);
-        assert!(c.keys.len() < 30, "{} keys", c.keys.len());
-        let tight = compress(&m, Budget::MaxErrorCm(0.1), 30).unwrap();
-        assert!(tight.keys.len() > c.keys.len());
-        let k = compress(&m, Budget::Keys(6), 10).unwrap();
+    fn the_decoded_file_keeps_every_bound_and_k_mode_uses_k_keys() {
+        for (i, m) in clips().iter().enumerate() {
+            let mut last_keys = 0;
+            for bound in [2.0, 1.0, 0.5, 0.1, 0.05] {
+                let c = compress(&m, Budget::MaxErrorCm(bound), 30).unwrap();
+                assert!(c.decoded_max_cm <= bound, "clip {i}, {bound} cm: decoded max {} cm", c.decoded_max_cm);
+                assert!(c.planned.max_cm <= bound);
+                // Tight enough to matter: the bound is approached, not met by keying everything.
+                assert!(c.decoded_max_cm > 0.3 * bound, "clip {i}, {bound} cm: only {} cm", c.decoded_max_cm);
+                assert!(
+                    c.keys.len() < m.num_frames() / 2 || bound < 0.1,
+                    "clip {i}, {bound} cm: {} keys",
+                    c.keys.len()
+                );
+                assert!(c.keys.len() >= last_keys, "a tighter bound never needs fewer keys");
+                last_keys = c.keys.len();
+                assert_eq!(c.unit.unit, LengthUnit::Cmu, "{}", c.unit.reason);
+            }
+        }
+        let m = &clips()[0];
+        let k = compress(m, Budget::Keys(6), 10).unwrap();
         assert_eq!(k.keys.len(), 6);
         assert_eq!(decode(&k.bytes).unwrap().key_frames, k.keys.frames());
+        let k10 = compress(m, Budget::Keys(10), 10).unwrap();
+        assert!(k10.decoded_mean_cm < k.decoded_mean_cm, "{} vs {}", k10.decoded_mean_cm, k.decoded_mean_cm);
+        assert!(compress(m, Budget::MaxErrorCm(f64::NAN), 10).is_err());
+        let e = compress(m, Budget::MaxErrorCm(1e-6), 10).unwrap_err().to_string();
+        assert!(e.contains("below what the .ibk format stores"), "{e}");
+    }
+
+    #[test]
+    fn the_same_clip_in_any_unit_gives_the_same_keys_and_cm_errors() {
+        let m = &clips()[1];
+        let reference = compress(m, Budget::MaxErrorCm(0.5), 30).unwrap();
+        for unit in CANDIDATES.into_iter().chain([LengthUnit::CmPerUnit(0.37)]) {
+            let scaled = scale_motion(m, CM_PER_CMU_UNIT / unit.cm_per_unit());
+            let guess = LengthUnit::infer(&scaled.skeleton);
+            let c = match unit {
+                LengthUnit::CmPerUnit(_) => compress_in(&scaled, UnitChoice::given(unit), Budget::MaxErrorCm(0.5), 30),
+                _ => {
+                    assert_eq!(guess.unit, unit, "{}", guess.reason);
+                    compress(&scaled, Budget::MaxErrorCm(0.5), 30)
+                }
+            }
+            .unwrap();
+            assert_eq!(c.keys, reference.keys, "{unit}");
+            let rel = |a: f64, b: f64| (a - b).abs() / b;
+            assert!(
+                rel(c.decoded_max_cm, reference.decoded_max_cm) < 1e-4,
+                "{unit}: {} vs {}",
+                c.decoded_max_cm,
+                reference.decoded_max_cm
+            );
+            assert!(rel(c.decoded_mean_cm, reference.decoded_mean_cm) < 1e-4, "{unit}");
+        }
+        // Read in the wrong unit, the same clip would be held to a bound 5.6 times too loose.
+        let as_cm = compress_in(m, UnitChoice::given(LengthUnit::Centimetre), Budget::MaxErrorCm(0.5), 30).unwrap();
+        assert!(as_cm.keys.len() < reference.keys.len());
+    }
+
+    #[test]
+    fn lengths_parse_with_units() {
         assert_eq!(parse_length_cm("10mm").unwrap(), 1.0);
         assert_eq!(parse_length_cm("0.5 cm").unwrap(), 0.5);
+        assert_eq!(parse_length_cm("0.01m").unwrap(), 1.0);
         assert!(parse_length_cm("fast").is_err());
+        assert!(parse_length_cm("-1cm").is_err());
     }
 }

@@ -1,12 +1,15 @@
-//! The CMU clips of the shared data folder (§5.1's "CMU data"), one entry per distinct take.
+//! The CMU clips of the shared data folder (§5.1's "CMU data"), one entry per distinct take, or
+//! every `.bvh` under any other folder.
 //!
 //! The corpus holds the same takes in three encodings: cgspeed BVH (31 joints, 120 fps, CMU length
 //! units), the original ASF/AMC (120 fps, CMU units) and iClone Character Creator retargets (100 or
 //! 101 joints, 60 fps, centimetres). A take present in several is read once, preferring cgspeed,
-//! then ASF/AMC. Every clip records its length unit, so errors in cm mean the same on all of them.
+//! then ASF/AMC. Every clip records its length unit, so errors in cm mean the same on all of them:
+//! the corpus folders' units are known; a clip from any other folder gets the unit inferred from
+//! its skeleton ([`LengthUnit::infer`]) unless the caller gives one.
 
 use crate::{MocapError, Result};
-use inbetween_core::procedural::CM_PER_CMU_UNIT;
+use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::Motion;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -14,7 +17,8 @@ use std::path::{Path, PathBuf};
 /// One take.
 #[derive(Clone, Debug)]
 pub struct Clip {
-    /// CMU take id, `subject_trial` (`131_01`), or the file stem for a plain folder.
+    /// CMU take id, `subject_trial` (`131_01`), or the path below the folder without `.bvh`
+    /// (`walk`, `sub/run`) for a plain folder.
     pub name: String,
     /// `cgspeed`, `asf_amc`, `iclone_cc` or `bvh`.
     pub source: &'static str,
@@ -23,39 +27,118 @@ pub struct Clip {
     pub cm_per_unit: f64,
 }
 
-/// Centimetres per unit of the iClone retargets (already centimetre-like, hip height ~85–105).
-const CM_PER_ICLONE_UNIT: f64 = 1.0;
+/// Clips with the unit each one was read in and why.
+#[derive(Clone, Debug)]
+pub struct Corpus {
+    pub clips: Vec<Clip>,
+    /// One per clip, same order.
+    pub units: Vec<UnitChoice>,
+}
 
-/// All distinct takes under `dir/mocap/cmu`, or, when `dir` has no such folder, every `.bvh` in
-/// `dir` itself (read as CMU units). Sorted by name.
-pub fn cmu_corpus(dir: &Path) -> Result<Vec<Clip>> {
-    let cmu = dir.join("mocap/cmu");
-    if !cmu.is_dir() {
-        let clips = bvh_folder(dir, "bvh", CM_PER_CMU_UNIT, |stem| Some(stem.to_string()))?;
-        if clips.is_empty() {
-            return Err(MocapError::Invalid(format!("no .bvh clips in {}", dir.display())));
+impl Corpus {
+    /// Report lines saying which unit the clips were read in and why; clips that share a source and
+    /// a reason share a line.
+    pub fn unit_notes(&self) -> Vec<String> {
+        let mut groups: Vec<(&str, &UnitChoice, Vec<&str>)> = Vec::new();
+        for (c, u) in self.clips.iter().zip(&self.units) {
+            match groups.iter_mut().find(|(s, g, _)| *s == c.source && *g == u) {
+                Some((_, _, names)) => names.push(&c.name),
+                None => groups.push((c.source, u, vec![&c.name])),
+            }
         }
-        return Ok(clips);
+        groups
+            .into_iter()
+            .map(|(source, u, names)| {
+                let who =
+                    if names.len() == 1 { names[0].to_string() } else { format!("{} {source} takes", names.len()) };
+                format!("{who}: {u}")
+            })
+            .collect()
     }
-    let mut clips = bvh_folder(&cmu.join("cgspeed"), "cgspeed", CM_PER_CMU_UNIT, |s| Some(s.to_string()))?;
-    let mut seen: BTreeSet<String> = clips.iter().map(|c| c.name.clone()).collect();
-    for (asf, amc) in asf_amc_pairs(&cmu.join("asf_amc"))? {
+}
+
+/// Centimetres per unit of the iClone retargets (already centimetre-like, hip height ~85–105).
+const ICLONE_UNIT: LengthUnit = LengthUnit::Centimetre;
+
+/// The sub-folders that mark a CMU corpus folder (`…/mocap/cmu`).
+const CORPUS_FOLDERS: [&str; 3] = ["cgspeed", "asf_amc", "iclone_cc"];
+
+/// All distinct takes of a data folder, sorted by name, each read in its inferred unit; see [`load`].
+pub fn cmu_corpus(dir: &Path) -> Result<Vec<Clip>> {
+    Ok(load(dir, None)?.clips)
+}
+
+/// The clips of `dir`: the CMU corpus when `dir` is the shared data folder, its `mocap` or its
+/// `mocap/cmu` folder (one entry per take, known units); otherwise every `.bvh` in `dir` and its
+/// sub-folders (sorted by path; units inferred per clip). `unit` overrides every clip's unit.
+pub fn load(dir: &Path, unit: Option<LengthUnit>) -> Result<Corpus> {
+    if !dir.is_dir() {
+        return Err(MocapError::Invalid(format!("{} is not a folder", dir.display())));
+    }
+    let corpus_root = [dir.join("mocap/cmu"), dir.join("cmu"), dir.to_path_buf()]
+        .into_iter()
+        .find(|d| CORPUS_FOLDERS.iter().any(|f| d.join(f).is_dir()));
+    match corpus_root {
+        Some(cmu) => cmu_folder(&cmu, unit),
+        None => plain_folder(dir, unit),
+    }
+}
+
+fn cmu_folder(cmu: &Path, unit: Option<LengthUnit>) -> Result<Corpus> {
+    let known = |u: LengthUnit, why: &str| match unit {
+        Some(g) => UnitChoice::given(g),
+        None => UnitChoice { unit: u, reason: format!("known corpus folder: {why}") },
+    };
+    let cgspeed = known(LengthUnit::Cmu, "cgspeed conversions of CMU mocap keep CMU units");
+    let asf = known(LengthUnit::Cmu, "CMU ASF/AMC files are in CMU units");
+    let iclone = known(ICLONE_UNIT, "iClone Character Creator exports are in cm");
+    let mut out = Corpus { clips: Vec::new(), units: Vec::new() };
+    for (name, motion) in bvh_files(&cmu.join("cgspeed"), false)? {
+        out.push(name, "cgspeed", motion, cgspeed.clone());
+    }
+    let mut seen: BTreeSet<String> = out.clips.iter().map(|c| c.name.clone()).collect();
+    for (asf_path, amc) in asf_amc_pairs(&cmu.join("asf_amc"))? {
         let name = stem(&amc);
         if seen.insert(name.clone()) {
-            let motion = inbetween_io::read_asf_amc(&asf, &amc)?;
-            clips.push(Clip { name, source: "asf_amc", motion, cm_per_unit: CM_PER_CMU_UNIT });
+            out.push(name, "asf_amc", inbetween_io::read_asf_amc(&asf_path, &amc)?, asf.clone());
         }
     }
-    for clip in bvh_folder(&cmu.join("iclone_cc"), "iclone_cc", CM_PER_ICLONE_UNIT, iclone_take)? {
-        if seen.insert(clip.name.clone()) {
-            clips.push(clip);
+    for (s, motion) in bvh_files(&cmu.join("iclone_cc"), false)? {
+        let name = iclone_take(&s).unwrap_or(s);
+        if seen.insert(name.clone()) {
+            out.push(name, "iclone_cc", motion, iclone.clone());
         }
     }
-    clips.sort_by(|a, b| a.name.cmp(&b.name));
-    if clips.is_empty() {
+    if out.clips.is_empty() {
         return Err(MocapError::Invalid(format!("no clips in {}", cmu.display())));
     }
-    Ok(clips)
+    out.sort();
+    Ok(out)
+}
+
+fn plain_folder(dir: &Path, unit: Option<LengthUnit>) -> Result<Corpus> {
+    let mut out = Corpus { clips: Vec::new(), units: Vec::new() };
+    for (name, motion) in bvh_files(dir, true)? {
+        let u = UnitChoice::resolve(unit, &motion.skeleton);
+        out.push(name, "bvh", motion, u);
+    }
+    if out.clips.is_empty() {
+        return Err(MocapError::Invalid(format!("no .bvh clips in {} or its sub-folders", dir.display())));
+    }
+    Ok(out)
+}
+
+impl Corpus {
+    fn push(&mut self, name: String, source: &'static str, motion: Motion, unit: UnitChoice) {
+        self.clips.push(Clip { name, source, motion, cm_per_unit: unit.cm_per_unit() });
+        self.units.push(unit);
+    }
+
+    fn sort(&mut self) {
+        let mut pairs: Vec<(Clip, UnitChoice)> = self.clips.drain(..).zip(self.units.drain(..)).collect();
+        pairs.sort_by(|a, b| a.0.name.cmp(&b.0.name));
+        (self.clips, self.units) = pairs.into_iter().unzip();
+    }
 }
 
 /// `001_08` → `01_08` (iClone pads subjects to three digits).
@@ -68,39 +151,59 @@ fn stem(p: &Path) -> String {
     p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
-fn sorted_files(dir: &Path, ext: &str) -> Result<Vec<PathBuf>> {
-    if !dir.is_dir() {
-        return Ok(Vec::new());
-    }
+fn read_dir_sorted(dir: &Path) -> Result<Vec<PathBuf>> {
     let entries =
         std::fs::read_dir(dir).map_err(|source| MocapError::Io { path: dir.display().to_string(), source })?;
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext)))
-        .collect();
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
     paths.sort();
     Ok(paths)
 }
 
-fn bvh_folder(
-    dir: &Path,
-    source: &'static str,
-    cm_per_unit: f64,
-    take: impl Fn(&str) -> Option<String>,
-) -> Result<Vec<Clip>> {
-    sorted_files(dir, "bvh")?
+fn has_ext(p: &Path, ext: &str) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
+/// Files with extension `ext` in `dir` (and, when `recursive`, its sub-folders; symbolic links to
+/// folders are not followed), sorted by their path relative to `dir`.
+pub fn find_files(dir: &Path, ext: &str, recursive: bool) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    if dir.is_dir() {
+        collect(dir, ext, recursive, &mut out)?;
+    }
+    out.sort();
+    Ok(out)
+}
+
+fn collect(dir: &Path, ext: &str, recursive: bool, out: &mut Vec<PathBuf>) -> Result<()> {
+    for p in read_dir_sorted(dir)? {
+        let is_real_dir = std::fs::symlink_metadata(&p).map(|m| m.is_dir()).unwrap_or(false);
+        if is_real_dir {
+            if recursive {
+                collect(&p, ext, recursive, out)?;
+            }
+        } else if p.is_file() && has_ext(&p, ext) {
+            out.push(p);
+        }
+    }
+    Ok(())
+}
+
+/// Every `.bvh` of a folder as (name, clip); the name is the path below `dir` without the
+/// extension, with `/` between folders.
+fn bvh_files(dir: &Path, recursive: bool) -> Result<Vec<(String, Motion)>> {
+    find_files(dir, "bvh", recursive)?
         .into_iter()
         .map(|p| {
-            let s = stem(&p);
-            let motion = inbetween_io::read_bvh(&p)?;
-            Ok(Clip { name: take(&s).unwrap_or(s), source, motion, cm_per_unit })
+            let rel = p.strip_prefix(dir).unwrap_or(&p).with_extension("");
+            let name = rel.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/");
+            Ok((name, inbetween_io::read_bvh(&p)?))
         })
         .collect()
 }
 
 /// `NN_TT.amc` files with their subject's `NN.asf` beside them.
 fn asf_amc_pairs(dir: &Path) -> Result<Vec<(PathBuf, PathBuf)>> {
-    Ok(sorted_files(dir, "amc")?
+    Ok(find_files(dir, "amc", false)?
         .into_iter()
         .filter_map(|amc| {
             let name = stem(&amc);
@@ -114,7 +217,8 @@ fn asf_amc_pairs(dir: &Path) -> Result<Vec<(PathBuf, PathBuf)>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use inbetween_core::procedural::{gait, GaitParams};
+    use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
+    use inbetween_core::units::scale_motion;
 
     #[test]
     fn iclone_names_map_to_cmu_takes() {
@@ -124,21 +228,35 @@ mod tests {
     }
 
     #[test]
-    fn plain_folder_reads_every_bvh_and_refuses_an_empty_one() {
+    fn plain_folder_reads_every_bvh_below_it_in_its_own_unit() {
         let dir = tempfile::tempdir().unwrap();
         assert!(cmu_corpus(dir.path()).unwrap_err().to_string().contains("no .bvh clips"));
         let m = gait(&GaitParams { frames: 10, fps: 30.0, ..GaitParams::walk() });
+        std::fs::create_dir_all(dir.path().join("sub/deeper")).unwrap();
         inbetween_io::write_bvh(&dir.path().join("b.bvh"), &m).unwrap();
         inbetween_io::write_bvh(&dir.path().join("a.bvh"), &m).unwrap();
-        let clips = cmu_corpus(dir.path()).unwrap();
-        assert_eq!(clips.iter().map(|c| c.name.as_str()).collect::<Vec<_>>(), ["a", "b"]);
-        assert_eq!(clips[0].cm_per_unit, CM_PER_CMU_UNIT);
+        // A centimetre rig two folders down, and a file that is not a clip.
+        inbetween_io::write_bvh(&dir.path().join("sub/deeper/cm.BVH"), &scale_motion(&m, CM_PER_CMU_UNIT)).unwrap();
+        std::fs::write(dir.path().join("sub/notes.txt"), "x").unwrap();
+        let corpus = load(dir.path(), None).unwrap();
+        let names: Vec<&str> = corpus.clips.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["a", "b", "sub/deeper/cm"]);
+        assert_eq!(corpus.clips[0].cm_per_unit, CM_PER_CMU_UNIT);
+        assert_eq!(corpus.clips[2].cm_per_unit, 1.0);
+        let notes = corpus.unit_notes();
+        assert!(notes.iter().any(|n| n.starts_with("sub/deeper/cm: length unit: cm (rest-pose height")), "{notes:?}");
+        // --unit overrides the inference; a sub-folder alone is a plain folder too.
+        let given = load(dir.path(), Some(LengthUnit::Metre)).unwrap();
+        assert!(given.clips.iter().all(|c| c.cm_per_unit == 100.0));
+        assert_eq!(given.unit_notes(), ["3 bvh takes: length unit: m (given with --unit)"]);
+        assert_eq!(cmu_corpus(&dir.path().join("sub")).unwrap()[0].name, "deeper/cm");
     }
 
     #[test]
-    fn shared_corpus_has_one_entry_per_take() {
+    fn shared_corpus_has_one_entry_per_take_from_any_of_its_folders() {
         inbetween_io::data::with_shared_data("the CMU corpus", |dir| {
-            let clips = cmu_corpus(&dir).unwrap();
+            let corpus = load(&dir, None).unwrap();
+            let clips = &corpus.clips;
             let names: BTreeSet<&str> = clips.iter().map(|c| c.name.as_str()).collect();
             assert_eq!(names.len(), clips.len(), "no take twice");
             assert!(names.contains("01_01") && names.contains("11_01") && names.contains("01_08"));
@@ -146,6 +264,17 @@ mod tests {
             assert_eq!(first.source, "cgspeed", "cgspeed preferred over ASF/AMC");
             let cc = clips.iter().find(|c| c.name == "01_08").unwrap();
             assert_eq!((cc.source, cc.cm_per_unit), ("iclone_cc", 1.0));
+            // The known units agree with what inference reads from each skeleton.
+            for (c, u) in clips.iter().zip(&corpus.units) {
+                assert!(u.reason.starts_with("known corpus folder"), "{}", u.reason);
+                let inferred = LengthUnit::infer(&c.motion.skeleton);
+                assert_eq!(inferred.cm_per_unit(), c.cm_per_unit, "{}: {}", c.name, inferred.reason);
+            }
+            assert_eq!(corpus.unit_notes().len(), 3, "{:?}", corpus.unit_notes());
+            // `--data …/mocap/cmu` and `--data …/mocap` find the same takes.
+            for sub in ["mocap", "mocap/cmu"] {
+                assert_eq!(cmu_corpus(&dir.join(sub)).unwrap().len(), clips.len(), "{sub}");
+            }
         });
     }
 }

@@ -9,6 +9,7 @@
 pub mod bench;
 pub mod codec;
 pub mod corpus;
+pub mod demo;
 pub mod dqn;
 pub mod error;
 pub mod reconstruct;
@@ -37,6 +38,9 @@ pub enum MocapError {
     Format(#[from] inbetween_io::IoError),
     #[error("model: {0}")]
     Model(String),
+    /// Weights or training (files named in the message).
+    #[error(transparent)]
+    Nn(#[from] inbetween_nn::NnError),
     #[error("stream: {0}")]
     Stream(String),
 }

@@ -10,9 +10,10 @@
 
 use crate::{MocapError, Result};
 use glam::DVec3;
+use inbetween_core::angle::wrap_angle;
 use inbetween_core::procedural::CM_PER_CMU_UNIT;
+use inbetween_core::units::LengthUnit;
 use inbetween_core::{Joint, Motion};
-use std::f64::consts::{PI, TAU};
 
 /// Below this sin θ, φ̇ comes from differencing φ rather than from Eq. 8.
 const POLE_SIN_THETA: f64 = 0.1;
@@ -34,8 +35,23 @@ impl JointFilter {
     /// share bones, face, breasts: 22 joints, 23 under an `RL_BoneRoot`).
     pub fn paper() -> JointFilter {
         let p = [
-            "finger", "thumb", "toe", "handindex", "lhand", "rhand", "index", "mid", "ring", "pinky",
-            "thightwist", "calftwist", "armtwist", "ribstwist", "sharebone", "facialbone", "breast",
+            "finger",
+            "thumb",
+            "toe",
+            "handindex",
+            "lhand",
+            "rhand",
+            "index",
+            "mid",
+            "ring",
+            "pinky",
+            "thightwist",
+            "calftwist",
+            "armtwist",
+            "ribstwist",
+            "sharebone",
+            "facialbone",
+            "breast",
         ];
         JointFilter { drop_patterns: p.iter().map(|s| s.to_string()).collect() }
     }
@@ -98,7 +114,8 @@ pub struct SphericalMotion {
     pub root_vel: Vec<DVec3>,
     /// Original global joint positions, frame-major `[f * num_joints + j]`, for position errors.
     pub positions: Vec<DVec3>,
-    /// Centimetres per length unit of the clip (CMU: 5.6444), for errors in cm.
+    /// Centimetres per length unit of the clip (CMU: 5.6444), for errors in cm. [`Self::from_positions`]
+    /// assumes CMU units; [`Self::from_motion`] infers the unit.
     pub cm_per_unit: f64,
 }
 
@@ -133,17 +150,6 @@ pub fn angular_velocity(theta: f64, phi: f64, r: f64, v: DVec3) -> (f64, Option<
     (dtheta, dphi)
 }
 
-/// Wraps an angle difference into (-π, π].
-#[inline]
-pub fn wrap_angle(a: f64) -> f64 {
-    let w = (a + PI).rem_euclid(TAU) - PI;
-    if w <= -PI {
-        w + TAU
-    } else {
-        w
-    }
-}
-
 /// Central difference of a per-frame series (one-sided at the ends), per second.
 fn central_difference<T>(values: &[T], f: usize, dt: f64) -> T
 where
@@ -159,6 +165,8 @@ where
 
 impl SphericalMotion {
     /// Converts a clip (use [`JointFilter::apply`] first to pick the joints). Needs at least 2 frames.
+    /// The length unit is inferred from the skeleton ([`LengthUnit::infer`]); set `cm_per_unit`
+    /// afterwards when it is known.
     pub fn from_motion(motion: &Motion) -> Result<SphericalMotion> {
         let n = motion.num_frames();
         if n < 2 {
@@ -167,11 +175,13 @@ impl SphericalMotion {
             )));
         }
         let global = inbetween_core::positions_clip(motion);
-        Ok(Self::from_positions(
+        let mut s = Self::from_positions(
             &motion.skeleton.joints().iter().map(|j| j.parent).collect::<Vec<_>>(),
             &global,
             motion.frame_time,
-        ))
+        );
+        s.cm_per_unit = LengthUnit::infer(&motion.skeleton).cm_per_unit();
+        Ok(s)
     }
 
     /// Builds the representation from global positions `[frame][joint]` and the joint parents.
@@ -261,6 +271,7 @@ impl SphericalMotion {
 mod tests {
     use super::*;
     use inbetween_core::procedural::{gait, GaitParams};
+    use std::f64::consts::PI;
 
     #[test]
     fn spherical_round_trip_and_velocity_projection() {
@@ -271,8 +282,6 @@ mod tests {
         let (dth, dph) = angular_velocity(t, p, r, DVec3::Z.cross(v) * 2.0);
         assert!(dth.abs() < 1e-12 && (dph.unwrap() - 2.0).abs() < 1e-12);
         assert!(angular_velocity(1e-3, 0.0, 1.0, DVec3::X).1.is_none(), "pole is flagged");
-        assert!((wrap_angle(3.0 * PI) - PI).abs() < 1e-12);
-        assert!((wrap_angle(-0.5) + 0.5).abs() < 1e-12);
     }
 
     #[test]

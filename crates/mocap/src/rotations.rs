@@ -7,8 +7,8 @@ use crate::error::{Scratch, SegmentCost, SegmentModel};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::interp::{angular_velocity, hermite_quat, hermite_vec3};
-use inbetween_core::procedural::CM_PER_CMU_UNIT;
 use inbetween_core::rotation::{angle_between, make_continuous};
+use inbetween_core::units::LengthUnit;
 use inbetween_core::{KeyframeSet, Motion, Pose, Skeleton};
 
 /// The local state of every joint at one frame: what a keyframe stores.
@@ -39,7 +39,13 @@ fn neighbours(f: usize, n: usize) -> (usize, usize) {
 }
 
 impl RotationMotion {
+    /// The clip with its length unit inferred from the skeleton ([`LengthUnit::infer`]).
     pub fn from_motion(motion: &Motion) -> Result<RotationMotion> {
+        Self::from_motion_in(motion, LengthUnit::infer(&motion.skeleton).cm_per_unit())
+    }
+
+    /// The clip, with errors measured at `cm_per_unit` centimetres per length unit.
+    pub fn from_motion_in(motion: &Motion, cm_per_unit: f64) -> Result<RotationMotion> {
         let n = motion.num_frames();
         if n < 2 {
             return Err(MocapError::Invalid(format!(
@@ -78,13 +84,7 @@ impl RotationMotion {
         for g in inbetween_core::forward_clip(motion) {
             positions.extend(g.positions);
         }
-        Ok(RotationMotion {
-            skeleton: motion.skeleton.clone(),
-            frame_time: dt,
-            frames,
-            positions,
-            cm_per_unit: CM_PER_CMU_UNIT,
-        })
+        Ok(RotationMotion { skeleton: motion.skeleton.clone(), frame_time: dt, frames, positions, cm_per_unit })
     }
 
     pub fn num_frames(&self) -> usize {
@@ -247,6 +247,44 @@ mod tests {
                 assert!(((frame[j] - frame[par]).length() - s.joint(j).offset.length()).abs() < 1e-9);
             }
         }
+    }
+
+    /// A walk that turns 2.5 rad/s for 3 s: the root's yaw channel wraps from +180° to −180° in
+    /// the BVH (twice). Quaternion keys stay in one hemisphere along the track, so the keys and the
+    /// Hermite in-betweens see a smooth turn: the error is that of the same walk without the turn.
+    #[test]
+    fn euler_wraps_at_180_degrees_do_not_disturb_the_reconstruction() {
+        let clip = |turn_rate: f64| {
+            let mut p = GaitParams::walk();
+            p.frames = 90;
+            p.turn_rate = turn_rate;
+            gait(&p)
+        };
+        let turning = clip(2.5);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("turn.bvh");
+        inbetween_io::write_bvh(&path, &turning).unwrap();
+        let turning = inbetween_io::read_bvh(&path).unwrap();
+        let nc = turning.num_channels();
+        let wraps = (1..90)
+            .flat_map(|f| (3..6).map(move |c| (f, c)))
+            .filter(|&(f, c)| (turning.data()[f * nc + c] - turning.data()[(f - 1) * nc + c]).abs() > 300.0)
+            .count();
+        assert!(wraps >= 2, "the root's Euler angles wrap at ±180° ({wraps} wraps)");
+        let rm = RotationMotion::from_motion(&turning).unwrap();
+        for j in 0..rm.skeleton.len() {
+            for f in 1..90 {
+                assert!(rm.frames[f - 1].rotations[j].dot(rm.frames[f].rotations[j]) >= 0.0, "joint {j} frame {f}");
+            }
+        }
+        let keys = KeyframeSet::new((0..90).step_by(6).chain([89]).collect(), 90).unwrap();
+        let straight = RotationMotion::from_motion(&clip(0.0)).unwrap().error(&keys);
+        let e = rm.error(&keys);
+        assert!(e.max_cm < 1.5 * straight.max_cm + 0.5, "turning {e:?} vs straight {straight:?}");
+        assert!(e.mean_angle < 1.5 * straight.mean_angle + 1e-3, "turning {e:?} vs straight {straight:?}");
+        // Quantised keys (rotation vectors, any hemisphere) decode to the same in-betweens.
+        let c = crate::codec::compress(&turning, crate::codec::Budget::MaxErrorCm(1.0), 30).unwrap();
+        assert!(c.decoded_max_cm <= 1.0 && c.keys.len() < 30, "{} keys, {} cm", c.keys.len(), c.decoded_max_cm);
     }
 
     #[test]

@@ -7,18 +7,24 @@
 //! frame after it, so candidates are `b ≤ t − 1`. While segment `(a, t−1)` keeps every joint within
 //! the error bound and is shorter than the look-ahead, the sender waits; otherwise it sends the
 //! farthest feasible `b` (at least `a + 1`). A frame therefore waits at most `lookahead + 1` frames.
+//! Segments are judged on the keys as the receiver decodes them ([`quantised_model`]), so the bound
+//! holds for the frames the receiver rebuilds, and errors are in cm in the clip's length unit
+//! (inferred from the skeleton, or given).
 //!
 //! Wire format: messages `type u8 | length u32 | payload | crc32(type, length, payload) u32`.
 //! Hello (1): magic "IBS1", frame time f64, frame count u32, skeleton (as in the `.ibk` codec).
 //! Key (2): frame u32, angular velocity scale f32, key values (as in the codec). End (3): empty.
 //! A sender whose connection breaks reconnects and resends Hello and its last key; a receiver whose
-//! peer vanishes keeps the frames it has and waits for the peer to come back.
+//! peer vanishes keeps the frames it has and waits for the peer to come back. A receiver that joins
+//! mid-stream (a new process after the old one died) starts at the first key it gets: every key
+//! carries its frame index, so [`Received::start_frame`] says where its frames belong in the clip.
 
-use crate::codec::{read_key, read_skeleton, write_key, write_skeleton, Reader};
+use crate::codec::{quantised_model, read_scaled_key, read_skeleton, write_scaled_key, write_skeleton, Reader};
 use crate::error::SegmentModel;
 use crate::rotations::{interpolate_pose_into, KeyPose, RotationMotion};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
+use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{Motion, Pose, Skeleton};
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream, ToSocketAddrs};
@@ -102,10 +108,8 @@ fn hello_payload(skeleton: &Skeleton, frame_time: f64, frames: usize) -> Vec<u8>
 }
 
 fn key_payload(skeleton: &Skeleton, frame: usize, key: &KeyPose) -> Vec<u8> {
-    let w_scale = key.angular_velocities.iter().map(|w| w.abs().max_element()).fold(1e-6, f64::max) as f32 * 1.0001;
     let mut p = (frame as u32).to_le_bytes().to_vec();
-    p.extend_from_slice(&w_scale.to_le_bytes());
-    write_key(&mut p, skeleton, key, w_scale as f64);
+    write_scaled_key(&mut p, skeleton, key);
     p
 }
 
@@ -118,11 +122,15 @@ pub struct SendOptions {
     pub realtime: bool,
     /// Reconnection attempts after a broken connection, 200 ms apart.
     pub retries: usize,
+    /// The clip's length unit; `None` infers it from the skeleton.
+    pub unit: Option<LengthUnit>,
 }
 
 /// What a sender did.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct SendReport {
+    /// The unit the error bound was applied in, and why.
+    pub unit: UnitChoice,
     pub frames: usize,
     pub keys: usize,
     pub bytes_sent: usize,
@@ -160,15 +168,21 @@ fn connect(addr: &str, retries: usize) -> Result<TcpStream> {
 
 /// Streams `motion` to a receiver at `addr`.
 pub fn send(addr: &str, motion: &Motion, opts: &SendOptions) -> Result<SendReport> {
-    let model = RotationMotion::from_motion(motion)?;
-    let events = online_keys(&model, opts.max_cm, opts.lookahead);
+    let unit = UnitChoice::resolve(opts.unit, &motion.skeleton);
+    let model = RotationMotion::from_motion_in(motion, unit.cm_per_unit())?;
+    let events = online_keys(&quantised_model(&model), opts.max_cm, opts.lookahead);
     let sk = &model.skeleton;
     let hello = frame_message(HELLO, &hello_payload(sk, model.frame_time, model.num_frames()));
     let mut report = SendReport {
+        unit,
         frames: model.num_frames(),
         keys: events.len(),
+        bytes_sent: 0,
         raw_bytes: inbetween_core::Motion::num_channels(motion) * 4 * model.num_frames(),
-        ..Default::default()
+        seconds: 0.0,
+        mean_latency_ms: 0.0,
+        max_latency_ms: 0.0,
+        reconnects: 0,
     };
     let start = Instant::now();
     let mut conn = connect(addr, opts.retries)?;
@@ -210,11 +224,35 @@ pub fn send(addr: &str, motion: &Motion, opts: &SendOptions) -> Result<SendRepor
     Ok(report)
 }
 
-/// One received message.
-enum Message {
-    Hello { skeleton: Skeleton, frame_time: f64 },
-    Key { frame: usize, key: KeyPose },
+/// One message of the stream.
+#[derive(Clone, Debug)]
+pub enum Message {
+    /// The clip's skeleton, frame time and frame count.
+    Hello {
+        skeleton: Skeleton,
+        frame_time: f64,
+        frames: usize,
+    },
+    Key {
+        frame: usize,
+        key: KeyPose,
+    },
     End,
+}
+
+/// Decodes the messages of a byte stream (what a receiver reads from its connection): untrusted
+/// input, checked message by message, never a panic. Keys need a Hello before them.
+pub fn decode_messages(mut bytes: &[u8]) -> Result<Vec<Message>> {
+    let mut out = Vec::new();
+    let mut skeleton: Option<Skeleton> = None;
+    while !bytes.is_empty() {
+        let (msg, _) = read_message(&mut bytes, skeleton.as_ref())?;
+        if let Message::Hello { skeleton: s, .. } = &msg {
+            skeleton = Some(s.clone());
+        }
+        out.push(msg);
+    }
+    Ok(out)
 }
 
 fn read_message(conn: &mut impl Read, skeleton: Option<&Skeleton>) -> Result<(Message, usize)> {
@@ -241,14 +279,16 @@ fn read_message(conn: &mut impl Read, skeleton: Option<&Skeleton>) -> Result<(Me
                 return Err(MocapError::Stream("hello without the IBS1 magic".into()));
             }
             let frame_time = r.f64("frame time")?;
-            let _frames = r.u32("frame count")?;
-            Message::Hello { skeleton: read_skeleton(&mut r)?, frame_time }
+            let frames = r.u32("frame count")? as usize;
+            if !(frame_time.is_finite() && frame_time > 0.0) || frames < 2 {
+                return Err(MocapError::Stream(format!("hello with frame time {frame_time} and {frames} frames")));
+            }
+            Message::Hello { skeleton: read_skeleton(&mut r)?, frame_time, frames }
         }
         KEY => {
             let sk = skeleton.ok_or_else(|| MocapError::Stream("key before hello".into()))?;
             let frame = r.u32("key frame")? as usize;
-            let w_scale = r.f32("angular velocity scale")?;
-            Message::Key { frame, key: read_key(&mut r, sk, w_scale)? }
+            Message::Key { frame, key: read_scaled_key(&mut r, sk)? }
         }
         END => Message::End,
         other => return Err(MocapError::Stream(format!("unknown message type {other}"))),
@@ -271,7 +311,13 @@ pub struct RecvOptions {
 /// What a receiver rebuilt.
 #[derive(Clone, Debug)]
 pub struct Received {
+    /// The frames rebuilt, from [`Received::start_frame`] of the sender's clip on.
     pub motion: Motion,
+    /// Frame of the sender's clip that `motion` starts at: 0, or later for a receiver that joined
+    /// mid-stream (its first key's frame).
+    pub start_frame: usize,
+    /// Frames of the sender's whole clip (from its Hello).
+    pub clip_frames: usize,
     pub keys: usize,
     pub bytes: usize,
     /// True when the sender's End arrived.
@@ -284,14 +330,28 @@ pub struct Received {
 struct Rebuild {
     skeleton: Skeleton,
     frame_time: f64,
+    clip_frames: usize,
     poses: Vec<Pose>,
+    /// Frame of the first key received.
+    start: Option<usize>,
     last: Option<(usize, KeyPose)>,
     keys: usize,
 }
 
 impl Rebuild {
-    /// Adds a key; emits the frames after the previous key up to this one.
-    fn key(&mut self, frame: usize, key: KeyPose) {
+    fn new(skeleton: Skeleton, frame_time: f64, clip_frames: usize) -> Rebuild {
+        Rebuild { skeleton, frame_time, clip_frames, poses: Vec::new(), start: None, last: None, keys: 0 }
+    }
+
+    /// Adds a key; emits the frames after the previous key up to this one. A key outside the
+    /// clip announced by Hello is refused (it would make the receiver emit frames without end).
+    fn key(&mut self, frame: usize, key: KeyPose) -> Result<()> {
+        if frame >= self.clip_frames {
+            return Err(MocapError::Stream(format!(
+                "key at frame {frame} is outside the announced clip of {} frames; ignored",
+                self.clip_frames
+            )));
+        }
         let nj = self.skeleton.len();
         match &self.last {
             Some((a, k0)) if frame > *a => {
@@ -309,12 +369,13 @@ impl Rebuild {
                     self.poses.push(p);
                 }
             }
-            Some(_) => return, // a repeated (resent) or stale key
-            None => {}
+            Some(_) => return Ok(()), // a repeated (resent) or stale key
+            None => self.start = Some(frame),
         }
         self.poses.push(Pose { rotations: key.rotations.clone(), translations: key.translations.clone() });
         self.last = Some((frame, key));
         self.keys += 1;
+        Ok(())
     }
 }
 
@@ -335,7 +396,7 @@ pub fn recv(listener: &TcpListener, opts: &RecvOptions) -> Result<Received> {
         loop {
             let sk = state.as_ref().map(|s| s.skeleton.clone());
             match read_message(&mut conn, sk.as_ref()) {
-                Ok((Message::Hello { skeleton, frame_time }, size)) => {
+                Ok((Message::Hello { skeleton, frame_time, frames }, size)) => {
                     bytes += size;
                     match &state {
                         Some(s) if s.skeleton != skeleton => {
@@ -343,13 +404,13 @@ pub fn recv(listener: &TcpListener, opts: &RecvOptions) -> Result<Received> {
                             break;
                         }
                         Some(_) => {}
-                        None => state = Some(Rebuild { skeleton, frame_time, poses: Vec::new(), last: None, keys: 0 }),
+                        None => state = Some(Rebuild::new(skeleton, frame_time, frames)),
                     }
                 }
                 Ok((Message::Key { frame, key }, size)) => {
                     bytes += size;
-                    if let Some(s) = &mut state {
-                        s.key(frame, key);
+                    if let Some(Err(e)) = state.as_mut().map(|s| s.key(frame, key)) {
+                        warnings.push(e.to_string());
                     }
                 }
                 Ok((Message::End, size)) => {
@@ -366,7 +427,52 @@ pub fn recv(listener: &TcpListener, opts: &RecvOptions) -> Result<Received> {
     }
     let s = state.ok_or_else(|| MocapError::Stream(format!("no stream received ({})", warnings.join("; "))))?;
     let motion = Motion::from_poses(s.skeleton.clone(), s.frame_time, &s.poses)?;
-    Ok(Received { motion, keys: s.keys, bytes, complete, sessions, warnings })
+    Ok(Received {
+        motion,
+        start_frame: s.start.unwrap_or(0),
+        clip_frames: s.clip_frames,
+        keys: s.keys,
+        bytes,
+        complete,
+        sessions,
+        warnings,
+    })
+}
+
+/// Position error of received frames against the sender's clip, at the right offset.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StreamError {
+    /// First frame of the reference compared (the receiver's start frame).
+    pub start_frame: usize,
+    /// Frames compared.
+    pub frames: usize,
+    pub mean_cm: f64,
+    pub max_cm: f64,
+}
+
+/// Compares `received` with the sender's clip `reference` (same skeleton), frame
+/// `received.start_frame + i` against received frame `i`, in cm at `cm_per_unit`.
+pub fn compare(received: &Received, reference: &Motion, cm_per_unit: f64) -> Result<StreamError> {
+    if reference.skeleton.len() != received.motion.skeleton.len() {
+        return Err(MocapError::Invalid(format!(
+            "the reference has {} joints, the stream {}",
+            reference.skeleton.len(),
+            received.motion.skeleton.len()
+        )));
+    }
+    let start = received.start_frame;
+    let frames = received.motion.num_frames().min(reference.num_frames().saturating_sub(start));
+    if frames == 0 {
+        return Err(MocapError::Invalid(format!(
+            "the stream starts at frame {start}, past the reference's {} frames",
+            reference.num_frames()
+        )));
+    }
+    let e = inbetween_core::position_error(
+        &inbetween_core::positions_clip(&reference.crop(start, start + frames)?),
+        &inbetween_core::positions_clip(&received.motion.crop(0, frames)?),
+    );
+    Ok(StreamError { start_frame: start, frames, mean_cm: e.mean * cm_per_unit, max_cm: e.max * cm_per_unit })
 }
 
 fn accept_with_timeout(listener: &TcpListener, timeout: Duration) -> Result<TcpStream> {
@@ -398,6 +504,7 @@ mod tests {
     use super::*;
     use inbetween_core::positions_clip;
     use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
+    use rand::{Rng, SeedableRng};
 
     fn walk() -> Motion {
         let mut p = GaitParams::walk();
@@ -407,6 +514,10 @@ mod tests {
 
     fn recv_opts() -> RecvOptions {
         RecvOptions { max_sessions: 3, accept_timeout: Duration::from_secs(5) }
+    }
+
+    fn fast(max_cm: f64, retries: usize) -> SendOptions {
+        SendOptions { max_cm, lookahead: 15, realtime: false, retries, unit: None }
     }
 
     #[test]
@@ -425,20 +536,23 @@ mod tests {
     }
 
     #[test]
-    fn loopback_stream_rebuilds_the_clip() {
+    fn loopback_stream_rebuilds_the_clip_within_the_bound() {
         let m = walk();
         let listener = TcpListener::bind("127.0.0.1:0").unwrap();
         let addr = listener.local_addr().unwrap().to_string();
         let rx = std::thread::spawn(move || recv(&listener, &recv_opts()));
-        let opts = SendOptions { max_cm: 1.0, lookahead: 15, realtime: false, retries: 3 };
-        let sent = send(&addr, &m, &opts).unwrap();
+        let sent = send(&addr, &m, &fast(1.0, 3)).unwrap();
+        assert_eq!(sent.unit.unit, LengthUnit::Cmu, "{}", sent.unit.reason);
         let got = rx.join().unwrap().unwrap();
         assert!(got.complete);
-        assert_eq!(got.motion.num_frames(), 90);
+        assert_eq!((got.start_frame, got.clip_frames, got.motion.num_frames()), (0, 90, 90));
         assert_eq!(got.keys, sent.keys);
         assert!(sent.bytes_sent < sent.raw_bytes);
-        let e = inbetween_core::position_error(&positions_clip(&m), &positions_clip(&got.motion));
-        assert!(e.max * CM_PER_CMU_UNIT < 1.1, "max {} cm", e.max * CM_PER_CMU_UNIT);
+        // Keys are chosen on what the receiver decodes: the bound holds for the rebuilt frames.
+        let e = compare(&got, &m, CM_PER_CMU_UNIT).unwrap();
+        assert!(e.max_cm <= 1.0 && e.max_cm > 0.3, "max {} cm", e.max_cm);
+        let direct = inbetween_core::position_error(&positions_clip(&m), &positions_clip(&got.motion));
+        assert!((direct.max * CM_PER_CMU_UNIT - e.max_cm).abs() < 1e-9);
     }
 
     #[test]
@@ -447,8 +561,7 @@ mod tests {
         let probe = TcpListener::bind("127.0.0.1:0").unwrap();
         let dead = probe.local_addr().unwrap().to_string();
         drop(probe);
-        let opts = SendOptions { max_cm: 1.0, lookahead: 15, realtime: false, retries: 1 };
-        assert!(send(&dead, &walk(), &opts).is_err());
+        assert!(send(&dead, &walk(), &fast(1.0, 1)).is_err());
         // A peer that says hello, sends half a key and vanishes; then a real sender connects.
         let listener = TcpListener::bind("127.0.0.1:0").unwrap();
         let addr = listener.local_addr().unwrap().to_string();
@@ -461,10 +574,92 @@ mod tests {
             let key = frame_message(KEY, &key_payload(&model.skeleton, 0, &model.frames[0]));
             c.write_all(&key[..key.len() / 2]).unwrap();
         }
-        send(&addr, &m, &SendOptions { retries: 3, ..opts }).unwrap();
+        send(&addr, &m, &fast(1.0, 3)).unwrap();
         let got = rx.join().unwrap().unwrap();
         assert!(got.complete && got.sessions == 2, "{:?}", got.warnings);
         assert!(!got.warnings.is_empty());
         assert_eq!(got.motion.num_frames(), 90);
+    }
+
+    /// A receiver dies after a few keys and a new one takes its place: the sender reconnects, the
+    /// new receiver's frames start where its first key is, and compared at that offset they match
+    /// the clip within the bound (compared from frame 0 they would not).
+    #[test]
+    fn a_receiver_joining_mid_stream_knows_where_its_frames_belong() {
+        let mut p = GaitParams::walk();
+        p.frames = 120;
+        p.fps = 60.0;
+        let m = gait(&p);
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        let rx = std::thread::spawn(move || {
+            // The first receiver: reads Hello and three keys, then dies.
+            let mut first = accept_with_timeout(&listener, Duration::from_secs(5)).unwrap();
+            let mut skeleton = None;
+            let mut keys = 0;
+            while keys < 3 {
+                match read_message(&mut first, skeleton.as_ref()).unwrap().0 {
+                    Message::Hello { skeleton: s, .. } => skeleton = Some(s),
+                    Message::Key { .. } => keys += 1,
+                    Message::End => panic!("the stream ended before the receiver died"),
+                }
+            }
+            drop(first);
+            recv(&listener, &recv_opts())
+        });
+        let opts = SendOptions { realtime: true, ..fast(1.0, 10) };
+        let sent = send(&addr, &m, &opts).unwrap();
+        assert_eq!(sent.reconnects, 1);
+        let got = rx.join().unwrap().unwrap();
+        assert!(got.complete, "{:?}", got.warnings);
+        assert!(got.start_frame > 0, "the new receiver joined mid-stream");
+        assert_eq!(got.start_frame + got.motion.num_frames(), 120);
+        let e = compare(&got, &m, CM_PER_CMU_UNIT).unwrap();
+        assert_eq!((e.start_frame, e.frames), (got.start_frame, 120 - got.start_frame));
+        assert!(e.max_cm <= 1.0, "at the right offset: max {} cm", e.max_cm);
+        let from_zero = inbetween_core::position_error(
+            &positions_clip(&m.crop(0, got.motion.num_frames()).unwrap()),
+            &positions_clip(&got.motion),
+        );
+        assert!(from_zero.max * CM_PER_CMU_UNIT > 5.0, "from frame 0 the walk is elsewhere");
+    }
+
+    /// What the fuzz target (`fuzz/fuzz_targets/stream_message.rs`) does, on seeded random inputs so
+    /// that CI runs it: random bytes, and a valid stream with bytes changed or cut, with and without
+    /// valid checksums. Decoding returns an error or messages, never panics.
+    #[test]
+    fn decoding_arbitrary_messages_never_panics() {
+        let model = RotationMotion::from_motion(&walk()).unwrap();
+        let mut good = frame_message(HELLO, &hello_payload(&model.skeleton, model.frame_time, 90));
+        for f in [0, 10, 89] {
+            good.extend(frame_message(KEY, &key_payload(&model.skeleton, f, &model.frames[f])));
+        }
+        good.extend(frame_message(END, &[]));
+        assert_eq!(decode_messages(&good).unwrap().len(), 5);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        for case in 0..3000 {
+            let bytes: Vec<u8> = match case % 3 {
+                0 => (0..rng.random_range(0..300)).map(|_| rng.random()).collect(),
+                1 => {
+                    let mut b = good.clone();
+                    for _ in 0..rng.random_range(1..4) {
+                        let i = rng.random_range(0..b.len());
+                        b[i] = rng.random();
+                    }
+                    b
+                }
+                _ => good[..rng.random_range(0..good.len())].to_vec(),
+            };
+            let _ = decode_messages(&bytes);
+            // The same payload behind a valid frame and checksum reaches the payload checks.
+            if bytes.len() > 1 {
+                let _ = decode_messages(&frame_message(bytes[0] % 4, &bytes[1..]));
+            }
+        }
+        // A key beyond the announced clip is refused, not rebuilt into billions of frames.
+        let mut r = Rebuild::new(model.skeleton.clone(), model.frame_time, 90);
+        r.key(0, model.frames[0].clone()).unwrap();
+        assert!(r.key(u32::MAX as usize, model.frames[1].clone()).is_err());
+        assert_eq!(r.poses.len(), 1);
     }
 }

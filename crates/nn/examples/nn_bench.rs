@@ -8,6 +8,9 @@ fn main() {
     } else {
         inbetween_nn::bench::LstmBenchOptions::default()
     };
-    let rows = inbetween_nn::bench::lstm_throughput(&opts);
-    print!("{}", inbetween_nn::bench::format_table(&rows));
+    let mut rows = inbetween_nn::bench::lstm_throughput(&opts);
+    // The same LSTM size stepped by the plain-Rust runtime layers (what camera inference uses).
+    let (batch, frames) = if smoke { (2, 8) } else { (opts.batch, opts.frames) };
+    rows.push(inbetween_nn::runtime::lstm_runtime_throughput(opts.hidden, opts.d_input, batch, frames, 3));
+    print!("{}", inbetween_nn::bench::table(&rows).to_text());
 }

@@ -59,13 +59,9 @@ pub fn seeded<T>(device: &Device, seed: u64, f: impl FnOnce() -> T) -> T {
     f()
 }
 
-/// Threads used by the flex backend for one operation.
-///
-/// The workspace pins burn with `default-features = false`, which builds flex without its
-/// `rayon` and `simd` features: every op runs on the calling thread. Parallelism therefore comes
-/// from batching (one matmul over many trajectories) or from running independent work on
-/// separate threads, not from a thread-count knob.
-pub const FLEX_THREADS_PER_OP: usize = 1;
+// flex is built with its `rayon` and `simd` features (workspace Cargo.toml): one op may use every
+// core of rayon's pool, and gives bit-identical results on any number of threads (see
+// `train::tests::thread_count_does_not_change_the_result`).
 
 /// Visitor that reads every float parameter once, which runs burn's lazy initialisers.
 struct InitializeParams;

@@ -2,15 +2,15 @@
 //!
 //! [`lstm_throughput`] measures the blocks the engines use: a 256-unit [`FusedLstm`] stepping
 //! one trajectory and a batch of trajectories (inference, no autodiff), and a stacked
-//! [`BiLstm`] forward + backward + Adam step (training). [`format_table`] prints the rows.
+//! [`BiLstm`] forward + backward + Adam step (training). [`table`] lays the rows out.
 
-use std::time::Instant;
 
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Distribution, Tensor};
 
 use crate::backend;
+use inbetween_io::report::{num, Table};
 use crate::lstm::{BiLstmConfig, FusedLstmConfig, LstmState};
 
 /// One measured quantity.
@@ -26,18 +26,7 @@ pub struct BenchRow {
     pub detail: String,
 }
 
-/// Wall-clock seconds per call of `f`, after `warmup` unmeasured calls, averaged over
-/// `iterations` calls. `f` must finish its device work (read a value back) before returning.
-pub fn seconds_per_call(warmup: usize, iterations: usize, mut f: impl FnMut()) -> f64 {
-    for _ in 0..warmup {
-        f();
-    }
-    let start = Instant::now();
-    for _ in 0..iterations.max(1) {
-        f();
-    }
-    start.elapsed().as_secs_f64() / iterations.max(1) as f64
-}
+pub use inbetween_io::report::seconds_per_call;
 
 /// Sizes for [`lstm_throughput`].
 #[derive(Debug, Clone, PartialEq)]
@@ -190,25 +179,13 @@ pub fn lstm_throughput(opts: &LstmBenchOptions) -> Vec<BenchRow> {
     ]
 }
 
-/// Plain-text table of bench rows, one per line, aligned.
-pub fn format_table(rows: &[BenchRow]) -> String {
-    let name_width = rows
-        .iter()
-        .map(|r| r.name.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4);
-    let mut out = format!(
-        "{:<name_width$}  {:>12}  {:<9}  {}\n",
-        "case", "value", "unit", "detail"
-    );
+/// The rows as a report table (`.to_text()` for the terminal).
+pub fn table(rows: &[BenchRow]) -> Table {
+    let mut t = Table::new("nn_bench", "nn blocks: throughput", &["case", "value", "unit", "detail"]);
     for row in rows {
-        out.push_str(&format!(
-            "{:<name_width$}  {:>12.3}  {:<9}  {}\n",
-            row.name, row.value, row.unit, row.detail
-        ));
+        t.row([row.name.clone(), num(row.value, 3), row.unit.clone(), row.detail.clone()]);
     }
-    out
+    t
 }
 
 #[cfg(test)]
@@ -220,8 +197,8 @@ mod tests {
         let rows = lstm_throughput(&LstmBenchOptions::smoke());
         assert_eq!(rows.len(), 3);
         assert!(rows.iter().all(|r| r.value.is_finite() && r.value > 0.0));
-        let table = format_table(&rows);
-        assert_eq!(table.lines().count(), 4);
+        let table = table(&rows).to_text();
+        assert_eq!(table.lines().count(), 5, "{table}");
         assert!(table.contains("frames/s") && table.contains("s/step"));
     }
 }

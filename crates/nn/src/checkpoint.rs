@@ -7,9 +7,9 @@
 //! never leaves a "latest" checkpoint that cannot be loaded.
 //!
 //! Layout in a checkpoint folder, for epoch `N` (number of completed epochs):
-//! `epoch-0000N.model.bpk`, `epoch-0000N.optim.bpk`, `epoch-0000N.json`.
+//! `epoch-0000N.model.bpk`, `epoch-0000N.optim.bpk`, `epoch-0000N.state.bin` (the training
+//! objective's own state, e.g. a replay buffer; only when it has any) and `epoch-0000N.json`.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use burn::module::Module;
@@ -20,36 +20,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::NnError;
 
-/// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed to disk,
-/// then renamed over `path`. Readers see the old file or the new one, never a partial one.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), NnError> {
-    let io_err = |source| NnError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir).map_err(io_err)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io_err)
+/// [`inbetween_io::write_atomic`] with the error as an [`NnError`] naming the file.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), NnError> {
+    inbetween_io::write_atomic(path, bytes).map_err(|source| NnError::Io { path: path.to_path_buf(), source })
 }
 
-fn read_file(path: &Path) -> Result<Vec<u8>, NnError> {
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, NnError> {
     std::fs::read(path).map_err(|source| NnError::Io {
         path: path.to_path_buf(),
         source,
@@ -63,14 +39,16 @@ fn record_err(path: &Path, err: impl std::fmt::Display) -> NnError {
     }
 }
 
+/// A module's parameters as burnpack bytes (`origin` names them in errors), e.g. to keep a copy
+/// of a network inside an objective's checkpointed state.
+pub fn module_bytes<M: Module>(module: &M, origin: &Path) -> Result<Vec<u8>, NnError> {
+    let bytes = module.clone().into_record().into_bytes().map_err(|e| record_err(origin, e))?;
+    Ok(bytes.to_vec())
+}
+
 /// Save a module's parameters to `path` (burnpack format), atomically.
 pub fn save_module<M: Module>(module: &M, path: &Path) -> Result<(), NnError> {
-    let bytes = module
-        .clone()
-        .into_record()
-        .into_bytes()
-        .map_err(|e| record_err(path, e))?;
-    write_atomic(path, &bytes)
+    write_atomic(path, &module_bytes(module, path)?)
 }
 
 /// Load parameters saved by [`save_module`] into `module` (which fixes the architecture and the
@@ -113,7 +91,9 @@ pub struct CheckpointMeta {
     pub epoch: usize,
     /// Optimizer steps taken so far.
     pub optimizer_steps: u64,
-    /// Mean loss of every completed epoch, in order.
+    /// Mean loss of every completed epoch, in order (NaN, written as null, for an epoch without a
+    /// loss).
+    #[serde(deserialize_with = "nan_as_null")]
     pub loss_history: Vec<f64>,
     /// Bit patterns (`f64::to_bits`) of `loss_history`, filled by [`save`](Self::save).
     /// serde_json (without its `float_roundtrip` feature) can parse a float back one ulp off,
@@ -123,8 +103,17 @@ pub struct CheckpointMeta {
     pub loss_history_bits: Vec<u64>,
     /// Learning rate used in the last completed epoch.
     pub lr: f64,
+    /// Seconds of training so far, over every invocation of the run.
+    #[serde(default)]
+    pub seconds: f64,
     /// The run's configuration (free-form, e.g. a serialised `TrainConfig` and model config).
     pub config: serde_json::Value,
+}
+
+/// JSON has no NaN: serde_json writes it as `null`; read `null` back as NaN.
+fn nan_as_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+    let values: Vec<Option<f64>> = Deserialize::deserialize(d)?;
+    Ok(values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
 }
 
 impl CheckpointMeta {
@@ -150,7 +139,7 @@ impl CheckpointMeta {
             path: path.to_path_buf(),
             line: e.line(),
             column: e.column(),
-            message: e.to_string(),
+            message: format!("invalid checkpoint metadata: {e}"),
         })?;
         if meta.loss_history_bits.len() == meta.loss_history.len() {
             meta.loss_history = meta
@@ -172,6 +161,8 @@ pub struct CheckpointFiles {
     pub model: PathBuf,
     /// Optimizer state (burnpack).
     pub optimizer: PathBuf,
+    /// The training objective's own state (present only when it had any).
+    pub state: PathBuf,
     /// JSON sidecar ([`CheckpointMeta`]).
     pub meta: PathBuf,
 }
@@ -184,21 +175,27 @@ impl CheckpointFiles {
             epoch,
             model: dir.join(format!("{stem}.model.bpk")),
             optimizer: dir.join(format!("{stem}.optim.bpk")),
+            state: dir.join(format!("{stem}.state.bin")),
             meta: dir.join(format!("{stem}.json")),
         }
     }
 }
 
-/// Save model, optimizer and sidecar for `meta.epoch` into `dir` (sidecar last).
+/// Save model, optimizer, the objective's `state` (skipped when empty) and sidecar for
+/// `meta.epoch` into `dir` (sidecar last).
 pub fn save_checkpoint<M: Module>(
     dir: &Path,
     model: &M,
     optim: &ModuleOptimizer,
+    state: &[u8],
     meta: &CheckpointMeta,
 ) -> Result<CheckpointFiles, NnError> {
     let files = CheckpointFiles::in_dir(dir, meta.epoch);
     save_module(model, &files.model)?;
     save_optimizer(optim, &files.optimizer)?;
+    if !state.is_empty() {
+        write_atomic(&files.state, state)?;
+    }
     meta.save(&files.meta)?;
     Ok(files)
 }
@@ -260,9 +257,10 @@ mod tests {
         let meta = CheckpointMeta {
             epoch: 2,
             optimizer_steps: 10,
-            loss_history: vec![tricky, 0.1, 1.0 / 3.0],
+            loss_history: vec![tricky, 0.1, 1.0 / 3.0, f64::NAN],
             loss_history_bits: Vec::new(),
             lr: 0.01,
+            seconds: 1.5,
             config: serde_json::json!({"seed": 1}),
         };
         meta.save(&path).unwrap();

@@ -4,23 +4,26 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum NnError {
     /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
     /// A burn record (module or optimizer state) could not be encoded, decoded or applied.
-    #[error("{path}: model record: {message}")]
+    #[error("{}: model record: {message}", path.display())]
     Record { path: PathBuf, message: String },
     /// A checkpoint's JSON sidecar is malformed.
-    #[error("{path}: line {line}, column {column}: invalid checkpoint metadata: {message}")]
+    #[error("{}: line {line}, column {column}: {message}", path.display())]
     Metadata {
         path: PathBuf,
         line: usize,
         column: usize,
         message: String,
     },
+    /// A weights file for another model, architecture version or configuration.
+    #[error("{}: {message}", path.display())]
+    Mismatch { path: PathBuf, message: String },
     /// A configuration value is out of range.
     #[error("invalid configuration: {0}")]
     Config(String),

@@ -31,9 +31,11 @@ pub mod backend;
 pub mod bench;
 pub mod checkpoint;
 pub mod lstm;
+pub mod runtime;
 pub mod spectral;
 pub mod train;
 pub mod tta;
+pub mod weights;
 
 mod error;
 

@@ -1,12 +1,16 @@
-//! A small, seeded training loop: Adam, exponential learning-rate decay per epoch, a progress
-//! bar, periodic checkpoints and resume from the latest checkpoint.
+//! The one training loop of inbetween: Adam, exponential learning-rate decay per epoch with warm
+//! restarts, gradient clipping, a progress bar, a wall-clock limit, per-step and per-epoch hooks,
+//! periodic checkpoints, and resume that is bit-identical to an uninterrupted run.
 //!
-//! The caller supplies two closures: one that builds the model on a device (called once, right
-//! after seeding, inside [`backend::seeded_module`](crate::backend::seeded_module), so the initial weights
-//! depend only on [`TrainConfig::seed`]) and one that
-//! returns the loss of one optimisation step. The loss closure gets a [`Step`] whose
-//! [`Step::seed`] depends only on (seed, epoch, step): draw batches from an RNG seeded with it and
-//! a resumed run sees exactly the batches an uninterrupted run would.
+//! The caller supplies a builder (called once, right after seeding, inside
+//! [`backend::seeded_module`](crate::backend::seeded_module), so the initial weights depend only on
+//! [`TrainConfig::seed`]) and an [`Objective`]: the loss of one optimisation step, plus optional
+//! hooks and state of its own. [`fit`] takes a plain loss closure; [`fit_with`] a whole objective.
+//! The objective gets a [`Step`] whose [`Step::seed`] depends only on (seed, epoch, step): draw
+//! batches from an RNG seeded with it and a resumed run sees exactly the batches an uninterrupted
+//! run would. An objective that keeps state between steps (a replay buffer, a target network, an
+//! environment) saves it through [`Objective::state`] / [`Objective::restore`], which travel with
+//! every checkpoint.
 //!
 //! ```no_run
 //! use inbetween_nn::{backend, lstm::FusedLstmConfig, train::{fit, TrainConfig}};
@@ -21,14 +25,14 @@
 //! println!("{:?}", report.loss_history);
 //! ```
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::time::Instant;
 
 use burn::grad_clipping::GradientClippingConfig;
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use inbetween_io::Progress;
 use serde::{Deserialize, Serialize};
 
 use crate::checkpoint::{self, CheckpointMeta};
@@ -41,18 +45,28 @@ pub struct TrainConfig {
     pub epochs: usize,
     /// Optimisation steps per epoch.
     pub steps_per_epoch: usize,
-    /// Learning rate of the first epoch.
+    /// Learning rate of the first epoch (of the first epoch after `lr_decay_from`).
     pub lr: f64,
-    /// Multiplicative decay per epoch: epoch `e` uses `lr · lr_decay^e` (1.0 = constant).
+    /// Multiplicative decay per epoch: epoch `e` uses `lr · lr_decay^(e − lr_decay_from)`
+    /// (1.0 = constant).
     pub lr_decay: f64,
+    /// Epoch the decay counts from. 0 for a fresh run; a resumed run that sets it to the epoch it
+    /// resumes at restarts the schedule at `lr` (a warm restart) instead of where it had decayed to.
+    #[serde(default)]
+    pub lr_decay_from: usize,
     /// Seeds the model initialisation, the device RNG of every epoch and [`Step::seed`].
     pub seed: u64,
     /// Save a checkpoint every this many epochs (0 = only at the end). Needs `checkpoint_dir`.
     pub checkpoint_every: usize,
     /// Folder for checkpoints; if it holds one, training resumes from the latest.
     pub checkpoint_dir: Option<PathBuf>,
-    /// Clip the global gradient norm to this value.
+    /// Clip the gradient norm of each parameter tensor to this value (burn's `GradientClipping::Norm`
+    /// acts per parameter, not on the norm of all gradients together).
     pub grad_clip_norm: Option<f32>,
+    /// Stop after the epoch during which this many seconds of this invocation have passed (that
+    /// epoch is finished and checkpointed, so the run can be resumed).
+    #[serde(default)]
+    pub time_limit_s: Option<f64>,
     /// Show a progress bar on stderr (never drawn when stderr is not a terminal).
     pub progress: bool,
 }
@@ -64,10 +78,12 @@ impl Default for TrainConfig {
             steps_per_epoch: 1,
             lr: 1e-3,
             lr_decay: 1.0,
+            lr_decay_from: 0,
             seed: 0,
             checkpoint_every: 0,
             checkpoint_dir: None,
             grad_clip_norm: None,
+            time_limit_s: None,
             progress: true,
         }
     }
@@ -80,42 +96,37 @@ impl TrainConfig {
             return Err(NnError::Config("steps_per_epoch must be at least 1".into()));
         }
         if !(self.lr > 0.0 && self.lr.is_finite()) {
-            return Err(NnError::Config(format!(
-                "lr must be positive and finite, got {}",
-                self.lr
-            )));
+            return Err(NnError::Config(format!("lr must be positive and finite, got {}", self.lr)));
         }
         if !(self.lr_decay > 0.0 && self.lr_decay <= 1.0) {
-            return Err(NnError::Config(format!(
-                "lr_decay must be in (0, 1], got {}",
-                self.lr_decay
-            )));
+            return Err(NnError::Config(format!("lr_decay must be in (0, 1], got {}", self.lr_decay)));
         }
         if let Some(clip) = self.grad_clip_norm {
             if !(clip > 0.0 && clip.is_finite()) {
-                return Err(NnError::Config(format!(
-                    "grad_clip_norm must be positive, got {clip}"
-                )));
+                return Err(NnError::Config(format!("grad_clip_norm must be positive, got {clip}")));
+            }
+        }
+        if let Some(t) = self.time_limit_s {
+            if !(t > 0.0) {
+                return Err(NnError::Config(format!("time_limit_s must be positive, got {t}")));
             }
         }
         Ok(())
     }
 
-    /// Learning rate of epoch `epoch` (0-based): `lr · lr_decay^epoch`.
+    /// Learning rate of epoch `epoch` (0-based): `lr · lr_decay^(epoch − lr_decay_from)`.
     pub fn lr_at(&self, epoch: usize) -> f64 {
-        self.lr * self.lr_decay.powi(epoch as i32)
+        self.lr * self.lr_decay.powi(epoch.saturating_sub(self.lr_decay_from) as i32)
     }
 
-    /// The fields a resumed run must share with the run that wrote the checkpoint
-    /// (everything that changes the trajectory; `epochs` may grow).
-    fn resume_key(&self) -> (u64, usize, u64, u64, Option<u32>) {
-        (
-            self.seed,
-            self.steps_per_epoch,
-            self.lr.to_bits(),
-            self.lr_decay.to_bits(),
-            self.grad_clip_norm.map(f32::to_bits),
-        )
+    /// The fields a resumed run must share with the run that wrote the checkpoint: everything
+    /// that changes the trajectory except the schedule (see [`check_resumable`]).
+    fn resume_key(&self) -> (u64, usize, Option<u32>) {
+        (self.seed, self.steps_per_epoch, self.grad_clip_norm.map(f32::to_bits))
+    }
+
+    fn schedule_key(&self) -> (u64, u64, usize) {
+        (self.lr.to_bits(), self.lr_decay.to_bits(), self.lr_decay_from)
     }
 }
 
@@ -130,17 +141,78 @@ pub struct Step {
     pub seed: u64,
 }
 
-/// SplitMix64 finaliser: decorrelates nearby seeds.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// Seed of step `step` of epoch `epoch` in a run seeded with `seed`.
 pub fn step_seed(seed: u64, epoch: usize, step: usize) -> u64 {
-    mix(mix(mix(seed) ^ epoch as u64) ^ step as u64)
+    use inbetween_core::seed::{derive, mix};
+    mix(derive(seed, epoch as u64) ^ step as u64)
+}
+
+/// What [`Objective::after_epoch`] learns about the epoch that just ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EpochEnd {
+    /// 0-based epoch that ended.
+    pub epoch: usize,
+    /// Mean loss over its steps that had one (NaN when none had).
+    pub mean_loss: f64,
+    /// Learning rate it used.
+    pub lr: f64,
+    /// Seconds of training so far, over every invocation of the run.
+    pub seconds: f64,
+}
+
+/// Whether training goes on after an epoch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Control {
+    Continue,
+    /// Finish now (the epoch is checkpointed first, so the run can be resumed).
+    Stop,
+}
+
+/// What a training run optimises, with hooks into the loop.
+pub trait Objective<M> {
+    /// Advances the objective one step and returns the `[1]`-shaped loss to minimise
+    /// (differentiable on an autodiff device), or `None` when this step has nothing to learn yet
+    /// (e.g. a DQN filling its replay memory); the optimiser then skips the step.
+    fn loss(&mut self, model: &M, step: &Step) -> Option<Tensor<1>>;
+
+    /// Called after every step, once the optimiser applied it, with the step's loss if it had one
+    /// (logging, target-network updates, …).
+    fn after_step(&mut self, _model: &M, _step: &Step, _loss: Option<f64>) {}
+
+    /// Called after every epoch (validation, early stopping, …).
+    fn after_epoch(&mut self, _model: &M, _end: &EpochEnd) -> Control {
+        Control::Continue
+    }
+
+    /// The objective's own state, saved with every checkpoint (empty: none).
+    fn state(&self) -> Result<Vec<u8>, String> {
+        Ok(Vec::new())
+    }
+
+    /// Restores what [`state`](Self::state) saved, when resuming.
+    fn restore(&mut self, _state: &[u8]) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// A loss closure as an [`Objective`] without hooks or state.
+struct LossFn<F>(F);
+
+impl<M, F: FnMut(&M, &Step) -> Tensor<1>> Objective<M> for LossFn<F> {
+    fn loss(&mut self, model: &M, step: &Step) -> Option<Tensor<1>> {
+        Some((self.0)(model, step))
+    }
+}
+
+/// Why [`fit_with`] returned.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Finish {
+    /// All `epochs` are done.
+    Completed,
+    /// `time_limit_s` ran out after this many epochs.
+    TimeLimit { epochs_done: usize },
+    /// The objective asked to stop after this many epochs.
+    Stopped { epochs_done: usize },
 }
 
 /// Outcome of [`fit`].
@@ -148,169 +220,219 @@ pub fn step_seed(seed: u64, epoch: usize, step: usize) -> u64 {
 pub struct TrainReport<M> {
     /// The trained model (still on the training device).
     pub model: M,
-    /// Mean loss of every epoch from the start of the run (including epochs before a resume).
+    /// Mean loss of every epoch from the start of the run (including epochs before a resume);
+    /// NaN for an epoch in which the objective returned no loss.
     pub loss_history: Vec<f64>,
     /// Epoch this invocation started at (0, or the resumed checkpoint's epoch).
     pub start_epoch: usize,
     /// Optimiser steps taken in total.
     pub optimizer_steps: u64,
+    /// Seconds of training over every invocation of the run.
+    pub seconds: f64,
+    /// Why training ended.
+    pub finish: Finish,
     /// The checkpoint training resumed from, if any.
     pub resumed_from: Option<PathBuf>,
     /// The last checkpoint written, if any.
     pub last_checkpoint: Option<PathBuf>,
 }
 
-fn progress_bar(config: &TrainConfig, start_epoch: usize) -> ProgressBar {
-    let total = (config.epochs * config.steps_per_epoch) as u64;
-    let target = if config.progress && std::io::stderr().is_terminal() {
-        ProgressDrawTarget::stderr()
-    } else {
-        ProgressDrawTarget::hidden()
-    };
-    let bar = ProgressBar::with_draw_target(Some(total), target);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{bar:30} {pos}/{len} steps, {elapsed} elapsed, eta {eta} {msg}",
-    ) {
-        bar.set_style(style);
-    }
-    bar.set_position((start_epoch * config.steps_per_epoch) as u64);
-    bar
-}
-
 fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
-    AdamConfig::new()
-        .with_grad_clipping(config.grad_clip_norm.map(GradientClippingConfig::Norm))
-        .init()
+    AdamConfig::new().with_grad_clipping(config.grad_clip_norm.map(GradientClippingConfig::Norm)).init()
 }
 
 /// Train a model built by `build` on `device` (which must have autodiff, e.g.
-/// [`backend::cpu_autodiff`](crate::backend::cpu_autodiff)), minimising the `[1]`-shaped loss
-/// returned by `loss` for every step.
-///
-/// With a `checkpoint_dir` that already holds checkpoints, the model, optimiser state and loss
-/// history are restored from the latest one and training continues at its epoch. Given the same
-/// config and a loss closure that samples data only from [`Step::seed`], the result is
-/// bit-identical to an uninterrupted run (flex runs every op on one thread in a fixed order).
-pub fn fit<M, B, L>(
-    config: &TrainConfig,
-    device: &Device,
-    build: B,
-    mut loss: L,
-) -> Result<TrainReport<M>, NnError>
+/// [`backend::cpu_autodiff`](crate::backend::cpu_autodiff)), minimising the loss `loss` returns
+/// for every step. See [`fit_with`].
+pub fn fit<M, B, L>(config: &TrainConfig, device: &Device, build: B, loss: L) -> Result<TrainReport<M>, NnError>
 where
     M: Module,
     B: FnOnce(&Device) -> M,
     L: FnMut(&M, &Step) -> Tensor<1>,
 {
+    fit_with(config, device, build, &mut LossFn(loss))
+}
+
+/// Train a model built by `build` on `device` against `objective`.
+///
+/// With a `checkpoint_dir` that already holds checkpoints, the model, optimiser state, loss
+/// history and the objective's state are restored from the latest one and training continues at
+/// its epoch. Given the same config and an objective that samples data only from [`Step::seed`]
+/// (or keeps the rest in its state), the result is bit-identical to an uninterrupted run.
+///
+/// The tensor kernels run on rayon's pool: every core by default (`RAYON_NUM_THREADS=1`, or a
+/// caller's `ThreadPool::install`, for fewer); flex gives bit-identical results on any number of
+/// threads (tested), so two single-threaded runs side by side are a fair use of two cores.
+pub fn fit_with<M, B, O>(config: &TrainConfig, device: &Device, build: B, objective: &mut O) -> Result<TrainReport<M>, NnError>
+where
+    M: Module,
+    B: FnOnce(&Device) -> M,
+    O: Objective<M>,
+{
     config.validate()?;
     if !device.is_autodiff() {
-        return Err(NnError::Config(
-            "fit needs an autodiff device (e.g. backend::cpu_autodiff())".into(),
-        ));
+        return Err(NnError::Config("fit needs an autodiff device (e.g. backend::cpu_autodiff())".into()));
     }
-    let mut model = crate::backend::seeded_module(device, config.seed, build);
-    let mut optim = new_optimizer(config);
-    let mut loss_history = Vec::new();
-    let mut optimizer_steps = 0u64;
-    let mut start_epoch = 0;
-    let mut resumed_from = None;
+    run(config, device, build, objective)
+}
 
-    if let Some(dir) = &config.checkpoint_dir {
-        if let Some(files) = checkpoint::latest_checkpoint(dir)? {
-            let (m, o, meta) = checkpoint::load_checkpoint(&files, model, optim)?;
-            check_resumable(config, &meta, &files.meta)?;
-            model = m;
-            optim = o;
-            loss_history = meta.loss_history;
-            optimizer_steps = meta.optimizer_steps;
-            start_epoch = meta.epoch;
-            resumed_from = Some(files.model);
-        }
+/// Where a run stands: restored from a checkpoint or fresh.
+struct RunState<M> {
+    model: M,
+    optim: ModuleOptimizer,
+    loss_history: Vec<f64>,
+    optimizer_steps: u64,
+    start_epoch: usize,
+    seconds_before: f64,
+    resumed_from: Option<PathBuf>,
+}
+
+fn start<M, B, O>(config: &TrainConfig, device: &Device, build: B, objective: &mut O) -> Result<RunState<M>, NnError>
+where
+    M: Module,
+    B: FnOnce(&Device) -> M,
+    O: Objective<M>,
+{
+    let model = crate::backend::seeded_module(device, config.seed, build);
+    let optim = new_optimizer(config);
+    let fresh = RunState { model, optim, loss_history: Vec::new(), optimizer_steps: 0, start_epoch: 0, seconds_before: 0.0, resumed_from: None };
+    let Some(dir) = &config.checkpoint_dir else { return Ok(fresh) };
+    let Some(files) = checkpoint::latest_checkpoint(dir)? else { return Ok(fresh) };
+    let (model, optim, meta) = checkpoint::load_checkpoint(&files, fresh.model, fresh.optim)?;
+    check_resumable(config, &meta, &files.meta)?;
+    if files.state.exists() {
+        let bytes = std::fs::read(&files.state).map_err(|source| NnError::Io { path: files.state.clone(), source })?;
+        objective
+            .restore(&bytes)
+            .map_err(|message| NnError::Record { path: files.state.clone(), message: format!("objective state: {message}") })?;
     }
+    Ok(RunState {
+        model,
+        optim,
+        loss_history: meta.loss_history,
+        optimizer_steps: meta.optimizer_steps,
+        start_epoch: meta.epoch,
+        seconds_before: meta.seconds,
+        resumed_from: Some(files.model),
+    })
+}
 
-    let bar = progress_bar(config, start_epoch);
+fn run<M, B, O>(config: &TrainConfig, device: &Device, build: B, objective: &mut O) -> Result<TrainReport<M>, NnError>
+where
+    M: Module,
+    B: FnOnce(&Device) -> M,
+    O: Objective<M>,
+{
+    let RunState { mut model, mut optim, mut loss_history, mut optimizer_steps, start_epoch, seconds_before, resumed_from } =
+        start(config, device, build, objective)?;
+    let total = (config.epochs * config.steps_per_epoch) as u64;
+    let bar = if config.progress { Progress::new(total, "training") } else { Progress::hidden() };
+    bar.set_position((start_epoch * config.steps_per_epoch) as u64);
+    let started = Instant::now();
     let mut last_checkpoint = None;
+    let mut finish = Finish::Completed;
     for epoch in start_epoch..config.epochs {
         // Re-seed per epoch so random ops inside the model (noise, dropout) replay identically
         // after a resume.
         crate::backend::seeded(device, step_seed(config.seed, epoch, usize::MAX), || ());
         let lr = config.lr_at(epoch);
-        let mut sum = 0.0;
+        let (mut sum, mut losses) = (0.0, 0usize);
         for step in 0..config.steps_per_epoch {
-            let step = Step {
-                epoch,
-                step,
-                seed: step_seed(config.seed, epoch, step),
-            };
-            let value = loss(&model, &step);
-            let scalar = f64::from(value.clone().into_scalar::<f32>());
-            if !scalar.is_finite() {
-                bar.abandon();
-                return Err(NnError::Config(format!(
-                    "loss became {scalar} at epoch {epoch}, step {}: lower lr or clip gradients",
-                    step.step
-                )));
+            let step = Step { epoch, step, seed: step_seed(config.seed, epoch, step) };
+            let mut scalar = None;
+            if let Some(value) = objective.loss(&model, &step) {
+                let v = f64::from(value.clone().into_scalar::<f32>());
+                if !v.is_finite() {
+                    bar.abandon();
+                    return Err(NnError::Config(format!(
+                        "loss became {v} at epoch {epoch}, step {}: lower lr or clip gradients",
+                        step.step
+                    )));
+                }
+                let grads = GradientsParams::from_grads(value.backward(), &model);
+                model = optim.step(lr, model, grads);
+                optimizer_steps += 1;
+                (sum, losses) = (sum + v, losses + 1);
+                scalar = Some(v);
             }
-            sum += scalar;
-            let grads = GradientsParams::from_grads(value.backward(), &model);
-            model = optim.step(lr, model, grads);
-            optimizer_steps += 1;
+            objective.after_step(&model, &step, scalar);
             bar.inc(1);
         }
-        let mean = sum / config.steps_per_epoch as f64;
+        // NaN marks an epoch without a single optimiser step.
+        let mean = if losses > 0 { sum / losses as f64 } else { f64::NAN };
         loss_history.push(mean);
         bar.set_message(format!("epoch {} loss {mean:.5} lr {lr:.2e}", epoch + 1));
-
+        let seconds = seconds_before + started.elapsed().as_secs_f64();
+        let end = EpochEnd { epoch, mean_loss: mean, lr, seconds };
         let done = epoch + 1;
+        if objective.after_epoch(&model, &end) == Control::Stop {
+            finish = Finish::Stopped { epochs_done: done };
+        } else if config.time_limit_s.is_some_and(|t| started.elapsed().as_secs_f64() >= t) && done < config.epochs {
+            finish = Finish::TimeLimit { epochs_done: done };
+        }
         let periodic = config.checkpoint_every > 0 && done % config.checkpoint_every == 0;
-        if let Some(dir) = &config.checkpoint_dir {
-            if periodic || done == config.epochs {
-                let meta = CheckpointMeta {
-                    epoch: done,
-                    optimizer_steps,
-                    loss_history: loss_history.clone(),
-                    loss_history_bits: Vec::new(),
-                    lr,
-                    config: serde_json::to_value(config).unwrap_or(serde_json::Value::Null),
-                };
-                let files = checkpoint::save_checkpoint(dir, &model, &optim, &meta)?;
-                last_checkpoint = Some(files.model);
-            }
+        let last = done == config.epochs || finish != Finish::Completed;
+        if let (Some(dir), true) = (&config.checkpoint_dir, periodic || last) {
+            let meta = CheckpointMeta {
+                epoch: done,
+                optimizer_steps,
+                loss_history: loss_history.clone(),
+                loss_history_bits: Vec::new(),
+                lr,
+                seconds,
+                config: serde_json::to_value(config).unwrap_or(serde_json::Value::Null),
+            };
+            let state = objective.state().map_err(|message| NnError::Record { path: dir.clone(), message: format!("objective state: {message}") })?;
+            let files = checkpoint::save_checkpoint(dir, &model, &optim, &state, &meta)?;
+            last_checkpoint = Some(files.model);
+        }
+        if finish != Finish::Completed {
+            break;
         }
     }
-    bar.finish_and_clear();
+    bar.finish();
     Ok(TrainReport {
         model,
         loss_history,
         start_epoch,
         optimizer_steps,
+        seconds: seconds_before + started.elapsed().as_secs_f64(),
+        finish,
         resumed_from,
         last_checkpoint,
     })
 }
 
-/// A checkpoint written with a different seed, lr, decay, steps per epoch or clipping would not
-/// continue the same run: refuse rather than silently mixing trajectories.
-fn check_resumable(
-    config: &TrainConfig,
-    meta: &CheckpointMeta,
-    path: &std::path::Path,
-) -> Result<(), NnError> {
-    let saved: TrainConfig =
-        serde_json::from_value(meta.config.clone()).map_err(|e| NnError::Metadata {
-            path: path.to_path_buf(),
-            line: 0,
-            column: 0,
-            message: format!("field \"config\" is not a TrainConfig: {e}"),
-        })?;
+/// A checkpoint written with a different seed, steps per epoch or clipping would not continue the
+/// same run: refuse rather than silently mixing trajectories. The schedule (lr, decay) may change
+/// only as a warm restart, i.e. with `lr_decay_from` at or after the checkpoint's epoch.
+fn check_resumable(config: &TrainConfig, meta: &CheckpointMeta, path: &std::path::Path) -> Result<(), NnError> {
+    let saved: TrainConfig = serde_json::from_value(meta.config.clone()).map_err(|e| NnError::Metadata {
+        path: path.to_path_buf(),
+        line: 0,
+        column: 0,
+        message: format!("field \"config\" is not a TrainConfig: {e}"),
+    })?;
     if saved.resume_key() != config.resume_key() {
         return Err(NnError::Config(format!(
-            "{}: checkpoint was written with seed {}, lr {}, lr_decay {}, steps_per_epoch {}, grad_clip_norm {:?}; \
-             this run has seed {}, lr {}, lr_decay {}, steps_per_epoch {}, grad_clip_norm {:?} \
+            "{}: checkpoint was written with seed {}, steps_per_epoch {}, grad_clip_norm {:?}; \
+             this run has seed {}, steps_per_epoch {}, grad_clip_norm {:?} \
              (use another checkpoint_dir to start afresh)",
             path.display(),
-            saved.seed, saved.lr, saved.lr_decay, saved.steps_per_epoch, saved.grad_clip_norm,
-            config.seed, config.lr, config.lr_decay, config.steps_per_epoch, config.grad_clip_norm,
+            saved.seed, saved.steps_per_epoch, saved.grad_clip_norm,
+            config.seed, config.steps_per_epoch, config.grad_clip_norm,
+        )));
+    }
+    if saved.schedule_key() != config.schedule_key() && config.lr_decay_from < meta.epoch {
+        return Err(NnError::Config(format!(
+            "{}: checkpoint at epoch {} was written with lr {}, lr_decay {}, lr_decay_from {}; this run has lr {}, \
+             lr_decay {}, lr_decay_from {}: a new schedule must start at or after the resumed epoch \
+             (set lr_decay_from to {} for a warm restart)",
+            path.display(),
+            meta.epoch,
+            saved.lr, saved.lr_decay, saved.lr_decay_from,
+            config.lr, config.lr_decay, config.lr_decay_from,
+            meta.epoch,
         )));
     }
     Ok(())
@@ -346,7 +468,7 @@ mod tests {
     fn sine_batch(seed: u64, device: &Device) -> (Vec<Tensor<2>>, Tensor<2>) {
         let mut state = seed;
         let mut uniform = || {
-            state = mix(state);
+            state = inbetween_core::seed::mix(state);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let waves: Vec<(f64, f64)> = (0..BATCH)
@@ -498,6 +620,125 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("seed 42") && err.contains("seed 7"), "{err}");
+    }
+
+    /// An objective with state of its own (a running count that feeds the loss, like a replay
+    /// buffer feeds a DQN) and hooks that record what the loop reports.
+    struct Counting<'a> {
+        device: &'a Device,
+        seen: u64,
+        steps: Vec<(usize, usize)>,
+        epochs: Vec<EpochEnd>,
+        stop_after: Option<usize>,
+    }
+
+    impl<'a> Counting<'a> {
+        fn new(device: &'a Device) -> Self {
+            Counting { device, seen: 0, steps: Vec::new(), epochs: Vec::new(), stop_after: None }
+        }
+    }
+
+    impl Objective<SinePredictor> for Counting<'_> {
+        fn loss(&mut self, model: &SinePredictor, step: &Step) -> Option<Tensor<1>> {
+            // Nothing to learn on the first step of an epoch (like a DQN warming up).
+            if step.step == 0 {
+                return None;
+            }
+            // The batch depends on the objective's state, not only on the step seed.
+            let (inputs, targets) = sine_batch(step.seed ^ self.seen, self.device);
+            Some((predict(model, &inputs) - targets).square().mean())
+        }
+        fn after_step(&mut self, _: &SinePredictor, step: &Step, loss: Option<f64>) {
+            assert_eq!(loss.is_none(), step.step == 0);
+            self.seen += 1 + loss.map_or(0, |l| (l * 1e6) as u64 % 7);
+            self.steps.push((step.epoch, step.step));
+        }
+        fn after_epoch(&mut self, _: &SinePredictor, end: &EpochEnd) -> Control {
+            self.epochs.push(*end);
+            if self.stop_after == Some(end.epoch + 1) { Control::Stop } else { Control::Continue }
+        }
+        fn state(&self) -> Result<Vec<u8>, String> {
+            Ok(self.seen.to_le_bytes().to_vec())
+        }
+        fn restore(&mut self, state: &[u8]) -> Result<(), String> {
+            self.seen = u64::from_le_bytes(state.try_into().map_err(|_| format!("{} bytes, expected 8", state.len()))?);
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn hooks_see_every_step_and_objective_state_resumes_bit_identically() {
+        let device = backend::cpu_autodiff();
+        let (straight_dir, split_dir) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let with_dir = |epochs, dir: &std::path::Path| TrainConfig { checkpoint_dir: Some(dir.to_path_buf()), ..config(epochs) };
+        let mut whole = Counting::new(&device);
+        let straight = fit_with(&with_dir(4, straight_dir.path()), &device, build, &mut whole).unwrap();
+        assert_eq!(whole.steps.len(), 20);
+        assert_eq!(whole.steps[7], (1, 2));
+        assert_eq!(straight.optimizer_steps, 16, "steps without a loss are skipped");
+        assert_eq!(whole.epochs.iter().map(|e| e.epoch).collect::<Vec<_>>(), [0, 1, 2, 3]);
+        assert_eq!(whole.epochs[3].mean_loss, straight.loss_history[3]);
+
+        // Stopped by the objective after 2 epochs, then resumed by a fresh objective.
+        let mut first = Counting::new(&device);
+        first.stop_after = Some(2);
+        let stopped = fit_with(&with_dir(4, split_dir.path()), &device, build, &mut first).unwrap();
+        assert_eq!(stopped.finish, Finish::Stopped { epochs_done: 2 });
+        let mut second = Counting::new(&device);
+        let resumed = fit_with(&with_dir(4, split_dir.path()), &device, build, &mut second).unwrap();
+        assert_eq!(resumed.start_epoch, 2);
+        assert_eq!(second.seen, whole.seen, "objective state was not restored");
+        assert_eq!(resumed.loss_history, straight.loss_history);
+        assert_eq!(weights(&resumed.model), weights(&straight.model));
+    }
+
+    #[test]
+    fn a_time_limit_stops_after_a_checkpointed_epoch_that_resumes() {
+        let device = backend::cpu_autodiff();
+        let dir = tempfile::tempdir().unwrap();
+        let limited = TrainConfig { time_limit_s: Some(1e-9), checkpoint_dir: Some(dir.path().to_path_buf()), ..config(3) };
+        let report = fit(&limited, &device, build, sine_loss(&device)).unwrap();
+        assert_eq!(report.finish, Finish::TimeLimit { epochs_done: 1 });
+        assert!(report.last_checkpoint.is_some());
+        let rest = TrainConfig { time_limit_s: None, ..limited.clone() };
+        let resumed = fit(&rest, &device, build, sine_loss(&device)).unwrap();
+        let straight = fit(&config(3), &device, build, sine_loss(&device)).unwrap();
+        assert_eq!(resumed.finish, Finish::Completed);
+        assert_eq!(resumed.loss_history, straight.loss_history);
+        assert!(resumed.seconds >= report.seconds);
+    }
+
+    #[test]
+    fn a_warm_restart_resumes_with_a_new_schedule_only_from_the_resumed_epoch() {
+        let restarted = TrainConfig { lr: 5e-4, lr_decay: 0.97, lr_decay_from: 95, ..TrainConfig::default() };
+        assert!((restarted.lr_at(95) - 5e-4).abs() < 1e-15);
+        assert!((restarted.lr_at(96) - 5e-4 * 0.97).abs() < 1e-15);
+        assert!((restarted.lr_at(10) - 5e-4).abs() < 1e-15);
+
+        let device = backend::cpu_autodiff();
+        let dir = tempfile::tempdir().unwrap();
+        let with_dir = |c: TrainConfig| TrainConfig { checkpoint_dir: Some(dir.path().to_path_buf()), ..c };
+        fit(&with_dir(config(2)), &device, build, sine_loss(&device)).unwrap();
+        // A new lr that claims to count from epoch 0 would rewrite history: refused.
+        let err = fit(&with_dir(TrainConfig { lr: 0.01, ..config(3) }), &device, build, sine_loss(&device)).unwrap_err().to_string();
+        assert!(err.contains("lr_decay_from") && err.contains("epoch 2"), "{err}");
+        let warm = with_dir(TrainConfig { lr: 0.01, lr_decay_from: 2, ..config(3) });
+        let report = fit(&warm, &device, build, sine_loss(&device)).unwrap();
+        assert_eq!(report.start_epoch, 2);
+        assert_eq!(report.loss_history.len(), 3);
+    }
+
+    #[test]
+    fn thread_count_does_not_change_the_result() {
+        let run_on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let device = backend::cpu_autodiff();
+                let r = fit(&config(2), &device, build, sine_loss(&device)).unwrap();
+                (r.loss_history, weights(&r.model))
+            })
+        };
+        assert_eq!(run_on(1), run_on(2));
     }
 
     #[test]

@@ -5,6 +5,7 @@ use crate::plot::{grouped_bar_chart, line_plot, Series};
 use crate::stick::{render_motion_gif, render_motion_png, StickOptions};
 use crate::RenderError;
 use inbetween_core::procedural::{gait, GaitParams};
+use inbetween_io::report::{num, Table};
 use std::path::Path;
 use std::time::Instant;
 
@@ -49,11 +50,11 @@ pub fn render_bench(dir: &Path, repeats: usize) -> Result<Vec<BenchRow>, RenderE
     Ok(rows)
 }
 
-/// The rows as an aligned text table.
-pub fn format_table(rows: &[BenchRow]) -> String {
-    let mut out = format!("{:<40} {:>10} {:>10}\n", "task", "best (s)", "size (KiB)");
+/// The rows as a report table (`.to_text()` for the terminal).
+pub fn table(rows: &[BenchRow]) -> Table {
+    let mut t = Table::new("render_bench", "previews: best time over repeats", &["task", "best (s)", "size (KiB)"]);
     for r in rows {
-        out += &format!("{:<40} {:>10.3} {:>10.1}\n", r.task, r.seconds, r.bytes as f64 / 1024.0);
+        t.row([r.task.clone(), num(r.seconds, 3), num(r.bytes as f64 / 1024.0, 1)]);
     }
-    out
+    t
 }

@@ -493,8 +493,9 @@ fn render_gif(path: &Path, figs: &[Figure], opts: &StickOptions, progress: &mut 
     crate::write_gif_with_progress(path, &images, gif_fps, progress)
 }
 
-/// Frame `frame` of the first motion (the others at the same time) as an image. A frame past the
-/// end shows the last frame; an empty motion list gives a blank image with the grid off.
+/// Frame `frame` of the first motion (the others at the same time) as an image. Bad input (a
+/// frame past the end, an empty motion list, a zero size) gives a blank background image;
+/// [`try_render_motion_frame`] says what was wrong.
 pub fn render_motion_frame(motions: &[&Motion], frame: usize, opts: &StickOptions) -> RgbImage {
     try_render_motion_frame(motions, frame, opts)
         .unwrap_or_else(|_| Canvas::new(opts.width.max(1), opts.height.max(1), opts.background).into_image())

@@ -1,10 +1,13 @@
 //! The SIDQL deep Q-network (§4): the keyframe MDP ([`env`]), the Q-network ([`model`]), the replay
-//! memory ([`replay`]) and training with main and target networks ([`train`]).
+//! memory ([`replay`]), training with main and target networks on the shared loop ([`train`]) and
+//! the trained policy, which needs no training code ([`policy`]).
 
 pub mod env;
 pub mod model;
+pub mod policy;
 pub mod replay;
 pub mod train;
 
 pub use model::{DqnConfig, QNet};
+pub use policy::{PolicyInfo, SidqlPolicy};
 pub use train::{train, TrainOptions, TrainReport};

@@ -1,7 +1,7 @@
 //! SIDQL selection (§4): a trained deep Q-network adds, one at a time, the frame with the highest
 //! Q-value until `k` keys are chosen. Training lives in [`crate::dqn`].
 
-pub use crate::dqn::train::SidqlPolicy;
+pub use crate::dqn::SidqlPolicy;
 
 use crate::representation::SphericalMotion;
 use crate::Result;

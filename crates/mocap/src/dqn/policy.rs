@@ -1,0 +1,175 @@
+//! A trained SIDQL policy (§4.1): inference only, no training code. Weights are saved and loaded
+//! through the shared [`inbetween_nn::weights`] format (`sidql.bpk` + its `sidql.json` card, kind
+//! [`POLICY_KIND`]).
+
+use super::env::{EnvWindow, INPUTS};
+use super::model::{DqnConfig, QNet};
+use super::train::TrainOptions;
+use crate::error::SegmentModel;
+use crate::representation::SphericalMotion;
+use crate::{MocapError, Result};
+use burn::tensor::{Device, Tensor, TensorData};
+use inbetween_core::KeyframeSet;
+use inbetween_nn::burn;
+use inbetween_nn::weights::{self, Weights, WeightsCard};
+use std::path::Path;
+
+/// Kind and architecture version written in a policy's weights card.
+pub const POLICY_KIND: &str = "mocap-sidql";
+pub const POLICY_FORMAT: u32 = 1;
+
+/// What a policy's card says: the network shape and how it was trained.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PolicyInfo {
+    pub config: DqnConfig,
+    /// The training data, in words (clips, split, windows).
+    pub trained_on: String,
+    pub episodes: usize,
+    pub updates: usize,
+    pub seconds: f64,
+    pub options: Option<TrainOptions>,
+}
+
+impl PolicyInfo {
+    fn to_card(&self) -> Result<WeightsCard> {
+        let json = |v: serde_json::Result<serde_json::Value>| v.map_err(|e| MocapError::Model(e.to_string()));
+        let mut card = WeightsCard::new(POLICY_KIND, POLICY_FORMAT, json(serde_json::to_value(&self.config))?, &self.trained_on);
+        card.training = json(serde_json::to_value(&self.options))?;
+        card.metrics.insert("episodes".into(), self.episodes as f64);
+        card.metrics.insert("updates".into(), self.updates as f64);
+        card.metrics.insert("seconds".into(), self.seconds);
+        Ok(card)
+    }
+
+    fn from_weights(w: &Weights) -> Result<PolicyInfo> {
+        w.expect_kind(POLICY_KIND, POLICY_FORMAT)?;
+        let card = w.card();
+        let metric = |k: &str| card.metrics.get(k).copied().unwrap_or(0.0);
+        Ok(PolicyInfo {
+            config: w.config()?,
+            trained_on: card.data.clone(),
+            episodes: metric("episodes") as usize,
+            updates: metric("updates") as usize,
+            seconds: metric("seconds"),
+            options: serde_json::from_value(card.training.clone()).ok(),
+        })
+    }
+}
+
+/// A trained SIDQL policy on the plain (inference) CPU device.
+pub struct SidqlPolicy {
+    pub info: PolicyInfo,
+    net: QNet,
+    device: Device,
+}
+
+impl SidqlPolicy {
+    /// A policy from a trained network (moved to the inference device).
+    pub fn new(info: PolicyInfo, net: QNet) -> SidqlPolicy {
+        SidqlPolicy { info, net, device: inbetween_nn::backend::cpu() }
+    }
+
+    /// Writes the weights (`path`, burnpack) and their card (`path` with `.json`).
+    pub fn save(&self, path: &Path) -> Result<()> {
+        Ok(weights::save(&self.net, &self.info.to_card()?, path)?)
+    }
+
+    /// Loads a policy saved by [`SidqlPolicy::save`].
+    pub fn load(path: &Path) -> Result<SidqlPolicy> {
+        Self::from_weights(&Weights::from_path(path)?)
+    }
+
+    /// The committed policy (`crates/mocap/weights/sidql.bpk`, trained by `inbetween mocap train
+    /// --procedural` on our own gaits), compiled into the binary so the bench and the tools run from
+    /// any folder.
+    pub fn committed() -> Result<SidqlPolicy> {
+        let w = Weights::embedded(
+            "crates/mocap/weights/sidql.bpk",
+            include_bytes!("../../weights/sidql.bpk"),
+            include_str!("../../weights/sidql.json"),
+        )?;
+        Self::from_weights(&w)
+    }
+
+    fn from_weights(w: &Weights) -> Result<SidqlPolicy> {
+        let info = PolicyInfo::from_weights(w)?;
+        if info.config.inputs_per_frame != INPUTS {
+            return Err(MocapError::Model(format!(
+                "{}: the policy reads {} inputs per frame, this version builds {INPUTS}; retrain it",
+                w.origin().display(),
+                info.config.inputs_per_frame
+            )));
+        }
+        let device = inbetween_nn::backend::cpu();
+        let net = w.load_into(info.config.init(&device))?;
+        Ok(SidqlPolicy { info, net, device })
+    }
+
+    /// Q-values `[batch × frames]` of states laid out `[batch, frames, INPUTS]`.
+    pub fn q_values(&self, states: &[f32], batch: usize, frames: usize) -> Vec<f32> {
+        q_values(&self.net, states, batch, frames, &self.device)
+    }
+
+    /// Chooses `k` keys for a window: starting from the end keys, repeatedly the frame with the
+    /// highest Q-value among the non-keys.
+    pub fn select(&self, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
+        crate::select::check_k(rep.num_frames, k)?;
+        if k <= 2 {
+            return Ok(KeyframeSet::new(vec![0, rep.num_frames - 1], rep.num_frames)?);
+        }
+        let w = EnvWindow::new(rep.clone())?;
+        let mut mask = w.initial_mask();
+        let mut scratch = rep.scratch();
+        let mut state = Vec::with_capacity(w.frames() * INPUTS);
+        while (mask.count_ones() as usize) < k {
+            state.clear();
+            w.state(mask, &mut scratch, &mut state);
+            let q = q_values(&self.net, &state, 1, w.frames(), &self.device);
+            mask |= 1 << best_action(&q, mask, w.frames());
+        }
+        Ok(KeyframeSet::new((0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect(), w.frames())?)
+    }
+}
+
+/// Q-values `[batch × frames]` of states laid out `[batch, frames, INPUTS]`.
+pub(crate) fn q_values(net: &QNet, states: &[f32], batch: usize, frames: usize, device: &Device) -> Vec<f32> {
+    let x = Tensor::<3>::from_data(TensorData::new(states.to_vec(), [batch, frames, INPUTS]), device);
+    net.forward(x).into_data().try_to_vec::<f32>().expect("f32 Q-values")
+}
+
+/// The non-key frame with the highest Q-value.
+pub(crate) fn best_action(q: &[f32], mask: u64, frames: usize) -> usize {
+    (0..frames).filter(|&f| mask >> f & 1 == 0).max_by(|&a, &b| q[a].total_cmp(&q[b])).expect("a non-key frame remains")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use inbetween_core::procedural::{gait, GaitParams};
+
+    #[test]
+    fn committed_policy_serves_any_skeleton_and_window_length() {
+        let policy = SidqlPolicy::committed().unwrap();
+        assert!(policy.info.trained_on.contains("procedural"), "{}", policy.info.trained_on);
+        let m = gait(&GaitParams { frames: 40, fps: 30.0, ..GaitParams::walk() });
+        // All 31 joints (the policy was trained on 23) and 40 frames (trained on 60).
+        let rep = SphericalMotion::from_motion(&m).unwrap();
+        let keys = policy.select(&rep, 6).unwrap();
+        assert_eq!(keys.len(), 6);
+        let two = KeyframeSet::new(vec![], 40).unwrap();
+        assert!(rep.error(&keys).mean_angle < 0.5 * rep.error(&two).mean_angle);
+    }
+
+    #[test]
+    fn a_file_of_another_model_is_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("other.bpk");
+        let net = DqnConfig::default().init(&inbetween_nn::backend::cpu());
+        let card = WeightsCard::new("camera", 1, serde_json::to_value(DqnConfig::default()).unwrap(), "x");
+        weights::save(&net, &card, &path).unwrap();
+        let err = SidqlPolicy::load(&path).err().unwrap().to_string();
+        assert!(err.contains("other.bpk") && err.contains("expected mocap-sidql"), "{err}");
+        let err = SidqlPolicy::load(&dir.path().join("missing.bpk")).err().unwrap().to_string();
+        assert!(err.contains("missing.bpk"), "{err}");
+    }
+}
