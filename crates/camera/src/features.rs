@@ -4,7 +4,6 @@
 use crate::toric::Toric;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::PI;
 
 /// Height of the framing target above the shoulder midpoint (≈ the face), metres.
 pub const TARGET_ABOVE_SHOULDERS: f64 = 0.15;
@@ -113,6 +112,7 @@ pub fn decode_camera(x: &[f32]) -> Toric {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     fn standing(at: DVec3, facing_yaw: f64) -> CharacterFrame {
         let front = DVec3::new(facing_yaw.sin(), 0.0, facing_yaw.cos());

@@ -9,6 +9,7 @@
 
 pub mod bench;
 pub mod dataset;
+pub mod demo;
 pub mod features;
 pub mod gltf;
 pub mod infer;

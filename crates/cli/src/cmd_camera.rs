@@ -4,7 +4,7 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_camera::bench;
 use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
-use inbetween_camera::infer::{self, GenerateJob, GenerateOptions, Keys, ReferenceClip, Style};
+use inbetween_camera::infer::{GenerateJob, GenerateOptions, Keys, ReferenceClip, Style};
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
 use inbetween_camera::weights::{self, CameraWeights};
 use std::path::{Path, PathBuf};
@@ -195,18 +195,8 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
 }
 
 fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let scene = Scene::procedural(a.seed, a.frames, 30.0);
-    scene.save(&a.out.join("scene.json"))?;
-    let n = a.frames - 1;
-    inbetween_camera::write_json(&a.out.join("keys.json"), &infer::example_keys(&scene, &[0, n / 2, n]))?;
-    let lens = inbetween_camera::toric::Lens::default();
-    for (i, b) in BEHAVIOURS.into_iter().enumerate() {
-        let mut rng = inbetween_camera::dataset::seeded_rng(a.seed + i as u64);
-        let seq = inbetween_camera::dataset::film_sequence(&scene, a.seed, b, true, &mut rng, &lens);
-        inbetween_camera::write_json(&a.out.join(format!("reference-{}.json", b.name())), &seq)?;
-    }
-    println!("wrote scene.json, keys.json and reference-{{direct,relative,side,orbit}}.json to {}", a.out.display());
+    let files = inbetween_camera::demo::write_example_scene(&a.out, a.seed, a.frames)?;
+    println!("wrote {} to {}", files.join(", "), a.out.display());
     Ok(())
 }
 
@@ -263,38 +253,4 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     Ok(())
-}
-
-/// The camera part of `inbetween demo`: a built-in scene, keyframes, the committed weights, one
-/// track per style; writes cam.json, cam.gltf and cam.gif (orbit style) and one JSON per style.
-pub fn demo(out: &Path) -> anyhow::Result<Vec<String>> {
-    let t0 = std::time::Instant::now();
-    let w = load_weights(None)?;
-    let scene = Scene::procedural(3, 300, 30.0);
-    let keys = infer::example_keys(&scene, &[0, 150, 299]);
-    let dir = out.join("camera");
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    scene.save(&dir.join("scene.json"))?;
-    inbetween_camera::write_json(&dir.join("keys.json"), &keys)?;
-    let mut lines = Vec::new();
-    for b in BEHAVIOURS {
-        let style = behaviour_style(&w, b)?;
-        let keys_path = dir.join("keys.json");
-        let track = GenerateJob { origin: &keys_path, ..GenerateJob::new(&w.model, &scene, &keys, &style) }.run()?;
-        let worst = track.worst_key_miss();
-        inbetween_camera::write_json(&dir.join(format!("cam-{}.json", b.name())), &track)?;
-        if b == Behaviour::Orbit {
-            inbetween_camera::write_json(&out.join("cam.json"), &track)?;
-            inbetween_camera::gltf::write_gltf(&out.join("cam.gltf"), &track, &scene)?;
-            inbetween_camera::preview::write_preview(&out.join("cam.gif"), &track, &scene, 3)?;
-        }
-        lines.push(format!("camera {:<8} {} frames, network key miss {worst:.3} (corrected to {:.0e})", b.name(), track.frames.len(), track.max_corrected_residual));
-    }
-    lines.push(format!(
-        "camera demo: {}, cam.gltf, cam.gif (orbit style; per-style tracks in {}) in {:.1} s",
-        out.join("cam.json").display(),
-        dir.display(),
-        t0.elapsed().as_secs_f64()
-    ));
-    Ok(lines)
 }

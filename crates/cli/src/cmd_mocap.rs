@@ -6,10 +6,10 @@ use clap::{Args, Subcommand};
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{positions_clip, Motion};
 use inbetween_io::fsutil::write_atomic;
-use inbetween_mocap::bench::{self, Clip, Protocol};
+use inbetween_mocap::bench::{self, Protocol};
 use inbetween_mocap::codec::{self, Budget};
 use inbetween_mocap::dqn::{DqnConfig, TrainOptions};
-use inbetween_mocap::representation::{JointFilter, SphericalMotion};
+use inbetween_mocap::representation::JointFilter;
 use inbetween_render::StickOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -336,16 +336,6 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The CMU takes of a data folder, or every .bvh below it (see [`inbetween_mocap::corpus`]);
-/// prints the length unit each was read in and why.
-fn cmu_clips(dir: &Path, unit: Option<LengthUnit>) -> anyhow::Result<Vec<Clip>> {
-    let corpus = inbetween_mocap::corpus::load(dir, unit)?;
-    for note in corpus.unit_notes() {
-        println!("{note}");
-    }
-    Ok(corpus.clips)
-}
-
 impl BenchArgs {
     /// The library's bench configuration for these arguments.
     fn config(&self) -> bench::BenchConfig {
@@ -380,54 +370,10 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Windows of the named clips with the given stride (see [`bench::training_windows`]).
-fn training_windows(
-    clips: &[Clip],
-    names: &[String],
-    protocol: &Protocol,
-    stride: usize,
-) -> anyhow::Result<Vec<SphericalMotion>> {
-    Ok(bench::training_windows(clips, names, protocol, stride)?)
-}
 
-/// Procedural gaits (our own data) as clips in CMU units (see [`bench::procedural_clips`]).
-fn procedural_clips(seed: u64, count: usize) -> Vec<Clip> {
-    bench::procedural_clips(seed, count)
-}
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
-    let protocol = Protocol { seed: a.seed, ..Protocol::paper() };
-    let (windows, data) = if a.procedural {
-        let clips = procedural_clips(a.seed, 24);
-        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-        let p = Protocol { skip_first_frame: false, ..protocol.clone() };
-        let windows = training_windows(&clips, &names, &p, a.stride)?;
-        let data = format!(
-            "{} procedural gaits (seed {}), {} windows of 60 frames at stride {}",
-            clips.len(),
-            a.seed,
-            windows.len(),
-            a.stride
-        );
-        (windows, data)
-    } else {
-        let dir = match a.data.clone() {
-            Some(d) => d,
-            None => inbetween_io::data::shared_data_dir()
-                .map_err(|p| anyhow::anyhow!("no data at {} (give --data DIR or --procedural)", p.display()))?,
-        };
-        let clips = cmu_clips(&dir, a.unit)?;
-        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-        let (train, test) = bench::split_clips(&names, &protocol);
-        let windows = training_windows(&clips, &train, &protocol, a.stride)?;
-        let data = format!(
-            "CMU training split (seed {}) {train:?}, {} windows of 60 frames at stride {}; test split {test:?} held out",
-            a.seed,
-            windows.len(),
-            a.stride
-        );
-        (windows, data)
-    };
+    let (windows, data) = bench::run::training_set(a.procedural, a.data.as_deref(), a.unit, a.seed, a.stride)?;
     let base = match a.preset.as_str() {
         "quick" => TrainOptions::quick(),
         "paper" => TrainOptions::paper(),

@@ -44,8 +44,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         gif.display()
     )];
     lines.extend(inbetween_mocap::demo::run(&a.out, &steps)?);
-    lines.extend(crate::cmd_camera::demo(&a.out)?);
-    steps.inc(1);
+    lines.extend(inbetween_camera::demo::run(&a.out, &steps)?);
     steps.finish();
     for l in lines {
         println!("{l}");

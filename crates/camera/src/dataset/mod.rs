@@ -9,8 +9,7 @@ pub use scene::Scene;
 
 use crate::features::{encode_camera, encode_character, CharacterFeatures, CAM_DIM, CHAR_ENC};
 use crate::toric::{Lens, Toric};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// Frames per scene in the paper's synthetic set (1500 at 30 fps).
@@ -19,10 +18,6 @@ pub const FPS: f64 = 30.0;
 /// The networks see every 5th frame (§4.5).
 pub const DOWNSAMPLE: usize = 5;
 
-/// The crate's seeded random generator (ChaCha8).
-pub fn seeded_rng(seed: u64) -> ChaCha8Rng {
-    ChaCha8Rng::seed_from_u64(seed)
-}
 
 /// One filmed sequence: character features and the camera track, frame by frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -70,7 +65,7 @@ impl Dataset {
         for i in 0..scenes {
             let scene_seed = seed.wrapping_mul(1_000_003).wrapping_add(i as u64);
             let scene = Scene::procedural(scene_seed, frames, FPS);
-            let mut rng = ChaCha8Rng::seed_from_u64(scene_seed ^ 0x5eed);
+            let mut rng = inbetween_core::seed::rng(scene_seed ^ 0x5eed);
             for behaviour in BEHAVIOURS {
                 for main_is_a in [true, false] {
                     sequences.push(film_sequence(&scene, scene_seed, behaviour, main_is_a, &mut rng, &lens));

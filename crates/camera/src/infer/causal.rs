@@ -116,12 +116,10 @@ mod tests {
     use super::*;
     use crate::dataset::Scene;
     use crate::infer::{example_keys, GenerateJob, GenerateOptions, Style};
-    use crate::model::{ModelConfig, MAP_FRAMES};
+    use crate::model::MAP_FRAMES;
 
     fn small() -> FastModel {
-        let device = inbetween_nn::backend::cpu();
-        let cfg = ModelConfig { hidden: 16, tta_dim: 8, ..ModelConfig::default() };
-        FastModel::from_burn(&inbetween_nn::backend::seeded_module(&device, 4, |d| cfg.init(d)), cfg)
+        crate::infer::test_model(16, 4)
     }
 
     #[test]

@@ -228,14 +228,11 @@ mod tests {
     use super::*;
     use crate::dataset::{film_sequence, Behaviour};
     use crate::infer::example_keys;
-    use crate::model::ModelConfig;
     use glam::DVec3;
     use rand::SeedableRng;
 
     fn small() -> FastModel {
-        let device = inbetween_nn::backend::cpu();
-        let cfg = ModelConfig { hidden: 16, tta_dim: 8, ..ModelConfig::default() };
-        FastModel::from_burn(&inbetween_nn::backend::seeded_module(&device, 4, |d| cfg.init(d)), cfg)
+        crate::infer::test_model(16, 4)
     }
 
     fn zero_style() -> Style {

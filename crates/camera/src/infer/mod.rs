@@ -65,3 +65,11 @@ pub fn toric_distance(a: &[f64; 6], b: &[f64; 6]) -> f64 {
 pub fn cam_distance(a: &Cam, b: &Cam) -> f64 {
     a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>().sqrt()
 }
+
+/// A small randomly initialised model for tests: `hidden` units, weights drawn under `seed`.
+#[cfg(test)]
+pub(crate) fn test_model(hidden: usize, seed: u64) -> FastModel {
+    let device = inbetween_nn::backend::cpu();
+    let cfg = crate::model::ModelConfig { hidden, tta_dim: 8, ..crate::model::ModelConfig::default() };
+    FastModel::from_burn(&inbetween_nn::backend::seeded_module(&device, seed, |d| cfg.init(d)), cfg)
+}

@@ -105,12 +105,9 @@ impl<'m> Rollout<'m> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ModelConfig;
 
     fn tiny() -> FastModel {
-        let device = inbetween_nn::backend::cpu();
-        let cfg = ModelConfig { hidden: 8, tta_dim: 8, ..ModelConfig::default() };
-        FastModel::from_burn(&inbetween_nn::backend::seeded_module(&device, 6, |d| cfg.init(d)), cfg)
+        crate::infer::test_model(8, 6)
     }
 
     #[test]

@@ -106,6 +106,31 @@ pub fn data_dir(data: Option<&Path>) -> Result<PathBuf> {
     }
 }
 
+/// SIDQL's training windows and their description in words (written in the policy's card):
+/// 24 procedural gaits, or the CMU training split of the corpus in `data` (the test split held out
+/// by the bench protocol with `seed`).
+pub fn training_set(procedural: bool, data: Option<&Path>, unit: Option<LengthUnit>, seed: u64, stride: usize) -> Result<(Vec<SphericalMotion>, String)> {
+    let protocol = Protocol { seed, ..Protocol::paper() };
+    if procedural {
+        let clips = super::procedural_clips(seed, 24);
+        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
+        let p = Protocol { skip_first_frame: false, ..protocol };
+        let windows = super::training_windows(&clips, &names, &p, stride)?;
+        let data = format!("{} procedural gaits (seed {seed}), {} windows of 60 frames at stride {stride}", clips.len(), windows.len());
+        return Ok((windows, data));
+    }
+    let dir = data_dir(data)?;
+    let clips = crate::corpus::load(&dir, unit)?.clips;
+    let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
+    let (train, test) = super::split_clips(&names, &protocol);
+    let windows = super::training_windows(&clips, &train, &protocol, stride)?;
+    let data = format!(
+        "CMU training split (seed {seed}) {train:?}, {} windows of 60 frames at stride {stride}; test split {test:?} held out",
+        windows.len()
+    );
+    Ok((windows, data))
+}
+
 /// Every measurement of the bench, no files written.
 pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
     let dir = data_dir(cfg.data.as_deref())?;
