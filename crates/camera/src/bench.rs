@@ -26,7 +26,12 @@ use inbetween_core::curve::{Curve, Samples, Track};
 use inbetween_nn::runtime::LstmState;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use crate::CameraError;
+use inbetween_io::report::{num, Report, Table};
+use inbetween_io::Progress;
+use inbetween_render::plot::{grouped_bar_chart, line_plot, scatter_plot, Series};
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Which benchmark size to run.
@@ -150,7 +155,7 @@ fn bend(track: &mut [Cam], keys: &[(usize, Cam)]) {
     }
 }
 
-fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng) -> Vec<Table1Row> {
+fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng, progress: &Progress) -> Vec<Table1Row> {
     let gap = 40;
     let hd = model.config.hidden;
     let mut sums = vec![[0.0f64; 5]; BEHAVIOURS.len()];
@@ -181,6 +186,7 @@ fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaC
             sums[b][3] += mean_err(&out[1..], &truth[1..]);
             sums[b][4] += mean_err(&lerp_track(&truth[0], &truth[gap], gap)[1..], &truth[1..]);
             counts[b] += 1;
+            progress.inc(1);
         }
     }
     BEHAVIOURS
@@ -240,7 +246,7 @@ fn lerp_track(a: &Cam, b: &Cam, n: usize) -> Vec<Cam> {
     (0..=n).map(|t| std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t as f32 / n as f32)).collect()
 }
 
-fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, rng: &mut ChaCha8Rng) -> Vec<Table2Row> {
+fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, rng: &mut ChaCha8Rng, progress: &Progress) -> Vec<Table2Row> {
     let len = STYLE_STEPS;
     // One segment per sequence, shared by every δ.
     let segs: Vec<(usize, Vec<f32>)> = seqs
@@ -282,6 +288,7 @@ fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, r
             let zr = style_of(model, &chars[1..], &x3[1..]);
             td[2] += mean_err(&lerp_track(&truth[0], &truth[len], len)[1..], &truth[1..]);
             interp.push((s.behaviour, z.clone(), zr));
+            progress.inc(1);
         }
         let n = seqs.len().max(1) as f64;
         rows.push(Table2Row {
@@ -298,7 +305,7 @@ fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, r
     rows
 }
 
-fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng) -> Vec<RailsRow> {
+fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng, progress: &Progress) -> Vec<RailsRow> {
     let len = STYLE_STEPS;
     let mut acc = vec![(0.0f64, 0.0f64, 0usize, 0usize); BEHAVIOURS.len()];
     for s in seqs {
@@ -330,6 +337,7 @@ fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCh
         a.1 += needed as f64;
         a.2 += 1;
         a.3 += capped;
+        progress.inc(1);
     }
     BEHAVIOURS
         .iter()
@@ -343,7 +351,7 @@ fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCh
 
 /// Mean pairwise distance between tracks through the same two keys (60 steps) generated with each
 /// behaviour's mean style code.
-fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool, Vec<f32>)], rng: &mut ChaCha8Rng) -> f64 {
+fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool, Vec<f32>)], rng: &mut ChaCha8Rng, progress: &Progress) -> f64 {
     let len = STYLE_STEPS;
     let codes: Vec<Vec<f32>> = BEHAVIOURS
         .iter()
@@ -365,6 +373,7 @@ fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool,
                 n += 1;
             }
         }
+        progress.inc(1);
     }
     total / n.max(1) as f64
 }
@@ -411,23 +420,31 @@ fn eval_sequences(seed: u64, scenes: usize) -> Vec<EvalSeq> {
         .collect()
 }
 
-/// Runs the whole benchmark.
-pub fn run(model: &FastModel, cfg: &BenchConfig) -> BenchReport {
+/// Runs the whole benchmark, advancing `progress` through its phases (style codes, Table 1,
+/// Table 2, §6.3, speed); the caller finishes the bar.
+pub fn run(model: &FastModel, cfg: &BenchConfig, progress: &Progress) -> BenchReport {
     let lens = Lens::default();
     let seqs = eval_sequences(cfg.seed, cfg.scenes);
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let styles: Vec<(Behaviour, bool, Vec<f32>)> = seqs.iter().map(|s| (s.behaviour, s.main_is_a, style_of(model, &s.chars[..STYLE_STEPS], &s.cams[..STYLE_STEPS]))).collect();
-    let spread = style_spread(model, &seqs, &styles, &mut ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x51));
-    BenchReport {
-        style_spread: spread,
-        config: cfg.clone(),
-        sequences: seqs.len(),
-        table1: table1(model, &seqs, cfg, &mut rng),
-        table2: table2(model, &seqs, cfg, &lens, &mut rng),
-        rails: rails(model, &seqs, cfg, &mut rng),
-        speed: speed(model, cfg.speed_seconds),
-        styles,
-    }
+    progress.phase(2 * seqs.len() as u64, "style codes");
+    let styles: Vec<(Behaviour, bool, Vec<f32>)> = seqs
+        .iter()
+        .map(|s| {
+            progress.inc(1);
+            (s.behaviour, s.main_is_a, style_of(model, &s.chars[..STYLE_STEPS], &s.cams[..STYLE_STEPS]))
+        })
+        .collect();
+    let style_spread = style_spread(model, &seqs, &styles, &mut ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x51), progress);
+    progress.phase((seqs.len() * cfg.windows_per_sequence) as u64, "Table 1");
+    let table1 = table1(model, &seqs, cfg, &mut rng, progress);
+    progress.phase((seqs.len() * cfg.displacements.len()) as u64, "Table 2");
+    let table2 = table2(model, &seqs, cfg, &lens, &mut rng, progress);
+    progress.phase(seqs.len() as u64, "§6.3 rails");
+    let rails = rails(model, &seqs, cfg, &mut rng, progress);
+    progress.phase(1, "speed");
+    let speed = speed(model, cfg.speed_seconds);
+    progress.inc(1);
+    BenchReport { config: cfg.clone(), sequences: seqs.len(), table1, table2, rails, speed, style_spread, styles }
 }
 
 /// The first two principal components of the style codes (power iteration on the covariance).
@@ -464,7 +481,7 @@ pub fn pca2(codes: &[Vec<f32>]) -> Vec<(f64, f64)> {
     centred.iter().map(|c| (proj(c, axes.first()), proj(c, axes.get(1)))).collect()
 }
 
-/// The paper's numbers for the README and the printed comparison.
+/// The paper's Table 1 (behaviour; zero, Gaussian, warm start, mapped H), beside ours.
 pub const PAPER_TABLE1: [(&str, f64, f64, f64, f64); 4] = [
     ("direct", 0.162, 0.146, 0.173, 0.107),
     ("relative", 0.081, 0.074, 0.088, 0.050),
@@ -472,100 +489,141 @@ pub const PAPER_TABLE1: [(&str, f64, f64, f64, f64); 4] = [
     ("orbit", 0.263, 0.263, 0.116, 0.049),
 ];
 
+/// The paper's Table 1 average row (zero, Gaussian, warm start, mapped H).
+pub const PAPER_TABLE1_AVERAGE: [f64; 4] = [0.138, 0.132, 0.112, 0.057];
+
+/// The paper's Table 2 "ours" rows for a displaced key (δ in radians; SD, TD, KD).
+pub const PAPER_TABLE2: [(f64, f64, f64, f64); 10] = [
+    (0.0, 1.009, 0.065, 0.016),
+    (0.1, 1.009, 0.069, 0.021),
+    (0.3, 1.015, 0.089, 0.051),
+    (0.5, 1.025, 0.115, 0.085),
+    (0.9, 1.058, 0.175, 0.154),
+    (1.2, 1.082, 0.219, 0.192),
+    (1.4, 1.1, 0.24, 0.216),
+    (1.6, 1.12, 0.263, 0.235),
+    (1.8, 1.157, 0.302, 0.251),
+    (2.0, 1.211, 0.359, 0.277),
+];
+
+/// A chart's PNG bytes (see [`inbetween_render::rendered_bytes`]), so that [`Report::write`]
+/// writes it atomically with the rest.
+fn png_bytes(name: &str, draw: impl FnOnce(&Path) -> Result<(), inbetween_render::RenderError>) -> Result<Vec<u8>, CameraError> {
+    inbetween_render::rendered_bytes(name, draw).map_err(|e| CameraError::invalid(Path::new(name), e.to_string()))
+}
+
 impl BenchReport {
-    /// The tables as text, ours beside the paper's where it has them.
-    pub fn text(&self) -> String {
-        let mut s = format!("camera bench: {} held-out sequences (seed {})\n", self.sequences, self.config.seed);
-        s += "\nTable 1: trajectory error (Toric units) by hidden-state initialisation   [paper: zero / gaussian / warm / mapped]\n";
-        s += &format!("{:<10}{:>9}{:>10}{:>9}{:>9}{:>9}   {}\n", "behaviour", "zero", "gaussian", "warm", "mapped", "lerp", "paper");
+    /// Table 1 (`table1.csv`): ours by initialisation and the straight line, the paper's beside.
+    pub fn table1(&self) -> Table {
+        let headers = ["behaviour", "zero", "gaussian", "warm_start", "mapped", "toric_lerp", "paper_zero", "paper_gaussian", "paper_warm_start", "paper_mapped"];
+        let mut t = Table::new("table1", "Table 1: trajectory error (Toric units) by hidden-state initialisation, 40 generated steps to a keyframe", &headers);
         let mut avg = [0.0; 5];
         for r in &self.table1 {
-            let p = PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).expect("paper row");
-            s += &format!("{:<10}{:>9.3}{:>10.3}{:>9.3}{:>9.3}{:>9.3}   {:.3} / {:.3} / {:.3} / {:.3}\n", r.behaviour, r.zero, r.gaussian, r.warm_start, r.mapped, r.lerp, p.1, p.2, p.3, p.4);
-            for (a, v) in avg.iter_mut().zip([r.zero, r.gaussian, r.warm_start, r.mapped, r.lerp]) {
+            let ours = [r.zero, r.gaussian, r.warm_start, r.mapped, r.lerp];
+            let paper = PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).map_or([f64::NAN; 4], |p| [p.1, p.2, p.3, p.4]);
+            let mut cells = vec![r.behaviour.clone()];
+            cells.extend(ours.iter().map(|v| num(*v, 4)));
+            cells.extend(paper.iter().map(|v| if v.is_nan() { num(*v, 0) } else { v.to_string() }));
+            t.row(cells);
+            for (a, v) in avg.iter_mut().zip(ours) {
                 *a += v / self.table1.len() as f64;
             }
         }
-        s += &format!("{:<10}{:>9.3}{:>10.3}{:>9.3}{:>9.3}{:>9.3}   0.138 / 0.132 / 0.112 / 0.057\n", "average", avg[0], avg[1], avg[2], avg[3], avg[4]);
-        s += "\nTable 2: keyframe displacement δ (rad on θ): SD (Eq. 8), TD, KD\n";
-        s += &format!("{:>6}{:>9}{:>10}{:>10}{:>9}{:>10}{:>10}{:>9}\n", "δ", "SD ours", "SD style", "SD lerp", "TD ours", "TD style", "TD lerp", "KD ours");
-        for r in &self.table2 {
-            s += &format!(
-                "{:>6.1}{:>9.3}{:>10.3}{:>10.3}{:>9.3}{:>10.3}{:>10.3}{:>9.3}\n",
-                r.displacement, r.sd_ours, r.sd_only_style, r.sd_interpolation, r.td_ours, r.td_only_style, r.td_interpolation, r.kd_ours
-            );
-        }
-        s += "\n§6.3: keys a Catmull-Rom spline through ground truth needs to match our 3-key track\n";
-        for r in &self.rails {
-            s += &format!("{:<10} ours {:.3}  spline keys {:.1}{}\n", r.behaviour, r.ours_error, r.spline_keys, if r.capped > 0 { format!(" ({} capped at {})", r.capped, self.config.max_spline_keys) } else { String::new() });
-        }
-        s += &format!("\nstyle effect: tracks through the same keys with the 4 behaviour codes differ by {:.4} on average\n", self.style_spread);
-        s += &format!(
-            "\nspeed: {:.0} frames/s end to end (one 900-frame track, one thread); {:.0} frames/s network, {} trajectories batched   [paper: > 2000]\n",
-            self.speed.single_frames_per_s, self.speed.batched_frames_per_s, self.speed.batch
-        );
-        s
+        let [pz, pg, pw, pm] = PAPER_TABLE1_AVERAGE;
+        t.note(format!(
+            "average: zero {}, gaussian {}, warm_start {}, mapped {}, toric_lerp {}; paper {pz} / {pg} / {pw} / {pm}",
+            num(avg[0], 3), num(avg[1], 3), num(avg[2], 3), num(avg[3], 3), num(avg[4], 3)
+        ));
+        t.note("toric_lerp: no network, the straight Toric line from the start to the key (the baseline to beat)");
+        t.note("warm_start reuses our network (the paper trains one per initialisation); paper_*: the paper's Table 1");
+        t
     }
 
-    /// CSV tables, PNG charts, the style PCA (Fig. 4) and the JSON report under `dir`.
-    pub fn write(&self, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, crate::CameraError> {
-        use inbetween_render::plot::{grouped_bar_chart, line_plot, scatter_plot, Series};
-        let io = |p: &std::path::Path, e: std::io::Error| crate::CameraError::Io { path: p.into(), source: e };
-        let render = |p: &std::path::Path, e: inbetween_render::RenderError| crate::CameraError::invalid(p, e.to_string());
-        std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
-        let mut written = Vec::new();
-        let put = |name: &str, text: String| -> Result<std::path::PathBuf, crate::CameraError> {
-            let p = dir.join(name);
-            inbetween_io::write_atomic(&p, text.as_bytes()).map_err(|e| io(&p, e))?;
-            Ok(p)
-        };
-        let mut t1 = String::from("behaviour,zero,gaussian,warm_start,mapped,toric_lerp,paper_zero,paper_gaussian,paper_warm_start,paper_mapped\n");
-        for r in &self.table1 {
-            let p = PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).expect("paper row");
-            t1 += &format!("{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{},{},{}\n", r.behaviour, r.zero, r.gaussian, r.warm_start, r.mapped, r.lerp, p.1, p.2, p.3, p.4);
-        }
-        written.push(put("table1.csv", t1)?);
-        let mut t2 = String::from("displacement,sd_ours,sd_only_style,sd_interpolation,td_ours,td_only_style,td_interpolation,kd_ours\n");
+    /// Table 2 (`table2.csv`): SD (Eq. 8), TD and KD against the key displacement δ.
+    pub fn table2(&self) -> Table {
+        let headers = ["displacement", "sd_ours", "sd_only_style", "sd_interpolation", "td_ours", "td_only_style", "td_interpolation", "kd_ours"];
+        let mut t = Table::new("table2", "Table 2: keyframe displacement δ (rad on θ): SD (Eq. 8), TD, KD", &headers);
         for r in &self.table2 {
-            t2 += &format!("{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}\n", r.displacement, r.sd_ours, r.sd_only_style, r.sd_interpolation, r.td_ours, r.td_only_style, r.td_interpolation, r.kd_ours);
+            let values = [r.sd_ours, r.sd_only_style, r.sd_interpolation, r.td_ours, r.td_only_style, r.td_interpolation, r.kd_ours];
+            t.row(std::iter::once(r.displacement.to_string()).chain(values.iter().map(|v| num(*v, 4))));
         }
-        written.push(put("table2.csv", t2)?);
-        let mut rl = String::from("behaviour,ours_error,spline_keys,capped\n");
-        for r in &self.rails {
-            rl += &format!("{},{:.4},{:.2},{}\n", r.behaviour, r.ours_error, r.spline_keys, r.capped);
-        }
-        written.push(put("rails.csv", rl)?);
-        written.push(put("report.json", serde_json::to_string_pretty(self).unwrap_or_default())?);
-        written.push(put("report.txt", self.text())?);
+        let paper = |f: fn(&(f64, f64, f64, f64)) -> f64| PAPER_TABLE2.iter().map(|p| f(p).to_string()).collect::<Vec<_>>().join(" / ");
+        let deltas = PAPER_TABLE2.iter().map(|p| p.0.to_string()).collect::<Vec<_>>().join(" / ");
+        t.note(format!("paper (its Table 2 \"ours\" rows) at δ = {deltas}:"));
+        t.note(format!("paper SD: {}", paper(|p| p.1)));
+        t.note(format!("paper TD: {}", paper(|p| p.2)));
+        t.note(format!("paper KD: {}", paper(|p| p.3)));
+        t.note("SD divides distances measured by each model's own extractor: SD of different weights are on different scales");
+        t
+    }
 
+    /// §6.3 (`rails.csv`): how many spline keys match our 3-key track.
+    pub fn rails_table(&self) -> Table {
+        let title = "§6.3: keys a Catmull-Rom spline through the ground truth needs to match our 3-key track (300 frames)";
+        let mut t = Table::new("rails", title, &["behaviour", "ours_error", "spline_keys", "capped"]);
+        for r in &self.rails {
+            t.row([r.behaviour.clone(), num(r.ours_error, 4), num(r.spline_keys, 2), r.capped.to_string()]);
+        }
+        t.note(format!("capped: sequences no spline of up to {} keys matched (counted as {})", self.config.max_spline_keys, self.config.max_spline_keys));
+        t.note("paper: up to 20 keys for camera-on-rails");
+        t
+    }
+
+    /// Generation speed (`speed.csv`), frames per second on this machine.
+    pub fn speed_table(&self) -> Table {
+        let mut t = Table::new("speed", "Speed: frames per second, one thread", &["measure", "frames_per_s", "paper"]);
+        t.row(["end to end, one 900-frame track", &num(self.speed.single_frames_per_s, 0), "> 2000"]);
+        t.row([&format!("network only, {} trajectories batched", self.speed.batch), &num(self.speed.batched_frames_per_s, 0), ""]);
+        t.note("end to end: network every 5th frame, cubic fill, world poses; batched: output frames (5 per step)");
+        t
+    }
+
+    /// The whole report: the tables, the style effect, `report.json` and the charts (Table 1,
+    /// Table 2's TD and SD, the style PCA of Fig. 4) as PNG files.
+    pub fn report(&self) -> Result<Report, CameraError> {
+        let mut r = Report::new("report", &format!("camera bench: {} held-out sequences (seed {})", self.sequences, self.config.seed));
+        r.table(self.table1()).table(self.table2()).table(self.rails_table());
+        r.text(format!("style effect: tracks through the same keys with the {} behaviour codes differ by {} on average", BEHAVIOURS.len(), num(self.style_spread, 4)));
+        r.table(self.speed_table());
+        r.json("report.json", self).map_err(io_error)?;
+        r.file("table1.png", self.table1_png()?);
+        let (td, sd) = self.table2_pngs()?;
+        r.file("table2_td.png", td).file("table2_sd.png", sd);
+        r.file("style_pca.png", self.style_pca_png()?);
+        Ok(r)
+    }
+
+    /// Writes [`BenchReport::report`] into `dir` atomically: report.txt, report.md, the table CSVs,
+    /// report.json and the PNG charts. Returns the paths written.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, CameraError> {
+        self.report()?.write(dir).map_err(io_error)
+    }
+
+    fn table1_png(&self) -> Result<Vec<u8>, CameraError> {
         let groups: Vec<String> = self.table1.iter().map(|r| r.behaviour.clone()).collect();
         let col = |f: fn(&Table1Row) -> f64| self.table1.iter().map(f).collect::<Vec<f64>>();
-        let p = dir.join("table1.png");
-        grouped_bar_chart(
-            &p,
-            "Table 1: trajectory error by hidden-state initialisation",
-            "error (Toric units)",
-            &groups,
-            &[
-                ("zero".into(), col(|r| r.zero)),
-                ("gaussian".into(), col(|r| r.gaussian)),
-                ("warm start".into(), col(|r| r.warm_start)),
-                ("mapped (H)".into(), col(|r| r.mapped)),
-                ("Toric lerp".into(), col(|r| r.lerp)),
-                ("paper mapped".into(), PAPER_TABLE1.iter().map(|p| p.4).collect()),
-            ],
-        )
-        .map_err(|e| render(&p, e))?;
-        written.push(p);
+        let series = [
+            ("zero".into(), col(|r| r.zero)),
+            ("gaussian".into(), col(|r| r.gaussian)),
+            ("warm start".into(), col(|r| r.warm_start)),
+            ("mapped (H)".into(), col(|r| r.mapped)),
+            ("Toric lerp".into(), col(|r| r.lerp)),
+            ("paper mapped".into(), PAPER_TABLE1.iter().map(|p| p.4).collect()),
+        ];
+        png_bytes("table1.png", |p| grouped_bar_chart(p, "Table 1: trajectory error by hidden-state initialisation", "error (Toric units)", &groups, &series))
+    }
+
+    fn table2_pngs(&self) -> Result<(Vec<u8>, Vec<u8>), CameraError> {
         let series = |name: &str, f: fn(&Table2Row) -> f64| Series::new(name, self.table2.iter().map(|r| (r.displacement, f(r))).collect());
-        let p = dir.join("table2_td.png");
-        line_plot(&p, "Table 2: TD vs keyframe displacement", "δ (rad)", "TD", &[series("ours", |r| r.td_ours), series("only style", |r| r.td_only_style), series("Toric lerp", |r| r.td_interpolation), series("KD ours", |r| r.kd_ours)])
-            .map_err(|e| render(&p, e))?;
-        written.push(p);
-        let p = dir.join("table2_sd.png");
-        line_plot(&p, "Table 2: SD vs keyframe displacement", "δ (rad)", "SD", &[series("ours", |r| r.sd_ours), series("only style", |r| r.sd_only_style), series("Toric lerp", |r| r.sd_interpolation)])
-            .map_err(|e| render(&p, e))?;
-        written.push(p);
+        let td = [series("ours", |r| r.td_ours), series("only style", |r| r.td_only_style), series("Toric lerp", |r| r.td_interpolation), series("KD ours", |r| r.kd_ours)];
+        let sd = [series("ours", |r| r.sd_ours), series("only style", |r| r.sd_only_style), series("Toric lerp", |r| r.sd_interpolation)];
+        Ok((
+            png_bytes("table2_td.png", |p| line_plot(p, "Table 2: TD vs keyframe displacement", "δ (rad)", "TD", &td))?,
+            png_bytes("table2_sd.png", |p| line_plot(p, "Table 2: SD vs keyframe displacement", "δ (rad)", "SD", &sd))?,
+        ))
+    }
+
+    fn style_pca_png(&self) -> Result<Vec<u8>, CameraError> {
         let codes: Vec<Vec<f32>> = self.styles.iter().map(|s| s.2.clone()).collect();
         let pts = pca2(&codes);
         let mut series = Vec::new();
@@ -579,16 +637,52 @@ impl BenchReport {
                 series.push(s);
             }
         }
-        let p = dir.join("style_pca.png");
-        scatter_plot(&p, "Style codes z, PCA (Fig. 4)", "PC 1", "PC 2", &series).map_err(|e| render(&p, e))?;
-        written.push(p);
-        Ok(written)
+        png_bytes("style_pca.png", |p| scatter_plot(p, "Style codes z, PCA (Fig. 4)", "PC 1", "PC 2", &series))
+    }
+}
+
+fn io_error(e: inbetween_io::IoError) -> CameraError {
+    match e {
+        inbetween_io::IoError::Io { path, source } => CameraError::Io { path, source },
+        other => CameraError::invalid(Path::new("camera bench"), other.to_string()),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn report_writes_the_committed_csv_layout_json_and_charts() {
+        let progress = Progress::hidden();
+        let r = run(&tiny_model(), &tiny_config(), &progress);
+        assert_eq!(progress.position(), 1, "the last phase (speed) is done");
+        let dir = tempfile::tempdir().unwrap();
+        let files = r.write(dir.path()).unwrap();
+        let names: Vec<String> = files.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        let expected = ["report.txt", "report.md", "table1.csv", "table2.csv", "rails.csv", "speed.csv", "report.json", "table1.png", "table2_td.png", "table2_sd.png", "style_pca.png"];
+        assert_eq!(names, expected);
+        let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
+        let t1 = read("table1.csv");
+        let t1: Vec<&str> = t1.lines().collect();
+        assert_eq!(t1[0], "behaviour,zero,gaussian,warm_start,mapped,toric_lerp,paper_zero,paper_gaussian,paper_warm_start,paper_mapped");
+        let direct = &r.table1[0];
+        assert_eq!(t1[1], format!("direct,{:.4},{:.4},{:.4},{:.4},{:.4},0.162,0.146,0.173,0.107", direct.zero, direct.gaussian, direct.warm_start, direct.mapped, direct.lerp));
+        let t2 = read("table2.csv");
+        assert_eq!(t2.lines().next(), Some("displacement,sd_ours,sd_only_style,sd_interpolation,td_ours,td_only_style,td_interpolation,kd_ours"));
+        assert!(t2.lines().nth(1).unwrap().starts_with("0,") && t2.lines().nth(2).unwrap().starts_with("1,"), "{t2}");
+        assert!(read("rails.csv").starts_with("behaviour,ours_error,spline_keys,capped\ndirect,"));
+        let back: BenchReport = serde_json::from_str(&read("report.json")).unwrap();
+        // serde_json parses floats to within an ulp, not bit for bit.
+        assert_eq!((back.sequences, back.table2.len(), back.styles.len()), (r.sequences, r.table2.len(), r.styles.len()));
+        for (a, b) in back.table1.iter().zip(&r.table1) {
+            assert!(a.behaviour == b.behaviour && (a.mapped - b.mapped).abs() < 1e-12 && (a.lerp - b.lerp).abs() < 1e-12, "{a:?} vs {b:?}");
+        }
+        let text = read("report.txt");
+        assert!(text.starts_with("camera bench: 8 held-out sequences (seed 9001)\n") && text.contains("style effect:"), "{text}");
+        assert!(std::fs::read(dir.path().join("style_pca.png")).unwrap().starts_with(b"\x89PNG"));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), expected.len(), "no temporary files left");
+    }
 
     #[test]
     fn pca_finds_the_dominant_axis() {
@@ -618,7 +712,7 @@ mod tests {
         let model = FastModel::committed().unwrap();
         let cfg = BenchConfig { seed: 4242, scenes: 1, windows_per_sequence: 2, ..BenchConfig::quick() };
         let seqs = eval_sequences(cfg.seed, cfg.scenes);
-        let rows = table1(&model, &seqs, &cfg, &mut ChaCha8Rng::seed_from_u64(1));
+        let rows = table1(&model, &seqs, &cfg, &mut ChaCha8Rng::seed_from_u64(1), &Progress::hidden());
         let mapped = rows.iter().map(|r| r.mapped).sum::<f64>() / rows.len() as f64;
         let lerp = rows.iter().map(|r| r.lerp).sum::<f64>() / rows.len() as f64;
         let orbit = rows.iter().find(|r| r.behaviour == "orbit").unwrap();
@@ -646,7 +740,7 @@ mod tests {
         let mut model = tiny_model();
         model.dec2.w.iter_mut().for_each(|w| *w = 0.0);
         model.dec2.b.iter_mut().for_each(|b| *b = 0.0);
-        let r = run(&model, &tiny_config());
+        let r = run(&model, &tiny_config(), &Progress::hidden());
         for row in &r.table1 {
             for (name, v) in [("zero", row.zero), ("gaussian", row.gaussian), ("warm", row.warm_start), ("mapped", row.mapped)] {
                 assert!((v - row.lerp).abs() < 1e-5, "{} {name}: {v} vs lerp {}", row.behaviour, row.lerp);
@@ -662,7 +756,7 @@ mod tests {
         }
         assert!(r.style_spread < 1e-6, "style spread {}", r.style_spread);
         // The same tiny model with its (random) decoder departs from the line and styles differ.
-        let r = run(&tiny_model(), &tiny_config());
+        let r = run(&tiny_model(), &tiny_config(), &Progress::hidden());
         let departs = r.table1.iter().map(|row| (row.mapped - row.lerp).abs()).fold(0.0, f64::max);
         assert!(departs > 1e-4 && r.style_spread > 1e-5, "departure {departs}, style spread {}", r.style_spread);
         assert!(r.speed.single_frames_per_s > 0.0 && r.speed.batched_frames_per_s > 0.0);

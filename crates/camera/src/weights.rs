@@ -126,8 +126,9 @@ pub fn from_weights(w: &Weights) -> Result<CameraWeights, CameraError> {
     Ok(CameraWeights { model: FastModel::from_burn(&model, config), styles: extra.style_codes })
 }
 
-/// Weights saved by [`save`] (`x.bpk` + card `x.json`). A training checkpoint (`last.bpk`, whose
-/// `last.json` is a training summary, not a card) loads too; its style codes are computed.
+/// Weights saved by [`save`] (`x.bpk` + card `x.json`). Weights beside a training summary instead
+/// of a card (what `camera train` wrote before weights cards, e.g. an old `last.bpk` + `last.json`)
+/// load too; their style codes are computed.
 pub fn load(path: &Path) -> Result<CameraWeights, CameraError> {
     let summary_path = path.with_extension("json");
     let text = std::fs::read_to_string(&summary_path).map_err(|source| CameraError::Io { path: summary_path.clone(), source })?;

@@ -204,9 +204,14 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
     let model = load_weights(a.weights.as_deref())?.model;
     let cfg = if a.quick { bench::BenchConfig::quick() } else { bench::BenchConfig::full() };
     let t0 = std::time::Instant::now();
-    let report = bench::run(&model, &cfg);
-    print!("{}", report.text());
-    let files = report.write(&a.out)?;
+    let progress = inbetween_io::Progress::new(1, "camera bench");
+    let results = bench::run(&model, &cfg, &progress);
+    progress.phase(1, "charts");
+    let report = results.report();
+    progress.finish();
+    let report = report?;
+    print!("{}", report.to_text());
+    let files = report.write(&a.out).with_context(|| format!("writing the camera bench to {}", a.out.display()))?;
     println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t0.elapsed().as_secs_f64());
     Ok(())
 }

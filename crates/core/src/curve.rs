@@ -72,35 +72,27 @@ pub trait Offset: Copy {
     fn zero() -> Self;
 }
 
-impl Offset for f64 {
-    fn difference(a: f64, b: f64) -> f64 {
-        a - b
-    }
-    fn offset(a: f64, d: f64) -> f64 {
-        a + d
-    }
-    fn blend(a: f64, b: f64, l: f64) -> f64 {
-        (1.0 - l) * a + l * b
-    }
-    fn zero() -> f64 {
-        0.0
-    }
+/// [`Offset`] for types with vector arithmetic (`-`, `+`, scaling by an `f64`).
+macro_rules! vector_offset {
+    ($($t:ty => $zero:expr),*) => {$(
+        impl Offset for $t {
+            fn difference(a: $t, b: $t) -> $t {
+                a - b
+            }
+            fn offset(a: $t, d: $t) -> $t {
+                a + d
+            }
+            fn blend(a: $t, b: $t, l: f64) -> $t {
+                (1.0 - l) * a + l * b
+            }
+            fn zero() -> $t {
+                $zero
+            }
+        }
+    )*};
 }
 
-impl Offset for DVec3 {
-    fn difference(a: DVec3, b: DVec3) -> DVec3 {
-        a - b
-    }
-    fn offset(a: DVec3, d: DVec3) -> DVec3 {
-        a + d
-    }
-    fn blend(a: DVec3, b: DVec3, l: f64) -> DVec3 {
-        (1.0 - l) * a + l * b
-    }
-    fn zero() -> DVec3 {
-        DVec3::ZERO
-    }
-}
+vector_offset!(f64 => 0.0, DVec3 => DVec3::ZERO);
 
 impl<const N: usize> Offset for [f64; N] {
     fn difference(a: Self, b: Self) -> Self {

@@ -49,6 +49,17 @@ pub fn png_bytes(img: &RgbImage) -> Result<Vec<u8>, RenderError> {
     Ok(out)
 }
 
+/// The bytes of a file that `draw` writes to the path it is given (a chart, a GIF), drawn in a
+/// private temporary folder that is removed afterwards: for callers that collect outputs in memory
+/// and write them together (e.g. `inbetween_io::report::Report::file`). `name` is the file's name,
+/// whose extension some writers read.
+pub fn rendered_bytes(name: &str, draw: impl FnOnce(&Path) -> Result<(), RenderError>) -> Result<Vec<u8>, RenderError> {
+    let dir = tempfile::tempdir().map_err(|source| RenderError::Io { path: std::env::temp_dir(), source })?;
+    let path = dir.path().join(name);
+    draw(&path)?;
+    std::fs::read(&path).map_err(|source| RenderError::Io { path, source })
+}
+
 /// Writes an RGB image as PNG (atomic write).
 pub fn write_png(path: &Path, img: &RgbImage) -> Result<(), RenderError> {
     write_file(path, &png_bytes(img)?)
@@ -69,6 +80,20 @@ pub fn write_gif_with_progress(
 ) -> Result<(), RenderError> {
     let bytes = gif_out::encode(frames, fps, progress)?;
     write_file(path, &bytes)
+}
+
+#[cfg(test)]
+mod rendered_bytes_tests {
+    use super::*;
+
+    #[test]
+    fn rendered_bytes_are_the_file_the_drawing_wrote_and_errors_pass_through() {
+        let img = RgbImage::from_pixel(3, 2, image::Rgb([10, 20, 30]));
+        let bytes = rendered_bytes("x.png", |p| write_png(p, &img)).unwrap();
+        assert_eq!(bytes, png_bytes(&img).unwrap());
+        let err = rendered_bytes("x.png", |_| Err(RenderError::InvalidInput("no data".into()))).unwrap_err();
+        assert!(err.to_string().contains("no data"), "{err}");
+    }
 }
 
 #[cfg(test)]

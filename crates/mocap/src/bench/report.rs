@@ -7,7 +7,7 @@ use super::{paper_decision_ms, paper_value, Method, Protocol, Row};
 use crate::{MocapError, Result};
 use inbetween_io::report::{num, Report, Table};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Everything one bench run measured (see [`super::run::measure`]).
 #[derive(Clone, Debug)]
@@ -253,26 +253,13 @@ impl BenchResults {
         )
     }
 
-    /// The chart as PNG bytes (drawn through a temporary file).
+    /// The chart as PNG bytes (see [`inbetween_render::rendered_bytes`]).
     pub fn plot_png(&self) -> Result<Vec<u8>> {
-        let tmp = temp_path("table3.png");
-        let out = self.plot(&tmp).and_then(|()| {
-            std::fs::read(&tmp).map_err(|source| MocapError::Io { path: tmp.display().to_string(), source })
-        });
-        let _ = std::fs::remove_file(&tmp);
-        out
+        inbetween_render::rendered_bytes("table3.png", |path| {
+            self.plot(path).map_err(|e| inbetween_render::RenderError::InvalidInput(e.to_string()))
+        })
+        .map_err(|e| MocapError::Io { path: "table3.png".into(), source: std::io::Error::other(e.to_string()) })
     }
-}
-
-/// A file name in the system's temporary folder unique to this process and call.
-fn temp_path(name: &str) -> PathBuf {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static N: AtomicU64 = AtomicU64::new(0);
-    std::env::temp_dir().join(format!(
-        "inbetween-mocap-{}-{}-{name}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ))
 }
 
 /// Selection time as a short cell: `<0.01`, `0.42`, `5.3`, `900`.
