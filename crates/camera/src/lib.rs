@@ -5,7 +5,7 @@
 //! the synthetic [`dataset`] (scenes + four behaviours), the three networks in [`model`], [`train`],
 //! loading trained [`weights`], inference with keyframes in [`infer`] (plain-Rust networks, one
 //! [`infer::Rollout`], [`infer::GenerateJob`], the causal mode), exports ([`gltf`], [`preview`]) and
-//! the [`bench`].
+//! the [`bench`](mod@bench).
 
 pub mod bench;
 pub mod dataset;

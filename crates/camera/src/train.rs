@@ -49,7 +49,7 @@ pub struct TrainConfig {
     pub grad_clip: Option<f32>,
     /// Stop after this many seconds (the epoch in progress is finished and saved).
     pub time_limit_s: Option<f64>,
-    /// ε of the smoothed training norm (see [`mean_l2`]); older summaries used [`LOSS_SMOOTHING`].
+    /// ε of the smoothed training norm (see `mean_l2`); older summaries used [`LOSS_SMOOTHING`].
     #[serde(default = "default_loss_smoothing")]
     pub loss_smoothing: f32,
     pub model: ModelConfig,
@@ -200,7 +200,7 @@ pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: u
     }
 }
 
-/// Default smoothing scale ε of the training norm (x^c units), see [`mean_l2`].
+/// Default smoothing scale ε of the training norm (x^c units), see `mean_l2`.
 pub const LOSS_SMOOTHING: f32 = 0.05;
 
 fn default_loss_smoothing() -> f32 {

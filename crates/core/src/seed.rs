@@ -1,5 +1,5 @@
 //! Seeding, in one place: every random choice in inbetween takes a `u64` seed, and streams that must
-//! not be correlated (per epoch, per step, per clip) get their seeds from [`derive`].
+//! not be correlated (per epoch, per step, per clip) get their seeds from [`derive()`].
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

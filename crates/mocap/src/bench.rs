@@ -4,7 +4,7 @@
 //! per window.
 //!
 //! - this file: the protocol (windows, split, training windows) and the scoring of one split;
-//! - [`run`]: `inbetween mocap bench` as one call: corpus, policy, both splits, the extra
+//! - [`run`](mod@run): `inbetween mocap bench` as one call: corpus, policy, both splits, the extra
 //!   measurements and the written report;
 //! - [`measure`]: what the bench measures beyond the paper's table (reconstruction throughput, the
 //!   spherical and rotation reconstructions side by side, codec ratios);

@@ -1,8 +1,8 @@
 //! Throughput helpers for a `bench` subcommand (speed goals live here, never in unit tests).
 //!
-//! [`lstm_throughput`] measures the blocks the engines use: a 256-unit [`FusedLstm`] stepping
+//! [`lstm_throughput`] measures the blocks the engines use: a 256-unit [`FusedLstm`](crate::lstm::FusedLstm) stepping
 //! one trajectory and a batch of trajectories (inference, no autodiff), and a stacked
-//! [`BiLstm`] forward + backward + Adam step (training). [`table`] lays the rows out.
+//! [`BiLstm`](crate::lstm::BiLstm) forward + backward + Adam step (training). [`table`] lays the rows out.
 
 
 use burn::module::Module;

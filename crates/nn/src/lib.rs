@@ -14,10 +14,15 @@
 //!   ([`lstm::BiLstm`]) over sequences kept as `Vec` of per-step `[batch, features]` tensors.
 //! - [`tta`]: time-to-arrival sinusoidal embedding (Harvey et al. 2020).
 //! - [`spectral`]: spectral-normalised linear and 1-D convolution layers.
-//! - [`train`]: a small seeded training loop (Adam, exponential LR decay, progress bar,
-//!   periodic checkpoints, resume).
-//! - [`checkpoint`]: atomic save/load of a module record plus a JSON sidecar.
-//! - [`bench`]: throughput helpers the CLI's `bench` subcommand can call.
+//! - [`train`]: the one training loop of every engine (Adam, lr decay with warm restarts, clipping,
+//!   time limit, per-step and per-epoch hooks, checkpoints, bit-identical resume including the
+//!   objective's own state).
+//! - [`checkpoint`]: atomic save/load of module and optimiser records plus a JSON sidecar.
+//! - [`weights`]: trained weights as burnpack + a JSON card (kind, config, provenance, metrics);
+//!   committed weights compiled in with `include_bytes!`.
+//! - [`runtime`]: plain-Rust Dense/LSTM inference layers built from trained modules, no allocation
+//!   per step.
+//! - [`bench`](mod@bench): throughput rows for the `bench` commands.
 //!
 //! # Note for a future WGAN-GP critic (face engine)
 //! burn has no double backward (`backward()` consumes the graph), so the gradient penalty

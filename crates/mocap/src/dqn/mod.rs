@@ -1,5 +1,5 @@
-//! The SIDQL deep Q-network (§4): the keyframe MDP ([`env`]), the Q-network ([`model`]), the replay
-//! memory ([`replay`]), training with main and target networks on the shared loop ([`train`]) and
+//! The SIDQL deep Q-network (§4): the keyframe MDP ([`env`](mod@env)), the Q-network ([`model`]), the replay
+//! memory ([`replay`]), training with main and target networks on the shared loop ([`train`](mod@train)) and
 //! the trained policy, which needs no training code ([`policy`]).
 
 pub mod env;

@@ -1,13 +1,13 @@
 //! Keyframe selectors. All keep the first and last frame (constraint 19b–c of the paper) and return
 //! `k` keyframes in total.
 //!
-//! - [`random`]: RC, `k − 2` interior frames drawn uniformly (seeded).
-//! - [`uniform`]: UC, evenly spaced frames.
-//! - [`greedy`]: the paper's Greedy (§5.4), adding the frame that lowers the error most, one at a time.
-//! - [`optimal`]: the exact minimum of the total error for `k` keys, a dynamic programme over the
+//! - [`random`](mod@random): RC, `k − 2` interior frames drawn uniformly (seeded).
+//! - [`uniform`](mod@uniform): UC, evenly spaced frames.
+//! - [`greedy`](mod@greedy): the paper's Greedy (§5.4), adding the frame that lowers the error most, one at a time.
+//! - [`optimal`](mod@optimal): the exact minimum of the total error for `k` keys, a dynamic programme over the
 //!   per-segment costs (beyond the paper); never worse than Greedy.
 //! - [`error_bounded`]: the fewest keys keeping every frame's error under a bound, also exact.
-//! - [`sidql`]: the paper's deep Q-network policy (§4).
+//! - [`sidql`](mod@sidql): the paper's deep Q-network policy (§4).
 
 pub mod greedy;
 pub mod optimal;
