@@ -227,7 +227,8 @@ pub struct TrainReport<M> {
     pub start_epoch: usize,
     /// Optimiser steps taken in total.
     pub optimizer_steps: u64,
-    /// Seconds of training over every invocation of the run.
+    /// Seconds of training over every invocation of the run, as of the end of the last epoch (the
+    /// figure its checkpoint records).
     pub seconds: f64,
     /// Why training ended.
     pub finish: Finish,
@@ -331,6 +332,8 @@ where
     let started = Instant::now();
     let mut last_checkpoint = None;
     let mut finish = Finish::Completed;
+    // Training time as of the last finished epoch: what checkpoints record and the report returns.
+    let mut seconds = seconds_before;
     for epoch in start_epoch..config.epochs {
         // Re-seed per epoch so random ops inside the model (noise, dropout) replay identically
         // after a resume.
@@ -362,7 +365,7 @@ where
         let mean = if losses > 0 { sum / losses as f64 } else { f64::NAN };
         loss_history.push(mean);
         bar.set_message(format!("epoch {} loss {mean:.5} lr {lr:.2e}", epoch + 1));
-        let seconds = seconds_before + started.elapsed().as_secs_f64();
+        seconds = seconds_before + started.elapsed().as_secs_f64();
         let end = EpochEnd { epoch, mean_loss: mean, lr, seconds };
         let done = epoch + 1;
         if objective.after_epoch(&model, &end) == Control::Stop {
@@ -396,7 +399,7 @@ where
         loss_history,
         start_epoch,
         optimizer_steps,
-        seconds: seconds_before + started.elapsed().as_secs_f64(),
+        seconds,
         finish,
         resumed_from,
         last_checkpoint,
@@ -705,7 +708,9 @@ mod tests {
         let straight = fit(&config(3), &device, build, sine_loss(&device)).unwrap();
         assert_eq!(resumed.finish, Finish::Completed);
         assert_eq!(resumed.loss_history, straight.loss_history);
-        assert!(resumed.seconds >= report.seconds);
+        let saved = CheckpointMeta::load(&checkpoint::CheckpointFiles::in_dir(dir.path(), 1).meta).unwrap();
+        assert_eq!(saved.seconds.to_bits(), report.seconds.to_bits(), "the report and its checkpoint disagree");
+        assert!(resumed.seconds > report.seconds, "the second sitting's time was not added");
     }
 
     #[test]
