@@ -73,7 +73,7 @@ impl Table {
         self.rows.iter().map(Vec::len).chain([self.headers.len()]).max().unwrap_or(0)
     }
 
-    fn cell<'a>(row: &'a [String], c: usize) -> &'a str {
+    fn cell(row: &[String], c: usize) -> &str {
         row.get(c).map(String::as_str).unwrap_or("")
     }
 

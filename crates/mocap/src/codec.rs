@@ -770,7 +770,7 @@ mod compress_tests {
         for (i, m) in clips().iter().enumerate() {
             let mut last_keys = 0;
             for bound in [2.0, 1.0, 0.5, 0.1, 0.05] {
-                let c = compress(&m, Budget::MaxErrorCm(bound), 30).unwrap();
+                let c = compress(m, Budget::MaxErrorCm(bound), 30).unwrap();
                 assert!(c.decoded_max_cm <= bound, "clip {i}, {bound} cm: decoded max {} cm", c.decoded_max_cm);
                 assert!(c.planned.max_cm <= bound);
                 // Tight enough to matter: the bound is approached, not met by keying everything.

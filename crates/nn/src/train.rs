@@ -107,7 +107,7 @@ impl TrainConfig {
             }
         }
         if let Some(t) = self.time_limit_s {
-            if !(t > 0.0) {
+            if t.is_nan() || t <= 0.0 {
                 return Err(NnError::Config(format!("time_limit_s must be positive, got {t}")));
             }
         }

@@ -289,6 +289,25 @@ fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage {
     })
 }
 
+
+/// The shared look of every chart's axes and grid: fonts, light grid lines, tick marks.
+fn house_mesh<'m, 'a, 'b, X, Y, DB>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: plotters::coord::ranged1d::Ranged,
+    Y: plotters::coord::ranged1d::Ranged,
+    DB: DrawingBackend,
+{
+    mesh.label_style((FONT, LABEL_SIZE))
+        .axis_desc_style((FONT, LABEL_SIZE + 1))
+        .max_light_lines(4)
+        .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
+        .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
+        .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
+        .set_all_tick_mark_size(px(5))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -358,22 +377,4 @@ mod tests {
         assert!(err.contains("2 values for 1 groups"), "{err}");
         assert!(!p.exists());
     }
-}
-
-/// The shared look of every chart's axes and grid: fonts, light grid lines, tick marks.
-fn house_mesh<'m, 'a, 'b, X, Y, DB>(
-    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
-) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
-where
-    X: plotters::coord::ranged1d::Ranged,
-    Y: plotters::coord::ranged1d::Ranged,
-    DB: DrawingBackend,
-{
-    mesh.label_style((FONT, LABEL_SIZE))
-        .axis_desc_style((FONT, LABEL_SIZE + 1))
-        .max_light_lines(4)
-        .light_line_style(RGBColor(238, 238, 238).stroke_width(px(1) as u32))
-        .bold_line_style(RGBColor(214, 214, 214).stroke_width(px(1) as u32))
-        .axis_style(RGBColor(60, 60, 60).stroke_width(px(1) as u32))
-        .set_all_tick_mark_size(px(5))
 }

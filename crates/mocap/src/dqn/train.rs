@@ -293,7 +293,7 @@ impl TrainObjective<QNet> for Dqn<'_> {
         }
         let mut rng = inbetween_core::seed::rng(step.seed);
         self.act(step, &mut rng);
-        let ready = self.s.replay.len() >= self.opts.batch && self.s.env_steps % self.opts.train_every.max(1) == 0;
+        let ready = self.s.replay.len() >= self.opts.batch && self.s.env_steps.is_multiple_of(self.opts.train_every.max(1));
         if !ready {
             return None;
         }
@@ -307,17 +307,17 @@ impl TrainObjective<QNet> for Dqn<'_> {
         self.s.loss_n += 1;
         self.s.updates += 1;
         let nets = self.nets.as_mut().expect("networks set before learning");
-        if self.s.updates % self.opts.target_every.max(1) == 0 {
+        if self.s.updates.is_multiple_of(self.opts.target_every.max(1)) {
             nets.0 = main.valid();
         }
-        if self.s.updates % 10 == 0 {
+        if self.s.updates.is_multiple_of(10) {
             nets.1 = main.valid();
         }
     }
 
     fn after_epoch(&mut self, _main: &QNet, end: &EpochEnd) -> Control {
         let done = end.epoch + 1;
-        if done % CURVE_BLOCK == 0 || done == self.opts.episodes {
+        if done.is_multiple_of(CURVE_BLOCK) || done == self.opts.episodes {
             let loss = if self.s.loss_n > 0 { f(self.s.loss_sum_bits) / self.s.loss_n as f64 } else { f64::NAN };
             self.s.loss_curve_bits.push(loss.to_bits());
             self.s.return_curve_bits.push((f(self.s.ret_sum_bits) / CURVE_BLOCK as f64).to_bits());
