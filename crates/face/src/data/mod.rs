@@ -1,0 +1,36 @@
+//! The data layer of the face engine: blendshape clips, their file formats and resampling.
+//!
+//! * [`BlendshapeClip`]: frame times plus, per frame, the 52 ARKit weights ([`ARKIT_NAMES`] order),
+//!   optionally the 9 head/eye rotations ([`HEAD_EYE_NAMES`]) and any extra channels by name.
+//! * [`livelink`]: the Live Link Face CSV layout (`Timecode`, `BlendshapeCount`, values), as in
+//!   `../shared/data/face/neurosync`.
+//! * [`curves`]: a plain curve format, CSV (`time_s` + named columns) and JSON.
+//! * [`resample`](BlendshapeClip::resample): linear resampling to the model rate ([`MODEL_FPS`], the
+//!   paper's 25 fps, §4.1) and back ([`BlendshapeClip::resample_at`]).
+//!
+//! Every reader returns [`FaceError`] on bad input, naming file, line and column; none panics
+//! (property tests here, `fuzz/fuzz_targets/face_csv.rs`). Every writer is atomic
+//! (`inbetween_io::write_atomic`).
+
+mod clip;
+pub mod curves;
+mod error;
+pub mod livelink;
+mod names;
+mod resample;
+mod text;
+
+pub use clip::BlendshapeClip;
+pub use curves::{parse_curve_csv, parse_curve_json, read_curves, to_curve_csv_string, to_curve_json_string, write_curves};
+pub use error::{Column, FaceError};
+pub use livelink::{parse_live_link, read_live_link, to_live_link_string, write_live_link};
+pub use names::{
+    arkit_index, head_eye_index, is_emotion, ARKIT_NAMES, EMOTION_NAMES, HEAD_EYE_NAMES, NUM_ARKIT, NUM_HEAD_EYE,
+};
+pub use resample::MODEL_FPS;
+
+/// Live Link Face timecode rate: the `FF` field counts frames at 60 per second.
+pub const LIVE_LINK_FPS: f64 = 60.0;
+
+#[cfg(test)]
+mod robustness;
