@@ -199,11 +199,9 @@ fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaC
         .collect()
 }
 
-/// Standard normal by Box–Muller (seeded through `rng`).
+/// Standard normal (seeded through `rng`).
 fn normal(rng: &mut ChaCha8Rng) -> f32 {
-    let u1: f64 = rng.random_range(1e-12..1.0);
-    let u2: f64 = rng.random_range(0.0..1.0);
-    ((-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()) as f32
+    inbetween_core::seed::normal(rng) as f32
 }
 
 /// θ displaced by δ with a random sign, kept inside the valid arc (the other sign when needed).

@@ -19,8 +19,8 @@ pub struct DemoArgs {
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    // One step for the walk, four for the mocap demo, one for the camera demo.
-    let steps = Progress::new(6, "demo");
+    // One step for the walk, four for the mocap demo, one for the camera demo, one for the face demo.
+    let steps = Progress::new(7, "demo");
     let mut params = GaitParams::walk().jittered(a.seed, 0.15);
     params.frames = 150;
     params.turn_rate = 0.35;
@@ -45,6 +45,14 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     )];
     lines.extend(inbetween_mocap::demo::run(&a.out, &steps)?);
     lines.extend(inbetween_camera::demo::run(&a.out, &steps)?);
+    let face = inbetween_face::demo::run(&a.out, a.seed, &Progress::hidden())?;
+    steps.inc(1);
+    let mse: Vec<String> = face.mse.iter().map(|(m, e)| format!("{m} {e:.5}")).collect();
+    lines.push(format!(
+        "face: 3 s occlusion of a procedural capture, masked MSE {} -> {}",
+        mse.join(", "),
+        face.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+    ));
     steps.finish();
     for l in lines {
         println!("{l}");

@@ -1,6 +1,7 @@
 //! `inbetween`: the command-line front end of every engine.
 
 mod cmd_camera;
+mod cmd_face;
 mod cmd_io;
 mod cmd_mocap;
 mod cmd_preview;
@@ -37,6 +38,9 @@ enum Command {
     /// Camera engine: style-aware camera in-betweening in Toric space.
     #[command(subcommand)]
     Camera(cmd_camera::CameraCommand),
+    /// Face engine: blendshape animation editing by inpainting (BiLSTM GAN), guided by keys, a noisy take or visemes.
+    #[command(subcommand)]
+    Face(cmd_face::FaceCommand),
 }
 
 fn main() -> ExitCode {
@@ -61,5 +65,6 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Demo(a) => demo::run(a),
         Command::Mocap(c) => cmd_mocap::run(c),
         Command::Camera(c) => cmd_camera::run(c),
+        Command::Face(c) => cmd_face::run(c),
     }
 }

@@ -7,11 +7,15 @@
 
 pub mod bench;
 pub mod canvas;
+pub mod curves;
+pub mod face;
 mod gif_out;
 pub mod plot;
 pub mod stick;
 
 pub use canvas::{Camera3, Canvas};
+pub use curves::{render_edit_plot, write_edit_plot, EditCurve, EditPlot};
+pub use face::{draw_face, render_face_frames, render_face_panels, write_face_gif, FaceGifOptions, FacePose};
 pub use stick::{render_motion_frame, render_motion_gif, render_motion_png, render_positions_gif, StickOptions};
 
 use image::RgbImage;

@@ -44,7 +44,7 @@ const fn px(v: i32) -> i32 {
 }
 
 /// Registers the bundled font with plotters once per process.
-fn ensure_fonts() -> Result<(), RenderError> {
+pub(crate) fn ensure_fonts() -> Result<(), RenderError> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| {
         let regular = plotters::style::register_font(FONT, FontStyle::Normal, notosans::REGULAR_TTF).is_ok();
@@ -272,7 +272,7 @@ pub fn grouped_bar_chart(
 }
 
 /// Averages each `factor` × `factor` block into one pixel.
-fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage {
+pub(crate) fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage {
     let (w, h) = (big.width() / factor, big.height() / factor);
     let n = factor * factor;
     image::RgbImage::from_fn(w, h, |x, y| {

@@ -51,6 +51,9 @@ pub enum FaceError {
     /// A clip that breaks the rules of [`super::BlendshapeClip`], or an argument out of range.
     #[error("invalid clip: {0}")]
     Invalid(String),
+    /// Weights could not be loaded or saved.
+    #[error(transparent)]
+    Weights(#[from] inbetween_nn::NnError),
 }
 
 impl FaceError {

@@ -18,7 +18,7 @@ mod error;
 pub mod livelink;
 mod names;
 mod resample;
-mod text;
+pub(crate) mod text;
 
 pub use clip::BlendshapeClip;
 pub use curves::{parse_curve_csv, parse_curve_json, read_curves, to_curve_csv_string, to_curve_json_string, write_curves};
@@ -34,3 +34,29 @@ pub const LIVE_LINK_FPS: f64 = 60.0;
 
 #[cfg(test)]
 mod robustness;
+
+/// Reads a clip in any format the engine knows: `.json` is the plain curve JSON; a CSV whose header
+/// starts with `Timecode` is Live Link Face, any other CSV the plain curve CSV.
+pub fn read_clip(path: &std::path::Path) -> Result<BlendshapeClip, FaceError> {
+    let text = text::read_text(path)?;
+    let file = path.display().to_string();
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+        return parse_curve_json(&text, &file);
+    }
+    let header = text.lines().map(|l| l.trim_start_matches('\u{feff}').trim()).find(|l| !l.is_empty() && !l.starts_with('#'));
+    if header.is_some_and(|h| h.to_ascii_lowercase().starts_with("timecode")) {
+        parse_live_link(&text, &file)
+    } else {
+        parse_curve_csv(&text, &file)
+    }
+}
+
+/// Writes a clip as Live Link Face CSV when `live_link`, else in the plain curve format chosen by the
+/// extension (`.json` or CSV). Atomic, like every writer here.
+pub fn write_clip(path: &std::path::Path, clip: &BlendshapeClip, live_link: bool) -> Result<(), FaceError> {
+    if live_link {
+        write_live_link(path, clip)
+    } else {
+        write_curves(path, clip)
+    }
+}

@@ -1,0 +1,371 @@
+//! `inbetween face …`: edit blendshape animation by inpainting, train the networks, benchmark.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand, ValueEnum};
+
+use inbetween_face::bench::{self, FaceBenchConfig};
+use inbetween_face::data::{read_clip, write_clip, BlendshapeClip, MODEL_FPS};
+use inbetween_face::edit::groups::parse_groups;
+use inbetween_face::edit::mask::{parse_span_spec, SpanSpec};
+use inbetween_face::edit::ConstraintKind;
+use inbetween_face::infer::{read_keys, EditJob, Guide, Inpainter, Method};
+use inbetween_face::preview::{span_flags, write_edit_gif, write_edit_png, CurvePreview};
+use inbetween_face::train::{save_face_weights, train_face, FaceTrainConfig};
+use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, phoneme_viseme, PhonemeSpan};
+use inbetween_face::{corpus, procedural, weights};
+use inbetween_io::Progress;
+
+#[derive(Subcommand)]
+pub enum FaceCommand {
+    /// Regenerate spans of a blendshape animation, unguided or guided by keys, a noisy take or visemes.
+    Edit(EditArgs),
+    /// Train one network (or all four) on procedural clips or on the real captures' training split.
+    Train(TrainArgs),
+    /// Held-out evaluation: gap lengths, constraint types, Table 3 and Table 4 (CSV, Markdown, PNG).
+    Bench(BenchArgs),
+    /// Write a procedural face capture (Live Link CSV or curve CSV/JSON) and its phoneme timing.
+    Synth(SynthArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MethodArg {
+    /// The trained network for the guidance given (the default).
+    Network,
+    /// Linear interpolation through the span's borders and keys.
+    Linear,
+    /// Cubic Hermite interpolation through the span's borders (values and slopes) and keys.
+    Cubic,
+}
+
+#[derive(Args)]
+pub struct EditArgs {
+    /// Input animation: Live Link Face CSV, or curve CSV/JSON (time_s + the 52 ARKit names).
+    pub input: PathBuf,
+    /// Span to regenerate, seconds from the first frame (4.0s..6.5s) or frames at the clip's rate
+    /// (240f..390f). Repeat for several spans.
+    #[arg(long, required = true)]
+    pub mask: Vec<String>,
+    /// Keyframes to hit exactly (JSON or CSV; see the face README).
+    #[arg(long, group = "guidance")]
+    pub keys: Option<PathBuf>,
+    /// A noisy take of the same performance (any clip format), aligned on its first frame.
+    #[arg(long, group = "guidance")]
+    pub guide: Option<PathBuf>,
+    /// Phoneme timings: a Montreal Forced Aligner TextGrid, or a CSV/JSON of start,end,phoneme.
+    #[arg(long, group = "guidance")]
+    pub visemes: Option<PathBuf>,
+    /// English text spoken during --text-span (default: the first --mask span).
+    #[arg(long, group = "guidance")]
+    pub text: Option<String>,
+    /// Span the --text is spoken over (same syntax as --mask).
+    #[arg(long)]
+    pub text_span: Option<String>,
+    /// TextGrid tier holding the phonemes (default: "phones").
+    #[arg(long)]
+    pub tier: Option<String>,
+    /// Blendshape groups to regenerate: eyes, brows, jaw, mouth, cheeks, tongue, lower, upper, all.
+    #[arg(long, default_value = "all")]
+    pub groups: String,
+    #[arg(long, value_enum, default_value = "network")]
+    pub method: MethodArg,
+    /// Weights for the network (default: the committed ones for the guidance given).
+    #[arg(long)]
+    pub weights: Option<PathBuf>,
+    /// Output file; Live Link CSV when the input is, else curve CSV/JSON by extension.
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// PNG of the edited curves (default: OUT with .png).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// GIF of the schematic face, original beside edited, over the spans ±1 s.
+    #[arg(long)]
+    pub gif: Option<PathBuf>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DataArg {
+    /// The procedural generator (exact viseme labels); the committed weights are trained on it.
+    Procedural,
+    /// The training split of ../shared/data/face (never commit these weights).
+    Real,
+}
+
+#[derive(Args)]
+pub struct TrainArgs {
+    /// unguided, keyframes, noisy, visemes, or all.
+    #[arg(long, default_value = "all")]
+    pub kind: String,
+    #[arg(long, value_enum, default_value = "procedural")]
+    pub data: DataArg,
+    /// Output folder: <kind>.bpk + <kind>.json per network. The committed folder is refused unless
+    /// --overwrite-committed.
+    #[arg(short, long, default_value = "out/face")]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub overwrite_committed: bool,
+    /// Checkpoint folder (one subfolder per network); training resumes from it.
+    #[arg(long, default_value = "out/face-train")]
+    pub checkpoints: PathBuf,
+    /// Minutes per network (the running epoch is finished and saved).
+    #[arg(long)]
+    pub minutes: Option<f64>,
+    #[arg(long, default_value_t = 40)]
+    pub epochs: usize,
+    #[arg(long, default_value_t = 25)]
+    pub steps_per_epoch: usize,
+    #[arg(long, default_value_t = 16)]
+    pub batch: usize,
+    /// Frames per training window at 25 fps.
+    #[arg(long, default_value_t = 100)]
+    pub window: usize,
+    /// Procedural clips (with --data procedural).
+    #[arg(long, default_value_t = 64)]
+    pub clips: usize,
+    /// Hidden units per direction (paper: 128).
+    #[arg(long, default_value_t = 128)]
+    pub hidden: usize,
+    /// Captures folder (default: ../shared/data/face/neurosync or $INBETWEEN_DATA/face/neurosync).
+    #[arg(long)]
+    pub captures: Option<PathBuf>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// A small run (one held-out file, few edits).
+    #[arg(long)]
+    pub quick: bool,
+    /// A folder of weights trained on the real captures (`face train --data real`), compared too.
+    #[arg(long)]
+    pub real_weights: Option<PathBuf>,
+    #[arg(long)]
+    pub captures: Option<PathBuf>,
+    #[arg(short, long, default_value = "out/face-bench")]
+    pub out: PathBuf,
+}
+
+#[derive(Args)]
+pub struct SynthArgs {
+    #[arg(short, long)]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 10.0)]
+    pub seconds: f64,
+    /// Write Live Link Face CSV (else curve CSV/JSON by extension).
+    #[arg(long)]
+    pub live_link: bool,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+pub fn run(c: FaceCommand) -> anyhow::Result<()> {
+    match c {
+        FaceCommand::Edit(a) => run_edit(a),
+        FaceCommand::Train(a) => run_train(a),
+        FaceCommand::Bench(a) => run_bench(a),
+        FaceCommand::Synth(a) => run_synth(a),
+    }
+}
+
+fn captures_dir(given: Option<&Path>) -> anyhow::Result<PathBuf> {
+    if let Some(p) = given {
+        return Ok(p.to_path_buf());
+    }
+    let root = std::env::var_os("INBETWEEN_DATA").map(PathBuf::from).unwrap_or_else(|| PathBuf::from("../shared/data"));
+    let dir = root.join("face/neurosync");
+    if !dir.is_dir() {
+        bail!("no face captures at {} (set INBETWEEN_DATA or pass --captures)", dir.display());
+    }
+    Ok(dir)
+}
+
+/// Seconds from the clip's first frame of a `--mask`-style span (frames index the clip's own frames).
+fn span_seconds(text: &str, clip: &BlendshapeClip) -> anyhow::Result<(f64, f64)> {
+    let t0 = clip.times()[0];
+    let duration = clip.duration();
+    let (a, b) = match parse_span_spec(text).map_err(anyhow::Error::msg)? {
+        SpanSpec::Seconds(a, b) => (a, b),
+        SpanSpec::Frames(a, b) => {
+            let n = clip.num_frames();
+            if a >= n {
+                bail!("mask '{text}' starts past the clip's last frame ({} frames)", n);
+            }
+            let end = clip.times().get(b).map_or(duration + 1.0 / clip.fps(), |t| t - t0);
+            (clip.times()[a] - t0, end)
+        }
+    };
+    if a >= duration {
+        bail!("mask '{text}' lies outside the clip ({duration:.2} s long)");
+    }
+    Ok((a, b))
+}
+
+fn viseme_runs(spans: &[PhonemeSpan]) -> anyhow::Result<Vec<(f64, f64, inbetween_face::visemes::Viseme)>> {
+    spans
+        .iter()
+        .map(|s| {
+            let v = phoneme_viseme(&s.phoneme).with_context(|| format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))?;
+            Ok((s.start_s, s.end_s, v))
+        })
+        .collect()
+}
+
+fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow::Result<Guide> {
+    Ok(if let Some(k) = &a.keys {
+        Guide::Keys(read_keys(k)?)
+    } else if let Some(g) = &a.guide {
+        Guide::Noisy(read_clip(g)?)
+    } else if let Some(v) = &a.visemes {
+        Guide::Visemes(viseme_runs(&read_viseme_source(v, a.tier.as_deref())?)?)
+    } else if let Some(text) = &a.text {
+        let (s, e) = match &a.text_span {
+            Some(t) => span_seconds(t, clip)?,
+            None => spans[0],
+        };
+        let ph = text_to_phonemes(text, s, e)?;
+        if !ph.guessed_words.is_empty() {
+            eprintln!("note: not in CMUdict, pronounced by our letter-to-sound rules: {}", ph.guessed_words.join(", "));
+        }
+        Guide::Visemes(viseme_runs(&ph.spans)?)
+    } else {
+        Guide::None
+    })
+}
+
+fn run_edit(a: EditArgs) -> anyhow::Result<()> {
+    let clip = read_clip(&a.input)?;
+    let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<anyhow::Result<Vec<_>>>()?;
+    let channels = parse_groups(&a.groups).map_err(anyhow::Error::msg)?;
+    let guide = guide_of(&a, &clip, &spans)?;
+    let net = match a.method {
+        MethodArg::Network => Some(match &a.weights {
+            Some(w) => weights::load(w).with_context(|| format!("loading face weights {}", w.display()))?,
+            None => weights::committed(guide.kind()).with_context(|| format!("loading the committed {} network", guide.kind().name()))?,
+        }),
+        _ => None,
+    };
+    let method = match (&a.method, &net) {
+        (MethodArg::Linear, _) => Method::Linear,
+        (MethodArg::Cubic, _) => Method::Cubic,
+        (MethodArg::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
+        (MethodArg::Network, None) => unreachable!("a network was loaded above"),
+    };
+    let job = EditJob { clip: &clip, spans: spans.clone(), channels, guide, method, seed: a.seed };
+    let t = std::time::Instant::now();
+    let out = job.run()?;
+    let ms = t.elapsed().as_secs_f64() * 1000.0;
+    let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) && is_live_link(&a.input);
+    write_clip(&a.out, &out.clip, live_link)?;
+    let segs = out.mask.segments();
+    let png = a.png.clone().unwrap_or_else(|| a.out.with_extension("png"));
+    let title = format!("{} · {} · {}", a.input.display(), method.name(), job.guide.kind().name());
+    let preview = CurvePreview { title: &title, fps: MODEL_FPS, before: &out.before, after: &out.after, spans: &segs, keys: &out.keys, extra: None, n_curves: 6 };
+    write_edit_png(&png, &preview).with_context(|| format!("writing {}", png.display()))?;
+    if let Some(gif) = &a.gif {
+        let first = segs.iter().map(|s| s.start).min().unwrap_or(0).saturating_sub(25);
+        let last = (segs.iter().map(|s| s.end).max().unwrap_or(0) + 25).min(out.before.len());
+        let local: Vec<_> = segs.iter().map(|s| inbetween_face::edit::Segment { start: s.start - first, end: s.end - first }).collect();
+        let progress = Progress::new((last - first) as u64, "face gif");
+        write_edit_gif(gif, MODEL_FPS, &[("original", &out.before[first..last]), ("edited", &out.after[first..last])], None, &span_flags(last - first, &local), &progress)
+            .with_context(|| format!("writing {}", gif.display()))?;
+        progress.finish();
+        println!("  preview {}", gif.display());
+    }
+    println!(
+        "edited {} span(s) of {} ({} frames at {:.3} fps) with {} in {ms:.1} ms -> {} (curves: {})",
+        spans.len(),
+        a.input.display(),
+        clip.num_frames(),
+        clip.measured_fps(),
+        method.name(),
+        a.out.display(),
+        png.display()
+    );
+    Ok(())
+}
+
+fn is_live_link(path: &Path) -> bool {
+    std::fs::read_to_string(path).map(|t| t.trim_start_matches('\u{feff}').trim_start().to_ascii_lowercase().starts_with("timecode")).unwrap_or(false)
+}
+
+fn kinds(arg: &str) -> anyhow::Result<Vec<ConstraintKind>> {
+    if arg == "all" {
+        return Ok(ConstraintKind::ALL.to_vec());
+    }
+    arg.split(',')
+        .map(|k| ConstraintKind::from_name(k.trim()).with_context(|| format!("unknown network kind '{k}' (unguided, keyframes, noisy, visemes or all)")))
+        .collect()
+}
+
+fn run_train(a: TrainArgs) -> anyhow::Result<()> {
+    let kinds = kinds(&a.kind)?;
+    for k in &kinds {
+        weights::check_output(&a.out.join(weights::committed_file(*k)), a.overwrite_committed)?;
+    }
+    let pool = match a.data {
+        DataArg::Procedural => corpus::procedural_pool(a.clips, 20.0, a.seed)?,
+        DataArg::Real => corpus::real_pool(&captures_dir(a.captures.as_deref())?)?,
+    };
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    for kind in kinds {
+        if a.data == DataArg::Real && kind == ConstraintKind::Visemes {
+            println!("visemes: skipped, the real captures have no phoneme labels");
+            continue;
+        }
+        let mut cfg = FaceTrainConfig::new(kind);
+        cfg.epochs = a.epochs;
+        cfg.steps_per_epoch = a.steps_per_epoch;
+        cfg.batch = a.batch;
+        cfg.window = a.window;
+        cfg.d_hidden = a.hidden;
+        cfg.seed = a.seed;
+        cfg.time_limit_s = a.minutes.map(|m| m * 60.0);
+        cfg.checkpoint_dir = Some(a.checkpoints.join(kind.name()));
+        let progress = Progress::new((cfg.epochs * cfg.steps_per_epoch) as u64, &format!("train {}", kind.name()));
+        let report = train_face(&cfg, &pool, &progress)?;
+        progress.finish();
+        let out = a.out.join(weights::committed_file(kind));
+        save_face_weights(&report, &out)?;
+        let f = report.final_losses();
+        println!(
+            "{}: {} steps in {:.1} min, final generator loss {:.4} (reconstruction {:.4}); weights {}",
+            kind.name(),
+            report.steps,
+            report.seconds / 60.0,
+            f.generator,
+            f.rec,
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
+    let captures = captures_dir(a.captures.as_deref())?;
+    let cfg = if a.quick { FaceBenchConfig::quick(captures) } else { FaceBenchConfig::full(captures) };
+    let mut sets = vec![weights::committed_set()?];
+    if let Some(dir) = &a.real_weights {
+        sets.push(weights::set_from_dir(dir, "real")?);
+    }
+    let t = std::time::Instant::now();
+    let progress = Progress::new(1, "face bench");
+    let report = bench::run(&cfg, &sets, &progress)?;
+    print!("{}", report.to_text());
+    let files = report.write(&a.out).with_context(|| format!("writing the face bench to {}", a.out.display()))?;
+    println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
+    let p = procedural::generate(&procedural::ProceduralConfig { duration_s: a.seconds, ..Default::default() }, a.seed);
+    write_clip(&a.out, &p.clip, a.live_link)?;
+    let spans: Vec<PhonemeSpan> = p.phonemes.iter().map(|(s, e, ph)| PhonemeSpan { start_s: *s, end_s: *e, phoneme: ph.to_string() }).collect();
+    let timing = a.out.with_extension("phonemes.csv");
+    inbetween_face::visemes::write_phoneme_timing(&timing, &spans)?;
+    println!("wrote {} ({} frames at {MODEL_FPS} fps) and its phoneme timing {}", a.out.display(), p.clip.num_frames(), timing.display());
+    Ok(())
+}

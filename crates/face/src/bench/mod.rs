@@ -1,0 +1,474 @@
+//! The evaluation (`inbetween face bench`): §5 of the paper on our data, ours beside the paper's
+//! numbers.
+//!
+//! * Held-out captures, split by file: masked MSE and the six distance errors for linear, cubic and
+//!   the networks, by constraint type and gap length (0.5, 1, 2, 3 s).
+//! * Table 4 protocol: the whole clip masked, guidance only.
+//! * Table 3: Bézier keys per edit at tolerance 0.01 and the CPU time of an edit.
+//! * Visemes on procedural clips (the captures have no phoneme labels).
+//!
+//! Every edit goes through [`EditJob`], the same path as `face edit`.
+
+pub mod bezier;
+
+use std::path::{Path, PathBuf};
+
+use inbetween_core::seed::{derive, rng};
+use inbetween_io::report::{num, seconds_per_call, Report, Table};
+use inbetween_io::Progress;
+use rand::Rng;
+
+use crate::data::{read_live_link, BlendshapeClip, FaceError, ARKIT_NAMES, MODEL_FPS, NUM_ARKIT};
+use crate::edit::constraints::{noisy_guide, sample_keyframes, TrackerNoise};
+use crate::edit::distances::{distances, DISTANCE_NAMES, NUM_DISTANCES};
+use crate::edit::{ConstraintKind, Frame, Mask, Segment};
+use crate::infer::{EditJob, Guide, Inpainter, KeyPose, Method};
+use crate::procedural;
+use crate::visemes::Viseme;
+
+/// Held-out capture files (relative to `face/neurosync/`): one file of each emotion that has two or
+/// more takes, so every emotion is still seen in training.
+pub const TEST_FILES: [&str; 2] = ["livelink/Fearful/MySlate_162_iPhone_cal.csv", "livelink/Sad/MySlate_168_iPhone_cal.csv"];
+
+/// Training capture files: every Live Link capture not in [`TEST_FILES`].
+pub const TRAIN_FILES: [&str; 6] = [
+    "livelink/Angry/MySlate_164_iPhone_cal.csv",
+    "livelink/Angry/MySlate_165_iPhone_cal.csv",
+    "livelink/Angry/MySlate_166_iPhone_cal.csv",
+    "livelink/Fearful/MySlate_161_iPhone_cal.csv",
+    "livelink/Happy/Happy.csv",
+    "livelink/Sad/MySlate_167_iPhone_cal.csv",
+];
+
+/// Gap lengths of the held-out evaluation, seconds.
+pub const GAPS_S: [f64; 4] = [0.5, 1.0, 2.0, 3.0];
+
+/// A set of trained networks (one per constraint type) under one label.
+pub struct NetworkSet {
+    /// Label in the tables ("procedural", "real").
+    pub label: String,
+    /// The networks.
+    pub nets: Vec<Box<dyn Inpainter>>,
+}
+
+impl NetworkSet {
+    fn get(&self, kind: ConstraintKind) -> Option<&dyn Inpainter> {
+        self.nets.iter().find(|n| n.kind() == kind).map(|n| n.as_ref())
+    }
+}
+
+/// What to run.
+pub struct FaceBenchConfig {
+    /// `face/neurosync` folder of the shared data.
+    pub captures: PathBuf,
+    /// Edits per (clip, gap length, constraint).
+    pub edits_per_gap: usize,
+    /// Procedural held-out clips for the viseme evaluation.
+    pub procedural_clips: usize,
+    /// Seconds of each procedural clip.
+    pub procedural_seconds: f64,
+    /// Use only the first held-out file (quick runs).
+    pub one_test_file: bool,
+    /// Seed of every random choice.
+    pub seed: u64,
+}
+
+impl FaceBenchConfig {
+    /// The full evaluation.
+    pub fn full(captures: PathBuf) -> Self {
+        FaceBenchConfig { captures, edits_per_gap: 12, procedural_clips: 6, procedural_seconds: 20.0, one_test_file: false, seed: 2026 }
+    }
+
+    /// A small run for tests.
+    pub fn quick(captures: PathBuf) -> Self {
+        FaceBenchConfig { captures, edits_per_gap: 2, procedural_clips: 1, procedural_seconds: 10.0, one_test_file: true, seed: 7 }
+    }
+}
+
+/// Error sums of one (constraint, gap, method) cell.
+#[derive(Clone, Debug, Default)]
+struct Acc {
+    sq: f64,
+    entries: usize,
+    dist: [f64; NUM_DISTANCES],
+    frames: usize,
+    edits: usize,
+}
+
+impl Acc {
+    fn add(&mut self, truth: &[Frame], out: &[Frame], mask: &Mask) {
+        for f in 0..mask.frames() {
+            if !mask.frame_erased(f) {
+                continue;
+            }
+            for c in 0..NUM_ARKIT {
+                if mask.erased(f, c) {
+                    self.sq += f64::from(out[f][c] - truth[f][c]).powi(2);
+                    self.entries += 1;
+                }
+            }
+            let (dt, d_o) = (distances(&truth[f]), distances(&out[f]));
+            for k in 0..NUM_DISTANCES {
+                self.dist[k] += f64::from((dt[k] - d_o[k]).abs());
+            }
+            self.frames += 1;
+        }
+        self.edits += 1;
+    }
+
+    fn mse(&self) -> f64 {
+        self.sq / self.entries.max(1) as f64
+    }
+
+    fn dist(&self, k: usize) -> f64 {
+        self.dist[k] / self.frames.max(1) as f64
+    }
+}
+
+/// Model-rate frames of a clip.
+fn frames_of(clip: &BlendshapeClip) -> Vec<Frame> {
+    (0..clip.num_frames())
+        .map(|f| {
+            let mut x = [0.0; NUM_ARKIT];
+            x.copy_from_slice(&clip.arkit(f)[..NUM_ARKIT]);
+            x
+        })
+        .collect()
+}
+
+/// A 25 fps clip of the given frames (times from 0).
+pub fn clip_of(frames: &[Frame]) -> BlendshapeClip {
+    let times = (0..frames.len()).map(|f| f as f64 / MODEL_FPS).collect();
+    BlendshapeClip::new(MODEL_FPS, times, false, vec![], frames.iter().flatten().copied().collect()).expect("frames make a valid clip")
+}
+
+/// The guide a test edit gets, drawn from the truth.
+fn guide_for(kind: ConstraintKind, truth: &[Frame], mask: &Mask, visemes: Option<&[Viseme]>, seed: u64) -> Guide {
+    let mut r = rng(seed);
+    match kind {
+        ConstraintKind::None => Guide::None,
+        ConstraintKind::Keyframes => Guide::Keys(
+            sample_keyframes(&mut r, truth, mask, MODEL_FPS)
+                .into_iter()
+                .map(|(f, k)| KeyPose { time_s: f as f64 / MODEL_FPS, shapes: k.iter().copied().enumerate().collect() })
+                .collect(),
+        ),
+        ConstraintKind::Noisy => Guide::Noisy(clip_of(&noisy_guide(&mut r, truth, &TrackerNoise::default()))),
+        ConstraintKind::Visemes => Guide::Visemes(viseme_runs(visemes.expect("viseme labels"))),
+    }
+}
+
+/// Per-frame labels as `(start_s, end_s, viseme)` runs.
+pub fn viseme_runs(labels: &[Viseme]) -> Vec<(f64, f64, Viseme)> {
+    let mut runs: Vec<(f64, f64, Viseme)> = Vec::new();
+    for (f, v) in labels.iter().enumerate() {
+        let (a, b) = ((f as f64 - 0.5).max(0.0) / MODEL_FPS, (f as f64 + 0.5) / MODEL_FPS);
+        match runs.last_mut() {
+            Some(last) if last.2 == *v => last.1 = b,
+            _ => runs.push((a, b, *v)),
+        }
+    }
+    runs
+}
+
+/// The methods compared for one constraint type: linear, cubic, each network set's network, and for
+/// the noisy guide the guide itself.
+fn methods<'a>(kind: ConstraintKind, sets: &'a [NetworkSet]) -> Vec<(String, Method<'a>)> {
+    let mut m = vec![("linear".to_string(), Method::Linear), ("cubic".to_string(), Method::Cubic)];
+    for s in sets {
+        if let Some(net) = s.get(kind) {
+            m.push((format!("ours ({})", s.label), Method::Network(net)));
+        }
+    }
+    m
+}
+
+/// One edit of `truth` (25 fps) on `seg` with `method`; returns the model-rate output and mask.
+fn edit(truth: &BlendshapeClip, seg: Segment, guide: &Guide, method: Method, seed: u64) -> Result<(Vec<Frame>, Mask), FaceError> {
+    let spans = vec![(seg.start as f64 / MODEL_FPS, seg.end as f64 / MODEL_FPS)];
+    let job = EditJob { clip: truth, spans, channels: [true; NUM_ARKIT], guide: guide.clone(), method, seed };
+    let out = job.run()?;
+    Ok((out.after, out.mask))
+}
+
+/// The guide recomposed into the gap (the "use the noisy take as is" baseline).
+fn guide_as_is(truth: &[Frame], mask: &Mask, guide: &Guide) -> Vec<Frame> {
+    let Guide::Noisy(g) = guide else { return truth.to_vec() };
+    crate::model::input::recompose(truth, mask, &frames_of(g))
+}
+
+type Cells = Vec<((ConstraintKind, f64, String), Acc)>;
+
+fn cell(cells: &mut Cells, key: (ConstraintKind, f64, String)) -> &mut Acc {
+    if let Some(i) = cells.iter().position(|(k, _)| *k == key) {
+        return &mut cells[i].1;
+    }
+    cells.push((key, Acc::default()));
+    &mut cells.last_mut().expect("just pushed").1
+}
+
+/// Evaluate edits of `gap` seconds on clip `truth` (25 fps) for every constraint in `kinds`.
+#[allow(clippy::too_many_arguments)]
+fn evaluate_clip(
+    truth_clip: &BlendshapeClip,
+    visemes: Option<&[Viseme]>,
+    kinds: &[ConstraintKind],
+    sets: &[NetworkSet],
+    edits: usize,
+    seed: u64,
+    cells: &mut Cells,
+    progress: &Progress,
+) -> Result<(), FaceError> {
+    let truth = frames_of(truth_clip);
+    let n = truth.len();
+    for (gi, gap_s) in GAPS_S.iter().enumerate() {
+        let len = (gap_s * MODEL_FPS).round() as usize;
+        let margin = 2 * MODEL_FPS as usize;
+        if n < len + 2 * margin {
+            continue;
+        }
+        for e in 0..edits {
+            let s = derive(derive(seed, gi as u64), e as u64);
+            let start = rng(s).random_range(margin..=n - len - margin);
+            let seg = Segment { start, end: start + len };
+            let mask = Mask::from_segments(n, &[seg], &[true; NUM_ARKIT]);
+            for kind in kinds {
+                let guide = guide_for(*kind, &truth, &mask, visemes, derive(s, 1));
+                for (name, method) in methods(*kind, sets) {
+                    let (out, mask) = edit(truth_clip, seg, &guide, method, derive(s, 2))?;
+                    cell(cells, (*kind, *gap_s, name)).add(&truth, &out, &mask);
+                }
+                if *kind == ConstraintKind::Noisy {
+                    cell(cells, (*kind, *gap_s, "noisy guide as is".into())).add(&truth, &guide_as_is(&truth, &mask, &guide), &mask);
+                }
+            }
+            progress.inc(1);
+        }
+    }
+    Ok(())
+}
+
+fn heldout_table(name: &str, title: &str, cells: &Cells) -> Table {
+    let mut headers = vec!["constraint", "gap_s", "method", "masked_mse"];
+    headers.extend(DISTANCE_NAMES);
+    headers.push("edits");
+    let mut t = Table::new(name, title, &headers);
+    for ((kind, gap, method), acc) in cells {
+        let gap_cell = if *gap == 0.0 { "all".to_string() } else { num(*gap, 1) };
+        let mut row = vec![kind.name().to_string(), gap_cell, method.clone(), num(acc.mse(), 5)];
+        row.extend((0..NUM_DISTANCES).map(|k| num(acc.dist(k), 4)));
+        row.push(acc.edits.to_string());
+        t.row(row);
+    }
+    t
+}
+
+/// Cells summed over gap lengths.
+fn by_constraint(cells: &Cells) -> Cells {
+    let mut out: Cells = Vec::new();
+    for ((kind, _, method), acc) in cells {
+        let a = cell(&mut out, (*kind, 0.0, method.clone()));
+        a.sq += acc.sq;
+        a.entries += acc.entries;
+        a.frames += acc.frames;
+        a.edits += acc.edits;
+        for k in 0..NUM_DISTANCES {
+            a.dist[k] += acc.dist[k];
+        }
+    }
+    out
+}
+
+/// Load the held-out captures at the model rate.
+pub fn test_clips(captures: &Path, one: bool) -> Result<Vec<(String, BlendshapeClip)>, FaceError> {
+    let files = if one { &TEST_FILES[..1] } else { &TEST_FILES[..] };
+    files.iter().map(|f| Ok((f.to_string(), read_live_link(&captures.join(f))?.resample(MODEL_FPS)?))).collect()
+}
+
+/// Run the whole evaluation.
+pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> Result<Report, FaceError> {
+    let mut report = Report::new("face-bench", "Face engine benchmark (facial animation editing, Berson et al.)");
+    let tests = test_clips(&cfg.captures, cfg.one_test_file)?;
+    let real_kinds = [ConstraintKind::None, ConstraintKind::Keyframes, ConstraintKind::Noisy];
+    let proc_clips = procedural::generate_corpus(cfg.procedural_clips, cfg.procedural_seconds, derive(cfg.seed, 99));
+    progress.set_length(((tests.len() + proc_clips.len()) * GAPS_S.len() * cfg.edits_per_gap) as u64);
+    progress.set_message("held-out edits");
+    let mut cells: Cells = Vec::new();
+    for (i, (_, clip)) in tests.iter().enumerate() {
+        evaluate_clip(clip, None, &real_kinds, sets, cfg.edits_per_gap, derive(cfg.seed, i as u64), &mut cells, progress)?;
+    }
+    report.table(heldout_table("heldout_by_gap", "Held-out captures: error inside the gap by constraint, gap length and method", &cells));
+    report.table(heldout_table("heldout", "Held-out captures: all gap lengths together", &by_constraint(&cells)));
+    let mut vcells: Cells = Vec::new();
+    for (i, p) in proc_clips.iter().enumerate() {
+        let kinds = [ConstraintKind::Visemes, ConstraintKind::None];
+        evaluate_clip(&p.clip, Some(&p.visemes), &kinds, sets, cfg.edits_per_gap, derive(cfg.seed, 1000 + i as u64), &mut vcells, progress)?;
+    }
+    report.table(heldout_table("visemes", "Viseme editing on held-out procedural clips (the captures have no phoneme labels)", &by_constraint(&vcells)));
+    report.table(table4(&tests, &proc_clips, sets, cfg.seed)?);
+    report.table(table3(&tests, &proc_clips, sets, cfg.seed)?);
+    charts(&mut report, &cells);
+    progress.finish();
+    Ok(report)
+}
+
+/// Table 4 protocol: the whole window masked, guidance only (10 s windows of each held-out clip).
+fn table4(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralClip], sets: &[NetworkSet], seed: u64) -> Result<Table, FaceError> {
+    let mut t = Table::new("table4", "Table 4 protocol: whole window masked, guidance only (MSE of the weights)", &["guidance", "method", "mse", "windows"]);
+    let window = (10.0 * MODEL_FPS) as usize;
+    let mut cells: Cells = Vec::new();
+    let mut add = |truth_clip: &BlendshapeClip, visemes: Option<&[Viseme]>, kind: ConstraintKind, s: u64| -> Result<(), FaceError> {
+        let all = frames_of(truth_clip);
+        for (w, chunk) in all.chunks_exact(window).enumerate() {
+            let truth = chunk.to_vec();
+            let clip = clip_of(&truth);
+            let mask = Mask::all(truth.len());
+            let labels = visemes.map(|v| &v[w * window..(w + 1) * window]);
+            let guide = guide_for(kind, &truth, &mask, labels, derive(s, w as u64));
+            let seg = Segment { start: 0, end: truth.len() };
+            for (name, method) in methods(kind, sets) {
+                let (out, mask) = edit(&clip, seg, &guide, method, derive(s, 7))?;
+                cell(&mut cells, (kind, 0.0, name)).add(&truth, &out, &mask);
+            }
+            if kind == ConstraintKind::Noisy {
+                cell(&mut cells, (kind, 0.0, "noisy guide as is".into())).add(&truth, &guide_as_is(&truth, &mask, &guide), &mask);
+            }
+        }
+        Ok(())
+    };
+    for (i, (_, clip)) in tests.iter().enumerate() {
+        for kind in [ConstraintKind::Noisy, ConstraintKind::Keyframes, ConstraintKind::None] {
+            add(clip, None, kind, derive(seed, 500 + i as u64))?;
+        }
+    }
+    for (i, p) in procs.iter().enumerate() {
+        add(&p.clip, Some(&p.visemes), ConstraintKind::Visemes, derive(seed, 600 + i as u64))?;
+    }
+    for ((kind, _, method), acc) in &cells {
+        let guidance = if *kind == ConstraintKind::Visemes { "visemes (procedural)".to_string() } else { kind.name().to_string() };
+        t.row([guidance, method.clone(), num(acc.mse(), 5), acc.edits.to_string()]);
+    }
+    t.note("paper (8 dense control parameters, B3D(AC)^2 test set): ours 0.014, Holden et al. 0.016, Berson et al. 0.018");
+    t.note("we have no control-parameter network; the dense noisy guide is the closest guidance we have");
+    Ok(t)
+}
+
+/// Table 3: keys an animator would need (cubic Bézier at tolerance 0.01) and CPU time per edit.
+fn table3(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralClip], sets: &[NetworkSet], seed: u64) -> Result<Table, FaceError> {
+    let mut t = Table::new(
+        "table3",
+        "Table 3: keys per edit (cubic Bézier, tolerance 0.01) and CPU time of one edit",
+        &["edit", "frames", "bezier_keys_per_shape", "bezier_keys_all_shapes", "ms_per_edit", "paper_bezier_points", "paper_cpu_s"],
+    );
+    let Some(set) = sets.first() else {
+        t.note("no network given: nothing to time");
+        return Ok(t);
+    };
+    let rows: [(&str, ConstraintKind, usize, &str, &str); 3] = [
+        ("occlusion completion (unguided)", ConstraintKind::None, 62, "36", "0.14"),
+        ("viseme editing (procedural)", ConstraintKind::Visemes, 19, "15", "0.12"),
+        ("noisy-guided", ConstraintKind::Noisy, 116, "93", "0.12"),
+    ];
+    for (name, kind, frames, paper_pts, paper_s) in rows {
+        let Some(net) = set.get(kind) else { continue };
+        let (clip, labels) = if kind == ConstraintKind::Visemes {
+            let Some(p) = procs.first() else { continue };
+            (p.clip.clone(), Some(p.visemes.as_slice()))
+        } else {
+            (tests[0].1.clone(), None)
+        };
+        let truth = frames_of(&clip);
+        let start = truth.len() / 2 - frames / 2;
+        let seg = Segment { start, end: start + frames };
+        let mask = Mask::from_segments(truth.len(), &[seg], &[true; NUM_ARKIT]);
+        let guide = guide_for(kind, &truth, &mask, labels, derive(seed, 300));
+        let (out, _) = edit(&clip, seg, &guide, Method::Network(net), derive(seed, 301))?;
+        let keys: Vec<usize> = (0..NUM_ARKIT)
+            .map(|c| {
+                let curve: Vec<f32> = out[seg.start.saturating_sub(1)..(seg.end + 1).min(out.len())].iter().map(|f| f[c]).collect();
+                bezier::bezier_keys(&curve, 0.01)
+            })
+            .collect();
+        let total: usize = keys.iter().sum();
+        let secs = seconds_per_call(1, 5, || {
+            let _ = edit(&clip, seg, &guide, Method::Network(net), 1);
+        });
+        t.row([
+            name.to_string(),
+            frames.to_string(),
+            num(total as f64 / NUM_ARKIT as f64, 1),
+            total.to_string(),
+            num(secs * 1000.0, 2),
+            paper_pts.to_string(),
+            paper_s.to_string(),
+        ]);
+    }
+    t.note(format!("keys per shape averaged over the {} ARKit shapes; an animator sets each key with two tangent handles", ARKIT_NAMES.len()));
+    t.note("ms_per_edit: the whole EditJob (resampling, network on the gap plus 2 s of context each side, post-processing) on one thread of this machine");
+    Ok(t)
+}
+
+fn charts(report: &mut Report, cells: &Cells) {
+    for kind in [ConstraintKind::None, ConstraintKind::Keyframes, ConstraintKind::Noisy] {
+        let groups: Vec<String> = GAPS_S.iter().map(|g| format!("{g} s")).collect();
+        let mut names: Vec<String> = Vec::new();
+        for ((k, _, m), _) in cells {
+            if *k == kind && !names.contains(m) {
+                names.push(m.clone());
+            }
+        }
+        let series: Vec<(String, Vec<f64>)> = names
+            .iter()
+            .map(|m| {
+                let v = GAPS_S
+                    .iter()
+                    .map(|g| cells.iter().find(|((k, gg, mm), _)| *k == kind && gg == g && mm == m).map_or(0.0, |(_, a)| a.mse()))
+                    .collect();
+                (m.clone(), v)
+            })
+            .collect();
+        if series.is_empty() {
+            continue;
+        }
+        let title = format!("masked MSE by gap length, {} edits (held-out captures)", kind.name());
+        let file = format!("mse_{}.png", kind.name());
+        if let Ok(bytes) = inbetween_render::rendered_bytes(&file, |p| {
+            inbetween_render::plot::grouped_bar_chart(p, &title, "masked MSE", &groups, &series)
+        }) {
+            report.file(&file, bytes);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quick_bench_on_real_captures_fills_every_table_with_finite_errors() {
+        inbetween_io::data::with_shared_data("face bench", |data| {
+            let cfg = FaceBenchConfig::quick(data.join("face/neurosync"));
+            let sets = vec![crate::weights::committed_set().expect("committed weights")];
+            let report = run(&cfg, &sets, &Progress::hidden()).expect("bench runs");
+            let names: Vec<&str> = report.tables().map(|t| t.name.as_str()).collect();
+            for n in ["heldout_by_gap", "heldout", "visemes", "table4", "table3"] {
+                assert!(names.contains(&n), "{names:?}");
+            }
+            let csv = report.tables().find(|t| t.name == "heldout").unwrap().to_csv();
+            assert!(csv.contains("ours (procedural)") && csv.contains("cubic") && csv.contains("noisy guide as is"), "{csv}");
+            for line in csv.lines().skip(1) {
+                let mse: f64 = line.split(',').nth(3).unwrap().parse().unwrap();
+                assert!(mse.is_finite() && mse >= 0.0, "{line}");
+            }
+        });
+    }
+
+    #[test]
+    fn viseme_runs_cover_the_frames() {
+        let labels = [Viseme::Sil, Viseme::Sil, Viseme::MBP, Viseme::AaAeAy];
+        let runs = viseme_runs(&labels);
+        assert_eq!(runs.len(), 3);
+        assert_eq!(runs[1].2, Viseme::MBP);
+        assert!((runs[1].0 - 1.5 / MODEL_FPS).abs() < 1e-12 && (runs[1].1 - 2.5 / MODEL_FPS).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,430 @@
+//! The edit job: a clip, the spans to regenerate, optional guidance and a method in; the edited clip
+//! out, at the clip's own frame times. Validation comes first and names every problem; nothing is
+//! written here (the caller writes atomically).
+//!
+//! Steps (§3.1, §4): resample to the model rate (25 fps) → mask (spans × selected groups) → constraint
+//! → network input → generator → recomposition `X ⊙ (1 − M) + G ⊙ M` → post-processing (exact keys, C1
+//! borders, [0, 1]) → back to the capture's frame times, touching only frames inside the spans.
+
+use crate::data::{BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT, NUM_HEAD_EYE};
+use crate::edit::hermite::{hermite, Knot};
+use crate::edit::{correct, interpolate, Constraint, ConstraintKind, Frame, Interp, Mask, Segment};
+use crate::model::input;
+use crate::visemes::Viseme;
+
+use super::keys::KeyPose;
+
+/// Something that fills erased entries from the network input (the trained generator).
+pub trait Inpainter: Sync {
+    /// The constraint type the network was trained for.
+    fn kind(&self) -> ConstraintKind;
+    /// Generated frames for `frames` frames of input laid out by [`crate::model::input`].
+    fn generate(&self, input: &[f32], frames: usize) -> Vec<Frame>;
+}
+
+/// How the erased entries are filled.
+#[derive(Clone, Copy)]
+pub enum Method<'a> {
+    /// A trained generator.
+    Network(&'a dyn Inpainter),
+    /// Linear interpolation through the borders and keys.
+    Linear,
+    /// Cubic Hermite interpolation through the borders (values and slopes) and keys.
+    Cubic,
+}
+
+impl Method<'_> {
+    /// Name for tables and messages.
+    pub fn name(&self) -> String {
+        match self {
+            Method::Network(n) => format!("network ({})", n.kind().name()),
+            Method::Linear => "linear".into(),
+            Method::Cubic => "cubic".into(),
+        }
+    }
+}
+
+/// Guidance for the edited spans, with times in seconds from the clip's first frame.
+#[derive(Clone, Debug)]
+pub enum Guide {
+    /// Unguided filling.
+    None,
+    /// Expressions to hit.
+    Keys(Vec<KeyPose>),
+    /// A noisy take of the same performance, aligned on its first frame.
+    Noisy(BlendshapeClip),
+    /// The viseme of each span of time: `(start_s, end_s, viseme)`; uncovered time is silence.
+    Visemes(Vec<(f64, f64, Viseme)>),
+}
+
+impl Guide {
+    /// The network type this guidance needs.
+    pub fn kind(&self) -> ConstraintKind {
+        match self {
+            Guide::None => ConstraintKind::None,
+            Guide::Keys(_) => ConstraintKind::Keyframes,
+            Guide::Noisy(_) => ConstraintKind::Noisy,
+            Guide::Visemes(_) => ConstraintKind::Visemes,
+        }
+    }
+}
+
+/// An edit to run.
+pub struct EditJob<'a> {
+    /// The clip to edit, at any frame rate.
+    pub clip: &'a BlendshapeClip,
+    /// Spans to regenerate, seconds from the first frame (`start < end`).
+    pub spans: Vec<(f64, f64)>,
+    /// ARKit shapes to regenerate (others stay exactly as they are).
+    pub channels: [bool; NUM_ARKIT],
+    /// Guidance.
+    pub guide: Guide,
+    /// How to fill.
+    pub method: Method<'a>,
+    /// Seed of the generator's noise.
+    pub seed: u64,
+}
+
+/// What an edit produced.
+#[derive(Clone, Debug)]
+pub struct EditOutcome {
+    /// The edited clip, at the input's frame times; frames outside the spans are the input's, bit for bit.
+    pub clip: BlendshapeClip,
+    /// The input at the model rate.
+    pub before: Vec<Frame>,
+    /// The edit at the model rate.
+    pub after: Vec<Frame>,
+    /// The mask at the model rate.
+    pub mask: Mask,
+    /// The keys at the model rate (full frames), if any.
+    pub keys: Vec<(usize, Frame)>,
+}
+
+fn invalid(m: impl Into<String>) -> FaceError {
+    FaceError::Invalid(m.into())
+}
+
+impl EditJob<'_> {
+    /// Check everything that can be checked before running.
+    pub fn validate(&self) -> Result<(), FaceError> {
+        let duration = self.clip.duration();
+        if self.clip.num_frames() < 2 {
+            return Err(invalid("the clip has a single frame; an edit needs at least two"));
+        }
+        if self.spans.is_empty() {
+            return Err(invalid("no span to edit; give at least one --mask START..END"));
+        }
+        for (a, b) in &self.spans {
+            if !(a.is_finite() && b.is_finite() && *a >= 0.0 && b > a) {
+                return Err(invalid(format!("span {a} s..{b} s: expected 0 ≤ start < end")));
+            }
+            if *a >= duration {
+                return Err(invalid(format!("span {a:.3} s..{b:.3} s starts after the clip ends ({duration:.3} s)")));
+            }
+        }
+        if !self.channels.iter().any(|c| *c) {
+            return Err(invalid("no blendshape selected to edit"));
+        }
+        if let Method::Network(net) = self.method {
+            if net.kind() != self.guide.kind() {
+                return Err(invalid(format!(
+                    "the {} network cannot take {} guidance; use the {} network",
+                    net.kind().name(),
+                    self.guide.kind().name(),
+                    self.guide.kind().name()
+                )));
+            }
+        }
+        if let Guide::Keys(keys) = &self.guide {
+            if keys.is_empty() {
+                return Err(invalid("the keys file holds no key"));
+            }
+            for k in keys {
+                if !self.spans.iter().any(|(a, b)| k.time_s >= *a && k.time_s <= *b) {
+                    return Err(invalid(format!(
+                        "key at {:.3} s lies outside every edited span; keys guide the edit only inside --mask",
+                        k.time_s
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Run the edit.
+    pub fn run(&self) -> Result<EditOutcome, FaceError> {
+        self.validate()?;
+        let model = self.clip.resample(MODEL_FPS)?;
+        let before: Vec<Frame> = (0..model.num_frames()).map(|f| frame_of(model.arkit(f))).collect();
+        let n = before.len();
+        let segments = self.segments(n);
+        let mask = Mask::from_segments(n, &segments, &self.channels);
+        let keys = self.model_keys(&before);
+        let constraint = self.constraint(&model, &keys)?;
+        let after = match self.method {
+            Method::Network(net) => {
+                let generated = generate_in_window(net, &before, &segments, &self.channels, &constraint, self.seed);
+                correct(&input::recompose(&before, &mask, &generated), &before, &mask, &keys)
+            }
+            Method::Linear => interpolate(&before, &mask, &keys, Interp::Linear),
+            Method::Cubic => interpolate(&before, &mask, &keys, Interp::Cubic),
+        };
+        let clip = self.back_to_capture_rate(&after, &mask)?;
+        Ok(EditOutcome { clip, before, after, mask, keys })
+    }
+
+    /// Spans as model-rate frames (at least one frame each).
+    fn segments(&self, n: usize) -> Vec<Segment> {
+        self.spans
+            .iter()
+            .map(|(a, b)| {
+                let start = ((a * MODEL_FPS).round() as usize).min(n - 1);
+                let end = ((b * MODEL_FPS).round() as usize).clamp(start + 1, n);
+                Segment { start, end }
+            })
+            .collect()
+    }
+
+    /// Keys at model-rate frames, unset shapes taken from the input there.
+    fn model_keys(&self, before: &[Frame]) -> Vec<(usize, Frame)> {
+        let Guide::Keys(keys) = &self.guide else { return Vec::new() };
+        keys.iter()
+            .map(|k| {
+                let f = ((k.time_s * MODEL_FPS).round() as usize).min(before.len() - 1);
+                let mut frame = before[f];
+                for (c, v) in &k.shapes {
+                    frame[*c] = *v;
+                }
+                (f, frame)
+            })
+            .collect()
+    }
+
+    fn constraint(&self, model: &BlendshapeClip, keys: &[(usize, Frame)]) -> Result<Constraint, FaceError> {
+        let n = model.num_frames();
+        Ok(match &self.guide {
+            Guide::None => Constraint::None,
+            Guide::Keys(_) => Constraint::Keyframes(keys.to_vec()),
+            Guide::Noisy(guide) => {
+                let g0 = guide.times()[0];
+                let times: Vec<f64> = (0..n).map(|f| g0 + f as f64 / MODEL_FPS).collect();
+                let g = guide.resample_at(&times, MODEL_FPS)?;
+                Constraint::Noisy((0..n).map(|f| frame_of(g.arkit(f))).collect())
+            }
+            Guide::Visemes(spans) => Constraint::Visemes(
+                (0..n)
+                    .map(|f| {
+                        let t = f as f64 / MODEL_FPS;
+                        spans.iter().find(|(a, b, _)| t >= *a && t < *b).map_or(Viseme::Sil, |s| s.2)
+                    })
+                    .collect(),
+            ),
+        })
+    }
+
+    /// The input clip with every frame inside an edited span replaced by the model-rate edit
+    /// (linear between model frames), head/eye rotations inside the spans filled by cubic Hermite
+    /// interpolation (the networks do not model them).
+    fn back_to_capture_rate(&self, after: &[Frame], mask: &Mask) -> Result<BlendshapeClip, FaceError> {
+        let clip = self.clip;
+        let t0 = clip.times()[0];
+        let stride = clip.num_channels();
+        let mut values = clip.values().to_vec();
+        let last = after.len() - 1;
+        let inside: Vec<bool> = clip.times().iter().map(|t| self.spans.iter().any(|(a, b)| t - t0 >= *a && t - t0 <= *b)).collect();
+        for (i, t) in clip.times().iter().enumerate() {
+            let x = ((t - t0) * MODEL_FPS).clamp(0.0, last as f64);
+            let (f0, f1) = (x.floor() as usize, (x.ceil() as usize).min(last));
+            let w = (x - f0 as f64) as f32;
+            for c in 0..NUM_ARKIT {
+                if mask.erased(f0, c) || mask.erased(f1, c) {
+                    values[i * stride + c] = after[f0][c] + (after[f1][c] - after[f0][c]) * w;
+                }
+            }
+        }
+        if clip.has_head_eye() && self.channels.iter().all(|c| *c) {
+            fill_head_eye(&mut values, stride, clip.times(), &inside);
+        }
+        BlendshapeClip::new(clip.fps(), clip.times().to_vec(), clip.has_head_eye(), clip.extra_names().to_vec(), values)
+    }
+}
+
+/// Context the network sees on each side of the edited spans (2 s at 25 fps): enough for the BiLSTM
+/// to pick up the motion around the gap, and it bounds the cost of an edit in a long clip.
+pub const CONTEXT_FRAMES: usize = 50;
+
+/// Run the generator on the window spanning the segments plus [`CONTEXT_FRAMES`] on each side; frames
+/// outside the window keep the input.
+fn generate_in_window(
+    net: &dyn Inpainter,
+    before: &[Frame],
+    segments: &[Segment],
+    channels: &[bool; NUM_ARKIT],
+    constraint: &Constraint,
+    seed: u64,
+) -> Vec<Frame> {
+    let n = before.len();
+    let first = segments.iter().map(|s| s.start).min().unwrap_or(0);
+    let last = segments.iter().map(|s| s.end).max().unwrap_or(n);
+    let (w0, w1) = (first.saturating_sub(CONTEXT_FRAMES), (last + CONTEXT_FRAMES).min(n));
+    let local: Vec<Segment> = segments.iter().map(|s| Segment { start: s.start - w0, end: s.end.min(w1) - w0 }).collect();
+    let mask = Mask::from_segments(w1 - w0, &local, channels);
+    let noise = input::noise(&mut inbetween_core::seed::rng(seed), w1 - w0);
+    let x = input::assemble(&before[w0..w1], &mask, &constraint.crop(w0, w1), &noise);
+    let mut out = before.to_vec();
+    out[w0..w1].copy_from_slice(&net.generate(&x, w1 - w0));
+    out
+}
+
+fn frame_of(values: &[f32]) -> Frame {
+    let mut f = [0.0; NUM_ARKIT];
+    f.copy_from_slice(&values[..NUM_ARKIT]);
+    f
+}
+
+/// Cubic Hermite across each run of `inside` frames for the head/eye channels, from the values and
+/// slopes just outside the run.
+fn fill_head_eye(values: &mut [f32], stride: usize, times: &[f64], inside: &[bool]) {
+    let n = times.len();
+    let mut f = 0;
+    while f < n {
+        if !inside[f] {
+            f += 1;
+            continue;
+        }
+        let start = f;
+        while f < n && inside[f] {
+            f += 1;
+        }
+        let end = f;
+        for c in NUM_ARKIT..NUM_ARKIT + NUM_HEAD_EYE {
+            let v = |i: usize| f64::from(values[i * stride + c]);
+            let mut knots = Vec::new();
+            if start > 0 {
+                let a = start - 1;
+                let slope = (a > 0).then(|| (v(a) - v(a - 1)) / (times[a] - times[a - 1]));
+                knots.push(Knot { t: times[a], v: v(a), slope });
+            }
+            if end < n {
+                let slope = (end + 1 < n).then(|| (v(end + 1) - v(end)) / (times[end + 1] - times[end]));
+                knots.push(Knot { t: times[end], v: v(end), slope });
+            }
+            if knots.is_empty() {
+                continue;
+            }
+            for i in start..end {
+                values[i * stride + c] = hermite(&knots, times[i]) as f32;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::arkit_index;
+
+    /// A 60 fps clip with head/eye channels: smooth waves per channel.
+    fn capture(seconds: f64) -> BlendshapeClip {
+        let n = (seconds * 60.0) as usize;
+        let times: Vec<f64> = (0..n).map(|i| 100.0 + i as f64 / 60.0).collect();
+        let stride = NUM_ARKIT + NUM_HEAD_EYE;
+        let values = (0..n * stride)
+            .map(|k| {
+                let (i, c) = (k / stride, k % stride);
+                0.5 + 0.3 * ((i as f32) * 0.05 + c as f32).sin()
+            })
+            .collect();
+        BlendshapeClip::new(60.0, times, true, vec![], values).unwrap()
+    }
+
+    struct Constant(ConstraintKind, f32);
+    impl Inpainter for Constant {
+        fn kind(&self) -> ConstraintKind {
+            self.0
+        }
+        fn generate(&self, input: &[f32], frames: usize) -> Vec<Frame> {
+            assert_eq!(input.len(), frames * input::input_dim(self.0));
+            vec![[self.1; NUM_ARKIT]; frames]
+        }
+    }
+
+    fn job<'a>(clip: &'a BlendshapeClip, guide: Guide, method: Method<'a>) -> EditJob<'a> {
+        EditJob { clip, spans: vec![(2.0, 3.5)], channels: [true; NUM_ARKIT], guide, method, seed: 1 }
+    }
+
+    #[test]
+    fn frames_outside_the_span_are_untouched_and_inside_change() {
+        let clip = capture(6.0);
+        let net = Constant(ConstraintKind::None, 0.9);
+        let out = job(&clip, Guide::None, Method::Network(&net)).run().unwrap();
+        assert_eq!(out.clip.times(), clip.times());
+        let t0 = clip.times()[0];
+        for (i, t) in clip.times().iter().enumerate() {
+            let rel = t - t0;
+            if !(1.9..=3.6).contains(&rel) {
+                assert_eq!(out.clip.frame(i), clip.frame(i), "frame {i} at {rel} s");
+            }
+        }
+        let mid = clip.times().iter().position(|t| t - t0 >= 2.75).unwrap();
+        assert!(out.clip.frame(mid)[..NUM_ARKIT].iter().zip(clip.frame(mid)).any(|(a, b)| (a - b).abs() > 0.05));
+        assert!(out.clip.values().iter().take(NUM_ARKIT).all(|v| (0.0..=1.0).contains(v)));
+    }
+
+    #[test]
+    fn keys_are_hit_exactly_and_unset_shapes_follow_the_input() {
+        let clip = capture(6.0);
+        let jaw = arkit_index("JawOpen").unwrap();
+        let keys = vec![KeyPose { time_s: 3.0, shapes: vec![(jaw, 0.95)] }];
+        let net = Constant(ConstraintKind::Keyframes, 0.2);
+        let out = job(&clip, Guide::Keys(keys), Method::Network(&net)).run().unwrap();
+        let (f, key) = out.keys[0];
+        assert_eq!(f, 75);
+        assert_eq!(out.after[75][jaw], 0.95);
+        assert_eq!(out.after[75], key);
+        assert_eq!(out.after[75][0], out.before[75][0]);
+        // the 60 fps frame at exactly 3.0 s carries the key too
+        let i = clip.times().iter().position(|t| (t - clip.times()[0] - 3.0).abs() < 1e-9).unwrap();
+        assert!((out.clip.frame(i)[jaw] - 0.95).abs() < 1e-6);
+    }
+
+    #[test]
+    fn group_edits_leave_other_groups_alone() {
+        let clip = capture(6.0);
+        let mut job = job(&clip, Guide::None, Method::Cubic);
+        job.channels = crate::edit::groups::parse_groups("mouth,jaw").unwrap();
+        let out = job.run().unwrap();
+        let blink = arkit_index("EyeBlinkLeft").unwrap();
+        for i in 0..clip.num_frames() {
+            assert_eq!(out.clip.frame(i)[blink], clip.frame(i)[blink]);
+            assert_eq!(out.clip.frame(i)[NUM_ARKIT..], clip.frame(i)[NUM_ARKIT..]);
+        }
+    }
+
+    #[test]
+    fn validation_names_mismatches() {
+        let clip = capture(4.0);
+        let net = Constant(ConstraintKind::None, 0.5);
+        let keys = Guide::Keys(vec![KeyPose { time_s: 3.9, shapes: vec![(0, 0.5)] }]);
+        let e = job(&clip, keys.clone(), Method::Network(&net)).validate().unwrap_err().to_string();
+        assert!(e.contains("unguided network") && e.contains("keyframes"), "{e}");
+        let e = job(&clip, keys, Method::Cubic).validate().unwrap_err().to_string();
+        assert!(e.contains("3.900 s") && e.contains("outside"), "{e}");
+        let mut late = job(&clip, Guide::None, Method::Linear);
+        late.spans = vec![(5.0, 6.0)];
+        assert!(late.validate().unwrap_err().to_string().contains("after the clip ends"));
+    }
+
+    #[test]
+    fn head_and_eye_rotations_join_smoothly() {
+        let clip = capture(6.0);
+        let out = job(&clip, Guide::None, Method::Cubic).run().unwrap();
+        let c = NUM_ARKIT;
+        let t0 = clip.times()[0];
+        let first = clip.times().iter().position(|t| t - t0 >= 2.0).unwrap();
+        let v = |i: usize| out.clip.frame(i)[c];
+        let step_in = (v(first) - v(first - 1)).abs();
+        let step_before = (v(first - 1) - v(first - 2)).abs();
+        assert!(step_in < 2.0 * step_before + 1e-4, "{step_in} vs {step_before}");
+    }
+}

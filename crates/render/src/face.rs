@@ -1,0 +1,1023 @@
+//! A schematic 2-D face: head outline, brows, eyes with lids and gaze, nose, lips, jaw and tongue,
+//! drawn from a [`FacePose`] of plain expression weights. It knows nothing about any rig or blendshape
+//! set: an engine maps its own channels onto a pose (the face engine maps the 52 ARKit blendshapes in
+//! `inbetween_face::preview`). People judge facial animation by looking at faces, so edits are shown
+//! as side-by-side GIFs ([`write_face_gif`]) or still panels ([`render_face_panels`]).
+//!
+//! Conventions: "left" and "right" are the *subject's* sides, as in ARKit (`MouthSmileLeft` is the
+//! subject's left corner), so with the subject facing the viewer, `_left` features are drawn on the
+//! image's right. Face geometry lives in face units (the head's half-height is 1, x right, y down);
+//! each feature also has a depth in front of the head's centre plane, so head yaw and pitch shift
+//! near features (nose, mouth) more than far ones (the outline).
+
+use crate::canvas::{text_width, Canvas};
+use crate::RenderError;
+use image::RgbImage;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// Expression weights of the schematic face. Weights are 0 (neutral) to 1 (full) unless noted;
+/// values outside the documented range are clamped and non-finite ones read as neutral
+/// ([`FacePose::sanitized`]), so any input draws without panicking. [`Default`] is the neutral face
+/// with open eyes looking ahead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FacePose {
+    /// Lower jaw drops (chin and lower lip move down): 0..1.
+    pub jaw_open: f32,
+    /// Jaw slides sideways: -1 (subject's right, image left) .. 1 (subject's left, image right).
+    pub jaw_shift: f32,
+    /// Whole mouth slides sideways, same sign as `jaw_shift`: -1..1.
+    pub mouth_shift: f32,
+    /// Upper lip lifts on the subject's left / right: 0..1.
+    pub upper_lip_raise_left: f32,
+    pub upper_lip_raise_right: f32,
+    /// Lower lip drops on the subject's left / right: 0..1.
+    pub lower_lip_drop_left: f32,
+    pub lower_lip_drop_right: f32,
+    /// Lips close despite an open jaw (cancels up to `jaw_open` of the lip opening): 0..1.
+    pub lip_close: f32,
+    /// Mouth corners rise and widen: 0..1 each side.
+    pub smile_left: f32,
+    pub smile_right: f32,
+    /// Mouth corners drop: 0..1 each side.
+    pub frown_left: f32,
+    pub frown_right: f32,
+    /// Mouth corners pull outwards (and slightly down): 0..1 each side.
+    pub stretch_left: f32,
+    pub stretch_right: f32,
+    /// Lips push forward into a narrow, thick kiss shape: 0..1.
+    pub pucker: f32,
+    /// Lips form a narrow, open funnel: 0..1.
+    pub funnel: f32,
+    /// Lips press together and thin out: 0..1.
+    pub lip_press: f32,
+    /// Lips roll inwards (less red shows): 0..1.
+    pub lip_roll: f32,
+    /// Chin pushes the lower lip up (closes the lip opening from below): 0..1.
+    pub chin_raise: f32,
+    /// Inner ends of both brows rise: 0..1.
+    pub brow_inner_up: f32,
+    /// Outer end of the brow rises: 0..1 each side.
+    pub brow_outer_up_left: f32,
+    pub brow_outer_up_right: f32,
+    /// Brow lowers and furrows towards the nose: 0..1 each side.
+    pub brow_down_left: f32,
+    pub brow_down_right: f32,
+    /// Upper lid opening: 0 closed, 1 relaxed open, up to 1.4 wide open (1.5 at most).
+    pub eyelid_open_left: f32,
+    pub eyelid_open_right: f32,
+    /// Lower lid rises, upper lid lowers a little: 0..1 each side.
+    pub squint_left: f32,
+    pub squint_right: f32,
+    /// Gaze of the subject's left eye: x -1 (image left) .. 1 (image right), y -1 (up) .. 1 (down).
+    pub gaze_left_x: f32,
+    pub gaze_left_y: f32,
+    /// Gaze of the subject's right eye, same axes.
+    pub gaze_right_x: f32,
+    pub gaze_right_y: f32,
+    /// Cheeks bulge out: 0..1.
+    pub cheek_puff: f32,
+    /// Nostril wing rises and the nose wrinkles: 0..1 each side.
+    pub sneer_left: f32,
+    pub sneer_right: f32,
+    /// Tongue sticks out over the lower lip: 0..1.
+    pub tongue_out: f32,
+    /// Head turn in radians, positive turns the face towards the image right: -0.8..0.8.
+    pub head_yaw: f32,
+    /// Head nod in radians, positive tips the chin down: -0.8..0.8.
+    pub head_pitch: f32,
+    /// Head tilt in radians, positive rotates clockwise on screen: -0.8..0.8.
+    pub head_roll: f32,
+}
+
+impl Default for FacePose {
+    fn default() -> Self {
+        FacePose {
+            jaw_open: 0.0,
+            jaw_shift: 0.0,
+            mouth_shift: 0.0,
+            upper_lip_raise_left: 0.0,
+            upper_lip_raise_right: 0.0,
+            lower_lip_drop_left: 0.0,
+            lower_lip_drop_right: 0.0,
+            lip_close: 0.0,
+            smile_left: 0.0,
+            smile_right: 0.0,
+            frown_left: 0.0,
+            frown_right: 0.0,
+            stretch_left: 0.0,
+            stretch_right: 0.0,
+            pucker: 0.0,
+            funnel: 0.0,
+            lip_press: 0.0,
+            lip_roll: 0.0,
+            chin_raise: 0.0,
+            brow_inner_up: 0.0,
+            brow_outer_up_left: 0.0,
+            brow_outer_up_right: 0.0,
+            brow_down_left: 0.0,
+            brow_down_right: 0.0,
+            eyelid_open_left: 1.0,
+            eyelid_open_right: 1.0,
+            squint_left: 0.0,
+            squint_right: 0.0,
+            gaze_left_x: 0.0,
+            gaze_left_y: 0.0,
+            gaze_right_x: 0.0,
+            gaze_right_y: 0.0,
+            cheek_puff: 0.0,
+            sneer_left: 0.0,
+            sneer_right: 0.0,
+            tongue_out: 0.0,
+            head_yaw: 0.0,
+            head_pitch: 0.0,
+            head_roll: 0.0,
+        }
+    }
+}
+
+/// `v` clamped to `lo..=hi`, or `neutral` when it is not finite.
+fn fit(v: f32, lo: f32, hi: f32, neutral: f32) -> f32 {
+    if v.is_finite() {
+        v.clamp(lo, hi)
+    } else {
+        neutral
+    }
+}
+
+/// Largest head rotation drawn, radians.
+const MAX_HEAD_ANGLE: f32 = 0.8;
+
+impl FacePose {
+    /// The pose with every field clamped to its documented range and non-finite values replaced by
+    /// the neutral ones.
+    pub fn sanitized(&self) -> FacePose {
+        let w = |v: f32| fit(v, 0.0, 1.0, 0.0);
+        let s = |v: f32| fit(v, -1.0, 1.0, 0.0);
+        let a = |v: f32| fit(v, -MAX_HEAD_ANGLE, MAX_HEAD_ANGLE, 0.0);
+        let lid = |v: f32| fit(v, 0.0, 1.5, 1.0);
+        FacePose {
+            jaw_open: w(self.jaw_open),
+            jaw_shift: s(self.jaw_shift),
+            mouth_shift: s(self.mouth_shift),
+            upper_lip_raise_left: w(self.upper_lip_raise_left),
+            upper_lip_raise_right: w(self.upper_lip_raise_right),
+            lower_lip_drop_left: w(self.lower_lip_drop_left),
+            lower_lip_drop_right: w(self.lower_lip_drop_right),
+            lip_close: w(self.lip_close),
+            smile_left: w(self.smile_left),
+            smile_right: w(self.smile_right),
+            frown_left: w(self.frown_left),
+            frown_right: w(self.frown_right),
+            stretch_left: w(self.stretch_left),
+            stretch_right: w(self.stretch_right),
+            pucker: w(self.pucker),
+            funnel: w(self.funnel),
+            lip_press: w(self.lip_press),
+            lip_roll: w(self.lip_roll),
+            chin_raise: w(self.chin_raise),
+            brow_inner_up: w(self.brow_inner_up),
+            brow_outer_up_left: w(self.brow_outer_up_left),
+            brow_outer_up_right: w(self.brow_outer_up_right),
+            brow_down_left: w(self.brow_down_left),
+            brow_down_right: w(self.brow_down_right),
+            eyelid_open_left: lid(self.eyelid_open_left),
+            eyelid_open_right: lid(self.eyelid_open_right),
+            squint_left: w(self.squint_left),
+            squint_right: w(self.squint_right),
+            gaze_left_x: s(self.gaze_left_x),
+            gaze_left_y: s(self.gaze_left_y),
+            gaze_right_x: s(self.gaze_right_x),
+            gaze_right_y: s(self.gaze_right_y),
+            cheek_puff: w(self.cheek_puff),
+            sneer_left: w(self.sneer_left),
+            sneer_right: w(self.sneer_right),
+            tongue_out: w(self.tongue_out),
+            head_yaw: a(self.head_yaw),
+            head_pitch: a(self.head_pitch),
+            head_roll: a(self.head_roll),
+        }
+    }
+
+    /// The value of a sided field for image side `side` (+1 image right = subject's left).
+    fn sided(side: f32, left: f32, right: f32) -> f32 {
+        if side > 0.0 {
+            left
+        } else {
+            right
+        }
+    }
+}
+
+// ---- colours ---------------------------------------------------------------------------------------
+
+const BACKGROUND: [u8; 3] = [250, 250, 247];
+const SKIN: [u8; 3] = [246, 222, 198];
+const OUTLINE: [u8; 3] = [120, 88, 72];
+const BROW: [u8; 3] = [92, 64, 48];
+const EYE_WHITE: [u8; 3] = [255, 255, 255];
+/// Iris colour (tests look for it).
+pub const IRIS: [u8; 3] = [64, 118, 170];
+const PUPIL: [u8; 3] = [24, 24, 30];
+const LID: [u8; 3] = [70, 46, 40];
+const LOWER_LID: [u8; 3] = [176, 136, 118];
+const LIP: [u8; 3] = [200, 98, 98];
+const LIP_LINE: [u8; 3] = [128, 52, 56];
+/// Inside of the open mouth (tests look for dark pixels of it).
+pub const MOUTH_CAVITY: [u8; 3] = [72, 22, 32];
+const TEETH: [u8; 3] = [243, 241, 232];
+const TONGUE: [u8; 3] = [222, 104, 124];
+const CHEEK: [u8; 3] = [238, 150, 140];
+const HIGHLIGHT: [u8; 3] = [230, 120, 20];
+const TEXT: [u8; 3] = [40, 40, 40];
+const SEPARATOR: [u8; 3] = [200, 200, 196];
+
+// ---- geometry in face units (head half-height 1, y down) -------------------------------------------
+
+const HEAD_RX: f32 = 0.80;
+/// Chin travel at full `jaw_open`.
+const JAW_DROP: f32 = 0.20;
+const EYE_X: f32 = 0.33;
+const EYE_Y: f32 = -0.12;
+const EYE_HALF_W: f32 = 0.16;
+/// Upper and lower lid heights above and below the eye line at the eye's middle.
+const EYE_UPPER: f32 = 0.085;
+const EYE_LOWER: f32 = 0.055;
+const IRIS_R: f32 = 0.066;
+const PUPIL_R: f32 = 0.03;
+const MOUTH_Y: f32 = 0.50;
+const MOUTH_HALF_W: f32 = 0.25;
+/// Depths in front of the head's centre plane (how far yaw and pitch shift a feature).
+const DEPTH_EYE: f32 = 0.55;
+const DEPTH_BROW: f32 = 0.6;
+const DEPTH_NOSE_BRIDGE: f32 = 0.8;
+const DEPTH_NOSE_TIP: f32 = 0.95;
+const DEPTH_MOUTH: f32 = 0.72;
+/// The outline barely moves with yaw and pitch (a sphere's silhouette).
+const DEPTH_OUTLINE: f32 = 0.08;
+/// Head roll pivots about this point (the neck), face units.
+const ROLL_PIVOT: (f32, f32) = (0.0, 0.6);
+
+/// Face units to pixels for one face drawn in one rectangle, with the head pose applied.
+struct View {
+    cx: f32,
+    cy: f32,
+    scale: f32,
+    yaw: (f32, f32),
+    pitch: (f32, f32),
+    roll: (f32, f32),
+}
+
+impl View {
+    fn new(rect: (f32, f32, f32, f32), pose: &FacePose) -> View {
+        let (x, y, w, h) = rect;
+        View {
+            cx: x + w * 0.5,
+            cy: y + h * 0.45,
+            scale: (w / 1.9).min(h / 2.45).max(0.0),
+            yaw: pose.head_yaw.sin_cos(),
+            pitch: pose.head_pitch.sin_cos(),
+            roll: pose.head_roll.sin_cos(),
+        }
+    }
+
+    /// Pixel position of the face point (x, y) lying `depth` in front of the head's centre plane.
+    fn at(&self, x: f32, y: f32, depth: f32) -> (f32, f32) {
+        let x1 = x * self.yaw.1 + depth * self.yaw.0;
+        let y1 = y * self.pitch.1 + depth * self.pitch.0;
+        self.place(x1, y1)
+    }
+
+    /// Pixel position of an outline point (not foreshortened, only shifted a little).
+    fn outline(&self, x: f32, y: f32) -> (f32, f32) {
+        self.place(x + DEPTH_OUTLINE * self.yaw.0, y + DEPTH_OUTLINE * self.pitch.0)
+    }
+
+    fn place(&self, x: f32, y: f32) -> (f32, f32) {
+        let (dx, dy) = (x - ROLL_PIVOT.0, y - ROLL_PIVOT.1);
+        let (s, c) = self.roll;
+        let (xr, yr) = (ROLL_PIVOT.0 + dx * c - dy * s, ROLL_PIVOT.1 + dx * s + dy * c);
+        (self.cx + self.scale * xr, self.cy + self.scale * yr)
+    }
+
+    /// A stroke width of `units` face units in pixels (at least one pixel).
+    fn width(&self, units: f32) -> f32 {
+        (units * self.scale).max(1.0)
+    }
+}
+
+// ---- filled polygons ------------------------------------------------------------------------------
+
+/// Vertical samples per pixel row for polygon coverage (horizontal coverage is exact).
+const SUBROWS: usize = 4;
+
+/// Crossings of the horizontal line at `y` with the polygon's edges, sorted: consecutive pairs are the
+/// inside spans (even-odd rule).
+fn crossings(poly: &[(f32, f32)], y: f32, out: &mut Vec<f32>) {
+    out.clear();
+    let n = poly.len();
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if (a.1 <= y) != (b.1 <= y) {
+            let x = a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1);
+            if x.is_finite() {
+                out.push(x);
+            }
+        }
+    }
+    out.sort_by(f32::total_cmp);
+}
+
+/// Intersection of two sorted span lists (`[x0, x1, x2, x3, …]` = spans x0..x1, x2..x3, …).
+fn intersect_spans(a: &[f32], b: &[f32]) -> Vec<f32> {
+    let mut out = Vec::new();
+    let (mut i, mut j) = (0, 0);
+    while i + 1 < a.len() && j + 1 < b.len() {
+        let (lo, hi) = (a[i].max(b[j]), a[i + 1].min(b[j + 1]));
+        if lo < hi {
+            out.extend([lo, hi]);
+        }
+        if a[i + 1] < b[j + 1] {
+            i += 2;
+        } else {
+            j += 2;
+        }
+    }
+    out
+}
+
+/// Fills the intersection of `polys` (each by the even-odd rule) with `color` at opacity `alpha`,
+/// anti-aliased: exact coverage across each row, [`SUBROWS`] samples down it.
+fn fill(cv: &mut Canvas, polys: &[&[(f32, f32)]], color: [u8; 3], alpha: f32) {
+    if polys.is_empty() || polys.iter().any(|p| p.len() < 3) || alpha <= 0.0 {
+        return;
+    }
+    let (mut x0, mut y0, mut x1, mut y1) = (0.0f32, 0.0f32, cv.width() as f32, cv.height() as f32);
+    for p in polys {
+        let (lo_x, hi_x) = p.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), q| (l.min(q.0), h.max(q.0)));
+        let (lo_y, hi_y) = p.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), q| (l.min(q.1), h.max(q.1)));
+        (x0, y0, x1, y1) = (x0.max(lo_x), y0.max(lo_y), x1.min(hi_x), y1.min(hi_y));
+    }
+    if !(x0 < x1 && y0 < y1) {
+        return;
+    }
+    let (px0, px1) = (x0.floor() as i64, x1.ceil() as i64);
+    let width = (px1 - px0) as usize;
+    // Per row: coverage of the pixels a span edge cuts (`edge`), plus a difference array of the
+    // pixels spans cover fully (`inner`), so a span costs O(1) whatever its length.
+    let mut edge = vec![0.0f32; width + 1];
+    let mut inner = vec![0.0f32; width + 1];
+    let mut xs = Vec::new();
+    let share = 1.0 / SUBROWS as f32;
+    for py in y0.floor() as i64..y1.ceil() as i64 {
+        edge.iter_mut().for_each(|a| *a = 0.0);
+        inner.iter_mut().for_each(|a| *a = 0.0);
+        for k in 0..SUBROWS {
+            let sy = py as f32 + (k as f32 + 0.5) * share;
+            crossings(polys[0], sy, &mut xs);
+            let mut spans = xs.clone();
+            for p in &polys[1..] {
+                crossings(p, sy, &mut xs);
+                spans = intersect_spans(&spans, &xs);
+            }
+            for s in spans.chunks_exact(2) {
+                let (a, b) = (s[0].max(x0) - px0 as f32, s[1].min(x1) - px0 as f32);
+                if a >= b {
+                    continue;
+                }
+                let (ia, ib) = (a.floor() as usize, b.floor() as usize);
+                if ia == ib {
+                    edge[ia] += (b - a) * share;
+                } else {
+                    edge[ia] += (ia as f32 + 1.0 - a) * share;
+                    edge[ib] += (b - ib as f32) * share;
+                    inner[ia + 1] += share;
+                    inner[ib] -= share;
+                }
+            }
+        }
+        // Fully covered opaque pixels are written in runs; the rest are blended.
+        let (mut run, mut solid_from) = (0.0, None);
+        for i in 0..=width {
+            run += inner[i];
+            let a = (edge[i] + run).min(1.0) * alpha;
+            let solid = i < width && a >= 0.999;
+            match (solid, solid_from) {
+                (true, None) => solid_from = Some(i),
+                (false, Some(from)) => {
+                    cv.rect((px0 + from as i64) as f32, py as f32, (i - from) as f32, 1.0, color);
+                    solid_from = None;
+                }
+                _ => {}
+            }
+            if !solid && i < width && a > 1e-4 {
+                cv.blend(px0 + i as i64, py, color, a);
+            }
+        }
+    }
+}
+
+/// Strokes a polyline with round joins.
+fn polyline(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3], width: f32) {
+    for w in pts.windows(2) {
+        cv.line(w[0], w[1], color, width);
+    }
+}
+
+/// `n + 1` points of the quadratic Bézier from `a` to `b` that passes through `mid` at its middle.
+fn curve_through(a: (f32, f32), mid: (f32, f32), b: (f32, f32), n: usize) -> Vec<(f32, f32)> {
+    let c = (2.0 * mid.0 - 0.5 * (a.0 + b.0), 2.0 * mid.1 - 0.5 * (a.1 + b.1));
+    (0..=n)
+        .map(|i| {
+            let t = i as f32 / n as f32;
+            let (u, v, w) = ((1.0 - t) * (1.0 - t), 2.0 * t * (1.0 - t), t * t);
+            (u * a.0 + v * c.0 + w * b.0, u * a.1 + v * c.1 + w * b.1)
+        })
+        .collect()
+}
+
+/// `n` points around an ellipse in face units, mapped by `map`.
+fn ellipse(center: (f32, f32), r: (f32, f32), n: usize, map: impl Fn(f32, f32) -> (f32, f32)) -> Vec<(f32, f32)> {
+    (0..n)
+        .map(|i| {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            map(center.0 + r.0 * a.cos(), center.1 + r.1 * a.sin())
+        })
+        .collect()
+}
+
+/// Mixes `a` towards `b` by `t` (0..1).
+fn mix(a: [u8; 3], b: [u8; 3], t: f32) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0);
+    [0, 1, 2].map(|i| (a[i] as f32 + (b[i] as f32 - a[i] as f32) * t).round() as u8)
+}
+
+/// Lid and lip profile across a feature: 1 in the middle (`u` = 0), 0 at the corners (`u` = ±1).
+fn bump(u: f32, power: f32) -> f32 {
+    (1.0 - u * u).max(0.0).powf(power)
+}
+
+/// Parameter values from -1 to 1.
+fn params(n: usize) -> impl Iterator<Item = f32> + Clone {
+    (0..=n).map(move |i| -1.0 + 2.0 * i as f32 / n as f32)
+}
+
+// ---- the face -------------------------------------------------------------------------------------
+
+/// Draws the schematic face for `pose` into `rect` = (left, top, width, height) pixels of `canvas`
+/// (the rectangle's background is left as it is; the head fills most of it). Sided fields follow the
+/// subject's sides: `_left` features appear on the image right.
+pub fn draw_face(canvas: &mut Canvas, rect: (f32, f32, f32, f32), pose: &FacePose) {
+    let p = pose.sanitized();
+    let v = View::new(rect, &p);
+    if v.scale < 4.0 {
+        return;
+    }
+    draw_head(canvas, &v, &p);
+    for side in [-1.0f32, 1.0] {
+        draw_brow(canvas, &v, &p, side);
+        draw_eye(canvas, &v, &p, side);
+    }
+    draw_nose(canvas, &v, &p);
+    draw_mouth(canvas, &v, &p);
+}
+
+/// Head outline: an ellipse whose lower half follows the jaw (drop and sideways shift) and bulges at
+/// the cheeks with `cheek_puff`.
+fn draw_head(cv: &mut Canvas, v: &View, p: &FacePose) {
+    let n = 72;
+    let outline: Vec<(f32, f32)> = (0..n)
+        .map(|i| {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            let (s, c) = a.sin_cos();
+            let (mut x, mut y) = (HEAD_RX * c, s);
+            if s > 0.0 {
+                let low = s * s;
+                y += JAW_DROP * p.jaw_open * low;
+                x += 0.08 * p.jaw_shift * low;
+            }
+            x *= 1.0 + 0.09 * p.cheek_puff * (-((y - 0.3) / 0.45).powi(2)).exp();
+            v.outline(x, y)
+        })
+        .collect();
+    fill(cv, &[&outline], SKIN, 1.0);
+    let mut closed = outline.clone();
+    closed.push(outline[0]);
+    polyline(cv, &closed, OUTLINE, v.width(0.022));
+    if p.cheek_puff > 0.01 {
+        for side in [-1.0f32, 1.0] {
+            let r = 0.09 + 0.05 * p.cheek_puff;
+            let blush = ellipse((side * 0.5, 0.32), (r, r * 0.8), 24, |x, y| v.at(x, y, DEPTH_EYE));
+            fill(cv, &[&blush], CHEEK, 0.45 * p.cheek_puff);
+        }
+    }
+}
+
+/// A brow: a thick curve over the eye whose inner end rises with `brow_inner_up`, outer end with
+/// `brow_outer_up_*`, and which lowers and slides towards the nose with `brow_down_*`.
+fn draw_brow(cv: &mut Canvas, v: &View, p: &FacePose, side: f32) {
+    let outer_up = FacePose::sided(side, p.brow_outer_up_left, p.brow_outer_up_right);
+    let down = FacePose::sided(side, p.brow_down_left, p.brow_down_right);
+    let inner_up = p.brow_inner_up;
+    let inner = (side * (0.13 - 0.03 * down), -0.34 - 0.11 * inner_up + 0.09 * down);
+    let mid = (side * 0.30, -0.40 - 0.05 * inner_up - 0.05 * outer_up + 0.06 * down);
+    let outer = (side * 0.47, -0.35 - 0.10 * outer_up + 0.05 * down);
+    let pts: Vec<(f32, f32)> =
+        curve_through(inner, mid, outer, 10).into_iter().map(|(x, y)| v.at(x, y, DEPTH_BROW)).collect();
+    polyline(cv, &pts, BROW, v.width(0.036));
+}
+
+/// An eye: the white between the lids, the iris and pupil (moved by gaze) clipped to that opening,
+/// then the upper lid line (thick) and the lower lid line (thin). `eyelid_open` 0 brings the upper lid
+/// down onto the lower one, hiding the iris; squint raises the lower lid.
+fn draw_eye(cv: &mut Canvas, v: &View, p: &FacePose, side: f32) {
+    let open = FacePose::sided(side, p.eyelid_open_left, p.eyelid_open_right);
+    let squint = FacePose::sided(side, p.squint_left, p.squint_right);
+    let gaze = if side > 0.0 { (p.gaze_left_x, p.gaze_left_y) } else { (p.gaze_right_x, p.gaze_right_y) };
+    let (ex, ey) = (side * EYE_X, EYE_Y);
+    let open = open * (1.0 - 0.25 * squint);
+    let lower_y = |u: f32| ey + EYE_LOWER * bump(u, 0.75) * (1.0 - 0.55 * squint);
+    let upper_y = |u: f32| {
+        let low = lower_y(u);
+        (low + (ey - EYE_UPPER * bump(u, 0.75) - low) * open).min(low)
+    };
+    let map = |u: f32, y: f32| v.at(ex + u * EYE_HALF_W, y, DEPTH_EYE);
+    let upper: Vec<(f32, f32)> = params(16).map(|u| map(u, upper_y(u))).collect();
+    let lower: Vec<(f32, f32)> = params(16).map(|u| map(u, lower_y(u))).collect();
+    let opening: Vec<(f32, f32)> = upper.iter().chain(lower.iter().rev()).copied().collect();
+    fill(cv, &[&opening], EYE_WHITE, 1.0);
+    let iris_c = (ex + gaze.0 * 0.08, ey - 0.004 + gaze.1 * 0.045);
+    let iris = ellipse(iris_c, (IRIS_R, IRIS_R), 28, |x, y| v.at(x, y, DEPTH_EYE));
+    fill(cv, &[&iris, &opening], IRIS, 1.0);
+    let pupil = ellipse(iris_c, (PUPIL_R, PUPIL_R), 20, |x, y| v.at(x, y, DEPTH_EYE));
+    fill(cv, &[&pupil, &opening], PUPIL, 1.0);
+    polyline(cv, &lower, LOWER_LID, v.width(0.009));
+    polyline(cv, &upper, LID, v.width(0.024));
+}
+
+/// Nose: a bridge line and a base curve whose nostril ends rise with `sneer_*`, plus wrinkle lines
+/// that darken with the sneer.
+fn draw_nose(cv: &mut Canvas, v: &View, p: &FacePose) {
+    let bridge = [v.at(0.015, -0.07, DEPTH_NOSE_BRIDGE), v.at(0.04, 0.15, DEPTH_NOSE_TIP)];
+    polyline(cv, &bridge, OUTLINE, v.width(0.014));
+    let (sl, sr) = (p.sneer_left, p.sneer_right);
+    let base = curve_through((-0.085, 0.17 - 0.045 * sr), (0.0, 0.215), (0.085, 0.17 - 0.045 * sl), 10);
+    let base: Vec<(f32, f32)> = base.into_iter().map(|(x, y)| v.at(x, y, DEPTH_NOSE_TIP)).collect();
+    polyline(cv, &base, OUTLINE, v.width(0.016));
+    for (side, s) in [(-1.0f32, sr), (1.0, sl)] {
+        if s > 0.05 {
+            let c = mix(SKIN, OUTLINE, s);
+            let a = v.at(side * 0.05, 0.0, DEPTH_NOSE_BRIDGE);
+            let b = v.at(side * 0.095, 0.07, DEPTH_NOSE_BRIDGE);
+            cv.line(a, b, c, v.width(0.01));
+        }
+    }
+}
+
+/// The mouth's shape in face units: the lip contours sampled from the subject's right corner
+/// (image left, `u` = -1) to the left corner (`u` = 1).
+struct MouthShape {
+    upper_outer: Vec<(f32, f32)>,
+    upper_inner: Vec<(f32, f32)>,
+    lower_inner: Vec<(f32, f32)>,
+    lower_outer: Vec<(f32, f32)>,
+    /// Middle of the lower inner lip edge (where the tongue comes out).
+    lower_mid: (f32, f32),
+}
+
+/// Mouth corners follow smile (up, out), frown (down), stretch (out), pucker and funnel (in); the
+/// lip opening follows the jaw (less what `lip_close` and `chin_raise` cancel), the lip raise/drop
+/// shapes and the funnel; lips thin with press and roll and thicken with pucker.
+fn mouth_shape(p: &FacePose) -> MouthShape {
+    let mx = 0.06 * p.mouth_shift;
+    let side_w = |side: f32| {
+        let smile = FacePose::sided(side, p.smile_left, p.smile_right);
+        let stretch = FacePose::sided(side, p.stretch_left, p.stretch_right);
+        (MOUTH_HALF_W * (1.0 + 0.22 * smile + 0.30 * stretch - 0.40 * p.pucker - 0.30 * p.funnel)).max(0.06)
+    };
+    let jaw_lips = (p.jaw_open - p.lip_close).max(0.0) * JAW_DROP;
+    let corner_y = |side: f32| {
+        let smile = FacePose::sided(side, p.smile_left, p.smile_right);
+        let frown = FacePose::sided(side, p.frown_left, p.frown_right);
+        let stretch = FacePose::sided(side, p.stretch_left, p.stretch_right);
+        MOUTH_Y - 0.07 * smile + 0.07 * frown + 0.02 * stretch + 0.4 * JAW_DROP * p.jaw_open
+    };
+    let (w_r, w_l) = (side_w(-1.0), side_w(1.0));
+    let (cy_r, cy_l) = (corner_y(-1.0), corner_y(1.0));
+    let open_up = |side: f32| 0.05 * FacePose::sided(side, p.upper_lip_raise_left, p.upper_lip_raise_right) + 0.02 * p.funnel;
+    let open_lo = |side: f32| {
+        let drop = FacePose::sided(side, p.lower_lip_drop_left, p.lower_lip_drop_right);
+        (jaw_lips + 0.06 * drop + 0.03 * p.funnel - 0.04 * p.chin_raise).max(0.0)
+    };
+    let thin = (1.0 - 0.7 * p.lip_roll) * (1.0 - 0.4 * p.lip_press);
+    let (t_up, t_lo) = (0.045 * thin + 0.02 * p.pucker, 0.055 * thin + 0.025 * p.pucker);
+    let jaw_x = 0.06 * p.jaw_shift;
+    let mut m = MouthShape {
+        upper_outer: Vec::new(),
+        upper_inner: Vec::new(),
+        lower_inner: Vec::new(),
+        lower_outer: Vec::new(),
+        lower_mid: (0.0, 0.0),
+    };
+    for u in params(24) {
+        let s = (u + 1.0) * 0.5; // 0 at the image-left corner, 1 at the image-right one
+        let x = mx + if u < 0.0 { u * w_r } else { u * w_l };
+        let line = (cy_r + (cy_l - cy_r) * s) * u * u + MOUTH_Y * (1.0 - u * u);
+        let b = bump(u, 0.6);
+        let up = open_up(-1.0) + (open_up(1.0) - open_up(-1.0)) * s;
+        let lo = open_lo(-1.0) + (open_lo(1.0) - open_lo(-1.0)) * s;
+        let ui = line - up * b;
+        let li = line + lo * b;
+        let bow = 0.012 * (-(u / 0.12).powi(2)).exp();
+        let xl = x + jaw_x * b;
+        m.upper_inner.push((x, ui));
+        m.upper_outer.push((x, ui - t_up * (0.3 + 0.7 * b) + bow));
+        m.lower_inner.push((xl, li));
+        m.lower_outer.push((xl, li + t_lo * (0.3 + 0.7 * b)));
+    }
+    m.lower_mid = m.lower_inner[m.lower_inner.len() / 2];
+    m
+}
+
+/// Mouth: dark cavity with upper and lower teeth when open, the two lips, the line where they meet,
+/// and the tongue when it is out.
+fn draw_mouth(cv: &mut Canvas, v: &View, p: &FacePose) {
+    let m = mouth_shape(p);
+    let px = |pts: &[(f32, f32)]| -> Vec<(f32, f32)> { pts.iter().map(|&(x, y)| v.at(x, y, DEPTH_MOUTH)).collect() };
+    let offset = |pts: &[(f32, f32)], dy: f32| -> Vec<(f32, f32)> { pts.iter().map(|&(x, y)| (x, y + dy)).collect() };
+    let join = |a: Vec<(f32, f32)>, b: Vec<(f32, f32)>| -> Vec<(f32, f32)> { a.into_iter().chain(b.into_iter().rev()).collect() };
+    let cavity = join(px(&m.upper_inner), px(&m.lower_inner));
+    fill(cv, &[&cavity], MOUTH_CAVITY, 1.0);
+    let upper_teeth = join(px(&offset(&m.upper_inner, -0.01)), px(&offset(&m.upper_inner, 0.032)));
+    fill(cv, &[&upper_teeth, &cavity], TEETH, 1.0);
+    let lower_teeth = join(px(&offset(&m.lower_inner, -0.022)), px(&offset(&m.lower_inner, 0.01)));
+    fill(cv, &[&lower_teeth, &cavity], TEETH, 1.0);
+    fill(cv, &[&join(px(&m.upper_outer), px(&m.upper_inner))], LIP, 1.0);
+    fill(cv, &[&join(px(&m.lower_inner), px(&m.lower_outer))], LIP, 1.0);
+    polyline(cv, &px(&m.upper_inner), LIP_LINE, v.width(0.012));
+    if p.tongue_out > 0.02 {
+        let t = p.tongue_out;
+        let c = (m.lower_mid.0, m.lower_mid.1 + 0.01 + 0.06 * t);
+        let tongue = ellipse(c, (0.085, 0.025 + 0.07 * t), 28, |x, y| v.at(x, y, DEPTH_MOUTH + 0.05));
+        fill(cv, &[&tongue], TONGUE, 1.0);
+        let mid = [v.at(c.0, c.1 - 0.01, DEPTH_MOUTH + 0.05), v.at(c.0, c.1 + 0.04 * t, DEPTH_MOUTH + 0.05)];
+        polyline(cv, &mid, mix(TONGUE, LIP_LINE, 0.5), v.width(0.008));
+    }
+}
+
+// ---- panels and GIFs ------------------------------------------------------------------------------
+
+/// Smallest and largest panel edge accepted, pixels.
+const PANEL_RANGE: (u32, u32) = (48, 2048);
+
+fn check_panel_size(panel_size: u32) -> Result<(), RenderError> {
+    if panel_size < PANEL_RANGE.0 || panel_size > PANEL_RANGE.1 {
+        return Err(RenderError::InvalidInput(format!(
+            "face panel size {panel_size} must be between {} and {} pixels",
+            PANEL_RANGE.0, PANEL_RANGE.1
+        )));
+    }
+    Ok(())
+}
+
+/// Text height for labels on panels of `panel_size` pixels.
+fn label_size(panel_size: u32) -> f32 {
+    (panel_size as f32 / 14.0).clamp(11.0, 28.0)
+}
+
+/// Height of a strip holding one line of text of `size`.
+fn strip_height(size: f32) -> u32 {
+    (size * 1.6).ceil() as u32
+}
+
+/// Draws `text` centred horizontally in the `width`-pixel column starting at `x`.
+fn centred_text(cv: &mut Canvas, x: f32, width: f32, y: f32, text: &str, size: f32, color: [u8; 3]) {
+    let w = text_width(text, size);
+    cv.text((x + (width - w).max(0.0) * 0.5, y), text, size, color);
+}
+
+/// Faces side by side, each in a `panel_size`-pixel square under its label.
+pub fn render_face_panels(panels: &[(&str, &FacePose)], panel_size: u32) -> Result<RgbImage, RenderError> {
+    check_panel_size(panel_size)?;
+    if panels.is_empty() {
+        return Err(RenderError::InvalidInput("no face panels to draw".into()));
+    }
+    let labels: Vec<&str> = panels.iter().map(|p| p.0).collect();
+    let mut cv = header(&labels, None, panel_size, 0);
+    let top = strip_height(label_size(panel_size)) as f32;
+    for (i, (_, pose)) in panels.iter().enumerate() {
+        draw_face(&mut cv, ((i as u32 * panel_size) as f32, top, panel_size as f32, panel_size as f32), pose);
+    }
+    separators(&mut cv, panels.len(), panel_size);
+    Ok(cv.into_image())
+}
+
+/// A canvas for `labels.len()` panels: the optional title line and the label line on top, the
+/// panels, and `footer` pixels below them.
+fn header(labels: &[&str], title: Option<&str>, panel_size: u32, footer: u32) -> Canvas {
+    let size = label_size(panel_size);
+    let line = strip_height(size);
+    let title_h = if title.is_some() { line } else { 0 };
+    let width = labels.len() as u32 * panel_size;
+    let mut cv = Canvas::new(width, title_h + line + panel_size + footer, BACKGROUND);
+    if let Some(t) = title {
+        centred_text(&mut cv, 0.0, width as f32, size * 0.3, t, size, TEXT);
+    }
+    for (i, l) in labels.iter().enumerate() {
+        centred_text(&mut cv, (i as u32 * panel_size) as f32, panel_size as f32, title_h as f32 + size * 0.3, l, size, TEXT);
+    }
+    cv
+}
+
+/// One-pixel lines between neighbouring panels.
+fn separators(cv: &mut Canvas, panels: usize, panel_size: u32) {
+    for i in 1..panels {
+        cv.rect((i as u32 * panel_size) as f32, 0.0, 1.0, cv.height() as f32, SEPARATOR);
+    }
+}
+
+/// How [`write_face_gif`] lays out its frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaceGifOptions {
+    /// Playback rate, frames per second (one GIF frame per pose).
+    pub fps: f64,
+    /// Edge of each face's square panel, pixels.
+    pub panel_size: u32,
+    /// A line above the column labels.
+    pub title: Option<String>,
+    /// Caption shown (and the frame tinted) on highlighted frames.
+    pub highlight_caption: String,
+}
+
+impl Default for FaceGifOptions {
+    fn default() -> Self {
+        FaceGifOptions { fps: 25.0, panel_size: 240, title: None, highlight_caption: "edited span".into() }
+    }
+}
+
+/// Checks columns and highlight flags; returns the number of frames.
+fn check_columns(columns: &[(String, Vec<FacePose>)], highlight: &[bool]) -> Result<usize, RenderError> {
+    let first = columns.first().ok_or_else(|| RenderError::InvalidInput("no face columns to draw".into()))?;
+    let n = first.1.len();
+    if n == 0 {
+        return Err(RenderError::InvalidInput(format!("face column '{}' has no frames", first.0)));
+    }
+    if let Some((name, poses)) = columns.iter().find(|c| c.1.len() != n) {
+        return Err(RenderError::InvalidInput(format!(
+            "face column '{name}' has {} frames but '{}' has {n}; all columns must have one length",
+            poses.len(),
+            first.0
+        )));
+    }
+    if !highlight.is_empty() && highlight.len() != n {
+        return Err(RenderError::InvalidInput(format!(
+            "{} highlight flags for {n} frames (give one per frame, or none)",
+            highlight.len()
+        )));
+    }
+    Ok(n)
+}
+
+/// The frames of [`write_face_gif`]: one image per pose index, columns side by side under their
+/// labels, a footer with the time, and on highlighted frames an orange frame and the caption.
+pub fn render_face_frames(
+    columns: &[(String, Vec<FacePose>)],
+    highlight: &[bool],
+    opts: &FaceGifOptions,
+) -> Result<Vec<RgbImage>, RenderError> {
+    check_panel_size(opts.panel_size)?;
+    let n = check_columns(columns, highlight)?;
+    if !(opts.fps.is_finite() && opts.fps > 0.0) {
+        return Err(RenderError::InvalidInput(format!("face GIF frame rate {} must be a positive number", opts.fps)));
+    }
+    let size = label_size(opts.panel_size);
+    let footer = strip_height(size);
+    let labels: Vec<&str> = columns.iter().map(|c| c.0.as_str()).collect();
+    let base = header(&labels, opts.title.as_deref(), opts.panel_size, footer);
+    let top = (base.height() - footer - opts.panel_size) as f32;
+    let frames = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let mut cv = base.clone();
+            let ps = opts.panel_size as f32;
+            for (c, (_, poses)) in columns.iter().enumerate() {
+                draw_face(&mut cv, (c as f32 * ps, top, ps, ps), &poses[i]);
+            }
+            separators(&mut cv, columns.len(), opts.panel_size);
+            let y = top + ps + size * 0.3;
+            cv.text((size * 0.5, y), &format!("{:.2} s", i as f64 / opts.fps), size, TEXT);
+            if highlight.get(i).copied().unwrap_or(false) {
+                let border = (opts.panel_size as f32 / 80.0).max(2.0).round();
+                let (w, h) = (cv.width() as f32, ps);
+                for k in 0..border as u32 {
+                    let k = k as f32;
+                    cv.rect_outline(k, top + k, w - 2.0 * k, h - 2.0 * k, HIGHLIGHT);
+                }
+                let tw = text_width(&opts.highlight_caption, size);
+                cv.text((w - tw - size * 0.5, y), &opts.highlight_caption, size, HIGHLIGHT);
+            }
+            cv.into_image()
+        })
+        .collect();
+    Ok(frames)
+}
+
+/// Writes an animated GIF of several face animations side by side (e.g. original, edited), one
+/// frame per pose at `opts.fps`, atomically. `highlight` is empty or one flag per frame: flagged
+/// frames get an orange frame and `opts.highlight_caption` (e.g. while inside the edited span).
+/// `progress(done, total)` is called as frames are encoded.
+pub fn write_face_gif(
+    path: &Path,
+    columns: &[(String, Vec<FacePose>)],
+    highlight: &[bool],
+    opts: &FaceGifOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(), RenderError> {
+    let frames = render_face_frames(columns, highlight, opts)?;
+    crate::write_gif_with_progress(path, &frames, opts.fps, progress)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SIZE: u32 = 240;
+
+    fn face(pose: &FacePose) -> Canvas {
+        let mut cv = Canvas::new(SIZE, SIZE, BACKGROUND);
+        draw_face(&mut cv, (0.0, 0.0, SIZE as f32, SIZE as f32), pose);
+        cv
+    }
+
+    /// Pixels in the region (pixel rectangle) that satisfy `pred`.
+    fn count(cv: &Canvas, region: (u32, u32, u32, u32), pred: impl Fn([u8; 3]) -> bool) -> Vec<(u32, u32)> {
+        let (x0, y0, x1, y1) = region;
+        (y0..y1.min(cv.height())).flat_map(|y| (x0..x1.min(cv.width())).map(move |x| (x, y))).filter(|&(x, y)| pred(cv.pixel(x, y))).collect()
+    }
+
+    fn whole() -> (u32, u32, u32, u32) {
+        (0, 0, SIZE, SIZE)
+    }
+
+    fn is_dark(c: [u8; 3]) -> bool {
+        c.iter().all(|&v| v < 110)
+    }
+
+    fn is_iris(c: [u8; 3]) -> bool {
+        c == IRIS
+    }
+
+    /// Pixel box of the mouth region in the neutral framing (face units 0.2..1.0 down, ±0.5 across).
+    fn mouth_region() -> (u32, u32, u32, u32) {
+        let v = View::new((0.0, 0.0, SIZE as f32, SIZE as f32), &FacePose::default());
+        let (a, b) = (v.at(-0.5, 0.25, 0.0), v.at(0.5, 1.0, 0.0));
+        (a.0 as u32, a.1 as u32, b.0 as u32, b.1 as u32)
+    }
+
+    fn centroid_x(pts: &[(u32, u32)]) -> f32 {
+        pts.iter().map(|p| p.0 as f32).sum::<f32>() / pts.len().max(1) as f32
+    }
+
+    #[test]
+    fn an_open_jaw_shows_more_dark_mouth_than_a_closed_one() {
+        let closed = count(&face(&FacePose::default()), mouth_region(), is_dark).len();
+        let open = count(&face(&FacePose { jaw_open: 0.8, ..FacePose::default() }), mouth_region(), is_dark).len();
+        assert!(open > closed + 150, "open mouth {open} dark pixels, closed {closed}");
+        // MouthClose cancels the lip opening the jaw would give.
+        let sealed = FacePose { jaw_open: 0.8, lip_close: 0.8, ..FacePose::default() };
+        let sealed = count(&face(&sealed), mouth_region(), is_dark).len();
+        assert!(sealed < open / 3, "lips closed over an open jaw: {sealed} dark pixels vs {open}");
+    }
+
+    #[test]
+    fn closed_lids_hide_the_iris_and_wide_lids_show_more() {
+        let open = count(&face(&FacePose::default()), whole(), is_iris).len();
+        assert!(open > 100, "open eyes show {open} iris pixels");
+        let shut = FacePose { eyelid_open_left: 0.0, eyelid_open_right: 0.0, ..FacePose::default() };
+        assert_eq!(count(&face(&shut), whole(), is_iris).len(), 0, "closed lids must hide the iris");
+        let half = FacePose { eyelid_open_left: 0.5, eyelid_open_right: 0.5, ..FacePose::default() };
+        let half = count(&face(&half), whole(), is_iris).len();
+        assert!(half > 0 && half < open, "half-closed {half} vs open {open}");
+        // One lid only: the iris remains on the other side of the image.
+        let wink = FacePose { eyelid_open_left: 0.0, ..FacePose::default() };
+        let wink = count(&face(&wink), whole(), is_iris);
+        assert!(!wink.is_empty() && wink.iter().all(|p| p.0 < SIZE / 2), "the subject's left eye is on the image right");
+    }
+
+    #[test]
+    fn gaze_moves_the_iris() {
+        let ahead = centroid_x(&count(&face(&FacePose::default()), whole(), is_iris));
+        let right = FacePose { gaze_left_x: 1.0, gaze_right_x: 1.0, ..FacePose::default() };
+        let right = centroid_x(&count(&face(&right), whole(), is_iris));
+        assert!(right > ahead + 4.0, "looking right moves the iris right: {ahead} -> {right}");
+        let up = FacePose { gaze_left_y: -1.0, gaze_right_y: -1.0, eyelid_open_left: 1.4, eyelid_open_right: 1.4, ..FacePose::default() };
+        let wide = FacePose { eyelid_open_left: 1.4, eyelid_open_right: 1.4, ..FacePose::default() };
+        let cy = |pose: &FacePose| {
+            let pts = count(&face(pose), whole(), is_iris);
+            pts.iter().map(|p| p.1 as f32).sum::<f32>() / pts.len() as f32
+        };
+        assert!(cy(&up) < cy(&wide) - 1.0, "looking up moves the iris up");
+    }
+
+    /// Leftmost and rightmost lip pixels of the mouth.
+    fn mouth_extent(pose: &FacePose) -> (u32, u32) {
+        let pts = count(&face(pose), mouth_region(), |c| c == LIP || c == LIP_LINE);
+        (pts.iter().map(|p| p.0).min().unwrap(), pts.iter().map(|p| p.0).max().unwrap())
+    }
+
+    #[test]
+    fn a_smile_moves_the_corners_outwards_and_a_pucker_inwards() {
+        let (l0, r0) = mouth_extent(&FacePose::default());
+        let (l1, r1) = mouth_extent(&FacePose { smile_left: 1.0, smile_right: 1.0, ..FacePose::default() });
+        assert!(l1 + 3 < l0 && r1 > r0 + 3, "smile widens the mouth: {l0}..{r0} -> {l1}..{r1}");
+        let (l2, r2) = mouth_extent(&FacePose { pucker: 1.0, ..FacePose::default() });
+        assert!(l2 > l0 + 5 && r2 + 5 < r0, "pucker narrows the mouth: {l0}..{r0} -> {l2}..{r2}");
+        // A one-sided smile moves only the subject's left corner (image right).
+        let (l3, r3) = mouth_extent(&FacePose { smile_left: 1.0, ..FacePose::default() });
+        assert!(l3.abs_diff(l0) <= 1 && r3 > r0 + 3, "{l0}..{r0} -> {l3}..{r3}");
+    }
+
+    #[test]
+    fn tongue_brows_and_head_pose_change_the_picture() {
+        let neutral = face(&FacePose::default());
+        let tongue = face(&FacePose { tongue_out: 1.0, jaw_open: 0.4, ..FacePose::default() });
+        assert!(!count(&tongue, mouth_region(), |c| c == TONGUE).is_empty());
+        assert!(count(&neutral, whole(), |c| c == TONGUE).is_empty());
+        // Raised brows move brow pixels up.
+        let brow_y = |cv: &Canvas| {
+            let pts = count(cv, (0, 0, SIZE, SIZE / 2), |c| c == BROW);
+            pts.iter().map(|p| p.1 as f32).sum::<f32>() / pts.len() as f32
+        };
+        let raised = face(&FacePose { brow_inner_up: 1.0, brow_outer_up_left: 1.0, brow_outer_up_right: 1.0, ..FacePose::default() });
+        assert!(brow_y(&raised) < brow_y(&neutral) - 3.0);
+        // Yaw shifts the features (iris) more than nothing.
+        let turned = face(&FacePose { head_yaw: 0.5, ..FacePose::default() });
+        let shift = centroid_x(&count(&turned, whole(), is_iris)) - centroid_x(&count(&neutral, whole(), is_iris));
+        assert!(shift > 10.0, "a head turn to the right moves the eyes right by {shift} px");
+    }
+
+    #[test]
+    fn bad_values_draw_without_panicking() {
+        let wild = FacePose { jaw_open: f32::NAN, head_yaw: f32::INFINITY, eyelid_open_left: -5.0, smile_left: 1e9, ..FacePose::default() };
+        assert_eq!(wild.sanitized().jaw_open, 0.0);
+        assert_eq!(wild.sanitized().eyelid_open_left, 0.0);
+        let cv = face(&wild);
+        assert!(count(&cv, whole(), |c| c == SKIN).len() > 1000);
+        // A tiny rectangle draws nothing rather than failing.
+        let mut small = Canvas::new(4, 4, BACKGROUND);
+        draw_face(&mut small, (0.0, 0.0, 4.0, 4.0), &FacePose::default());
+        assert_eq!(small.pixel(2, 2), BACKGROUND);
+    }
+
+    #[test]
+    fn span_intersection() {
+        assert_eq!(intersect_spans(&[0.0, 5.0, 7.0, 9.0], &[3.0, 8.0]), vec![3.0, 5.0, 7.0, 8.0]);
+        assert!(intersect_spans(&[0.0, 1.0], &[2.0, 3.0]).is_empty());
+    }
+
+    #[test]
+    fn panels_sit_side_by_side_under_labels() {
+        let smile = FacePose { smile_left: 1.0, smile_right: 1.0, ..FacePose::default() };
+        let img = render_face_panels(&[("neutral", &FacePose::default()), ("smile", &smile)], 120).unwrap();
+        let top = strip_height(label_size(120));
+        assert_eq!(img.dimensions(), (240, 120 + top));
+        let cv = Canvas::from_image(img);
+        assert!(!count(&cv, (0, 0, 120, top), |c| c[0] < 100).is_empty(), "label text");
+        assert!(count(&cv, (0, top, 120, top + 120), |c| c == SKIN).len() > 1000);
+        assert!(count(&cv, (120, top, 240, top + 120), |c| c == SKIN).len() > 1000);
+        assert!(render_face_panels(&[], 120).is_err());
+        assert!(render_face_panels(&[("x", &smile)], 8).is_err());
+    }
+
+    #[test]
+    fn gif_has_one_frame_per_pose_and_highlights_flagged_frames() {
+        use image::AnimationDecoder;
+        let n = 6;
+        let talk: Vec<FacePose> = (0..n).map(|i| FacePose { jaw_open: i as f32 / n as f32, ..FacePose::default() }).collect();
+        let still = vec![FacePose::default(); n];
+        let columns = vec![("original".to_string(), still), ("edited".to_string(), talk)];
+        let highlight: Vec<bool> = (0..n).map(|i| (2..4).contains(&i)).collect();
+        let opts = FaceGifOptions { panel_size: 96, title: Some("test".into()), ..FaceGifOptions::default() };
+        let frames = render_face_frames(&columns, &highlight, &opts).unwrap();
+        let orange = |img: &RgbImage| img.pixels().filter(|p| p.0 == HIGHLIGHT).count();
+        assert_eq!(orange(&frames[1]), 0);
+        assert!(orange(&frames[2]) > 300, "highlighted frame has an orange frame: {}", orange(&frames[2]));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("face.gif");
+        let mut calls = 0;
+        write_face_gif(&path, &columns, &highlight, &opts, &mut |_, _| calls += 1).unwrap();
+        assert_eq!(calls, n);
+        let file = std::io::BufReader::new(std::fs::File::open(&path).unwrap());
+        let decoded = image::codecs::gif::GifDecoder::new(file).unwrap().into_frames().collect_frames().unwrap();
+        assert_eq!(decoded.len(), n);
+        assert_eq!(decoded[0].buffer().dimensions(), frames[0].dimensions());
+        assert_eq!(frames[0].width(), 2 * 96);
+        // Mismatched inputs are errors and write nothing.
+        let bad = vec![("a".to_string(), vec![FacePose::default(); 3]), ("b".to_string(), vec![FacePose::default(); 2])];
+        let bad_path = dir.path().join("bad.gif");
+        let err = write_face_gif(&bad_path, &bad, &[], &opts, &mut |_, _| {}).unwrap_err().to_string();
+        assert!(err.contains("'b' has 2 frames"), "{err}");
+        assert!(write_face_gif(&bad_path, &columns, &[true], &opts, &mut |_, _| {}).is_err());
+        assert!(!bad_path.exists());
+    }
+}
