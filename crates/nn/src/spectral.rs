@@ -85,6 +85,9 @@ impl SpectralState {
         let u0 = self.u.value_sync().to_device(&m.device()).detach();
         let (u, v) = power_iteration(m.clone().detach(), u0, self.n_power_iterations);
         self.u.update(u.clone().detach());
+        // burn's RunningState holds an update pending until the next `value_sync`, and records read
+        // the committed value: commit now, so a checkpoint holds this `u` and a resumed run is exact.
+        let _ = self.u.value_sync();
         let sigma = sigma_estimate(m.clone(), u, v);
         let [rows, cols] = m.dims();
         (

@@ -17,46 +17,32 @@ pub struct Knot {
 /// after the last knot the curve is held flat, since a blendshape should
 /// not drift away from its last known value.
 pub fn hermite(knots: &[Knot], t: f64) -> f64 {
-    match knots {
-        [] => 0.0,
-        [k] => k.v,
-        _ => {
-            let last = knots.len() - 1;
-            if t <= knots[0].t {
-                return knots[0].v;
-            }
-            if t >= knots[last].t {
-                return knots[last].v;
-            }
-            let i = knots.partition_point(|k| k.t <= t).saturating_sub(1).min(last - 1);
-            let (a, b) = (&knots[i], &knots[i + 1]);
-            let h = b.t - a.t;
-            let s = (t - a.t) / h;
-            let (ma, mb) = (slope_at(knots, i) * h, slope_at(knots, i + 1) * h);
-            let (s2, s3) = (s * s, s * s * s);
-            (2.0 * s3 - 3.0 * s2 + 1.0) * a.v + (s3 - 2.0 * s2 + s) * ma + (-2.0 * s3 + 3.0 * s2) * b.v + (s3 - s2) * mb
-        }
-    }
+    interval(knots, t, |i, s, h| {
+        let (a, b) = (&knots[i], &knots[i + 1]);
+        let (ma, mb) = (slope_at(knots, i) * h, slope_at(knots, i + 1) * h);
+        let (s2, s3) = (s * s, s * s * s);
+        (2.0 * s3 - 3.0 * s2 + 1.0) * a.v + (s3 - 2.0 * s2 + s) * ma + (-2.0 * s3 + 3.0 * s2) * b.v + (s3 - s2) * mb
+    })
 }
 
 /// Linear interpolation through `knots` (held flat outside them).
 pub fn linear(knots: &[Knot], t: f64) -> f64 {
-    match knots {
-        [] => 0.0,
-        [k] => k.v,
-        _ => {
-            let last = knots.len() - 1;
-            if t <= knots[0].t {
-                return knots[0].v;
-            }
-            if t >= knots[last].t {
-                return knots[last].v;
-            }
-            let i = knots.partition_point(|k| k.t <= t).saturating_sub(1).min(last - 1);
-            let (a, b) = (&knots[i], &knots[i + 1]);
-            a.v + (b.v - a.v) * (t - a.t) / (b.t - a.t)
-        }
+    interval(knots, t, |i, s, _| knots[i].v + (knots[i + 1].v - knots[i].v) * s)
+}
+
+/// The value at `t`: the end values outside the knots (0 with none), else `inside(i, s, h)` on the
+/// interval `knots[i]..knots[i + 1]` of length `h` at the fraction `s` of it.
+fn interval(knots: &[Knot], t: f64, inside: impl Fn(usize, f64, f64) -> f64) -> f64 {
+    let (Some(first), Some(last)) = (knots.first(), knots.last()) else { return 0.0 };
+    if knots.len() == 1 || t <= first.t {
+        return first.v;
     }
+    if t >= last.t {
+        return last.v;
+    }
+    let i = knots.partition_point(|k| k.t <= t).saturating_sub(1).min(knots.len() - 2);
+    let h = knots[i + 1].t - knots[i].t;
+    inside(i, (t - knots[i].t) / h, h)
 }
 
 /// The slope at knot `i`: its own, else Catmull–Rom (central difference of the neighbours), one-sided

@@ -131,12 +131,6 @@ impl Critic {
     /// The normalised weights for this step (advances each power iteration once).
     pub fn weights(&self) -> CriticWeights {
         let kernels = self.convs.iter().map(SpectralConv1d::normalized_weight).collect();
-        // burn's RunningState keeps an update pending (per thread) until the next read with
-        // `value_sync`; records read the committed value, so a checkpoint would hold `u` one power
-        // iteration behind and a resumed run would diverge. Commit the update now.
-        for conv in &self.convs {
-            let _ = conv.spectral.u.value_sync();
-        }
         CriticWeights {
             kernels,
             biases: self.convs.iter().map(|c| c.bias.as_ref().map(|b| b.val())).collect(),
