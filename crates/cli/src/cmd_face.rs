@@ -140,6 +140,10 @@ pub struct BenchArgs {
     /// A small run (one held-out file, few edits).
     #[arg(long)]
     pub quick: bool,
+    /// A folder of weights trained on procedural clips (`face train`) to bench instead of the
+    /// committed ones.
+    #[arg(long)]
+    pub weights: Option<PathBuf>,
     /// A folder of weights trained on the real captures (`face train --data real`), compared too.
     #[arg(long)]
     pub real_weights: Option<PathBuf>,
@@ -347,7 +351,10 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
     let captures = captures_dir(a.captures.as_deref())?;
     let cfg = if a.quick { FaceBenchConfig::quick(captures) } else { FaceBenchConfig::full(captures) };
-    let mut sets = vec![weights::committed_set()?];
+    let mut sets = vec![match &a.weights {
+        Some(dir) => weights::set_from_dir(dir, "procedural")?,
+        None => weights::committed_set()?,
+    }];
     if let Some(dir) = &a.real_weights {
         sets.push(weights::set_from_dir(dir, "real")?);
     }

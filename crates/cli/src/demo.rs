@@ -19,8 +19,8 @@ pub struct DemoArgs {
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    // One step for the walk, four for the mocap demo, one for the camera demo, one for the face demo.
-    let steps = Progress::new(7, "demo");
+    // One step for the walk, four for the mocap demo, one each for the camera, face and video demos.
+    let steps = Progress::new(8, "demo");
     let mut params = GaitParams::walk().jittered(a.seed, 0.15);
     params.frames = 150;
     params.turn_rate = 0.35;
@@ -52,6 +52,17 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         "face: 3 s occlusion of a procedural capture, masked MSE {} -> {}",
         mse.join(", "),
         face.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+    ));
+    let video = inbetween_video::demo::run(&a.out, a.seed, &Progress::hidden())?;
+    steps.inc(1);
+    lines.push(format!(
+        "video: procedural clip resequenced from frame {}: {} frames, M_D {:.4} (source {:.4}), Δo {:.3} -> {}",
+        inbetween_video::demo::START,
+        video.order.len(),
+        video.md.0,
+        video.md.1,
+        video.delta_o,
+        video.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
     ));
     steps.finish();
     for l in lines {

@@ -5,6 +5,7 @@ mod cmd_face;
 mod cmd_io;
 mod cmd_mocap;
 mod cmd_preview;
+mod cmd_video;
 mod demo;
 mod errors;
 
@@ -41,6 +42,9 @@ enum Command {
     /// Face engine: blendshape animation editing by inpainting (BiLSTM GAN), guided by keys, a noisy take or visemes.
     #[command(subcommand)]
     Face(cmd_face::FaceCommand),
+    /// Video engine: new frame orders from one clip (learned frame metric RSFNet + SDPF path finding).
+    #[command(subcommand)]
+    Video(cmd_video::VideoCommand),
 }
 
 fn main() -> ExitCode {
@@ -66,5 +70,6 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Mocap(c) => cmd_mocap::run(c),
         Command::Camera(c) => cmd_camera::run(c),
         Command::Face(c) => cmd_face::run(c),
+        Command::Video(c) => cmd_video::run(c),
     }
 }

@@ -5,15 +5,17 @@
 //! from a seeded generator, not from the device's global random generator: a training step is then
 //! a function of its seed alone, whatever else runs in the process.
 //!
-//! The output goes through a sigmoid, so every generated weight lies in (0, 1) (the issue's "weights
-//! stay in [0, 1]"); the paper's dense layer is linear. The sequence is a `Vec` of per-step
+//! The dense layer outputs a correction of the linear prior that the input carries in its first 52
+//! features ([`super::input`]: a difference on purpose), and starts at zero, so an untrained
+//! generator gives the linear baseline. [`Generator::forward`] clamps `prior + correction` to
+//! [0, 1] (the issue's "weights stay in [0, 1]"); training uses the unclamped sum
+//! ([`Generator::forward_dropped`]) so that no gradient is cut. The sequence is a `Vec` of per-step
 //! `[batch, input_dim]` tensors ([`inbetween_nn::lstm`]: slicing one big tensor per step makes
 //! backward quadratic in the length); the dense layer then runs once over the stacked
 //! `[batch, frames, 2·d_hidden]` outputs.
 
 use burn::module::Module;
-use burn::nn::{Linear, LinearConfig};
-use burn::tensor::activation::sigmoid;
+use burn::nn::{Initializer, Linear, LinearConfig};
 use burn::tensor::{Device, Tensor, TensorData};
 use inbetween_nn::burn;
 use inbetween_nn::lstm::{stack_time, BiLstm, BiLstmConfig};
@@ -54,7 +56,8 @@ impl GeneratorConfig {
     /// [`inbetween_nn::backend::seeded_module`] for seeded weights.
     pub fn init(&self, device: &Device) -> Generator {
         let lstm = BiLstmConfig::new(self.d_input(), self.d_hidden).with_num_layers(self.layers.max(1)).init(device);
-        Generator { lstm, output: LinearConfig::new(2 * self.d_hidden, NUM_ARKIT).init(device) }
+        let output = LinearConfig::new(2 * self.d_hidden, NUM_ARKIT).with_initializer(Initializer::Zeros).init(device);
+        Generator { lstm, output }
     }
 
     /// The configuration as saved in a weights card.
@@ -111,7 +114,7 @@ impl GeneratorCard {
 /// `kind` of the weights card of a face generator ([`inbetween_nn::weights`]).
 pub const WEIGHTS_KIND: &str = "face";
 /// Architecture version of face generator weights; bump it when the parameter layout changes.
-pub const WEIGHTS_FORMAT: u32 = 1;
+pub const WEIGHTS_FORMAT: u32 = 2;
 
 /// The `config` of a face weights card: the generator and the window length it was trained on.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -122,12 +125,12 @@ pub struct FaceWeightsConfig {
     pub window: usize,
 }
 
-/// BiLSTM stack + (training) dropout + dense layer with a sigmoid (§3.2).
+/// BiLSTM stack + (training) dropout + dense layer adding to the linear prior (§3.2).
 #[derive(Module, Debug)]
 pub struct Generator {
     /// The bidirectional LSTM layers.
     pub lstm: BiLstm,
-    /// `2·d_hidden → 52`, followed by a sigmoid.
+    /// `2·d_hidden → 52`: the correction of the prior.
     pub output: Linear,
 }
 
@@ -151,19 +154,31 @@ impl Generator {
         self.lstm.layers[0].forward.d_hidden
     }
 
-    /// The generated animation `[batch, frames, 52]` in (0, 1) from per-frame inputs
+    /// The generated animation `[batch, frames, 52]` in [0, 1] from per-frame inputs
     /// (`frames` tensors of `[batch, input_dim]`, laid out by [`super::input`]).
     pub fn forward(&self, steps: &[Tensor<2>]) -> Tensor<3> {
         let hidden = stack_time(&self.lstm.forward_seq(steps));
-        sigmoid(self.output.forward(hidden))
+        (prior(steps) + self.output.forward(hidden)).clamp(0.0, 1.0)
     }
 
-    /// [`Self::forward`] with dropout: the recurrent outputs are multiplied by `keep` (a
-    /// [`dropout_mask`] of shape `[batch, frames, 2·d_hidden]`) before the dense layer.
+    /// The training forward pass: dropout (the recurrent outputs are multiplied by `keep`, a
+    /// [`dropout_mask`] of shape `[batch, frames, 2·d_hidden]`, before the dense layer) and no clamp.
     pub fn forward_dropped(&self, steps: &[Tensor<2>], keep: Tensor<3>) -> Tensor<3> {
         let hidden = stack_time(&self.lstm.forward_seq(steps));
-        sigmoid(self.output.forward(hidden * keep))
+        prior(steps) + self.output.forward(hidden * keep)
     }
+}
+
+/// The linear prior `[batch, frames, 52]`: the first 52 input features of every step.
+fn prior(steps: &[Tensor<2>]) -> Tensor<3> {
+    let p: Vec<Tensor<2>> = steps
+        .iter()
+        .map(|s| {
+            let [batch, _] = s.dims();
+            s.clone().slice([0..batch, 0..NUM_ARKIT])
+        })
+        .collect();
+    stack_time(&p)
 }
 
 #[cfg(test)]
@@ -181,26 +196,33 @@ mod tests {
     }
 
     #[test]
-    fn model_generator_output_has_52_weights_in_the_unit_interval() {
+    fn model_generator_starts_at_the_prior_and_stays_in_the_unit_interval() {
         let device = backend::cpu();
         let config = GeneratorConfig { kind: ConstraintKind::Keyframes, d_hidden: 8, layers: 2, dropout: 0.3 };
         let g = backend::seeded_module(&device, 1, |d| config.init(d));
         assert_eq!(g.d_input(), input_dim(ConstraintKind::Keyframes));
         assert_eq!(g.d_hidden(), 8);
-        let y = g.forward(&steps(6, 3, g.d_input(), &device));
+        let x = steps(6, 3, g.d_input(), &device);
+        let y = g.forward(&x);
         assert_eq!(y.dims(), [3, 6, NUM_ARKIT]);
         let v = y.into_data().try_to_vec::<f32>().unwrap();
-        assert!(v.iter().all(|x| *x > 0.0 && *x < 1.0));
+        let p: Vec<f32> = prior(&x).clamp(0.0, 1.0).into_data().try_to_vec::<f32>().unwrap();
+        assert_eq!(v, p, "an untrained generator gives the prior");
+        // A trained (non-zero) output layer: still in [0, 1]; the training pass is unclamped.
+        let g = Generator { output: LinearConfig::new(16, NUM_ARKIT).init(&device), ..g };
+        let v = g.forward(&x).into_data().try_to_vec::<f32>().unwrap();
+        assert!(v.iter().all(|x| (0.0..=1.0).contains(x)));
+        assert_ne!(v, p);
         // An all-ones mask is no dropout; a real one changes the output.
         let ones = Tensor::<3>::ones([3, 6, 16], &device);
-        let same = g.forward_dropped(&steps(6, 3, g.d_input(), &device), ones).into_data().try_to_vec::<f32>().unwrap();
+        let same = g.forward_dropped(&x, ones).clamp(0.0, 1.0).into_data().try_to_vec::<f32>().unwrap();
         assert_eq!(v, same);
         let mask = dropout_mask(&mut inbetween_core::seed::rng(4), [3, 6, 16], 0.3, &device);
         let m = mask.clone().into_data().try_to_vec::<f32>().unwrap();
         let dropped = m.iter().filter(|x| **x == 0.0).count();
         assert!(dropped > 60 && dropped < 200, "{dropped} of 288 dropped");
         assert!(m.iter().all(|x| *x == 0.0 || (*x - 1.0 / 0.7).abs() < 1e-6));
-        let other = g.forward_dropped(&steps(6, 3, g.d_input(), &device), mask).into_data().try_to_vec::<f32>().unwrap();
+        let other = g.forward_dropped(&x, mask).clamp(0.0, 1.0).into_data().try_to_vec::<f32>().unwrap();
         assert_ne!(v, other);
     }
 

@@ -1,12 +1,13 @@
 //! The generator for inference in plain Rust ([`inbetween_nn::runtime`]): no tensors, no autodiff,
 //! buffers reused between calls. The BiLSTM runs over the whole sequence at once
-//! ([`inbetween_nn::runtime::BiLstm`]), then the dense layer over every frame, then the sigmoid.
+//! ([`inbetween_nn::runtime::BiLstm`]), then the dense layer over every frame, added to the linear
+//! prior of the input and clamped to [0, 1].
 //! Tests check it against the burn [`Generator`] (inference, no dropout) to 1e-4.
 
 use std::sync::Mutex;
 
 use inbetween_nn::burn;
-use inbetween_nn::runtime::{sigmoid, BiLstm, BiLstmScratch, Dense};
+use inbetween_nn::runtime::{BiLstm, BiLstmScratch, Dense};
 use inbetween_nn::weights::Weights;
 use inbetween_nn::NnError;
 
@@ -68,7 +69,7 @@ impl GeneratorRuntime {
     }
 
     /// The generated animation for `frames` frames of input (`frames × d_input`, laid out by
-    /// [`super::input::assemble_into`]); every weight in (0, 1).
+    /// [`super::input::assemble_into`]); every weight in [0, 1].
     pub fn run(&self, input: &[f32], frames: usize) -> Vec<Frame> {
         let mut guard = self.scratch.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         let Scratch { lstm, out } = &mut *guard;
@@ -81,12 +82,14 @@ impl GeneratorRuntime {
             out.resize(frames * NUM_ARKIT, 0.0);
         }
         self.output.forward(hidden, out, frames);
+        let d_input = self.d_input();
         out[..frames * NUM_ARKIT]
             .chunks_exact(NUM_ARKIT)
-            .map(|row| {
+            .zip(input.chunks_exact(d_input))
+            .map(|(row, x)| {
                 let mut f = [0.0; NUM_ARKIT];
-                for (o, v) in f.iter_mut().zip(row) {
-                    *o = sigmoid(*v);
+                for ((o, v), p) in f.iter_mut().zip(row).zip(&x[..NUM_ARKIT]) {
+                    *o = (p + v).clamp(0.0, 1.0);
                 }
                 f
             })

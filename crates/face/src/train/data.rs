@@ -235,6 +235,8 @@ pub fn sample_batch_from(pool: &ClipPool, usable: &[usize], cfg: &SamplerConfig,
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::edit::fill::{interpolate, Interp};
+    use crate::edit::{Frame, Mask, Segment};
     use crate::model::input::{CONSTRAINT_OFFSET, MASK_OFFSET};
     use crate::visemes::NUM_VISEMES;
 
@@ -273,12 +275,37 @@ mod tests {
                 for t in 1..16 {
                     assert!((frame(t) - frame(t - 1) - 0.001).abs() < 1e-6, "window is contiguous");
                 }
+                // The input's first 52 features: the kept values, and the linear prior through the
+                // keys (read back from the constraint features) where erased.
+                let row_of = |t: usize| &a.inputs[(t * 4 + b) * d..(t * 4 + b + 1) * d];
+                let truth: Vec<Frame> =
+                    (0..16).map(|t| a.target[(b * 16 + t) * NUM_ARKIT..(b * 16 + t + 1) * NUM_ARKIT].try_into().unwrap()).collect();
+                let erased = |t: usize, ch: usize| a.mask[(b * 16 + t) * NUM_ARKIT + ch] > 0.0;
+                // One channel's mask at a time (group edits erase some channels only).
+                let channel_mask = |ch: usize| {
+                    let segments: Vec<Segment> =
+                        (0..16).filter(|t| erased(*t, ch)).map(|t| Segment { start: t, end: t + 1 }).collect();
+                    let mut only = [false; NUM_ARKIT];
+                    only[ch] = true;
+                    Mask::from_segments(16, &segments, &only)
+                };
+                let keys: Vec<(usize, Frame)> = if kind == ConstraintKind::Keyframes {
+                    (0..16)
+                        .filter(|t| row_of(*t)[d - 1] > 0.0)
+                        .map(|t| (t, row_of(t)[CONSTRAINT_OFFSET..CONSTRAINT_OFFSET + NUM_ARKIT].try_into().unwrap()))
+                        .collect()
+                } else {
+                    Vec::new()
+                };
+                let prior: Vec<Vec<f32>> = (0..NUM_ARKIT)
+                    .map(|ch| interpolate(&truth, &channel_mask(ch), &keys, Interp::Linear).iter().map(|f| f[ch]).collect())
+                    .collect();
                 for t in 0..16 {
-                    let row = &a.inputs[(t * 4 + b) * d..(t * 4 + b + 1) * d];
+                    let row = row_of(t);
                     for ch in 0..NUM_ARKIT {
                         let m = a.mask[(b * 16 + t) * NUM_ARKIT + ch];
                         assert_eq!(row[MASK_OFFSET + ch], m);
-                        let expected = if m > 0.0 { 0.0 } else { a.target[(b * 16 + t) * NUM_ARKIT + ch] };
+                        let expected = if m > 0.0 { prior[ch][t] } else { truth[t][ch] };
                         assert_eq!(row[ch], expected);
                     }
                     if kind == ConstraintKind::Visemes && row[d - 1] > 0.0 {

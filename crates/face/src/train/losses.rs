@@ -84,14 +84,22 @@ pub fn recompose(target: Tensor<3>, generated: Tensor<3>, mask: Tensor<3>) -> Te
     target.clone() + (generated - target) * mask
 }
 
-/// `L_rec = mean |G − X|`.
-pub fn reconstruction_loss(generated: Tensor<3>, target: Tensor<3>) -> Tensor<1> {
-    (generated - target).abs().mean()
+/// The masked reconstruction loss (§3.3): the mean `|G − X|` over the erased entries plus the mean
+/// over the kept ones. The erased part is what the edit keeps; the kept part holds the output to the
+/// input there, which the C1 join reads at the border frames ([`crate::edit::fill::correct`]).
+pub fn reconstruction_loss(generated: Tensor<3>, target: Tensor<3>, mask: Tensor<3>) -> Tensor<1> {
+    let err = (generated - target).abs();
+    let kept = mask.ones_like() - mask.clone();
+    let erased_mean = (err.clone() * mask.clone()).sum() / mask.sum().clamp_min(1.0);
+    let kept_mean = (err * kept.clone()).sum() / kept.sum().clamp_min(1.0);
+    erased_mean + kept_mean
 }
 
-/// `L_dist = mean |d(G) − d(X)|`.
-pub fn distance_loss(generated: Tensor<3>, target: Tensor<3>, dist: &DistanceMap) -> Tensor<1> {
-    dist.linear_part(generated - target).abs().mean()
+/// `L_dist = mean |d(G) − d(X)|` over the frames with an erased entry.
+pub fn distance_loss(generated: Tensor<3>, target: Tensor<3>, mask: Tensor<3>, dist: &DistanceMap) -> Tensor<1> {
+    let frame_mask = mask.max_dim(2);
+    let count = frame_mask.clone().sum().clamp_min(1.0).mul_scalar(NUM_DISTANCES as f64);
+    (dist.linear_part(generated - target).abs() * frame_mask).sum() / count
 }
 
 /// The generator's loss and its terms (each `[1]`).
@@ -114,8 +122,8 @@ pub fn generator_loss(
     dist: &DistanceMap,
     lambdas: &LossWeights,
 ) -> GeneratorLoss {
-    let rec = reconstruction_loss(generated.clone(), target.clone());
-    let d = distance_loss(generated.clone(), target.clone(), dist);
+    let rec = reconstruction_loss(generated.clone(), target.clone(), mask.clone());
+    let d = distance_loss(generated.clone(), target.clone(), mask.clone(), dist);
     let fake = critic_input(recompose(target, generated, mask), dist);
     let adv = critic.forward_with(weights, fake).mean().neg();
     let total = rec.clone() + d.clone().mul_scalar(lambdas.dist) + adv.clone().mul_scalar(lambdas.adv);
@@ -185,21 +193,36 @@ mod tests {
         }
     }
 
+    fn half_mask(device: &Device) -> Tensor<3> {
+        Tensor::cat(vec![Tensor::<3>::ones([2, 8, NUM_ARKIT], device), Tensor::zeros([2, 8, NUM_ARKIT], device)], 1)
+    }
+
     #[test]
     fn train_losses_vanish_for_a_perfect_generator_and_recompose_keeps_the_input() {
         let device = backend::cpu();
         let (_, x) = anim(2, 16, 0.0, &device);
         let (_, g) = anim(2, 16, 1.0, &device);
         let dist = DistanceMap::new(&device);
-        assert_eq!(scalar(reconstruction_loss(x.clone(), x.clone())), 0.0);
-        assert!(scalar(distance_loss(x.clone(), x.clone(), &dist)).abs() < 1e-7);
-        assert!(scalar(reconstruction_loss(g.clone(), x.clone())) > 0.1);
-        assert!(scalar(distance_loss(g.clone(), x.clone(), &dist)) > 0.01);
         let zeros = Tensor::<3>::zeros([2, 16, NUM_ARKIT], &device);
+        let all = zeros.ones_like();
+        assert_eq!(scalar(reconstruction_loss(x.clone(), x.clone(), all.clone())), 0.0);
+        assert!(scalar(distance_loss(x.clone(), x.clone(), all.clone(), &dist)).abs() < 1e-7);
+        assert!(scalar(reconstruction_loss(g.clone(), x.clone(), all.clone())) > 0.1);
+        assert!(scalar(distance_loss(g.clone(), x.clone(), all.clone(), &dist)) > 0.01);
+        // Masked: the erased and the kept entries are averaged apart, then added.
+        assert_eq!(scalar(distance_loss(g.clone(), x.clone(), zeros.clone(), &dist)), 0.0);
+        let half = half_mask(&device);
+        let part = |t: Tensor<3>, r: std::ops::Range<usize>| t.slice([0..2, r, 0..NUM_ARKIT]);
+        let expected = scalar((part(g.clone(), 0..8) - part(x.clone(), 0..8)).abs().mean())
+            + scalar((part(g.clone(), 8..16) - part(x.clone(), 8..16)).abs().mean());
+        assert!((scalar(reconstruction_loss(g.clone(), x.clone(), half)) - expected).abs() < 1e-6);
+        let erased_only = recompose(x.clone(), g.clone(), half_mask(&device));
+        let e = scalar((part(erased_only.clone(), 0..8) - part(x.clone(), 0..8)).abs().mean());
+        assert!((scalar(reconstruction_loss(erased_only, x.clone(), half_mask(&device))) - e).abs() < 1e-6);
         let kept = recompose(x.clone(), g.clone(), zeros.clone());
-        assert_eq!(scalar(reconstruction_loss(kept, x.clone())), 0.0);
-        let replaced = recompose(x.clone(), g.clone(), zeros.ones_like());
-        assert!(scalar(reconstruction_loss(replaced, g.clone())) < 1e-7);
+        assert_eq!(scalar(reconstruction_loss(kept, x.clone(), all.clone())), 0.0);
+        let replaced = recompose(x.clone(), g.clone(), all);
+        assert!(scalar(reconstruction_loss(replaced, g.clone(), zeros.ones_like())) < 1e-7);
 
         let critic = backend::seeded_module(&device, 3, |d| CriticConfig::new(16).init(d));
         let w = critic.weights();

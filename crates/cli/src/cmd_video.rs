@@ -1,0 +1,258 @@
+//! `inbetween video …`: new frame orders from one clip (RSFNet metric + SDPF path finding).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::{Args, Subcommand, ValueEnum};
+use inbetween_io::Progress;
+use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, Decoder, ProceduralKind, ReadOptions};
+use inbetween_video::pipeline::{analyse, reorder, resequence, MetricChoice, ResequenceConfig};
+use inbetween_video::preview::{write_contact_sheet, SheetOptions};
+use inbetween_video::sdpf::{explain, overlap_delta_o, stability_md, SdpfParams};
+
+#[derive(Subcommand)]
+pub enum VideoCommand {
+    /// A new frame order from a start frame: MP4/GIF/PNG-folder in, MP4 or GIF out, plus a contact sheet.
+    Resequence(ResequenceArgs),
+    /// Write a procedural test clip (no files needed).
+    Synth(SynthArgs),
+    /// What the bundled H.264 decoder does with an MP4, sample by sample.
+    Probe(ProbeArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum DecoderArg {
+    Auto,
+    Openh264,
+    Ffmpeg,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MetricArg {
+    /// RSFNet trained on the clip (the paper).
+    Rsfnet,
+    /// Euclidean distance of downscaled pixels (ablation).
+    Pixels,
+}
+
+#[derive(Args)]
+pub struct ResequenceArgs {
+    /// Input clip: .mp4, .gif, or a folder of PNG/JPEG frames.
+    pub input: PathBuf,
+    /// Output clip (.mp4 or .gif). With --count N > 1, files are numbered (new-1.mp4, …).
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// Start frame (0-based source index).
+    #[arg(long, default_value_t = 0)]
+    pub start: usize,
+    /// Target length in frames (default: until no candidate is left).
+    #[arg(long)]
+    pub length: Option<usize>,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Distinct sequences to write.
+    #[arg(long, default_value_t = 1)]
+    pub count: usize,
+    /// End on a frame that can transition back to the start (a loop).
+    #[arg(long = "loop")]
+    pub loop_close: bool,
+    /// Allow jumps across detected scene cuts.
+    #[arg(long)]
+    pub allow_cuts: bool,
+    /// Print each transition's candidates, what removed them and the softmax choice.
+    #[arg(long)]
+    pub explain: bool,
+    /// Contact sheet PNG (default: next to the output, <out>.sheet.png).
+    #[arg(long)]
+    pub sheet: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "rsfnet")]
+    pub metric: MetricArg,
+    /// Drop the directional distillation C_d (ablation).
+    #[arg(long)]
+    pub no_cd: bool,
+    /// Drop the coherent distillation C_t (ablation).
+    #[arg(long)]
+    pub no_ct: bool,
+    /// RSFNet training steps (batch 8).
+    #[arg(long)]
+    pub steps: Option<usize>,
+    /// Cache of trained networks per clip (default ~/.cache/inbetween/video).
+    #[arg(long)]
+    pub cache_dir: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "auto")]
+    pub decoder: DecoderArg,
+    /// Read at most this many frames.
+    #[arg(long)]
+    pub max_frames: Option<usize>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum KindArg {
+    Pendulum,
+    Walker,
+    Slider,
+    Mixed,
+}
+
+#[derive(Args)]
+pub struct SynthArgs {
+    /// Output clip (.gif or .mp4).
+    #[arg(short, long)]
+    pub out: PathBuf,
+    #[arg(long, value_enum, default_value = "mixed")]
+    pub kind: KindArg,
+    #[arg(long, default_value_t = 96)]
+    pub frames: usize,
+    #[arg(long, default_value_t = 320)]
+    pub width: u32,
+    #[arg(long, default_value_t = 180)]
+    pub height: u32,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+#[derive(Args)]
+pub struct ProbeArgs {
+    pub input: PathBuf,
+}
+
+pub fn run(c: VideoCommand) -> anyhow::Result<()> {
+    match c {
+        VideoCommand::Resequence(a) => run_resequence(a),
+        VideoCommand::Synth(a) => run_synth(a),
+        VideoCommand::Probe(a) => run_probe(a),
+    }
+}
+
+fn kind(k: KindArg) -> ProceduralKind {
+    match k {
+        KindArg::Pendulum => ProceduralKind::Pendulum,
+        KindArg::Walker => ProceduralKind::Walker,
+        KindArg::Slider => ProceduralKind::Slider,
+        KindArg::Mixed => ProceduralKind::Mixed,
+    }
+}
+
+fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
+    let clip = procedural_clip(kind(a.kind), a.frames, a.width, a.height, a.seed);
+    write_clip(&a.out, &clip)?;
+    println!("wrote {} ({} frames, {}x{}, {} fps)", a.out.display(), clip.len(), clip.width(), clip.height(), clip.fps);
+    Ok(())
+}
+
+fn run_probe(a: ProbeArgs) -> anyhow::Result<()> {
+    let p = inbetween_video::frames::probe_openh264(&a.input)?;
+    println!(
+        "{}: H.264 profile {}, B-frames {}, {} samples, openh264 decoded {} pictures",
+        a.input.display(),
+        p.profile,
+        if p.has_b_frames { "yes (ctts box)" } else { "no" },
+        p.samples.len(),
+        p.frames()
+    );
+    for (i, s) in p.samples.iter().enumerate() {
+        println!("  sample {i}: {s:?}");
+    }
+    Ok(())
+}
+
+/// `new.mp4` → `new-2.mp4` for the second of several outputs.
+fn numbered(path: &Path, i: usize, count: usize) -> PathBuf {
+    if count <= 1 {
+        return path.to_path_buf();
+    }
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    path.with_file_name(format!("{stem}-{}{ext}", i + 1))
+}
+
+fn sheet_path(out: &Path) -> PathBuf {
+    out.with_extension("sheet.png")
+}
+
+fn read_input(a: &ResequenceArgs) -> anyhow::Result<Clip> {
+    let decoder = match a.decoder {
+        DecoderArg::Auto => Decoder::Auto,
+        DecoderArg::Openh264 => Decoder::OpenH264,
+        DecoderArg::Ffmpeg => Decoder::Ffmpeg,
+    };
+    let (clip, report) = read_clip(&a.input, &ReadOptions { decoder, max_frames: a.max_frames })?;
+    println!(
+        "{}: {} frames {}x{} at {:.3} fps, decoded by {}",
+        a.input.display(),
+        clip.len(),
+        clip.width(),
+        clip.height(),
+        clip.fps,
+        report.decoder
+    );
+    for n in &report.notes {
+        println!("  {n}");
+    }
+    Ok(clip)
+}
+
+fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
+    let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    anyhow::ensure!(ext == "mp4" || ext == "gif", "{}: the output must end in .mp4 or .gif", a.out.display());
+    let clip = read_input(&a)?;
+    anyhow::ensure!(a.start < clip.len(), "--start {} is outside the clip (frames 0..{})", a.start, clip.len().saturating_sub(1));
+    let mut cfg = ResequenceConfig {
+        metric: match a.metric {
+            MetricArg::Rsfnet => MetricChoice::RsfNet,
+            MetricArg::Pixels => MetricChoice::Pixels,
+        },
+        ..ResequenceConfig::default()
+    };
+    if let Some(s) = a.steps {
+        cfg.train.steps = s;
+    }
+    if let Some(d) = &a.cache_dir {
+        cfg.cache_dir = d.clone();
+    }
+    let progress = Progress::new(cfg.train.steps as u64, "RSFNet");
+    let analysis = analyse(&clip, &cfg, &progress)?;
+    progress.finish();
+    println!("{}", analysis.metric_note);
+    let params = SdpfParams {
+        use_cd: !a.no_cd,
+        use_ct: !a.no_ct,
+        length: a.length,
+        loop_close: a.loop_close,
+        allow_cuts: a.allow_cuts,
+        seed: a.seed,
+        ..SdpfParams::default()
+    };
+    let (paths, walk_s) = resequence(&analysis, a.start, &params, a.count)?;
+    let source: Vec<usize> = (0..clip.len()).collect();
+    let md_source = stability_md(&clip.frames, &source);
+    for (i, path) in paths.iter().enumerate() {
+        let out = numbered(&a.out, i, a.count);
+        write_clip(&out, &reorder(&clip, &path.frames)).with_context(|| format!("writing {}", out.display()))?;
+        let sheet = a.sheet.as_ref().map(|s| numbered(s, i, a.count)).unwrap_or_else(|| sheet_path(&out));
+        let title = format!("{} from frame {} (seed {}): {} frames", a.input.display(), a.start, path.seed, path.frames.len());
+        write_contact_sheet(&sheet, &clip.frames, &path.frames, &SheetOptions { title, ..SheetOptions::default() })?;
+        println!(
+            "{}: {} frames ({:?}{}), M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
+            out.display(),
+            path.frames.len(),
+            path.stop,
+            if a.loop_close { if path.closes_loop { ", loop closes" } else { ", no loop found" } } else { "" },
+            stability_md(&clip.frames, &path.frames),
+            md_source,
+            overlap_delta_o(&path.frames, clip.len()),
+            sheet.display()
+        );
+        if a.explain {
+            print!("{}", explain(path));
+        }
+    }
+    if paths.len() < a.count {
+        println!("only {} distinct sequences exist from frame {} under these constraints", paths.len(), a.start);
+    }
+    for (stage, s) in &analysis.stages {
+        println!("  {stage}: {s:.2} s");
+    }
+    println!("  SDPF walks: {walk_s:.2} s");
+    Ok(())
+}

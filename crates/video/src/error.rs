@@ -1,0 +1,30 @@
+//! Errors of the video engine.
+
+use std::path::PathBuf;
+
+/// What went wrong, naming the file (and frame) where there is one.
+#[derive(Debug, thiserror::Error)]
+pub enum VideoError {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    /// A file that could not be read as a clip: which file, which frame (if known), what was expected.
+    #[error("{path}{}: {message}", frame.map(|f| format!(" (frame {f})")).unwrap_or_default())]
+    Decode { path: PathBuf, frame: Option<usize>, message: String },
+    /// Writing a clip failed.
+    #[error("{path}: {message}")]
+    Encode { path: PathBuf, message: String },
+    /// Neither the bundled decoder nor an ffmpeg on PATH can read the stream.
+    #[error("{path}: {message}")]
+    Unsupported { path: PathBuf, message: String },
+    /// Bad arguments or inconsistent inputs.
+    #[error("{0}")]
+    Invalid(String),
+    #[error(transparent)]
+    Nn(#[from] inbetween_nn::NnError),
+}
+
+impl VideoError {
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> VideoError {
+        VideoError::Io { path: path.into(), source }
+    }
+}
