@@ -18,6 +18,20 @@ pub enum VideoCommand {
     Synth(SynthArgs),
     /// What the bundled H.264 decoder does with an MP4, sample by sample.
     Probe(ProbeArgs),
+    /// M_D / Δo per clip, the ablations of Table 3 and seconds per stage (procedural and real clips).
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// One short procedural clip and a tiny network (seconds).
+    #[arg(long)]
+    pub quick: bool,
+    /// Folder of the real clips (default: ../shared/data/video or $INBETWEEN_DATA/video).
+    #[arg(long)]
+    pub clips: Option<PathBuf>,
+    #[arg(short, long, default_value = "out/video-bench")]
+    pub out: PathBuf,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -121,6 +135,7 @@ pub fn run(c: VideoCommand) -> anyhow::Result<()> {
         VideoCommand::Resequence(a) => run_resequence(a),
         VideoCommand::Synth(a) => run_synth(a),
         VideoCommand::Probe(a) => run_probe(a),
+        VideoCommand::Bench(a) => run_bench(a),
     }
 }
 
@@ -255,4 +270,36 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
     }
     println!("  SDPF walks: {walk_s:.2} s");
     Ok(())
+}
+
+fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
+    use inbetween_video::bench::{run, VideoBenchConfig};
+    // A fresh cache, so the stage times include training the metric.
+    let cache = tempfile_dir()?;
+    let cfg = if a.quick {
+        VideoBenchConfig::quick(cache.clone())
+    } else {
+        let dir = a.clips.clone().or_else(|| Some(inbetween_io::shared_data_dir().unwrap_or_else(|missing| missing).join("video")));
+        match &dir {
+            Some(d) if d.exists() => println!("real clips from {}", d.display()),
+            _ => println!("skipped real clips: no data at {}", dir.as_ref().map(|d| d.display().to_string()).unwrap_or_else(|| "../shared/data/video".into())),
+        }
+        VideoBenchConfig::full(dir.as_deref().filter(|d| d.exists()), cache.clone())
+    };
+    let t = std::time::Instant::now();
+    let progress = Progress::new(1, "video bench");
+    let report = run(&cfg, &progress)?;
+    progress.finish();
+    print!("{}", report.to_text());
+    let files = report.write(&a.out).with_context(|| format!("writing the video bench to {}", a.out.display()))?;
+    let _ = std::fs::remove_dir_all(&cache);
+    println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// A new empty folder under the system temp dir.
+fn tempfile_dir() -> anyhow::Result<PathBuf> {
+    let dir = std::env::temp_dir().join(format!("inbetween-video-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    Ok(dir)
 }

@@ -9,6 +9,7 @@
 //! - [`sdpf`]: Single-source Distillation Path-Finding (Algorithm 1, Eq. 8, 12, 15–20), the
 //!   evaluation metrics (Eq. 21–23) and the whole pipeline.
 
+pub mod bench;
 pub mod demo;
 pub mod error;
 pub mod frames;

@@ -27,7 +27,7 @@ mod tests;
 pub use ffmpeg::ffmpeg_available;
 pub use folder::natural_cmp;
 pub use mp4_in::{probe_openh264, OpenH264Probe, SampleOutcome};
-pub use procedural::{procedural_clip, ProceduralKind};
+pub use procedural::{procedural_clip, procedural_truth, ProceduralKind, ProceduralTruth};
 
 use crate::VideoError;
 use image::RgbImage;

@@ -176,7 +176,7 @@ fn solve(normal: &Grid<5>, prior: &Grid<2>, lambda: f32) -> Grid<2> {
             let (g11, g12, g22) = (n[0] + l, n[1], n[2] + l);
             let (h1, h2) = (n[3] + l * d[0], n[4] + l * d[1]);
             let det = g11 * g22 - g12 * g12;
-            if !(det > 0.0) || !det.is_finite() {
+            if !det.is_finite() || det <= 0.0 {
                 return *d;
             }
             [(g22 * h1 - g12 * h2) / det, (g11 * h2 - g12 * h1) / det]
