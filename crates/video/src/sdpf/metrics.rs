@@ -1,77 +1,86 @@
-//! The paper's measures of a new order (§6.3) and our scene-cut detector.
+//! The evaluation metrics of §6.3: stability M_D (Eq. 21) and the degree of difference Δo
+//! (Eq. 22–23).
 
 use image::RgbImage;
 
-/// RMS difference per pixel (channels in [0, 1]) of two frames of the same size.
-fn rms_difference(a: &RgbImage, b: &RgbImage) -> f64 {
-    let n = a.as_raw().len().min(b.as_raw().len()).max(1);
-    let s: f64 = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| (f64::from(*x) - f64::from(*y)) / 255.0).map(|d| d * d).sum();
-    (s / n as f64).sqrt()
-}
+use crate::VideoError;
 
-/// M_D (Eq. 21): the mean over consecutive frames of `order` of ‖F_t − F_{t−1}‖, here the RMS per
-/// pixel in [0, 1]. The source order (0, 1, 2, …) gives the clip's own value, the reference a new
-/// order should stay close to. 0 for fewer than two frames.
+/// M_D of Eq. 21: the mean over the transitions of `order` of `D = ‖F_t − F_{t−1}‖`, taken as the
+/// RMS per-channel difference with pixel values scaled to [0, 1] (so D and M_D lie in [0, 1] and
+/// do not grow with the frame size; the paper does not say its normalisation, its values
+/// 0.037–0.067 fit this range). The source order `0, 1, …, n − 1` gives the ground-truth M_D.
+/// An order with fewer than two frames has no transition: 0. An index out of range or frames of
+/// different sizes give NaN (see [`try_stability_md`] for the error that says which).
 pub fn stability_md(frames: &[RgbImage], order: &[usize]) -> f64 {
+    try_stability_md(frames, order).unwrap_or(f64::NAN)
+}
+
+/// [`stability_md`], with an error naming the frame out of range or the frames whose sizes differ.
+pub fn try_stability_md(frames: &[RgbImage], order: &[usize]) -> Result<f64, VideoError> {
+    if let Some(&bad) = order.iter().find(|&&i| i >= frames.len()) {
+        return Err(VideoError::Invalid(format!("M_D: frame {bad} is out of range (the clip has {} frames)", frames.len())));
+    }
     if order.len() < 2 {
-        return 0.0;
+        return Ok(0.0);
     }
-    let s: f64 = order.windows(2).map(|w| rms_difference(&frames[w[0]], &frames[w[1]])).sum();
-    s / (order.len() - 1) as f64
+    let diffs = order.windows(2).map(|w| frame_rms(&frames[w[0]], &frames[w[1]], w[0], w[1])).collect::<Result<Vec<_>, _>>()?;
+    Ok(diffs.iter().sum::<f64>() / diffs.len() as f64)
 }
 
-/// Δ_o (Eq. 22–23): the F-measure of the temporal overlap between a new order G and the source T.
-/// The overlap δ counts G's transitions that are also source transitions (f → f + 1); d_G is G's
-/// number of transitions and d_T the source's (n − 1 for an n-frame clip). 1 for the source itself,
-/// 0 when no transition is kept.
-pub fn overlap_delta_o(order: &[usize], clip_frames: usize) -> f64 {
-    let d_g = order.len().saturating_sub(1);
-    let d_t = clip_frames.saturating_sub(1);
-    let overlap = order.windows(2).filter(|w| w[1] == w[0] + 1).count();
-    if d_g == 0 || d_t == 0 || overlap == 0 {
-        return 0.0;
+/// M_D of the source order itself (the "ground truth" column of Table 2).
+pub fn source_md(frames: &[RgbImage]) -> f64 {
+    stability_md(frames, &(0..frames.len()).collect::<Vec<_>>())
+}
+
+/// `D` of Eq. 21 for one transition: RMS difference in [0, 1].
+pub fn frame_rms(a: &RgbImage, b: &RgbImage, ia: usize, ib: usize) -> Result<f64, VideoError> {
+    if a.dimensions() != b.dimensions() {
+        return Err(VideoError::Invalid(format!(
+            "M_D: frame {ia} is {}x{} but frame {ib} is {}x{}",
+            a.width(),
+            a.height(),
+            b.width(),
+            b.height()
+        )));
     }
-    let (p, r) = (overlap as f64 / d_g as f64, overlap as f64 / d_t as f64);
-    2.0 * p * r / (p + r)
-}
-
-/// Scene cuts (beyond the paper): shot index per frame. A cut falls before frame i when its
-/// colour-histogram distance to frame i − 1 is both large in absolute terms (> `min_jump`, half the
-/// histogram mass changing) and much larger than the clip's typical step (> `ratio` × median).
-pub fn detect_shots(frames: &[RgbImage]) -> Vec<usize> {
-    detect_shots_with(frames, 0.5, 4.0)
-}
-
-/// [`detect_shots`] with its thresholds.
-pub fn detect_shots_with(frames: &[RgbImage], min_jump: f64, ratio: f64) -> Vec<usize> {
-    let hists: Vec<Vec<f64>> = frames.iter().map(histogram).collect();
-    let steps: Vec<f64> = hists.windows(2).map(|w| l1(&w[0], &w[1]) / 2.0).collect();
-    let mut sorted = steps.clone();
-    sorted.sort_by(|a, b| a.total_cmp(b));
-    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
-    let mut shot = 0;
-    let mut out = Vec::with_capacity(frames.len());
-    for i in 0..frames.len() {
-        if i > 0 && steps[i - 1] > min_jump && steps[i - 1] > ratio * median {
-            shot += 1;
-        }
-        out.push(shot);
+    let n = a.as_raw().len();
+    if n == 0 {
+        return Ok(0.0);
     }
-    out
+    let sq: f64 = a.as_raw().iter().zip(b.as_raw()).map(|(&x, &y)| ((x as f64 - y as f64) / 255.0).powi(2)).sum();
+    Ok((sq / n as f64).sqrt())
 }
 
-/// A normalised 4×4×4 RGB histogram.
-fn histogram(img: &RgbImage) -> Vec<f64> {
-    let mut h = vec![0.0; 64];
-    for p in img.pixels() {
-        let b = |v: u8| usize::from(v >> 6);
-        h[b(p.0[0]) * 16 + b(p.0[1]) * 4 + b(p.0[2])] += 1.0;
-    }
-    let n = (img.width() * img.height()).max(1) as f64;
-    h.iter_mut().for_each(|v| *v /= n);
-    h
+/// P, R and Δo of Eq. 22–23 for one generated order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Overlap {
+    /// δ: transitions of the new order that are source transitions `f → f + 1`.
+    pub overlap: usize,
+    /// d_G: transitions of the new order; d_T: transitions of the source.
+    pub generated: usize,
+    pub source: usize,
+    pub precision: f64,
+    pub recall: f64,
+    /// Δo = 2PR / (P + R), as a fraction in [0, 1] (Table 2 prints it so; the paper's "× 100%"
+    /// is the same number as a percentage). Smaller means a more novel order.
+    pub delta_o: f64,
 }
 
-fn l1(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum()
+/// Eq. 22–23. Durations are counted in transitions (frame pairs): the "temporal overlap" δ is the
+/// number of steps `f → f + 1` of the new order, which play exactly as in the source; d_G is the
+/// new order's step count and d_T the source's (`source_len − 1`). The source order itself has
+/// P = R = Δo = 1. With no step on either side P or R is 0, and so is Δo.
+pub fn overlap(order: &[usize], source_len: usize) -> Overlap {
+    let overlap = order.windows(2).filter(|w| w[1] == w[0] + 1 && w[1] < source_len).count();
+    let generated = order.len().saturating_sub(1);
+    let source = source_len.saturating_sub(1);
+    let ratio = |d: usize| if d == 0 { 0.0 } else { overlap as f64 / d as f64 };
+    let (precision, recall) = (ratio(generated), ratio(source));
+    let delta_o = if precision + recall > 0.0 { 2.0 * precision * recall / (precision + recall) } else { 0.0 };
+    Overlap { overlap, generated, source, precision, recall, delta_o }
+}
+
+/// Δo of Eq. 23 for `order` against a source of `source_len` frames.
+pub fn overlap_delta_o(order: &[usize], source_len: usize) -> f64 {
+    overlap(order, source_len).delta_o
 }

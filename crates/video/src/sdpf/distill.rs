@@ -1,0 +1,200 @@
+//! One step of Algorithm 1: the content-aware layer (Eq. 8), the motion-aware layer (C_d Eq. 12,
+//! C_t Eq. 15–17, S2 Eq. 18–19) and the softmax choice (Eq. 20).
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+use rand::Rng;
+
+use super::types::{Candidate, CdState, MotionDistance, MotionInfo, Omega, SdpfParams, Transition};
+use crate::metric::Graph;
+use crate::motion::angle_between;
+
+/// η of Eq. 8: the mean edge weight of the graph. The paper writes `Σ e_ij / N` and calls it "the
+/// mean of the weights"; we average over the `N(N − 1)` off-diagonal edges (the diagonal is the
+/// zero self-distance, not an edge), skipping non-finite weights. NaN when there is no such edge
+/// (then no edge is below it and the walk stops at once).
+pub fn eta(graph: &Graph) -> f32 {
+    let n = graph.n;
+    let (mut sum, mut count) = (0.0f64, 0usize);
+    for i in 0..n {
+        for j in (0..n).filter(|&j| j != i) {
+            let e = graph.dist[i * n + j];
+            if e.is_finite() {
+                sum += e as f64;
+                count += 1;
+            }
+        }
+    }
+    if count == 0 {
+        f32::NAN
+    } else {
+        (sum / count as f64) as f32
+    }
+}
+
+/// What one step needs, fixed for a whole SDPF call (and shared by its attempts). Motion distances
+/// are memoised per pair: retries and loop-closure checks ask for the same pairs again, and each
+/// may cost a network call (PMSM embeds pseudo-images).
+pub(crate) struct Ctx<'a> {
+    pub graph: &'a Graph,
+    pub motion: &'a MotionInfo,
+    pub md: &'a dyn MotionDistance,
+    pub p: &'a SdpfParams,
+    pub eta: f32,
+    memo: RefCell<HashMap<(usize, usize), f32>>,
+    floors: RefCell<HashMap<usize, f32>>,
+}
+
+impl<'a> Ctx<'a> {
+    pub fn new(graph: &'a Graph, motion: &'a MotionInfo, md: &'a dyn MotionDistance, p: &'a SdpfParams) -> Self {
+        Ctx { graph, motion, md, p, eta: eta(graph), memo: RefCell::default(), floors: RefCell::default() }
+    }
+
+    /// Lines 7–21 of Algorithm 1 from frame `from`; `chosen` is left `None` for the caller's draw.
+    pub fn step(&self, from: usize, visited: &[bool]) -> Transition {
+        let (s1, removed_cut) = self.content(from, visited);
+        let (cd, removed_cd) = self.directional(from, &s1);
+        let motions = self.motion_distances(from, &s1);
+        let candidates: Vec<Candidate> = s1
+            .iter()
+            .zip(&motions)
+            .map(|(&k, &m)| Candidate {
+                frame: k,
+                edge: self.edge(from, k),
+                motion: m,
+                tendency: self.motion.tendency_of(k),
+                lms: self.motion.is_lms(k),
+            })
+            .collect();
+        let (omega, removed_ct) = self.coherent(from, &candidates);
+        let s2: Vec<&Candidate> =
+            candidates.iter().filter(|c| !removed_cd.contains(&c.frame) && !removed_ct.contains(&c.frame)).collect();
+        let dists: Vec<f32> = s2.iter().map(|c| c.motion).collect();
+        let probs = s2.iter().map(|c| c.frame).zip(softmax(&dists, self.p.temperature)).collect();
+        Transition { from, chosen: None, s1, candidates, removed_cut, cd, removed_cd, omega, removed_ct, probs }
+    }
+
+    /// Whether `to` survives Eq. 8, the shot rule and C_d from `from` — the checks that need no
+    /// motion distance, so that hopeless loop closures cost nothing.
+    pub fn passes_cheap_checks(&self, from: usize, to: usize, visited: &[bool]) -> bool {
+        let (s1, _) = self.content(from, visited);
+        s1.contains(&to) && !self.directional(from, &s1).1.contains(&to)
+    }
+
+    fn edge(&self, c: usize, k: usize) -> f32 {
+        self.graph.dist[c * self.graph.n + k]
+    }
+
+    /// Eq. 8 (lines 7–11): unvisited frames with `e_ck < η`, strictly, as the paper writes. Those
+    /// in another shot are split off unless `allow_cuts` (beyond the paper).
+    fn content(&self, from: usize, visited: &[bool]) -> (Vec<usize>, Vec<usize>) {
+        let under: Vec<usize> =
+            (0..self.graph.n).filter(|&k| k != from && !visited[k] && self.edge(from, k) < self.eta).collect();
+        if self.p.allow_cuts {
+            return (under, Vec::new());
+        }
+        under.into_iter().partition(|&k| self.motion.shot_of(k) == self.motion.shot_of(from))
+    }
+
+    /// C_d of Eq. 12. It acts only when the current frame is an LMS frame with a known tendency and
+    /// S1 holds an LMS frame; then it keeps the LMS candidates whose tendency lies within ξ of T_c
+    /// (angles wrapped) and removes the rest, non-LMS candidates included: Fig. 13 reads "if S1
+    /// has LMS-frames, they will be considered", and the non-LMS frames 152 and 135 "may cause
+    /// artifacts". An LMS candidate with an unknown (or NaN) tendency cannot be checked and is removed.
+    fn directional(&self, from: usize, s1: &[usize]) -> (CdState, Vec<usize>) {
+        if !self.p.use_cd {
+            return (CdState::Disabled, Vec::new());
+        }
+        let Some(tc) = self.motion.tendency_of(from).filter(|_| self.motion.is_lms(from)) else {
+            return (CdState::NotLms, Vec::new());
+        };
+        if !s1.iter().any(|&k| self.motion.is_lms(k)) {
+            return (CdState::NoLmsCandidate, Vec::new());
+        }
+        let keeps =
+            |k: usize| self.motion.is_lms(k) && self.motion.tendency_of(k).is_some_and(|tk| angle_between(tc, tk) <= self.p.xi);
+        (CdState::Active { tendency: tc, xi: self.p.xi }, s1.iter().copied().filter(|&k| !keeps(k)).collect())
+    }
+
+    /// C_t of Eq. 16–17, read with distances. The paper writes `δ ≤ ω` with `δ = −distance`
+    /// (Eq. 15) and ω the mean δ over S1; taken literally that keeps the candidates whose motion
+    /// changes *more* than average, against the text ("a smaller PMSM reveals a smooth
+    /// transition"; C_t is "to control the motion in adjacent frames not to change frequently or
+    /// drastically") and against Eq. 20, which favours large δ. We keep the smoother ones:
+    /// `distance ≤ mean distance over S1` when n1 ≥ 2, else `distance ≤ rotated_floor(c)` (FC's
+    /// distance to its ±π/2 rotations). The threshold is taken over all of S1, independent of C_d
+    /// (Eq. 17 names S1 and n1). A candidate with a non-finite distance cannot be checked and is
+    /// removed; non-finite distances are left out of the mean.
+    fn coherent(&self, from: usize, cands: &[Candidate]) -> (Omega, Vec<usize>) {
+        if !self.p.use_ct || cands.is_empty() {
+            return (Omega::Off, Vec::new());
+        }
+        let (omega, w) = if cands.len() >= 2 {
+            let w = finite_mean(cands.iter().map(|c| c.motion));
+            (Omega::Mean(w), w)
+        } else {
+            let w = self.floor(from);
+            (Omega::Rotated(w), w)
+        };
+        let removed = cands.iter().filter(|c| !(c.motion.is_finite() && c.motion <= w)).map(|c| c.frame).collect();
+        (omega, removed)
+    }
+
+    /// Motion distances `from → k` for every `k` of `ks`, asking the [`MotionDistance`] (in one
+    /// batch) only for the pairs not seen before.
+    fn motion_distances(&self, from: usize, ks: &[usize]) -> Vec<f32> {
+        let missing: Vec<usize> = ks.iter().copied().filter(|&k| !self.memo.borrow().contains_key(&(from, k))).collect();
+        if !missing.is_empty() {
+            let got = self.md.distances(from, &missing);
+            let mut memo = self.memo.borrow_mut();
+            for (i, &k) in missing.iter().enumerate() {
+                memo.insert((from, k), got.get(i).copied().unwrap_or(f32::NAN));
+            }
+        }
+        let memo = self.memo.borrow();
+        ks.iter().map(|&k| memo[&(from, k)]).collect()
+    }
+
+    fn floor(&self, from: usize) -> f32 {
+        *self.floors.borrow_mut().entry(from).or_insert_with(|| self.md.rotated_floor(from))
+    }
+}
+
+/// Mean of the finite values (NaN when there is none).
+fn finite_mean(values: impl Iterator<Item = f32>) -> f32 {
+    let (sum, count) = values.filter(|v| v.is_finite()).fold((0.0f64, 0usize), |(s, c), v| (s + v as f64, c + 1));
+    if count == 0 {
+        f32::NAN
+    } else {
+        (sum / count as f64) as f32
+    }
+}
+
+/// Eq. 20 with δ_j = −distance_j: `Ω_j = exp(δ_j/τ) / Σ_i exp(δ_i/τ)`, computed with the largest δ
+/// subtracted so that large distances cannot underflow every term. Non-finite distances get
+/// probability 0 unless all are non-finite, in which case the choice is uniform.
+pub fn softmax(distances: &[f32], temperature: f32) -> Vec<f32> {
+    let best = distances.iter().copied().filter(|d| d.is_finite()).fold(f32::INFINITY, f32::min);
+    if !best.is_finite() {
+        return vec![1.0 / distances.len().max(1) as f32; distances.len()];
+    }
+    let w: Vec<f64> =
+        distances.iter().map(|&d| if d.is_finite() { (-((d - best) / temperature) as f64).exp() } else { 0.0 }).collect();
+    let total: f64 = w.iter().sum();
+    w.iter().map(|x| (x / total) as f32).collect()
+}
+
+/// Line 22 of Algorithm 1: one frame drawn from S2 with the probabilities of Eq. 20.
+pub fn draw(probs: &[(usize, f32)], rng: &mut impl Rng) -> Option<usize> {
+    let u: f32 = rng.random();
+    let mut acc = 0.0;
+    for &(frame, p) in probs {
+        acc += p;
+        if u < acc {
+            return Some(frame);
+        }
+    }
+    // Rounding left u above the total: the last frame with a non-zero probability.
+    probs.iter().rev().find(|&&(_, p)| p > 0.0).or(probs.last()).map(|&(f, _)| f)
+}

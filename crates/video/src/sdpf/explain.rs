@@ -1,0 +1,120 @@
+//! `--explain`: each transition of a path in words — its candidates, what each constraint
+//! removed and why, the softmax probabilities and the choice.
+
+use std::fmt::Write as _;
+
+use super::types::{Candidate, CdState, Omega, SdpfPath, StopReason, Transition};
+
+/// A readable account of `path`, one block per transition (plus the loop-closing step).
+pub fn explain(path: &SdpfPath) -> String {
+    let mut s = String::new();
+    let list: Vec<String> = path.frames.iter().map(|f| f.to_string()).collect();
+    let start = path.frames.first().map_or_else(|| "?".to_string(), |f| f.to_string());
+    let _ = writeln!(
+        s,
+        "SDPF path of {} frames from frame {start} (seed {}, attempt {}): {}",
+        path.len(),
+        path.seed,
+        path.attempt,
+        list.join(" ")
+    );
+    let _ = writeln!(s, "η (Eq. 8, mean edge weight) = {:.4}; stop: {}", path.eta, stop_words(path.stop));
+    for (i, t) in path.transitions.iter().enumerate() {
+        let _ = writeln!(s, "step {}: {}", i + 1, head(t));
+        body(&mut s, t);
+    }
+    if let Some(t) = &path.closing {
+        let _ = writeln!(s, "loop closure: {}", head(t));
+        body(&mut s, t);
+    }
+    s
+}
+
+fn stop_words(stop: StopReason) -> &'static str {
+    match stop {
+        StopReason::TargetLength => "target length reached",
+        StopReason::EarlyStop => "early stop, no candidate left (S2 empty, §5.2.3)",
+        StopReason::AllVisited => "every frame used",
+        StopReason::LoopClosed => "cut where the last frame returns to the start (loop closure)",
+    }
+}
+
+fn head(t: &Transition) -> String {
+    match t.chosen {
+        Some(k) => format!("frame {} → {k}", t.from),
+        None => format!("frame {} → (none)", t.from),
+    }
+}
+
+fn body(s: &mut String, t: &Transition) {
+    let s1: Vec<String> = t.candidates.iter().map(candidate).collect();
+    let _ = writeln!(s, "  S1 (content, Eq. 8) = frames with e < η, n1 = {}: {}", t.s1.len(), none_if_empty(&s1));
+    if !t.removed_cut.is_empty() {
+        let _ = writeln!(s, "  left out, another shot (scene cut): {}", frames(&t.removed_cut));
+    }
+    let _ = writeln!(s, "  C_d (Eq. 12): {}", cd_words(t));
+    let _ = writeln!(s, "  C_t (Eq. 16-17): {}", ct_words(t));
+    let s2: Vec<String> = t.probs.iter().map(|(f, p)| format!("{f} p={p:.3}")).collect();
+    let _ = writeln!(s, "  S2 with softmax probabilities (Eq. 20): {}", none_if_empty(&s2));
+    match t.chosen {
+        Some(k) => {
+            let _ = writeln!(s, "  chose {k}");
+        }
+        None => {
+            let _ = writeln!(s, "  no candidate left: early stop");
+        }
+    }
+}
+
+fn candidate(c: &Candidate) -> String {
+    let t = c.tendency.map_or_else(|| "-".to_string(), |t| format!("{:.0}°", t.to_degrees()));
+    format!("{} (e {:.3}, motion {:.3}, T {t}{})", c.frame, c.edge, c.motion, if c.lms { ", LMS" } else { "" })
+}
+
+fn cd_words(t: &Transition) -> String {
+    match t.cd {
+        CdState::Disabled => "off".into(),
+        CdState::NotLms => format!("skipped, frame {} is not an LMS frame", t.from),
+        CdState::NoLmsCandidate => "skipped, no LMS frame in S1".into(),
+        CdState::Active { tendency, xi } => format!(
+            "T_c = {:.0}°, keeps LMS frames within ξ = {:.0}°; removed {}",
+            tendency.to_degrees(),
+            xi.to_degrees(),
+            none_if_empty_frames(&t.removed_cd)
+        ),
+    }
+}
+
+fn ct_words(t: &Transition) -> String {
+    match t.omega {
+        Omega::Off if t.s1.is_empty() => "nothing to check".into(),
+        Omega::Off => "off".into(),
+        Omega::Mean(w) => format!("keeps motion ≤ ω = {w:.4} (mean over S1); removed {}", none_if_empty_frames(&t.removed_ct)),
+        Omega::Rotated(w) => {
+            format!(
+                "keeps motion ≤ ω = {w:.4} (FC against its ±90° rotations, n1 < 2); removed {}",
+                none_if_empty_frames(&t.removed_ct)
+            )
+        }
+    }
+}
+
+fn frames(f: &[usize]) -> String {
+    f.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ")
+}
+
+fn none_if_empty_frames(f: &[usize]) -> String {
+    if f.is_empty() {
+        "none".into()
+    } else {
+        frames(f)
+    }
+}
+
+fn none_if_empty(items: &[String]) -> String {
+    if items.is_empty() {
+        "none".into()
+    } else {
+        items.join(", ")
+    }
+}

@@ -1,0 +1,181 @@
+//! Algorithm 1 as a walk, plus what the paper lacks: a target length, loop closure back to the
+//! start frame, several distinct paths from one graph.
+
+use inbetween_core::seed::{derive, rng};
+
+use super::distill::{draw, Ctx};
+use super::types::{MotionDistance, MotionInfo, SdpfParams, SdpfPath, StopReason};
+use crate::metric::Graph;
+use crate::VideoError;
+
+/// Single-source Distillation Path-Finding (Algorithm 1) from `start`.
+///
+/// Each step builds S1 (Eq. 8, η = mean off-diagonal edge weight; frames of another shot left
+/// out unless `allow_cuts`), distils it with C_d (Eq. 12) and C_t (Eq. 16–17) into S2 (Eq. 18–19)
+/// and draws the next frame with the softmax of Eq. 20 from a seeded stream. No frame is visited
+/// twice. The walk ends when S2 is empty (the paper's early stop), every frame is used, or the
+/// target `length` is reached.
+///
+/// Goals beyond the paper are met by seeded retries: attempt 0 uses `seed` itself, attempt `a`
+/// uses `derive(seed, a)`, up to `attempts` walks, stopping at the first that meets the goal.
+/// - Target length without loop closure: the goal is `length` frames; failing that, the longest
+///   walk (the earliest among equals) is kept.
+/// - Loop closure: after each walk, its prefixes are scanned from the longest (at most `length`
+///   frames) down to 3 frames; the first whose last frame has the start frame in its S2 — the
+///   same constraints, with the start treated as unvisited and every other frame of the prefix
+///   visited — is kept, and that closing step is recorded in [`SdpfPath::closing`]. The goal is a
+///   closed loop (of exactly `length` frames when a target is set). Closed walks beat open ones,
+///   then longer beats shorter. When no attempt closes, the best open walk is returned with
+///   `closes_loop: false`.
+///
+/// Errors: an empty graph, a distance matrix of the wrong size, a start out of range, motion
+/// vectors of the wrong length, or invalid parameters.
+pub fn sdpf(
+    graph: &Graph,
+    motion: &MotionInfo,
+    md: &dyn MotionDistance,
+    start: usize,
+    p: &SdpfParams,
+) -> Result<SdpfPath, VideoError> {
+    validate(graph, motion, start, p)?;
+    Ok(best_walk(&Ctx::new(graph, motion, md, p), start, p.seed))
+}
+
+/// Several distinct paths from `start` (beyond the paper): path `i` is [`sdpf`] with a seed derived
+/// from `p.seed` and `i` (path 0 uses `p.seed`, so it equals `sdpf(…, p)`); a path with the same
+/// frames as one already kept is skipped. At most `4 · count + 8` seeds are tried, so a graph with
+/// fewer distinct paths returns fewer than `count` (never none: `count = 0` is read as 1).
+pub fn several(
+    graph: &Graph,
+    motion: &MotionInfo,
+    md: &dyn MotionDistance,
+    start: usize,
+    p: &SdpfParams,
+    count: usize,
+) -> Result<Vec<SdpfPath>, VideoError> {
+    validate(graph, motion, start, p)?;
+    let ctx = Ctx::new(graph, motion, md, p);
+    let count = count.max(1);
+    let mut kept: Vec<SdpfPath> = Vec::new();
+    for i in 0..(4 * count + 8) {
+        if kept.len() == count {
+            break;
+        }
+        let seed = if i == 0 { p.seed } else { derive(derive(p.seed, u64::MAX), i as u64) };
+        let path = best_walk(&ctx, start, seed);
+        if kept.iter().all(|k| k.frames != path.frames) {
+            kept.push(path);
+        }
+    }
+    Ok(kept)
+}
+
+fn validate(graph: &Graph, motion: &MotionInfo, start: usize, p: &SdpfParams) -> Result<(), VideoError> {
+    if graph.n == 0 {
+        return Err(VideoError::Invalid("SDPF: the graph has no frames".into()));
+    }
+    if graph.dist.len() != graph.n * graph.n {
+        return Err(VideoError::Invalid(format!(
+            "SDPF: the distance matrix has {} entries, expected {}×{}",
+            graph.dist.len(),
+            graph.n,
+            graph.n
+        )));
+    }
+    if start >= graph.n {
+        return Err(VideoError::Invalid(format!(
+            "SDPF: start frame {start} is out of range (the clip has {} frames, 0..{})",
+            graph.n,
+            graph.n - 1
+        )));
+    }
+    motion.validate(graph.n)?;
+    p.validate()
+}
+
+/// The seeded attempts of [`sdpf`], keeping the first that meets the goal, else the best.
+fn best_walk(ctx: &Ctx, start: usize, seed: u64) -> SdpfPath {
+    let p = ctx.p;
+    let mut best: Option<SdpfPath> = None;
+    for attempt in 0..p.attempts.max(1) {
+        let s = if attempt == 0 { seed } else { derive(seed, attempt as u64) };
+        let mut path = walk(ctx, start, s, attempt);
+        if p.loop_close {
+            close_loop(ctx, &mut path);
+        }
+        let done = goal_met(p, &path);
+        if best.as_ref().is_none_or(|b| rank(&path) > rank(b)) {
+            best = Some(path);
+        }
+        if done {
+            break;
+        }
+    }
+    best.unwrap_or_else(|| walk(ctx, start, seed, 0))
+}
+
+/// One seeded walk of Algorithm 1 (lines 3–24, repeated until a stop).
+fn walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> SdpfPath {
+    let n = ctx.graph.n;
+    let mut rng = rng(seed);
+    let mut visited = vec![false; n];
+    visited[start] = true;
+    let (mut frames, mut transitions) = (vec![start], Vec::new());
+    let mut current = start;
+    let stop = loop {
+        if ctx.p.length.is_some_and(|l| frames.len() >= l) {
+            break StopReason::TargetLength;
+        }
+        if frames.len() == n {
+            break StopReason::AllVisited;
+        }
+        let mut t = ctx.step(current, &visited);
+        t.chosen = draw(&t.probs, &mut rng);
+        let chosen = t.chosen;
+        transitions.push(t);
+        let Some(next) = chosen else { break StopReason::EarlyStop };
+        visited[next] = true;
+        frames.push(next);
+        current = next;
+    };
+    SdpfPath { frames, transitions, stop, closes_loop: false, closing: None, eta: ctx.eta, seed, attempt }
+}
+
+/// Cuts `path` at its longest prefix (≥ 3 frames, at most `length`) whose last frame can step
+/// back to the start under the same constraints, recording that step.
+fn close_loop(ctx: &Ctx, path: &mut SdpfPath) {
+    let start = path.frames[0];
+    let longest = path.frames.len().min(ctx.p.length.unwrap_or(usize::MAX));
+    let mut visited = vec![false; ctx.graph.n];
+    path.frames[1..longest].iter().for_each(|&f| visited[f] = true);
+    for last in (2..longest).rev() {
+        let from = path.frames[last];
+        if ctx.passes_cheap_checks(from, start, &visited) {
+            let mut t = ctx.step(from, &visited);
+            if t.probs.iter().any(|&(f, _)| f == start) {
+                t.chosen = Some(start);
+                path.frames.truncate(last + 1);
+                path.transitions.truncate(last);
+                path.stop = StopReason::LoopClosed;
+                path.closes_loop = true;
+                path.closing = Some(t);
+                return;
+            }
+        }
+        visited[from] = false;
+    }
+}
+
+fn goal_met(p: &SdpfParams, path: &SdpfPath) -> bool {
+    let long_enough = p.length.is_none_or(|l| path.len() >= l);
+    if p.loop_close {
+        path.closes_loop && long_enough
+    } else {
+        long_enough
+    }
+}
+
+/// Closed loops first, then longer paths; a strict `>` keeps the earliest among equals.
+fn rank(path: &SdpfPath) -> (bool, usize) {
+    (path.closes_loop, path.len())
+}

@@ -1,0 +1,282 @@
+//! The inputs and outputs of SDPF (Algorithm 1): parameters, per-frame motion facts, the motion
+//! distance of Eq. 15, and the recorded path with every transition's candidate sets.
+
+use crate::VideoError;
+
+/// Parameters of [`sdpf`](super::sdpf). [`Default`] is the paper's configuration (ξ = π/3, both
+/// constraints on, softmax temperature 1) plus our defaults for what the paper lacks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SdpfParams {
+    /// ξ of Eq. 12: the largest allowed angle (radians) between the tendencies of two LMS frames.
+    pub xi: f32,
+    /// Directional distillation C_d (Eq. 12); `false` is the "w/o C_d" ablation of Table 3.
+    pub use_cd: bool,
+    /// Coherent distillation C_t (Eq. 16–17); `false` is the "w/o C_t" ablation of Table 3.
+    pub use_ct: bool,
+    /// Target length in frames (the start frame included); `None`: walk until the early stop.
+    pub length: Option<usize>,
+    /// Loop closure: end on a frame that can transition back to the start frame under the same
+    /// constraints (beyond the paper; see [`sdpf`](super::sdpf) for the method).
+    pub loop_close: bool,
+    /// Allow transitions between frames of different scenes (see [`MotionInfo::cuts`]).
+    pub allow_cuts: bool,
+    /// Seed of the softmax draws (Eq. 20); every attempt derives its stream from it.
+    pub seed: u64,
+    /// Seeded attempts tried when the first walk misses its goal (target length or loop closure).
+    pub attempts: usize,
+    /// Softmax temperature τ: Ω ∝ exp(δ/τ). The paper's Eq. 20 is τ = 1.
+    pub temperature: f32,
+}
+
+impl Default for SdpfParams {
+    fn default() -> Self {
+        SdpfParams {
+            xi: std::f32::consts::FRAC_PI_3,
+            use_cd: true,
+            use_ct: true,
+            length: None,
+            loop_close: false,
+            allow_cuts: false,
+            seed: 0,
+            attempts: 8,
+            temperature: 1.0,
+        }
+    }
+}
+
+impl SdpfParams {
+    /// Rejects values that would make the walk meaningless (a NaN ξ, a non-positive temperature).
+    pub fn validate(&self) -> Result<(), VideoError> {
+        if !(self.xi.is_finite() && self.xi >= 0.0) {
+            return Err(VideoError::Invalid(format!("SDPF: xi must be a finite angle ≥ 0, got {}", self.xi)));
+        }
+        if !(self.temperature.is_finite() && self.temperature > 0.0) {
+            return Err(VideoError::Invalid(format!("SDPF: temperature must be > 0, got {}", self.temperature)));
+        }
+        Ok(())
+    }
+}
+
+/// Per-frame motion facts used by the distillation. Each vector is either empty (no such
+/// information: the corresponding rule never fires) or has one entry per frame.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MotionInfo {
+    /// Motion tendency T of each frame (Eq. 10), radians; `None` (or a NaN) where no pixel passes.
+    pub tendency: Vec<Option<f32>>,
+    /// LMS membership of each frame (Eq. 11).
+    pub lms: Vec<bool>,
+    /// Shot (scene) index of each frame: scene cuts split shots (see
+    /// [`detect_shots`](super::detect_shots)); empty or all equal for one shot.
+    pub shot: Vec<usize>,
+}
+
+impl MotionInfo {
+    /// No tendencies, no LMS, no cuts: only Eq. 8 and C_t act.
+    pub fn none() -> MotionInfo {
+        MotionInfo::default()
+    }
+
+    /// Tendencies and LMS flags with the shots that the cut flags of
+    /// [`detect_cuts`](super::detect_cuts) delimit (`cuts[i]`: a cut between frames `i − 1` and `i`).
+    pub fn with_cuts(tendency: Vec<Option<f32>>, lms: Vec<bool>, cuts: &[bool]) -> MotionInfo {
+        MotionInfo { tendency, lms, shot: super::cuts::shots_from_cuts(cuts) }
+    }
+
+    /// Checks that every non-empty vector has one entry per frame.
+    pub fn validate(&self, n: usize) -> Result<(), VideoError> {
+        for (name, len) in [("tendency", self.tendency.len()), ("lms", self.lms.len()), ("shot", self.shot.len())] {
+            if len != 0 && len != n {
+                return Err(VideoError::Invalid(format!("SDPF: motion {name} has {len} entries for {n} frames")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The tendency of frame `i` when it is known and finite.
+    pub fn tendency_of(&self, i: usize) -> Option<f32> {
+        self.tendency.get(i).copied().flatten().filter(|t| t.is_finite())
+    }
+
+    /// Whether frame `i` is an LMS frame (Eq. 11).
+    pub fn is_lms(&self, i: usize) -> bool {
+        self.lms.get(i).copied().unwrap_or(false)
+    }
+
+    /// The shot of frame `i` (0 when no shots are given).
+    pub fn shot_of(&self, i: usize) -> usize {
+        self.shot.get(i).copied().unwrap_or(0)
+    }
+}
+
+/// The motion distance of PMSM (Eq. 15), as a non-negative distance `‖R(X_c^p) − R(X_k^p)‖₂`, so
+/// that the paper's δ is its negation. Implementations may compute lazily (pseudo-images per pair).
+pub trait MotionDistance {
+    /// `−δ(FC, FK)` of Eq. 15 for the transition `c → k`: smaller is a smoother motion change.
+    fn distance(&self, c: usize, k: usize) -> f32;
+    /// The C_t threshold of Eq. 17 when `n1 < 2`, as a distance: the paper's
+    /// `ω = min(δ(FC, A1), δ(FC, A2))` with A1, A2 = FC rotated by ±π/2, i.e.
+    /// `max(dist(FC, A1), dist(FC, A2))`. A lone candidate passes when it is no farther from FC
+    /// than FC's own quarter-turns are. (Returning the smaller of the two distances instead is a
+    /// stricter reading; for a flow and its two quarter-turns both are usually close.)
+    fn rotated_floor(&self, c: usize) -> f32;
+    /// `distance(c, k)` for every `k` of `ks`; override to batch the work (one network call).
+    fn distances(&self, c: usize, ks: &[usize]) -> Vec<f32> {
+        ks.iter().map(|&k| self.distance(c, k)).collect()
+    }
+}
+
+/// Motion distances held in a matrix (`dist[c · n + k]`) with one rotated floor per frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatrixMotion {
+    pub n: usize,
+    pub dist: Vec<f32>,
+    pub floor: Vec<f32>,
+}
+
+impl MotionDistance for MatrixMotion {
+    fn distance(&self, c: usize, k: usize) -> f32 {
+        self.dist.get(c * self.n + k).copied().unwrap_or(f32::NAN)
+    }
+    fn rotated_floor(&self, c: usize) -> f32 {
+        self.floor.get(c).copied().unwrap_or(f32::NAN)
+    }
+}
+
+/// No motion information: every motion distance is 0, so C_t keeps every candidate and the
+/// softmax of Eq. 20 is uniform over S2 (what the paper says of S1 in §5.1).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoMotion;
+
+impl MotionDistance for NoMotion {
+    fn distance(&self, _c: usize, _k: usize) -> f32 {
+        0.0
+    }
+    fn rotated_floor(&self, _c: usize) -> f32 {
+        0.0
+    }
+}
+
+/// One candidate of S1 with the numbers the constraints looked at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    pub frame: usize,
+    /// Edge weight e_ck (Eq. 7/8).
+    pub edge: f32,
+    /// Motion distance −δ(FC, FK) (Eq. 15).
+    pub motion: f32,
+    /// Its motion tendency (Eq. 10) and LMS membership (Eq. 11).
+    pub tendency: Option<f32>,
+    pub lms: bool,
+}
+
+/// What the directional distillation (Eq. 12) did at one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CdState {
+    /// `use_cd` is off (ablation).
+    Disabled,
+    /// The current frame is not an LMS frame (or its tendency is unknown): C_d is skipped.
+    NotLms,
+    /// The current frame is an LMS frame but S1 holds no LMS frame: C_d is skipped.
+    NoLmsCandidate,
+    /// C_d applied with the current frame's tendency T_c and the angle ξ.
+    Active { tendency: f32, xi: f32 },
+}
+
+/// Which case of Eq. 17 set the C_t threshold ω (as a distance).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Omega {
+    /// `use_ct` is off (ablation), or S1 is empty.
+    Off,
+    /// n1 ≥ 2: the mean motion distance over S1.
+    Mean(f32),
+    /// n1 < 2: the distance of FC to its ±π/2 rotations ([`MotionDistance::rotated_floor`]).
+    Rotated(f32),
+}
+
+/// One step of Algorithm 1 from frame `from`, with everything `--explain` prints.
+///
+/// `removed_cd` and `removed_ct` are each constraint's own verdict on S1 (a candidate failing both
+/// is listed in both); S2 is S1 minus both (Eq. 18–19), with its softmax probabilities in `probs`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transition {
+    pub from: usize,
+    /// The frame drawn from S2; `None` only on the last transition of an early stop (S2 empty).
+    pub chosen: Option<usize>,
+    /// S1 (Eq. 8), ascending, after removing frames across a scene cut.
+    pub s1: Vec<usize>,
+    /// S1's numbers, in the order of `s1`.
+    pub candidates: Vec<Candidate>,
+    /// Frames under η that lie in another shot (beyond the paper; empty with `allow_cuts`).
+    pub removed_cut: Vec<usize>,
+    pub cd: CdState,
+    pub removed_cd: Vec<usize>,
+    pub omega: Omega,
+    pub removed_ct: Vec<usize>,
+    /// S2 with the probabilities of Eq. 20.
+    pub probs: Vec<(usize, f32)>,
+}
+
+impl Transition {
+    /// The frames of S2.
+    pub fn s2(&self) -> Vec<usize> {
+        self.probs.iter().map(|&(f, _)| f).collect()
+    }
+
+    /// The probability Eq. 20 gave frame `k` (0 when `k` is not in S2).
+    pub fn prob_of(&self, k: usize) -> f32 {
+        self.probs.iter().find(|&&(f, _)| f == k).map_or(0.0, |&(_, p)| p)
+    }
+}
+
+/// Why a walk ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// The target length was reached.
+    TargetLength,
+    /// S2 was empty (§5.2.3: "the algorithm will early stop to maintain the quality").
+    EarlyStop,
+    /// Every frame is on the path.
+    AllVisited,
+    /// The path was cut where its last frame can transition back to the start (loop closure).
+    LoopClosed,
+}
+
+/// The plan's name for [`SdpfPath`].
+pub type Path = SdpfPath;
+
+/// A path found by SDPF: the new frame order and how each step was taken.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SdpfPath {
+    /// Source frame indices in the new order, starting with the start frame; no repeats.
+    pub frames: Vec<usize>,
+    /// One entry per step (`frames.len() − 1`), plus the failed step of an early stop.
+    pub transitions: Vec<Transition>,
+    pub stop: StopReason,
+    /// Whether the last frame can transition back to the start (loop closure succeeded); the same
+    /// as `closing.is_some()`.
+    pub closes_loop: bool,
+    /// With loop closure: the step from the last frame back to the start (its `chosen` is the start).
+    pub closing: Option<Transition>,
+    /// η of Eq. 8 for this graph.
+    pub eta: f32,
+    /// The seed of the attempt that produced this path, and that attempt's index.
+    pub seed: u64,
+    pub attempt: usize,
+}
+
+impl SdpfPath {
+    /// Number of frames.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Whether the path is empty (never true for a path returned by SDPF).
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// Whether the last frame transitions back to the start (loop closure succeeded).
+    pub fn closed(&self) -> bool {
+        self.closes_loop
+    }
+}
