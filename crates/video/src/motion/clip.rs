@@ -1,7 +1,7 @@
 //! Motion of a whole clip: the backward flows FC used by PMSM (§5.2.2) and the per-frame tendency
 //! and LMS flags of §5.2.1 (Eq. 10–11).
 
-use super::farneback::{farneback, FlowParams};
+use super::farneback::{farneback, flow_between, FlowParams, Prepared};
 use super::tendency::{lms_frames, motion_tendency, DELTA, LMS_MIN_LEN, SIGMA};
 use super::Flow;
 use image::GrayImage;
@@ -24,28 +24,55 @@ pub struct ClipMotion {
 }
 
 /// Flows, tendencies and LMS flags of `gray` (frames of one size; a frame of another size is
-/// resampled by [`farneback`]). All 2(n − 1) flows run in parallel (rayon). An empty clip gives
+/// resampled by [`farneback`]). Each frame is expanded once (pyramid and polynomial expansion)
+/// and reused by its up to four flows; all 2(n − 1) flows run in parallel (rayon). An empty clip gives
 /// empty vectors; a single frame gets a zero flow and no tendency.
 pub fn analyse_clip(gray: &[GrayImage], p: &FlowParams) -> ClipMotion {
     let start = Instant::now();
     let (forward, backward) = clip_flows(gray, p);
     let tendency: Vec<Option<f32>> = forward.iter().map(|f| motion_tendency(f, SIGMA)).collect();
     let lms = lms_frames(&tendency, DELTA, LMS_MIN_LEN);
-    ClipMotion { backward, tendency, lms, seconds: start.elapsed().as_secs_f64() }
+    ClipMotion {
+        backward,
+        tendency,
+        lms,
+        seconds: start.elapsed().as_secs_f64(),
+    }
 }
 
 /// Per frame: (forward motion, backward flow FC), both n long.
 fn clip_flows(gray: &[GrayImage], p: &FlowParams) -> (Vec<Flow>, Vec<Flow>) {
     let n = gray.len();
     if n < 2 {
-        let still: Vec<Flow> =
-            gray.iter().map(|g| Flow::zeros(g.width() as usize, g.height() as usize)).collect();
+        let still: Vec<Flow> = gray
+            .iter()
+            .map(|g| Flow::zeros(g.width() as usize, g.height() as usize))
+            .collect();
         return (still.clone(), still);
     }
+    let frames: Vec<Prepared> = gray
+        .par_iter()
+        .map(|g| Prepared::from_image(g, p))
+        .collect();
+    let pair = |c: usize, d: usize| {
+        let (a, b) = (&frames[c], &frames[d]);
+        // A pair of different sizes: the public path resamples frame d to frame c's grid.
+        if gray[c].dimensions() == gray[d].dimensions() {
+            flow_between(a, b, p)
+        } else {
+            farneback(&gray[c], &gray[d], p)
+        }
+    };
     // Jobs 0..n−1: forward c → c+1; jobs n−1..2(n−1): backward c → c−1 for c = 1..n.
     let flows: Vec<Flow> = (0..2 * (n - 1))
         .into_par_iter()
-        .map(|j| if j < n - 1 { farneback(&gray[j], &gray[j + 1], p) } else { backward_of(gray, j - (n - 1) + 1, p) })
+        .map(|j| {
+            if j < n - 1 {
+                pair(j, j + 1)
+            } else {
+                pair(j + 2 - n, j + 1 - n)
+            }
+        })
         .collect();
     let (fwd, bwd) = flows.split_at(n - 1);
     let mut forward = fwd.to_vec();
@@ -53,8 +80,4 @@ fn clip_flows(gray: &[GrayImage], p: &FlowParams) -> (Vec<Flow>, Vec<Flow>) {
     let mut backward = vec![fwd[0].negated()];
     backward.extend_from_slice(bwd);
     (forward, backward)
-}
-
-fn backward_of(gray: &[GrayImage], c: usize, p: &FlowParams) -> Flow {
-    farneback(&gray[c], &gray[c - 1], p)
 }

@@ -14,7 +14,7 @@
 //! λ‖d − d̃‖² keeps the prior where the window has no texture (uniform regions), instead of
 //! pulling the flow to zero there; at a fixed point (d = d̃) it has no effect, so it adds no bias.
 
-use super::grid::{blur, from_gray, half, resample, Grid};
+use super::grid::{blur, from_gray, half, resample, Grid, ROWS_PER_TASK};
 use super::poly::{expand, Expansion};
 use super::Flow;
 use image::GrayImage;
@@ -66,19 +66,63 @@ pub fn farneback(prev: &GrayImage, next: &GrayImage, p: &FlowParams) -> Flow {
     if w == 0 || h == 0 {
         return Flow::zeros(w, h);
     }
-    let a = from_gray(prev);
     let mut b = from_gray(next);
     if b.w != w || b.h != h {
-        b = if b.w == 0 || b.h == 0 { Grid::zeros(w, h) } else { resample(&b, w, h) };
+        b = if b.w == 0 || b.h == 0 {
+            Grid::zeros(w, h)
+        } else {
+            resample(&b, w, h)
+        };
     }
-    let levels = level_count(w, h, p);
-    let (pa, pb) = (pyramid(a, levels), pyramid(b, levels));
-    let mut flow = Grid::<2>::zeros(pa[levels - 1].w, pa[levels - 1].h);
-    for level in (0..levels).rev() {
-        flow = upscale_flow(&flow, pa[level].w, pa[level].h);
-        flow = refine(&pa[level], &pb[level], flow, p);
+    flow_between(&Prepared::new(from_gray(prev), p), &Prepared::new(b, p), p)
+}
+
+/// One frame's polynomial expansions on every pyramid level (full resolution first). A frame takes
+/// part in up to four flows of a clip (as prev and next, forwards and backwards), so
+/// [`super::analyse_clip`] expands each frame once and reuses it.
+pub(crate) struct Prepared {
+    levels: Vec<Expansion>,
+}
+
+impl Prepared {
+    /// Expansions of `img` for the settings `p`.
+    pub(crate) fn new(img: Grid<1>, p: &FlowParams) -> Prepared {
+        let levels = level_count(img.w, img.h, p);
+        let levels = pyramid(img, levels)
+            .iter()
+            .map(|g| expand(g, p.poly_n, p.poly_sigma))
+            .collect();
+        Prepared { levels }
     }
-    Flow { width: w, height: h, uv: flow.px }
+
+    /// A frame from a grayscale image.
+    pub(crate) fn from_image(img: &GrayImage, p: &FlowParams) -> Prepared {
+        Prepared::new(from_gray(img), p)
+    }
+
+    fn size(&self) -> (usize, usize) {
+        self.levels.first().map_or((0, 0), |e| (e.w, e.h))
+    }
+}
+
+/// Flow from `a` to `b`, coarse to fine. Frames of different sizes or an empty frame give a zero
+/// flow on `a`'s grid (the public [`farneback`] resamples before it gets here).
+pub(crate) fn flow_between(a: &Prepared, b: &Prepared, p: &FlowParams) -> Flow {
+    let (w, h) = a.size();
+    if w == 0 || h == 0 || a.size() != b.size() || a.levels.len() != b.levels.len() {
+        return Flow::zeros(w, h);
+    }
+    let coarsest = &a.levels[a.levels.len() - 1];
+    let mut flow = Grid::<2>::zeros(coarsest.w, coarsest.h);
+    for (ea, eb) in a.levels.iter().zip(&b.levels).rev() {
+        flow = upscale_flow(&flow, ea.w, ea.h);
+        flow = refine(ea, eb, flow, p);
+    }
+    Flow {
+        width: w,
+        height: h,
+        uv: flow.px,
+    }
 }
 
 /// Levels actually used: at most `p.levels` (≥ 1), with the coarsest side ≥ `min_level_side`.
@@ -117,12 +161,11 @@ fn upscale_flow(flow: &Grid<2>, w: usize, h: usize) -> Grid<2> {
 }
 
 /// `p.iterations` displacement updates on one pyramid level.
-fn refine(a: &Grid<1>, b: &Grid<1>, mut flow: Grid<2>, p: &FlowParams) -> Grid<2> {
-    let (ea, eb) = (expand(a, p.poly_n, p.poly_sigma), expand(b, p.poly_n, p.poly_sigma));
+fn refine(ea: &Expansion, eb: &Expansion, mut flow: Grid<2>, p: &FlowParams) -> Grid<2> {
     let radius = (p.window / 2).max(1);
     let sigma = (p.window.max(3) as f32) / 4.0;
     for _ in 0..p.iterations.max(1) {
-        let normal = blur(&normal_equations(&ea, &eb, &flow), sigma, radius);
+        let normal = blur(&normal_equations(ea, eb, &flow), sigma, radius);
         flow = solve(&normal, &flow, p.regularization);
     }
     flow
@@ -133,17 +176,21 @@ fn refine(a: &Grid<1>, b: &Grid<1>, mut flow: Grid<2>, p: &FlowParams) -> Grid<2
 fn normal_equations(ea: &Expansion, eb: &Expansion, flow: &Grid<2>) -> Grid<5> {
     let (w, h) = (ea.w, ea.h);
     let mut out = Grid::<5>::zeros(w, h);
-    out.px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, o) in row.iter_mut().enumerate() {
-            let i = y * w + x;
-            let d = flow.px[i];
-            let (sx, sy) = (x as f32 + d[0], y as f32 + d[1]);
-            if !(sx >= 0.0 && sy >= 0.0 && sx <= (w - 1) as f32 && sy <= (h - 1) as f32) {
-                continue;
+    out.px
+        .par_chunks_mut(w)
+        .with_min_len(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                let i = y * w + x;
+                let d = flow.px[i];
+                let (sx, sy) = (x as f32 + d[0], y as f32 + d[1]);
+                if !(sx >= 0.0 && sy >= 0.0 && sx <= (w - 1) as f32 && sy <= (h - 1) as f32) {
+                    continue;
+                }
+                *o = pixel_equations(&ea.px[i], &eb.bilinear(sx, sy), d);
             }
-            *o = pixel_equations(&ea.px[i], &eb.bilinear(sx, sy), d);
-        }
-    });
+        });
     out
 }
 
@@ -182,5 +229,9 @@ fn solve(normal: &Grid<5>, prior: &Grid<2>, lambda: f32) -> Grid<2> {
             [(g22 * h1 - g12 * h2) / det, (g11 * h2 - g12 * h1) / det]
         })
         .collect();
-    Grid { w: normal.w, h: normal.h, px }
+    Grid {
+        w: normal.w,
+        h: normal.h,
+        px,
+    }
 }

@@ -14,60 +14,87 @@ pub(crate) struct Grid<const N: usize> {
 
 impl<const N: usize> Grid<N> {
     pub fn zeros(w: usize, h: usize) -> Self {
-        Grid { w, h, px: vec![[0.0; N]; w * h] }
-    }
-
-    /// The pixel at (x, y) with coordinates clamped into the image (replicated border).
-    #[inline]
-    pub fn clamped(&self, x: isize, y: isize) -> [f32; N] {
-        let x = x.clamp(0, self.w as isize - 1) as usize;
-        let y = y.clamp(0, self.h as isize - 1) as usize;
-        self.px[y * self.w + x]
+        Grid {
+            w,
+            h,
+            px: vec![[0.0; N]; w * h],
+        }
     }
 
     /// Bilinear interpolation at a real position, clamped into the image.
+    #[inline]
     pub fn bilinear(&self, x: f32, y: f32) -> [f32; N] {
         let x = x.clamp(0.0, (self.w - 1) as f32);
         let y = y.clamp(0.0, (self.h - 1) as f32);
-        let (x0, y0) = (x.floor() as isize, y.floor() as isize);
+        let (x0, y0) = (x as usize, y as usize);
         let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let (a, b) = (self.clamped(x0, y0), self.clamped(x0 + 1, y0));
-        let (c, d) = (self.clamped(x0, y0 + 1), self.clamped(x0 + 1, y0 + 1));
-        std::array::from_fn(|i| {
-            let top = a[i] + (b[i] - a[i]) * fx;
-            let bottom = c[i] + (d[i] - c[i]) * fx;
+        // Neighbours to the right / below, repeated on the last column / row.
+        let dx = usize::from(x0 + 1 < self.w);
+        let dy = if y0 + 1 < self.h { self.w } else { 0 };
+        let i = y0 * self.w + x0;
+        let (a, b, c, d) = (
+            self.px[i],
+            self.px[i + dx],
+            self.px[i + dy],
+            self.px[i + dy + dx],
+        );
+        std::array::from_fn(|k| {
+            let top = a[k] + (b[k] - a[k]) * fx;
+            let bottom = c[k] + (d[k] - c[k]) * fx;
             top + (bottom - top) * fy
         })
     }
 }
 
+/// Rows per rayon task: a 160-px row is too little work to be a task of its own.
+pub(crate) const ROWS_PER_TASK: usize = 16;
+
 /// Luma in [0, 1].
 pub(crate) fn from_gray(img: &GrayImage) -> Grid<1> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    Grid { w, h, px: img.as_raw().iter().map(|&v| [v as f32 / 255.0]).collect() }
+    Grid {
+        w,
+        h,
+        px: img.as_raw().iter().map(|&v| [v as f32 / 255.0]).collect(),
+    }
 }
 
 /// Separable correlation along rows: `out(x, y) = Σ_t k[t + r] · src(x + t, y)`, t ∈ [−r, r], with
-/// the border replicated. `k` has odd length 2r + 1.
+/// the border replicated. `k` has odd length 2r + 1. Each row is padded once so the inner loop
+/// has no bounds logic.
 pub(crate) fn correlate_rows<const N: usize>(src: &Grid<N>, k: &[f32]) -> Grid<N> {
-    let r = (k.len() / 2) as isize;
+    let r = k.len() / 2;
     let mut out = Grid::zeros(src.w, src.h);
     if src.w == 0 {
         return out;
     }
-    out.px.par_chunks_mut(src.w).enumerate().for_each(|(y, row)| {
-        for (x, o) in row.iter_mut().enumerate() {
-            let mut acc = [0.0f32; N];
-            for (i, &kv) in k.iter().enumerate() {
-                let p = src.clamped(x as isize + i as isize - r, y as isize);
-                for c in 0..N {
-                    acc[c] += kv * p[c];
+    out.px
+        .par_chunks_mut(src.w)
+        .with_min_len(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let line = &src.px[y * src.w..(y + 1) * src.w];
+            let padded = pad(line, r);
+            for (o, window) in row.iter_mut().zip(padded.windows(k.len())) {
+                let mut acc = [0.0f32; N];
+                for (kv, p) in k.iter().zip(window) {
+                    for c in 0..N {
+                        acc[c] += kv * p[c];
+                    }
                 }
+                *o = acc;
             }
-            *o = acc;
-        }
-    });
+        });
     out
+}
+
+/// `line` with its first and last values repeated `r` times on each side.
+pub(crate) fn pad<T: Copy>(line: &[T], r: usize) -> Vec<T> {
+    let mut v = Vec::with_capacity(line.len() + 2 * r);
+    v.extend(std::iter::repeat_n(line[0], r));
+    v.extend_from_slice(line);
+    v.extend(std::iter::repeat_n(line[line.len() - 1], r));
+    v
 }
 
 /// Separable correlation along columns, like [`correlate_rows`].
@@ -77,17 +104,21 @@ pub(crate) fn correlate_cols<const N: usize>(src: &Grid<N>, k: &[f32]) -> Grid<N
     if src.w == 0 {
         return out;
     }
-    out.px.par_chunks_mut(src.w).enumerate().for_each(|(y, row)| {
-        for (i, &kv) in k.iter().enumerate() {
-            let sy = (y as isize + i as isize - r).clamp(0, src.h as isize - 1) as usize;
-            let src_row = &src.px[sy * src.w..(sy + 1) * src.w];
-            for (o, p) in row.iter_mut().zip(src_row) {
-                for c in 0..N {
-                    o[c] += kv * p[c];
+    out.px
+        .par_chunks_mut(src.w)
+        .with_min_len(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (i, &kv) in k.iter().enumerate() {
+                let sy = (y as isize + i as isize - r).clamp(0, src.h as isize - 1) as usize;
+                let src_row = &src.px[sy * src.w..(sy + 1) * src.w];
+                for (o, p) in row.iter_mut().zip(src_row) {
+                    for c in 0..N {
+                        o[c] += kv * p[c];
+                    }
                 }
             }
-        }
-    });
+        });
     out
 }
 
@@ -119,12 +150,16 @@ pub(crate) fn resample<const N: usize>(src: &Grid<N>, w: usize, h: usize) -> Gri
         return out;
     }
     let (sx, sy) = (src.w as f32 / w as f32, src.h as f32 / h as f32);
-    out.px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        let fy = (y as f32 + 0.5) * sy - 0.5;
-        for (x, o) in row.iter_mut().enumerate() {
-            *o = src.bilinear((x as f32 + 0.5) * sx - 0.5, fy);
-        }
-    });
+    out.px
+        .par_chunks_mut(w)
+        .with_min_len(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let fy = (y as f32 + 0.5) * sy - 0.5;
+            for (x, o) in row.iter_mut().enumerate() {
+                *o = src.bilinear((x as f32 + 0.5) * sx - 0.5, fy);
+            }
+        });
     out
 }
 
@@ -140,26 +175,48 @@ mod tests {
 
     #[test]
     fn correlation_uses_the_kernel_orientation_and_replicates_borders() {
-        let g = Grid::<1> { w: 4, h: 1, px: vec![[0.0], [1.0], [2.0], [3.0]] };
+        let g = Grid::<1> {
+            w: 4,
+            h: 1,
+            px: vec![[0.0], [1.0], [2.0], [3.0]],
+        };
         // k = [0, 0, 1]: out(x) = src(x + 1), the last pixel repeats.
         let out = correlate_rows(&g, &[0.0, 0.0, 1.0]);
         assert_eq!(out.px, vec![[1.0], [2.0], [3.0], [3.0]]);
-        let col = Grid::<1> { w: 1, h: 3, px: vec![[5.0], [6.0], [7.0]] };
-        assert_eq!(correlate_cols(&col, &[1.0, 0.0, 0.0]).px, vec![[5.0], [5.0], [6.0]]);
+        let col = Grid::<1> {
+            w: 1,
+            h: 3,
+            px: vec![[5.0], [6.0], [7.0]],
+        };
+        assert_eq!(
+            correlate_cols(&col, &[1.0, 0.0, 0.0]).px,
+            vec![[5.0], [5.0], [6.0]]
+        );
     }
 
     #[test]
     fn bilinear_interpolates_and_clamps() {
-        let g = Grid::<1> { w: 2, h: 2, px: vec![[0.0], [1.0], [2.0], [3.0]] };
+        let g = Grid::<1> {
+            w: 2,
+            h: 2,
+            px: vec![[0.0], [1.0], [2.0], [3.0]],
+        };
         assert!((g.bilinear(0.5, 0.5)[0] - 1.5).abs() < 1e-6);
         assert_eq!(g.bilinear(-3.0, 9.0)[0], 2.0);
     }
 
     #[test]
     fn halving_keeps_a_constant_image_constant() {
-        let g = Grid::<2> { w: 7, h: 5, px: vec![[0.25, -1.0]; 35] };
+        let g = Grid::<2> {
+            w: 7,
+            h: 5,
+            px: vec![[0.25, -1.0]; 35],
+        };
         let h = half(&g);
         assert_eq!((h.w, h.h), (4, 3));
-        assert!(h.px.iter().all(|p| (p[0] - 0.25).abs() < 1e-6 && (p[1] + 1.0).abs() < 1e-6));
+        assert!(h
+            .px
+            .iter()
+            .all(|p| (p[0] - 0.25).abs() < 1e-6 && (p[1] + 1.0).abs() < 1e-6));
     }
 }

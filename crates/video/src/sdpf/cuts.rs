@@ -86,7 +86,7 @@ pub fn cut_scores(frames: &[RgbImage], p: &CutParams) -> Vec<f32> {
 /// Whether `scores[i]` is a cut: large, and `ratio` times above its neighbours' median.
 fn is_jump(scores: &[f32], i: usize, p: &CutParams) -> bool {
     let s = scores[i];
-    if !(s >= p.min_score) {
+    if s.is_nan() || s < p.min_score {
         return false;
     }
     let lo = i.saturating_sub(p.window).max(1);
