@@ -109,14 +109,7 @@ fn load(clip: &BenchClip) -> Result<(Clip, String, f64), VideoError> {
 
 /// The analysis of an ablation, reusing the full one's flows.
 fn ablated(full: &Analysis, clip: &Clip, cfg: &VideoBenchConfig, which: &str, progress: &Progress) -> Result<Analysis, VideoError> {
-    let mut a = Analysis {
-        motion: full.motion.clone(),
-        info: full.info.clone(),
-        graph: full.graph.clone(),
-        embedder: full.embedder.clone(),
-        stages: Vec::new(),
-        metric_note: String::new(),
-    };
+    let mut a = full.clone();
     match which {
         "w/o RSFNet" => a.graph = pixel_graph(&clip.frames, 32),
         "w/o L_d" => {
@@ -150,7 +143,7 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
     let mut walk_s = 0.0;
     let mut walks = 0usize;
     for which in CONFIGS {
-        let a = if matches!(which, "w/o RSFNet" | "w/o L_d") { ablated(&full, &clip, cfg, which, progress)? } else { full.clone_shallow() };
+        let a = if matches!(which, "w/o RSFNet" | "w/o L_d") { ablated(&full, &clip, cfg, which, progress)? } else { full.clone() };
         let (mut md, mut dq, mut len) = (0.0, 0.0, 0.0);
         for (i, &s) in starts.iter().enumerate() {
             let (paths, secs) = resequence(&a, s, &params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64)), 1)?;
@@ -177,20 +170,6 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
         md_source: stability_md(&clip.frames, &source),
         configs,
     })
-}
-
-impl Analysis {
-    /// A copy sharing nothing mutable (the walks only read it).
-    fn clone_shallow(&self) -> Analysis {
-        Analysis {
-            motion: self.motion.clone(),
-            info: self.info.clone(),
-            graph: self.graph.clone(),
-            embedder: self.embedder.clone(),
-            stages: self.stages.clone(),
-            metric_note: self.metric_note.clone(),
-        }
-    }
 }
 
 /// Runs the bench and returns its report (tables as text, Markdown and CSV).

@@ -62,6 +62,7 @@ pub fn default_cache_dir() -> PathBuf {
 }
 
 /// Everything the walks need, computed once per clip.
+#[derive(Clone)]
 pub struct Analysis {
     pub motion: ClipMotion,
     pub info: MotionInfo,

@@ -14,11 +14,10 @@
 //! λ‖d − d̃‖² keeps the prior where the window has no texture (uniform regions), instead of
 //! pulling the flow to zero there; at a fixed point (d = d̃) it has no effect, so it adds no bias.
 
-use super::grid::{blur, from_gray, half, resample, Grid, ROWS_PER_TASK};
+use super::grid::{blur, from_gray, half, resample, Grid};
 use super::poly::{expand, Expansion};
 use super::Flow;
 use image::GrayImage;
-use rayon::prelude::*;
 
 /// Settings of [`farneback`]. The defaults suit frames of ≤ 160 px width (the clip flows).
 #[derive(Clone, Debug, PartialEq)]
@@ -175,23 +174,17 @@ fn refine(ea: &Expansion, eb: &Expansion, mut flow: Grid<2>, p: &FlowParams) -> 
 /// whose displaced position leaves the image has no counterpart and contributes nothing.
 fn normal_equations(ea: &Expansion, eb: &Expansion, flow: &Grid<2>) -> Grid<5> {
     let (w, h) = (ea.w, ea.h);
-    let mut out = Grid::<5>::zeros(w, h);
-    out.px
-        .par_chunks_mut(w)
-        .with_min_len(ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, o) in row.iter_mut().enumerate() {
-                let i = y * w + x;
-                let d = flow.px[i];
-                let (sx, sy) = (x as f32 + d[0], y as f32 + d[1]);
-                if !(sx >= 0.0 && sy >= 0.0 && sx <= (w - 1) as f32 && sy <= (h - 1) as f32) {
-                    continue;
-                }
-                *o = pixel_equations(&ea.px[i], &eb.bilinear(sx, sy), d);
+    Grid::par_rows(w, h, |y, row| {
+        for (x, o) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            let d = flow.px[i];
+            let (sx, sy) = (x as f32 + d[0], y as f32 + d[1]);
+            if !(sx >= 0.0 && sy >= 0.0 && sx <= (w - 1) as f32 && sy <= (h - 1) as f32) {
+                continue;
             }
-        });
-    out
+            *o = pixel_equations(&ea.px[i], &eb.bilinear(sx, sy), d);
+        }
+    })
 }
 
 /// One pixel's contribution, from the two expansions `c1` (at x) and `c2` (at x + d̃).

@@ -21,6 +21,20 @@ impl<const N: usize> Grid<N> {
         }
     }
 
+    /// A `w`×`h` grid whose rows (starting at zero) are filled in parallel by `fill(y, row)`,
+    /// [`ROWS_PER_TASK`] rows per rayon task. An empty grid runs nothing.
+    pub fn par_rows(w: usize, h: usize, fill: impl Fn(usize, &mut [[f32; N]]) + Sync + Send) -> Self {
+        let mut out = Grid::zeros(w, h);
+        if w > 0 {
+            out.px
+                .par_chunks_mut(w)
+                .with_min_len(ROWS_PER_TASK)
+                .enumerate()
+                .for_each(|(y, row)| fill(y, row));
+        }
+        out
+    }
+
     /// Bilinear interpolation at a real position, clamped into the image.
     #[inline]
     pub fn bilinear(&self, x: f32, y: f32) -> [f32; N] {
@@ -32,12 +46,7 @@ impl<const N: usize> Grid<N> {
         let dx = usize::from(x0 + 1 < self.w);
         let dy = if y0 + 1 < self.h { self.w } else { 0 };
         let i = y0 * self.w + x0;
-        let (a, b, c, d) = (
-            self.px[i],
-            self.px[i + dx],
-            self.px[i + dy],
-            self.px[i + dy + dx],
-        );
+        let (a, b, c, d) = (self.px[i], self.px[i + dx], self.px[i + dy], self.px[i + dy + dx]);
         std::array::from_fn(|k| {
             let top = a[k] + (b[k] - a[k]) * fx;
             let bottom = c[k] + (d[k] - c[k]) * fx;
@@ -64,28 +73,19 @@ pub(crate) fn from_gray(img: &GrayImage) -> Grid<1> {
 /// has no bounds logic.
 pub(crate) fn correlate_rows<const N: usize>(src: &Grid<N>, k: &[f32]) -> Grid<N> {
     let r = k.len() / 2;
-    let mut out = Grid::zeros(src.w, src.h);
-    if src.w == 0 {
-        return out;
-    }
-    out.px
-        .par_chunks_mut(src.w)
-        .with_min_len(ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let line = &src.px[y * src.w..(y + 1) * src.w];
-            let padded = pad(line, r);
-            for (o, window) in row.iter_mut().zip(padded.windows(k.len())) {
-                let mut acc = [0.0f32; N];
-                for (kv, p) in k.iter().zip(window) {
-                    for c in 0..N {
-                        acc[c] += kv * p[c];
-                    }
+    Grid::par_rows(src.w, src.h, |y, row| {
+        let line = &src.px[y * src.w..(y + 1) * src.w];
+        let padded = pad(line, r);
+        for (o, window) in row.iter_mut().zip(padded.windows(k.len())) {
+            let mut acc = [0.0f32; N];
+            for (kv, p) in k.iter().zip(window) {
+                for c in 0..N {
+                    acc[c] += kv * p[c];
                 }
-                *o = acc;
             }
-        });
-    out
+            *o = acc;
+        }
+    })
 }
 
 /// `line` with its first and last values repeated `r` times on each side.
@@ -100,26 +100,17 @@ pub(crate) fn pad<T: Copy>(line: &[T], r: usize) -> Vec<T> {
 /// Separable correlation along columns, like [`correlate_rows`].
 pub(crate) fn correlate_cols<const N: usize>(src: &Grid<N>, k: &[f32]) -> Grid<N> {
     let r = (k.len() / 2) as isize;
-    let mut out = Grid::zeros(src.w, src.h);
-    if src.w == 0 {
-        return out;
-    }
-    out.px
-        .par_chunks_mut(src.w)
-        .with_min_len(ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (i, &kv) in k.iter().enumerate() {
-                let sy = (y as isize + i as isize - r).clamp(0, src.h as isize - 1) as usize;
-                let src_row = &src.px[sy * src.w..(sy + 1) * src.w];
-                for (o, p) in row.iter_mut().zip(src_row) {
-                    for c in 0..N {
-                        o[c] += kv * p[c];
-                    }
+    Grid::par_rows(src.w, src.h, |y, row| {
+        for (i, &kv) in k.iter().enumerate() {
+            let sy = (y as isize + i as isize - r).clamp(0, src.h as isize - 1) as usize;
+            let src_row = &src.px[sy * src.w..(sy + 1) * src.w];
+            for (o, p) in row.iter_mut().zip(src_row) {
+                for c in 0..N {
+                    o[c] += kv * p[c];
                 }
             }
-        });
-    out
+        }
+    })
 }
 
 /// Unnormalised Gaussian weights g(t) = exp(−t²/2σ²) for t ∈ [−r, r].
@@ -145,22 +136,16 @@ pub(crate) fn blur<const N: usize>(src: &Grid<N>, sigma: f32, radius: usize) -> 
 /// Bilinear resampling to `w`×`h`, pixel centres aligned (output pixel i samples the source at
 /// (i + ½)·src/dst − ½). Values are not scaled.
 pub(crate) fn resample<const N: usize>(src: &Grid<N>, w: usize, h: usize) -> Grid<N> {
-    let mut out = Grid::zeros(w, h);
     if src.w == 0 || src.h == 0 || w == 0 {
-        return out;
+        return Grid::zeros(w, h);
     }
     let (sx, sy) = (src.w as f32 / w as f32, src.h as f32 / h as f32);
-    out.px
-        .par_chunks_mut(w)
-        .with_min_len(ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let fy = (y as f32 + 0.5) * sy - 0.5;
-            for (x, o) in row.iter_mut().enumerate() {
-                *o = src.bilinear((x as f32 + 0.5) * sx - 0.5, fy);
-            }
-        });
-    out
+    Grid::par_rows(w, h, |y, row| {
+        let fy = (y as f32 + 0.5) * sy - 0.5;
+        for (x, o) in row.iter_mut().enumerate() {
+            *o = src.bilinear((x as f32 + 0.5) * sx - 0.5, fy);
+        }
+    })
 }
 
 /// The next pyramid level: anti-alias blur (σ = 1 px, enough for a factor 2) then half size
@@ -188,10 +173,7 @@ mod tests {
             h: 3,
             px: vec![[5.0], [6.0], [7.0]],
         };
-        assert_eq!(
-            correlate_cols(&col, &[1.0, 0.0, 0.0]).px,
-            vec![[5.0], [5.0], [6.0]]
-        );
+        assert_eq!(correlate_cols(&col, &[1.0, 0.0, 0.0]).px, vec![[5.0], [5.0], [6.0]]);
     }
 
     #[test]
@@ -214,9 +196,6 @@ mod tests {
         };
         let h = half(&g);
         assert_eq!((h.w, h.h), (4, 3));
-        assert!(h
-            .px
-            .iter()
-            .all(|p| (p[0] - 0.25).abs() < 1e-6 && (p[1] + 1.0).abs() < 1e-6));
+        assert!(h.px.iter().all(|p| (p[0] - 0.25).abs() < 1e-6 && (p[1] + 1.0).abs() < 1e-6));
     }
 }

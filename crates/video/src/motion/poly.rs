@@ -8,8 +8,7 @@
 //! followed by a column pass with g·tᵠ. The 6×6 Gram matrix of the basis {1, x₁, x₂, x₁², x₂²,
 //! x₁x₂} under the applicability is inverted once.
 
-use super::grid::{gaussian_weights, pad, Grid, ROWS_PER_TASK};
-use rayon::prelude::*;
+use super::grid::{gaussian_weights, pad, Grid};
 
 /// Per pixel: `[b₁, b₂, A₁₁, A₂₂, A₁₂]` of the local quadratic (c is not needed for motion).
 pub(crate) type Expansion = Grid<5>;
@@ -30,8 +29,7 @@ pub(crate) fn expand(img: &Grid<1>, poly_n: usize, sigma: f32) -> Expansion {
     let moments = column_moments(&row_moments(img, &k), &k);
     let inv = invert6(gram(&g, radius));
     // Only b and A are needed: rows 1..6 of the inverse, in f32 for speed (the entries are O(1)).
-    let rows: [[f32; 6]; 5] =
-        std::array::from_fn(|r| std::array::from_fn(|c| inv[r + 1][c] as f32));
+    let rows: [[f32; 6]; 5] = std::array::from_fn(|r| std::array::from_fn(|c| inv[r + 1][c] as f32));
     let mut out = Grid::zeros(img.w, img.h);
     for (o, m) in out.px.iter_mut().zip(&moments.px) {
         let r: [f32; 5] = std::array::from_fn(|i| dot6(&rows[i], m));
@@ -49,53 +47,35 @@ fn dot6(a: &[f32; 6], b: &[f32; 6]) -> f32 {
 fn row_moments(img: &Grid<1>, k: &[Vec<f32>; 3]) -> Grid<3> {
     let (w, len) = (img.w, k[0].len());
     debug_assert!(k[1].len() == len && k[2].len() == len);
-    let mut out = Grid::<3>::zeros(img.w, img.h);
-    if w == 0 {
-        return out;
-    }
-    out.px
-        .par_chunks_mut(w)
-        .with_min_len(ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let padded = pad(&img.px[y * w..(y + 1) * w], len / 2);
-            for (o, window) in row.iter_mut().zip(padded.windows(len)) {
-                for (((p, a), b), c) in window.iter().zip(&k[0]).zip(&k[1]).zip(&k[2]) {
-                    o[0] += a * p[0];
-                    o[1] += b * p[0];
-                    o[2] += c * p[0];
-                }
+    Grid::par_rows(img.w, img.h, |y, row| {
+        let padded = pad(&img.px[y * w..(y + 1) * w], len / 2);
+        for (o, window) in row.iter_mut().zip(padded.windows(len)) {
+            for (((p, a), b), c) in window.iter().zip(&k[0]).zip(&k[1]).zip(&k[2]) {
+                o[0] += a * p[0];
+                o[1] += b * p[0];
+                o[2] += c * p[0];
             }
-        });
-    out
+        }
+    })
 }
 
 /// Column pass: the six moments in basis order 1, x₁, x₂, x₁², x₂², x₁x₂ (x₁ along rows, x₂
 /// along columns) from the row moments h₀, h₁, h₂.
 fn column_moments(h: &Grid<3>, k: &[Vec<f32>; 3]) -> Grid<6> {
     let (w, hh, r) = (h.w, h.h as isize, (k[0].len() / 2) as isize);
-    let mut out = Grid::<6>::zeros(h.w, h.h);
-    if w == 0 {
-        return out;
-    }
-    out.px
-        .par_chunks_mut(w)
-        .with_min_len(ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (i, ((&g0, &g1), &g2)) in k[0].iter().zip(&k[1]).zip(&k[2]).enumerate() {
-                let sy = (y as isize + i as isize - r).clamp(0, hh - 1) as usize;
-                for (o, p) in row.iter_mut().zip(&h.px[sy * w..(sy + 1) * w]) {
-                    o[0] += g0 * p[0];
-                    o[1] += g0 * p[1];
-                    o[2] += g1 * p[0];
-                    o[3] += g0 * p[2];
-                    o[4] += g2 * p[0];
-                    o[5] += g1 * p[1];
-                }
+    Grid::par_rows(h.w, h.h, |y, row| {
+        for (i, ((&g0, &g1), &g2)) in k[0].iter().zip(&k[1]).zip(&k[2]).enumerate() {
+            let sy = (y as isize + i as isize - r).clamp(0, hh - 1) as usize;
+            for (o, p) in row.iter_mut().zip(&h.px[sy * w..(sy + 1) * w]) {
+                o[0] += g0 * p[0];
+                o[1] += g0 * p[1];
+                o[2] += g1 * p[0];
+                o[3] += g0 * p[2];
+                o[4] += g2 * p[0];
+                o[5] += g1 * p[1];
             }
-        });
-    out
+        }
+    })
 }
 
 /// Gram matrix Σ a(x)·bₖ(x)·bₗ(x) of the six basis functions over the window.
@@ -156,12 +136,8 @@ mod tests {
     #[test]
     fn recovers_the_coefficients_of_a_quadratic_image() {
         let (w, h) = (15usize, 13usize);
-        let f = |x: f64, y: f64| {
-            0.3 + 0.02 * x - 0.01 * y + 0.003 * x * x + 0.001 * y * y - 0.002 * x * y
-        };
-        let px = (0..w * h)
-            .map(|i| [f((i % w) as f64, (i / w) as f64) as f32])
-            .collect();
+        let f = |x: f64, y: f64| 0.3 + 0.02 * x - 0.01 * y + 0.003 * x * x + 0.001 * y * y - 0.002 * x * y;
+        let px = (0..w * h).map(|i| [f((i % w) as f64, (i / w) as f64) as f32]).collect();
         let e = expand(&Grid { w, h, px }, 5, 1.2);
         let (x, y) = (7.0, 6.0);
         let c = e.px[6 * w + 7];
