@@ -271,6 +271,107 @@ pub fn grouped_bar_chart(
     })
 }
 
+/// Five-number summary (min, lower quartile, median, upper quartile, max) of `values`, with
+/// quartiles by linear interpolation between order statistics. `None` for no finite value.
+pub fn five_numbers(values: &[f64]) -> Option<[f64; 5]> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| {
+        let pos = p * (v.len() - 1) as f64;
+        let (i, f) = (pos.floor() as usize, pos.fract());
+        v[i] + (v[(i + 1).min(v.len() - 1)] - v[i]) * f
+    };
+    Some([v[0], q(0.25), q(0.5), q(0.75), v[v.len() - 1]])
+}
+
+/// Box plot: `series[s].1[g]` holds the samples of series `s` in group `g` (e.g. matching scores per
+/// method, grouped by query-set size). Boxes span the quartiles, the bar inside is the median and
+/// whiskers reach the extremes.
+pub fn box_plot(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    groups: &[String],
+    series: &[(String, Vec<Vec<f64>>)],
+) -> Result<(), RenderError> {
+    if groups.is_empty() || series.is_empty() {
+        return Err(plot_err(title, "a box plot needs at least one group and one series"));
+    }
+    let mut summaries = Vec::new();
+    for (name, per_group) in series {
+        if per_group.len() != groups.len() {
+            return Err(plot_err(title, format!("series '{name}' has {} sample sets for {} groups", per_group.len(), groups.len())));
+        }
+        let mut row = Vec::new();
+        for (g, samples) in per_group.iter().enumerate() {
+            let five = five_numbers(samples)
+                .ok_or_else(|| plot_err(title, format!("series '{name}', group '{}': no finite sample", groups[g])))?;
+            row.push(five);
+        }
+        summaries.push(row);
+    }
+    let (lo, hi) = summaries.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f[0]), b.max(f[4])));
+    let span = (hi - lo).max(1e-9);
+    let yr = (lo - span * 0.08)..(hi + span * 0.12);
+    let n = groups.len() as f64;
+    let box_w = 0.8 / series.len() as f64;
+    render_png(path, title, |root| {
+        let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, TITLE_SIZE).into_font())
+            .margin(px(18))
+            .x_label_area_size(px(40))
+            .y_label_area_size(px(78))
+            .build_cartesian_2d(0.0..n, yr.clone())
+            .map_err(e)?;
+        house_mesh(chart.configure_mesh().disable_x_mesh().x_labels(0).y_desc(y_label)).draw().map_err(e)?;
+        for (s, (name, _)) in series.iter().enumerate() {
+            let color = rgb(DEFAULT_COLORS[s % DEFAULT_COLORS.len()]);
+            let stroke = color.stroke_width(px(2) as u32);
+            let mut elements: Vec<PathElement<(f64, f64)>> = Vec::new();
+            let mut boxes = Vec::new();
+            for (g, f) in summaries[s].iter().enumerate() {
+                let x0 = g as f64 + 0.1 + s as f64 * box_w + box_w * 0.1;
+                let x1 = x0 + box_w * 0.8;
+                let xm = (x0 + x1) / 2.0;
+                boxes.push(Rectangle::new([(x0, f[1]), (x1, f[3])], color.mix(0.35).filled()));
+                elements.push(PathElement::new(vec![(x0, f[2]), (x1, f[2])], stroke));
+                elements.push(PathElement::new(vec![(xm, f[0]), (xm, f[1])], stroke));
+                elements.push(PathElement::new(vec![(xm, f[3]), (xm, f[4])], stroke));
+                let cap = box_w * 0.2;
+                elements.push(PathElement::new(vec![(xm - cap, f[0]), (xm + cap, f[0])], stroke));
+                elements.push(PathElement::new(vec![(xm - cap, f[4]), (xm + cap, f[4])], stroke));
+                elements.push(PathElement::new(vec![(x0, f[1]), (x1, f[1]), (x1, f[3]), (x0, f[3]), (x0, f[1])], stroke));
+            }
+            chart
+                .draw_series(boxes)
+                .map_err(e)?
+                .label(name.as_str())
+                .legend(move |(x, y)| Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled()));
+            chart.draw_series(elements).map_err(e)?;
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FONT, LABEL_SIZE))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
+            .margin(px(8))
+            .legend_area_size(px(30))
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(e)?;
+        let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+        for (g, name) in groups.iter().enumerate() {
+            let (bx, by) = chart.backend_coord(&(g as f64 + 0.5, yr.start));
+            root.draw(&Text::new(name.as_str(), (bx, by + px(8)), style.clone())).map_err(e)?;
+        }
+        Ok(())
+    })
+}
+
 /// Averages each `factor` × `factor` block into one pixel.
 pub(crate) fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage {
     let (w, h) = (big.width() / factor, big.height() / factor);
@@ -311,6 +412,31 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn five_numbers_match_hand_computed_quartiles() {
+        let f = five_numbers(&[4.0, 1.0, 3.0, 2.0, 5.0, f64::NAN]).unwrap();
+        assert_eq!(f, [1.0, 2.0, 3.0, 4.0, 5.0]);
+        let f = five_numbers(&[0.0, 1.0]).unwrap();
+        assert_eq!(f, [0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert!(five_numbers(&[f64::NAN]).is_none());
+    }
+
+    #[test]
+    fn a_box_plot_draws_and_refuses_ragged_input() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("box.png");
+        let groups = vec!["5".to_string(), "10".to_string()];
+        let series = vec![
+            ("a".to_string(), vec![vec![0.5, 0.6, 0.7], vec![0.4, 0.8]]),
+            ("b".to_string(), vec![vec![0.2, 0.3], vec![0.1, 0.9, 0.5]]),
+        ];
+        box_plot(&path, "scores", "score", &groups, &series).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!((img.width(), img.height()), (PLOT_WIDTH, PLOT_HEIGHT));
+        let ragged = vec![("a".to_string(), vec![vec![0.5]])];
+        assert!(box_plot(&path, "scores", "score", &groups, &ragged).is_err());
+    }
 
     #[test]
     fn the_legend_goes_to_the_corner_without_data() {
