@@ -87,7 +87,11 @@ pub struct ResequenceArgs {
     /// Drop the coherent distillation C_t (ablation).
     #[arg(long)]
     pub no_ct: bool,
-    /// RSFNet training steps (batch 8).
+    /// Choose the next frame by Eq. 20 exactly as printed (motion only, τ = 1 in latent units)
+    /// instead of the default that also weighs content.
+    #[arg(long)]
+    pub paper_choice: bool,
+    /// Most RSFNet training steps (batch 8; early stopping usually ends sooner).
     #[arg(long)]
     pub steps: Option<usize>,
     /// Cache of trained networks per clip (default ~/.cache/inbetween/video).
@@ -238,6 +242,7 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         seed: a.seed,
         ..SdpfParams::default()
     };
+    let params = if a.paper_choice { params.paper_choice() } else { params };
     let (paths, walk_s) = resequence(&analysis, a.start, &params, a.count)?;
     let source: Vec<usize> = (0..clip.len()).collect();
     let md_source = stability_md(&clip.frames, &source);

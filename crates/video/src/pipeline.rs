@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use inbetween_io::Progress;
+use rayon::prelude::*;
 
 use crate::frames::Clip;
 use crate::metric::{embeddings_cached, graph_from_embeddings, pixel_graph, Embedder, Graph, RsfConfig, TrainOptions};
@@ -92,8 +93,13 @@ pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Resu
         format!("RSFNet read from the cache {}", metric.path.display())
     } else if metric.summary.trained {
         format!(
-            "RSFNet trained on the clip: {} steps in {:.1} s, triplet agreement {:.3} -> {:.3}",
-            metric.summary.steps, metric.summary.seconds, metric.summary.agreement_before, metric.summary.agreement_after
+            "RSFNet trained on the clip: {} steps in {:.1} s (kept epoch {} of {}, early stopping), held-out triplet agreement {:.3} -> {:.3}",
+            metric.summary.steps,
+            metric.summary.seconds,
+            metric.summary.best_epoch + 1,
+            metric.summary.loss_history.len(),
+            metric.summary.agreement_before,
+            metric.summary.agreement_after
         )
     } else {
         "RSFNet untrained (no distance loss)".to_string()
@@ -124,12 +130,13 @@ impl Pmsm<'_> {
     }
 
     fn pair_distances(&self, fc: &Flow, fks: &[&Flow], min_count: usize) -> Vec<f32> {
-        let mut imgs = Vec::with_capacity(2 * fks.len());
-        for fk in fks {
-            let (a, b) = pseudo_images(fc, fk, MU0, min_count);
-            imgs.push(a);
-            imgs.push(b);
-        }
+        let imgs: Vec<Vec<f32>> = fks
+            .par_iter()
+            .flat_map_iter(|fk| {
+                let (a, b) = pseudo_images(fc, fk, MU0, min_count);
+                [a, b]
+            })
+            .collect();
         match self.embedder.embed_pseudo(&imgs, fc.width, fc.height) {
             Ok(e) => e.chunks_exact(2).map(|p| l2(&p[0], &p[1])).collect(),
             Err(_) => vec![f32::INFINITY; fks.len()],

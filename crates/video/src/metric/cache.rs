@@ -29,7 +29,7 @@ use crate::VideoError;
 
 const MAGIC: &[u8; 8] = b"INBRSF01";
 /// Version of the cached content; bump it when training or the network change meaning.
-pub const CACHE_FORMAT: u32 = 1;
+pub const CACHE_FORMAT: u32 = 2;
 
 /// A trained metric for one clip: the network, every frame's latent vector and how it was made.
 #[derive(Debug, Clone)]

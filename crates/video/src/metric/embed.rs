@@ -5,13 +5,15 @@ use burn::module::Module;
 use burn::tensor::Device;
 use image::RgbImage;
 use inbetween_nn::backend;
+use rayon::prelude::*;
 
 use super::input::{batch_tensor, frame_planes, resize_planes, Planes};
 use super::model::{RsfConfig, RsfNet};
 use crate::VideoError;
 
-/// Images per forward pass.
-pub const EMBED_BATCH: usize = 32;
+/// Images per forward pass; the chunks of a call run in parallel (rayon). Small chunks cost no
+/// more per image on the CPU backend and keep both cores busy.
+pub const EMBED_BATCH: usize = 8;
 
 /// A trained (or, for the "w/o L_d" ablation, untrained) RSFNet ready for inference.
 #[derive(Debug, Clone)]
@@ -39,14 +41,18 @@ impl Embedder {
     pub fn embed_planes(&self, planes: &[Planes]) -> Vec<Vec<f32>> {
         let side = self.side();
         let latent = self.config.latent;
-        let mut out = Vec::with_capacity(planes.len());
         let indices: Vec<usize> = (0..planes.len()).collect();
-        for chunk in indices.chunks(EMBED_BATCH) {
-            let x = batch_tensor(planes, chunk, side, &self.device);
-            let values = self.net.forward(x).into_data().try_to_vec::<f32>().expect("f32 latents");
-            out.extend(values.chunks_exact(latent).map(<[f32]>::to_vec));
-        }
-        out
+        // Fixed chunks, run in parallel: each chunk's result depends only on its images, so the
+        // output is the same on any number of threads.
+        let chunks: Vec<Vec<Vec<f32>>> = indices
+            .par_chunks(EMBED_BATCH)
+            .map(|chunk| {
+                let x = batch_tensor(planes, chunk, side, &self.device);
+                let values = self.net.forward(x).into_data().try_to_vec::<f32>().expect("f32 latents");
+                values.chunks_exact(latent).map(<[f32]>::to_vec).collect()
+            })
+            .collect();
+        chunks.into_iter().flatten().collect()
     }
 
     /// Eq. 7's `R(x_i)` for every frame: one latent vector per frame.
@@ -68,7 +74,7 @@ impl Embedder {
             )));
         }
         let side = self.side();
-        let planes: Vec<Planes> = imgs.iter().map(|img| resize_planes(img, w, h, side)).collect();
+        let planes: Vec<Planes> = imgs.par_iter().map(|img| resize_planes(img, w, h, side)).collect();
         Ok(self.embed_planes(&planes))
     }
 }

@@ -55,7 +55,7 @@ pub struct RsfConfig {
 
 impl Default for RsfConfig {
     fn default() -> Self {
-        RsfConfig { input_side: 64, channels: [8, 16, 32, 32], convs_per_block: 1, pool_grid: 2, latent: 32, use_rff: true }
+        RsfConfig { input_side: 32, channels: [8, 16, 32, 32], convs_per_block: 1, pool_grid: 2, latent: 32, use_rff: true }
     }
 }
 

@@ -118,6 +118,28 @@ fn triplets_are_seeded_and_labelled_by_psnr() {
 }
 
 #[test]
+fn early_stopping_keeps_the_best_validated_epoch() {
+    let frames = moving_square(16, 32);
+    let cfg = RsfConfig::tiny();
+    // Patience 1 on a long budget: stops once an epoch fails to beat the best validation agreement.
+    let opts = TrainOptions { patience: 1, ..quick(200, 4) };
+    let (embedder, summary) = train_rsfnet(&frames, &cfg, &opts, &Progress::hidden()).unwrap();
+    let epochs = summary.loss_history.len();
+    assert_eq!(summary.val_agreement.len(), epochs);
+    assert!(epochs < 40 && summary.steps == 5 * epochs, "{summary:?}");
+    assert_eq!(summary.best_epoch + 2, epochs, "stopped one epoch after the best: {summary:?}");
+    let best = summary.val_agreement[summary.best_epoch];
+    assert!(summary.val_agreement.iter().all(|&a| a <= best));
+    // The kept network is the best epoch's, and the run is reproducible.
+    let (again, s2) = train_rsfnet(&frames, &cfg, &opts, &Progress::hidden()).unwrap();
+    assert_eq!(embedder.embed(&frames), again.embed(&frames));
+    assert_eq!(summary.val_agreement, s2.val_agreement);
+    // Patience 0 trains the whole budget.
+    let (_, full) = train_rsfnet(&frames, &cfg, &TrainOptions { patience: 0, ..quick(20, 4) }, &Progress::hidden()).unwrap();
+    assert_eq!((full.steps, full.loss_history.len()), (20, 4));
+}
+
+#[test]
 fn same_seed_gives_identical_embeddings() {
     let frames = moving_square(12, 32);
     let cfg = RsfConfig::tiny();
@@ -208,7 +230,7 @@ fn cache_round_trip_and_corrupt_file_rebuild() {
     }
 }
 
-/// Training time of the default network on a 132-frame clip at 64×64 (run with `--ignored
+/// Training time of the default network on a 132-frame clip of 64×64 frames (run with `--ignored
 /// --nocapture`).
 #[test]
 #[ignore]

@@ -7,8 +7,10 @@
 //! neighbours (`ratio` × the median score of the `window` pairs on either side), so that a clip with
 //! fast motion everywhere does not read as cuts everywhere.
 
-use image::imageops::{resize, FilterType};
 use image::RgbImage;
+use rayon::prelude::*;
+
+use crate::metric::input::frame_planes;
 
 /// Settings of [`detect_cuts_with`].
 #[derive(Debug, Clone, PartialEq)]
@@ -68,7 +70,7 @@ pub fn detect_cuts_with(frames: &[RgbImage], p: &CutParams) -> Vec<bool> {
 pub fn cut_scores(frames: &[RgbImage], p: &CutParams) -> Vec<f32> {
     let side = p.side.max(1);
     let thumbs: Vec<Option<RgbImage>> =
-        frames.iter().map(|f| (f.width() > 0 && f.height() > 0).then(|| resize(f, side, side, FilterType::Triangle))).collect();
+        frames.par_iter().map(|f| (f.width() > 0 && f.height() > 0).then(|| thumbnail(f, side))).collect();
     let hists: Vec<Option<Vec<f32>>> = thumbs.iter().map(|t| t.as_ref().map(|t| histogram(t, p.bins))).collect();
     (0..frames.len())
         .map(|i| {
@@ -97,6 +99,16 @@ fn is_jump(scores: &[f32], i: usize, p: &CutParams) -> bool {
     }
     others.sort_by(f32::total_cmp);
     s >= p.ratio * others[others.len() / 2]
+}
+
+/// `side × side` area-average thumbnail (cheap at any source size, unlike a filtered resize).
+fn thumbnail(f: &RgbImage, side: u32) -> RgbImage {
+    let s = side as usize;
+    let planes = frame_planes(f, s);
+    RgbImage::from_fn(side, side, |x, y| {
+        let at = |c: usize| (planes[(c * s + y as usize) * s + x as usize] * 255.0).round().clamp(0.0, 255.0) as u8;
+        image::Rgb([at(0), at(1), at(2)])
+    })
 }
 
 /// Normalised joint colour histogram with `bins` cells per channel.

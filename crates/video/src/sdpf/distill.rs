@@ -70,9 +70,28 @@ impl<'a> Ctx<'a> {
         let (omega, removed_ct) = self.coherent(from, &candidates);
         let s2: Vec<&Candidate> =
             candidates.iter().filter(|c| !removed_cd.contains(&c.frame) && !removed_ct.contains(&c.frame)).collect();
-        let dists: Vec<f32> = s2.iter().map(|c| c.motion).collect();
+        let scale = self.softmax_scale(&candidates);
+        let edge_scale = finite_mean(candidates.iter().map(|c| c.edge));
+        let dists: Vec<f32> = s2
+            .iter()
+            .map(|c| {
+                let content = if self.p.content_weight > 0.0 && edge_scale > 0.0 { self.p.content_weight * c.edge / edge_scale } else { 0.0 };
+                c.motion / scale + content
+            })
+            .collect();
         let probs = s2.iter().map(|c| c.frame).zip(softmax(&dists, self.p.temperature)).collect();
         Transition { from, chosen: None, s1, candidates, removed_cut, cd, removed_cd, omega, removed_ct, probs }
+    }
+
+    /// What the motion distances are divided by before Eq. 20: their mean over S1 with
+    /// `relative_temperature` (1 when that mean is not a positive number), else 1.
+    fn softmax_scale(&self, cands: &[Candidate]) -> f32 {
+        let scale = if self.p.relative_temperature { finite_mean(cands.iter().map(|c| c.motion)) } else { 1.0 };
+        if scale.is_finite() && scale > 0.0 {
+            scale
+        } else {
+            1.0
+        }
     }
 
     /// Whether `to` survives Eq. 8, the shot rule and C_d from `from` — the checks that need no

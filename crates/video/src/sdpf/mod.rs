@@ -27,6 +27,13 @@
 //! - **S2 (Eq. 18–19)** holds the candidates that pass both C_d and C_t ("+" read as "and").
 //!   Each constraint judges all of S1, and ω is the mean over all of S1.
 //!
+//! Differences on purpose (see [`SdpfParams`]):
+//! - **Eq. 20's scale.** δ is a latent distance, whose scale depends on the network; we divide
+//!   it by ω so that the temperature τ means the same on any clip, and use τ = 0.1.
+//! - **Content in the choice.** Eq. 20 adds λ · e_ck / ē (λ = 2) to the relative motion distance,
+//!   so that among the S1 frames the closer in content are likelier. `SdpfParams::paper_choice`
+//!   gives Eq. 20 as printed.
+//!
 //! Beyond the paper:
 //! - shots: no jump across a scene cut unless `allow_cuts`;
 //! - a target length;

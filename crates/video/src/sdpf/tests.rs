@@ -61,7 +61,7 @@ fn eta_is_the_mean_of_the_off_diagonal_edges() {
 #[test]
 fn s1_holds_the_unvisited_frames_strictly_below_eta() {
     let g = line_graph(9); // η = mean |i − j| over i ≠ j = 10/3
-    let t = step_from(&g, &MotionInfo::none(), &NoMotion, &SdpfParams::default(), 4, &[3]);
+    let t = step_from(&g, &MotionInfo::none(), &NoMotion, &SdpfParams::default().paper_choice(), 4, &[3]);
     assert_eq!(t.s1, vec![1, 2, 5, 6, 7], "|4 − k| < 10/3, frames 3 and 4 visited");
     // Without motion differences every S1 frame survives, with equal probabilities (§5.1).
     assert_eq!(t.s2(), t.s1);
@@ -120,7 +120,7 @@ fn cd_is_skipped_unless_both_sides_are_lms() {
 fn ct_keeps_the_candidates_at_most_the_mean_motion_distance_of_s1() {
     let g = star_graph(4);
     let md = motion_from_zero(&[0.0, 1.0, 2.0, 6.0], 100.0);
-    let t = step_from(&g, &MotionInfo::none(), &md, &SdpfParams::default(), 0, &[]);
+    let t = step_from(&g, &MotionInfo::none(), &md, &SdpfParams::default().paper_choice(), 0, &[]);
     assert_eq!(t.omega, Omega::Mean(3.0), "n1 = 3 ≥ 2: ω is the mean of 1, 2, 6");
     assert_eq!(t.removed_ct, vec![3], "the least smooth candidate goes (the floor is not used)");
     // Eq. 20: Ω ∝ exp(−distance), so frame 1 is e times as likely as frame 2.
@@ -128,6 +128,28 @@ fn ct_keeps_the_candidates_at_most_the_mean_motion_distance_of_s1() {
     let off = SdpfParams { use_ct: false, ..SdpfParams::default() };
     let t = step_from(&g, &MotionInfo::none(), &md, &off, 0, &[]);
     assert_eq!((t.omega, t.s2()), (Omega::Off, vec![1, 2, 3]));
+}
+
+#[test]
+fn the_default_choice_is_relative_to_omega_and_weighs_content() {
+    // From 0 on a line of 6: S1 = {1, 2} (η = 7/3), edges 1 and 2 (ē = 1.5); motion distances 4
+    // and 2 (ω = 3).
+    let g = line_graph(6);
+    let md = motion_from_zero(&[0.0, 4.0, 2.0, 0.0, 0.0, 0.0], 100.0);
+    let p = SdpfParams { use_ct: false, ..SdpfParams::default() };
+    let t = step_from(&g, &MotionInfo::none(), &md, &p, 0, &[]);
+    assert_eq!(t.s2(), vec![1, 2]);
+    // Ω_1/Ω_2 = exp(−((4 − 2)/ω + λ(1 − 2)/ē)/τ) with ω = 3, ē = 1.5, λ = 2, τ = 0.1.
+    let expected = (-((4.0f32 - 2.0) / 3.0 + 2.0 * (1.0 - 2.0) / 1.5) / 0.1).exp();
+    assert!((t.prob_of(1) / t.prob_of(2) / expected - 1.0).abs() < 1e-3, "{:?} vs {expected}", t.probs);
+    // Scaling every motion distance leaves the relative choice unchanged.
+    let md10 = MatrixMotion { dist: md.dist.iter().map(|d| d * 10.0).collect(), ..md.clone() };
+    let t10 = step_from(&g, &MotionInfo::none(), &md10, &p, 0, &[]);
+    assert!((t10.prob_of(1) - t.prob_of(1)).abs() < 1e-6);
+    // Without the content term, the smoother motion (frame 2) wins.
+    let motion_only = SdpfParams { content_weight: 0.0, ..p };
+    let t = step_from(&g, &MotionInfo::none(), &md, &motion_only, 0, &[]);
+    assert!(t.prob_of(2) > 0.99, "{:?}", t.probs);
 }
 
 #[test]
@@ -195,7 +217,7 @@ fn walks_never_revisit_and_only_take_s2_frames() {
 #[test]
 fn the_seed_alone_decides_the_path() {
     let g = line_graph(20);
-    let run = |seed| sdpf(&g, &MotionInfo::none(), &NoMotion, 10, &SdpfParams { seed, ..SdpfParams::default() }).unwrap();
+    let run = |seed| sdpf(&g, &MotionInfo::none(), &NoMotion, 10, &SdpfParams { seed, ..SdpfParams::default() }.paper_choice()).unwrap();
     assert_eq!(run(3), run(3));
     let mut distinct: Vec<Vec<usize>> = (0..8).map(|s| run(s).frames).collect();
     distinct.sort();
@@ -286,7 +308,7 @@ fn loop_closure_reports_failure_on_a_chain() {
 #[test]
 fn several_sequences_are_distinct_and_the_first_is_sdpf() {
     let g = line_graph(14);
-    let p = SdpfParams { seed: 9, ..SdpfParams::default() };
+    let p = SdpfParams { seed: 9, ..SdpfParams::default() }.paper_choice();
     let paths = several(&g, &MotionInfo::none(), &NoMotion, 7, &p, 4).unwrap();
     assert_eq!(paths.len(), 4);
     for i in 0..paths.len() {

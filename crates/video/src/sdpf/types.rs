@@ -4,7 +4,9 @@
 use crate::VideoError;
 
 /// Parameters of [`sdpf`](super::sdpf). [`Default`] is the paper's configuration (ξ = π/3, both
-/// constraints on, softmax temperature 1) plus our defaults for what the paper lacks.
+/// constraints on) plus our defaults for what the paper lacks, and a choice (Eq. 20) that also
+/// weighs content: τ = 0.1 on motion distances relative to ω, content weight λ = 2 (see
+/// [`SdpfParams::paper_choice`] for Eq. 20 as printed, and the crate README for why).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SdpfParams {
     /// ξ of Eq. 12: the largest allowed angle (radians) between the tendencies of two LMS frames.
@@ -24,8 +26,26 @@ pub struct SdpfParams {
     pub seed: u64,
     /// Seeded attempts tried when the first walk misses its goal (target length or loop closure).
     pub attempts: usize,
-    /// Softmax temperature τ: Ω ∝ exp(δ/τ). The paper's Eq. 20 is τ = 1.
+    /// Softmax temperature τ: Ω ∝ exp(δ/τ). The paper's Eq. 20 is τ = 1 on its own latent scale.
     pub temperature: f32,
+    /// Divide the motion distances by their mean over S1 (ω of Eq. 17) before Eq. 20, so that τ
+    /// is in units of ω and the choice does not depend on the arbitrary scale of the latent space
+    /// (ours is not the paper's). `false`: δ in latent units, as Eq. 20 prints it.
+    pub relative_temperature: bool,
+    /// Weight λ of the content distance in the choice (beyond the paper; 0 is Eq. 20 as printed):
+    /// Ω_k ∝ exp(−(m_k/ω + λ·e_ck/ē)/τ), with m_k the motion distance, ω its mean over S1, e_ck
+    /// the edge weight (Eq. 7) and ē its mean over S1. The paper treats the S1 frames alike
+    /// whatever their edge weight (§5.1); with η the mean edge weight, S1 is about half of the
+    /// clip, and a choice blind to content jumps across it (measured: M_D 1.8–3× the source's).
+    pub content_weight: f32,
+}
+
+impl SdpfParams {
+    /// Eq. 20 exactly as printed: Ω ∝ exp(δ) on the latent motion distances (τ = 1, absolute),
+    /// no content term. The bench reports it beside the default.
+    pub fn paper_choice(self) -> SdpfParams {
+        SdpfParams { temperature: 1.0, relative_temperature: false, content_weight: 0.0, ..self }
+    }
 }
 
 impl Default for SdpfParams {
@@ -39,7 +59,9 @@ impl Default for SdpfParams {
             allow_cuts: false,
             seed: 0,
             attempts: 8,
-            temperature: 1.0,
+            temperature: 0.1,
+            relative_temperature: true,
+            content_weight: 2.0,
         }
     }
 }
