@@ -18,7 +18,7 @@ pub use crate::corpus::Clip;
 pub use report::BenchResults;
 pub use run::{run, BenchConfig, BenchOutput, PolicyChoice};
 
-use crate::error::{Objective, SegmentModel, SegmentTable};
+use crate::error::{Objective, SegmentModel};
 use crate::representation::{JointFilter, SphericalMotion};
 use crate::select;
 use crate::{MocapError, Result};
@@ -193,7 +193,7 @@ pub fn select_keys(
         Method::Rc => select::random(n, k, &mut ChaCha8Rng::seed_from_u64(seed)),
         Method::Uc => select::uniform(n, k),
         Method::Greedy => select::greedy(rep, k, Objective::Angle),
-        Method::Optimal => select::optimal(&SegmentTable::full_serial(rep), k, Objective::Angle),
+        Method::Optimal => select::optimal_spherical(rep, k, Objective::Angle),
         Method::Sidql => match policy {
             Some(p) => p(rep, k),
             None => Err(MocapError::Invalid("SIDQL needs a trained model".into())),

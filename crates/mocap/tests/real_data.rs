@@ -32,6 +32,32 @@ fn every_cmu_take_filters_to_the_major_joints_and_optimal_never_loses() {
     });
 }
 
+/// Every 60-frame window of the corpus (the bench's 116): the fast optimum picks the keys of the
+/// programme over the full segment table, with the same total to the bit.
+#[test]
+fn fast_optimum_equals_the_full_table_programme_on_every_cmu_window() {
+    use inbetween_mocap::select::optimal::optimal_spherical_with_total;
+    use inbetween_mocap::select::optimal;
+    use inbetween_mocap::{Objective, SegmentTable};
+    with_shared_data("mocap fast-optimum real-data test", |dir| {
+        let corpus = inbetween_mocap::corpus::load(&dir, None).unwrap();
+        let mut windows = 0;
+        for clip in &corpus.clips {
+            for w in clip_windows(clip, &Protocol::paper()).unwrap() {
+                let table = SegmentTable::full_serial(&w.rep);
+                for k in [5, 10, 15] {
+                    let want = optimal(&table, k, Objective::Angle).unwrap();
+                    let (got, total) = optimal_spherical_with_total(&w.rep, k, Objective::Angle).unwrap();
+                    assert_eq!(got, want, "{} window at {}, K={k}", w.clip, w.start);
+                    assert_eq!(total.to_bits(), table.total(&want).unwrap().angle_sum.to_bits(), "{} K={k}", w.clip);
+                }
+                windows += 1;
+            }
+        }
+        assert!(windows >= 100, "{windows} windows");
+    });
+}
+
 /// Every take of the corpus (its first 2 s after the T-pose frame, to keep CI fast), at 1 cm and
 /// 0.1 cm: the decoded file keeps the bound, quantisation included, in each clip's own unit.
 #[test]

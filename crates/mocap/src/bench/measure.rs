@@ -4,7 +4,7 @@
 
 use super::{Clip, Window};
 use crate::codec::{self, Budget};
-use crate::error::{Objective, SegmentModel, SegmentTable};
+use crate::error::{Objective, SegmentModel};
 use crate::rotations::RotationMotion;
 use crate::Result;
 use inbetween_core::units::UnitChoice;
@@ -75,11 +75,10 @@ pub fn both_reconstructions(windows: &[Window], ks: &[usize], progress: &Progres
         })
         .collect();
     for w in windows {
-        let table = SegmentTable::full(&w.rep);
         let mut rm = RotationMotion::from_motion(&w.motion)?;
         rm.cm_per_unit = w.rep.cm_per_unit;
         for row in out.iter_mut() {
-            let keys = crate::select::optimal(&table, row.k, Objective::Angle)?;
+            let keys = crate::select::optimal_spherical(&w.rep, row.k, Objective::Angle)?;
             let (es, er) = (w.rep.error(&keys), rm.error(&keys));
             row.spherical_mean_cm += es.mean_cm;
             row.rotation_mean_cm += er.mean_cm;

@@ -5,7 +5,8 @@
 //! - [`uniform`](mod@uniform): UC, evenly spaced frames.
 //! - [`greedy`](mod@greedy): the paper's Greedy (§5.4), adding the frame that lowers the error most, one at a time.
 //! - [`optimal`](mod@optimal): the exact minimum of the total error for `k` keys, a dynamic programme over the
-//!   per-segment costs (beyond the paper); never worse than Greedy.
+//!   per-segment costs (beyond the paper); never worse than Greedy. [`optimal_spherical`] gives the same
+//!   keys on one clip in about a millisecond (only the objective is tabulated, hopeless segments dropped).
 //! - [`error_bounded`]: the fewest keys keeping every frame's error under a bound, also exact.
 //! - [`sidql`](mod@sidql): the paper's deep Q-network policy (§4).
 
@@ -16,7 +17,7 @@ pub mod sidql;
 pub mod uniform;
 
 pub use greedy::greedy;
-pub use optimal::{error_bounded, optimal};
+pub use optimal::{error_bounded, optimal, optimal_spherical};
 pub use random::random;
 pub use uniform::uniform;
 
