@@ -19,8 +19,8 @@ pub struct DemoArgs {
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    // One step for the walk, four for the mocap demo, one each for the camera, face and video demos.
-    let steps = Progress::new(8, "demo");
+    // One step for the walk, four for the mocap demo, one each for the camera, face, video and script demos.
+    let steps = Progress::new(9, "demo");
     let mut params = GaitParams::walk().jittered(a.seed, 0.15);
     params.frames = 150;
     params.turn_rate = 0.35;
@@ -64,6 +64,8 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         video.delta_o,
         video.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
     ));
+    lines.extend(inbetween_script::demo::run(&a.out, a.seed)?);
+    steps.inc(1);
     steps.finish();
     for l in lines {
         println!("{l}");

@@ -5,6 +5,7 @@ mod cmd_face;
 mod cmd_io;
 mod cmd_mocap;
 mod cmd_preview;
+mod cmd_script;
 mod cmd_video;
 mod demo;
 mod errors;
@@ -45,6 +46,9 @@ enum Command {
     /// Video engine: new frame orders from one clip (learned frame metric RSFNet + SDPF path finding).
     #[command(subcommand)]
     Video(cmd_video::VideoCommand),
+    /// Script engine: text → semantic scene graph → furnished scene (Write-An-Animation).
+    #[command(subcommand)]
+    Script(cmd_script::ScriptCommand),
 }
 
 fn main() -> ExitCode {
@@ -71,5 +75,6 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Camera(c) => cmd_camera::run(c),
         Command::Face(c) => cmd_face::run(c),
         Command::Video(c) => cmd_video::run(c),
+        Command::Script(c) => cmd_script::run(c),
     }
 }

@@ -315,7 +315,8 @@ pub fn box_plot(
     }
     let (lo, hi) = summaries.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f[0]), b.max(f[4])));
     let span = (hi - lo).max(1e-9);
-    let yr = (lo - span * 0.08)..(hi + span * 0.12);
+    // Room below the data for the legend.
+    let yr = (lo - span * 0.3)..(hi + span * 0.12);
     let n = groups.len() as f64;
     let box_w = 0.8 / series.len() as f64;
     render_png(path, title, |root| {
@@ -360,7 +361,7 @@ pub fn box_plot(
             .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
             .margin(px(8))
             .legend_area_size(px(30))
-            .position(SeriesLabelPosition::LowerRight)
+            .position(SeriesLabelPosition::LowerLeft)
             .draw()
             .map_err(e)?;
         let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));

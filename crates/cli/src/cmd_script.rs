@@ -1,0 +1,195 @@
+//! `inbetween script …`: text → semantic scene graph → furnished scene (Write-An-Animation §3–4.1).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::{Args, Subcommand, ValueEnum};
+use inbetween_io::Progress;
+use inbetween_script::compose::{ComposeConfig, Matcher};
+use inbetween_script::job::{read_script, run_scene, SceneJob};
+use inbetween_script::stories;
+
+#[derive(Subcommand)]
+pub enum ScriptCommand {
+    /// Compose the scene a script describes: scene.json, scene.gltf, ssg.json, top.png, view.png.
+    Scene(SceneArgs),
+    /// Print the semantic scene graph of each sentence (JSON), and any problems found.
+    Parse(ParseArgs),
+    /// List the built-in scripts (paper captions, film lines, demo story) or print one.
+    Stories(StoriesArgs),
+    /// Parse/compose speed, matching scores (Fig. 8), layout violations and incremental edits.
+    Bench(BenchArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MatcherArg {
+    /// Relation nodes first, single objects as the fallback (the paper's Algorithm 1).
+    Relation,
+    /// Single objects first (the LDS baseline).
+    Object,
+}
+
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Script file (plain text; scene sentences end in `$`). Use `builtin:NAME` for a built-in one
+    /// (see `inbetween script stories`).
+    pub script: String,
+    /// Output folder.
+    #[arg(short, long, default_value = "out/script")]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Camera of the perspective preview: front, back, left, right, top (default: the script's
+    /// last "camera …" command, else front).
+    #[arg(long)]
+    pub view: Option<String>,
+    /// Folder of Kenney furniture .glb files: real meshes and measured sizes instead of boxes
+    /// (e.g. ../shared/data/assets/kenney_furniture).
+    #[arg(long)]
+    pub models: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "relation")]
+    pub matcher: MatcherArg,
+    /// Only the objects the text names: do not furnish a named room from the database.
+    #[arg(long)]
+    pub bare: bool,
+    /// Read words outside the synonym tables with the all-MiniLM-L6-v2 sentence-embedding model
+    /// (needs a build with `--features embeddings` and scripts/fetch-minilm.sh).
+    #[arg(long)]
+    pub semantic: bool,
+    /// Folder of the embedding model (default: ~/.cache/inbetween/models/all-MiniLM-L6-v2).
+    #[arg(long, requires = "semantic")]
+    pub model_dir: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct ParseArgs {
+    /// Script file, or `builtin:NAME`.
+    pub script: String,
+}
+
+#[derive(Args)]
+pub struct StoriesArgs {
+    /// Print this one instead of the list.
+    pub name: Option<String>,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    #[arg(short, long, default_value = "out/script-bench")]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Fewer timing repetitions (seconds).
+    #[arg(long)]
+    pub quick: bool,
+}
+
+pub fn run(c: ScriptCommand) -> anyhow::Result<()> {
+    match c {
+        ScriptCommand::Scene(a) => scene(a),
+        ScriptCommand::Parse(a) => parse(a),
+        ScriptCommand::Stories(a) => list_stories(a),
+        ScriptCommand::Bench(a) => bench(a),
+    }
+}
+
+/// The script's text and the name messages use for it.
+fn load(script: &str) -> anyhow::Result<(String, PathBuf)> {
+    if let Some(name) = script.strip_prefix("builtin:") {
+        let all = stories::all();
+        let text = all.iter().find(|(n, _)| *n == name).map(|(_, t)| t.to_string()).with_context(|| {
+            let names: Vec<&str> = all.iter().map(|(n, _)| *n).collect();
+            format!("no built-in script '{name}'; there are: {}", names.join(", "))
+        })?;
+        return Ok((text, PathBuf::from(script)));
+    }
+    let path = Path::new(script);
+    Ok((read_script(path)?, path.to_path_buf()))
+}
+
+fn scene(a: SceneArgs) -> anyhow::Result<()> {
+    let (text, source) = load(&a.script)?;
+    let matcher = match a.matcher {
+        MatcherArg::Relation => Matcher::RelationFirst,
+        MatcherArg::Object => Matcher::ObjectFirst,
+    };
+    let job = SceneJob {
+        out_dir: a.out.clone(),
+        seed: a.seed,
+        view: a.view,
+        models: a.models,
+        config: ComposeConfig { seed: a.seed, matcher, furnish: !a.bare },
+        semantic: a.semantic.then_some(a.model_dir),
+    };
+    let report = run_scene(&text, &source, &job).with_context(|| format!("composing {}", source.display()))?;
+    for d in &report.diagnostics {
+        eprintln!("warning: {}: {d}", source.display());
+    }
+    let scene = &report.composition.scene;
+    println!(
+        "{}: {} objects in a {:.1} m × {:.1} m {} (match score {:.2}, {} violations) in {:.1} ms",
+        source.display(),
+        scene.objects.len(),
+        scene.room.width,
+        scene.room.depth,
+        scene.room.name,
+        report.composition.match_score,
+        report.composition.violations.total(),
+        report.seconds * 1e3
+    );
+    for f in &report.files {
+        println!("  wrote {}", f.display());
+    }
+    Ok(())
+}
+
+fn parse(a: ParseArgs) -> anyhow::Result<()> {
+    let (text, source) = load(&a.script)?;
+    let cat = inbetween_script::catalogue::builtin::builtin();
+    let parsed = inbetween_script::parse::parse_script(&text, &cat);
+    for s in &parsed.sentences {
+        println!("# {} ({:?})", s.raw.at, s.raw.kind);
+        println!("{}", serde_json::to_string_pretty(&s.ssg)?);
+    }
+    for d in &parsed.diagnostics {
+        eprintln!("warning: {}: {d}", source.display());
+    }
+    Ok(())
+}
+
+fn list_stories(a: StoriesArgs) -> anyhow::Result<()> {
+    let all = stories::all();
+    match a.name {
+        Some(name) => {
+            let (_, text) = all.iter().find(|(n, _)| *n == name).with_context(|| format!("no built-in script '{name}'"))?;
+            println!("{text}");
+        }
+        None => {
+            for (name, text) in &all {
+                let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+                println!("{name:<24} {first}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn bench(a: BenchArgs) -> anyhow::Result<()> {
+    use inbetween_script::bench::{run, BenchConfig};
+    let cfg = if a.quick {
+        BenchConfig { seed: a.seed, repeats: 2 }
+    } else {
+        BenchConfig { seed: a.seed, ..BenchConfig::default() }
+    };
+    let progress = Progress::new(1, "script bench");
+    let files = run(&a.out, &cfg, &progress).with_context(|| format!("writing the script bench to {}", a.out.display()))?;
+    progress.finish();
+    let txt = files.iter().find(|f| f.extension().is_some_and(|e| e == "txt"));
+    if let Some(txt) = txt {
+        print!("{}", std::fs::read_to_string(txt).with_context(|| format!("reading {}", txt.display()))?);
+    }
+    for f in &files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,73 @@
+//! `inbetween script …` end to end: outputs written, clear errors naming the file.
+
+use std::process::Command;
+
+fn inbetween() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_inbetween"))
+}
+
+#[test]
+fn scene_writes_json_gltf_and_previews() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("story.txt");
+    std::fs::write(&script, "In the room, an organized office desk is near a bed$.\nA lamp is on the desk$.\ncamera left\nEve sits on the bed.\n").unwrap();
+    let out = dir.path().join("out");
+    let o = inbetween().args(["script", "scene"]).arg(&script).arg("-o").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["scene.json", "scene.gltf", "ssg.json", "top.png", "view.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let scene: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("scene.json")).unwrap()).unwrap();
+    let cats: Vec<&str> = scene["objects"].as_array().unwrap().iter().map(|o| o["category"].as_str().unwrap()).collect();
+    for c in ["desk", "bed", "lamp"] {
+        assert!(cats.contains(&c), "{c} not in {cats:?}");
+    }
+    assert_eq!(scene["camera"][0], "left");
+}
+
+#[test]
+fn an_empty_script_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("empty.txt");
+    std::fs::write(&script, "\n  \n# only a comment\n").unwrap();
+    let o = inbetween().args(["script", "scene"]).arg(&script).arg("-o").arg(dir.path().join("out")).output().unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("error:") && err.contains("empty.txt") && err.contains("empty"), "{err}");
+    assert!(!err.contains("panicked") && !err.contains("stack backtrace"), "{err}");
+    assert!(!dir.path().join("out").join("scene.json").exists());
+}
+
+#[test]
+fn an_unknown_word_warns_with_suggestions_and_the_rest_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("typo.txt");
+    std::fs::write(&script, "A desk is near a bedd$.\nA sofa is in front of a tv$.\n").unwrap();
+    let out = dir.path().join("out");
+    let o = inbetween().args(["script", "scene"]).arg(&script).arg("-o").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("typo.txt") && err.contains("bedd") && err.contains("bed"), "{err}");
+    assert!(err.contains("line 1"), "{err}");
+    assert!(out.join("scene.json").is_file());
+}
+
+#[test]
+fn builtin_stories_are_listed_and_parsed() {
+    let o = inbetween().args(["script", "stories"]).output().unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("demo"));
+    let o = inbetween().args(["script", "parse", "builtin:demo"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"objects\""));
+}
+
+#[test]
+fn the_quick_bench_writes_its_tables_and_box_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = inbetween().args(["script", "bench", "--quick", "-o"]).arg(dir.path()).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["speed.csv", "layout.csv", "fig8.csv", "incremental.csv", "fig8.png"] {
+        assert!(dir.path().join(f).is_file(), "{f} missing");
+    }
+}

@@ -1,0 +1,151 @@
+//! The common skeleton every clip is retargeted to (§4.2: "a standard T-pose" space shared by
+//! locomotion and actions): core's 31-joint CMU-style skeleton scaled to metres, Y up, floor at
+//! y = 0, facing +Z in its rest pose.
+
+use glam::{DQuat, DVec3};
+use inbetween_core::fk::{forward, GlobalPose};
+use inbetween_core::procedural::{standard_hip_height, standard_skeleton, CM_PER_CMU_UNIT};
+use inbetween_core::units::scale_motion;
+use inbetween_core::{Motion, Pose, Skeleton};
+
+/// Metres per CMU length unit.
+pub const M_PER_CMU: f64 = CM_PER_CMU_UNIT / 100.0;
+
+/// Frame rate of every library clip and of generated motion.
+pub const FPS: f64 = 30.0;
+
+/// The standard skeleton in metres.
+pub fn skeleton() -> Skeleton {
+    let empty = Motion::new(standard_skeleton(), 1.0 / FPS, Vec::new()).expect("empty clip");
+    scale_motion(&empty, M_PER_CMU).skeleton
+}
+
+/// Height of the `Hips` joint above the floor in the rest pose, metres.
+pub fn hip_height() -> f64 {
+    standard_hip_height() * M_PER_CMU
+}
+
+/// Joint indices of the standard skeleton that the motion code uses.
+#[derive(Clone, Debug)]
+pub struct Rig {
+    pub skeleton: Skeleton,
+    pub hips: usize,
+    pub lower_back: usize,
+    pub spine1: usize,
+    pub neck: usize,
+    pub head: usize,
+    /// `[UpLeg, Leg, Foot, ToeBase]`, left then right.
+    pub legs: [[usize; 4]; 2],
+    /// `[Shoulder, Arm, ForeArm, Hand]`, left then right.
+    pub arms: [[usize; 4]; 2],
+    /// Rest height of the ankle (`Foot` joint) above the floor, metres.
+    pub ankle_height: f64,
+}
+
+impl Rig {
+    pub fn standard() -> Rig {
+        Rig::of(skeleton())
+    }
+
+    /// Indices on a skeleton with the standard joint names (panics on another layout).
+    pub fn of(skeleton: Skeleton) -> Rig {
+        let f = |n: &str| {
+            skeleton
+                .find(n)
+                .unwrap_or_else(|| panic!("joint {n} missing"))
+        };
+        let legs = ["Left", "Right"].map(|s| {
+            [
+                f(&format!("{s}UpLeg")),
+                f(&format!("{s}Leg")),
+                f(&format!("{s}Foot")),
+                f(&format!("{s}ToeBase")),
+            ]
+        });
+        let arms = ["Left", "Right"].map(|s| {
+            [
+                f(&format!("{s}Shoulder")),
+                f(&format!("{s}Arm")),
+                f(&format!("{s}ForeArm")),
+                f(&format!("{s}Hand")),
+            ]
+        });
+        let mut rest = Pose::rest(&skeleton);
+        rest.translations[0] = DVec3::new(0.0, hip_height(), 0.0);
+        let g = forward(&skeleton, &rest);
+        let ankle_height = g.positions[legs[0][2]].y;
+        Rig {
+            hips: f("Hips"),
+            lower_back: f("LowerBack"),
+            spine1: f("Spine1"),
+            neck: f("Neck"),
+            head: f("Head"),
+            legs,
+            arms,
+            ankle_height,
+            skeleton,
+        }
+    }
+
+    /// True for the joints of the upper body: `LowerBack` and everything below it (§4.2, "joints
+    /// above the hip").
+    pub fn upper_body_mask(&self) -> Vec<bool> {
+        let mut m = vec![false; self.skeleton.len()];
+        m[self.lower_back] = true;
+        for j in 0..self.skeleton.len() {
+            if let Some(p) = self.skeleton.parent(j) {
+                if m[p] {
+                    m[j] = true;
+                }
+            }
+        }
+        m
+    }
+
+    /// Rest pose standing at the origin, feet on the floor.
+    pub fn standing(&self) -> Pose {
+        let mut p = Pose::rest(&self.skeleton);
+        p.translations[self.hips] = DVec3::new(0.0, hip_height(), 0.0);
+        p
+    }
+
+    pub fn fk(&self, pose: &Pose) -> GlobalPose {
+        forward(&self.skeleton, pose)
+    }
+}
+
+/// Heading (yaw about +Y, 0 = facing +Z) of a root rotation: its forward axis projected on the floor.
+pub fn heading_of(q: DQuat) -> f64 {
+    let f = q * DVec3::Z;
+    f.x.atan2(f.z)
+}
+
+/// Yaw rotation about +Y.
+pub fn yaw(angle: f64) -> DQuat {
+    DQuat::from_rotation_y(angle)
+}
+
+/// The minimal rotation taking direction `from` to direction `to` (both non-zero).
+pub fn arc(from: DVec3, to: DVec3) -> DQuat {
+    let (a, b) = (from.normalize_or_zero(), to.normalize_or_zero());
+    if a == DVec3::ZERO || b == DVec3::ZERO {
+        return DQuat::IDENTITY;
+    }
+    DQuat::from_rotation_arc(a, b)
+}
+
+/// Wraps an angle to (-π, π].
+pub fn wrap(a: f64) -> f64 {
+    inbetween_core::angle::wrap_angle(a)
+}
+
+/// Local rotation of joint `j` that gives it the global rotation `global`, under `parent_global`.
+pub fn local_from_global(parent_global: DQuat, global: DQuat) -> DQuat {
+    (parent_global.inverse() * global).normalize()
+}
+
+/// Clip from poses on the standard skeleton at [`FPS`].
+pub fn clip(rig: &Rig, poses: &[Pose]) -> Motion {
+    Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, poses)
+        .expect("poses fit the standard skeleton")
+}

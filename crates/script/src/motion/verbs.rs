@@ -1,0 +1,218 @@
+//! Verb table for template-action retrieval (§3.2, §4.2): each canonical action tag with the verb
+//! lemmas (and description words) that name it.
+
+/// Canonical tag and the lemmas that retrieve it. The canonical tag is listed first among its own
+/// words. Order matters only for [`canonical`] ties (first table entry wins).
+pub const VERBS: &[(&str, &[&str])] = &[
+    (
+        "walk",
+        &[
+            "walk", "stroll", "stride", "march", "wander", "go", "move", "step", "pace", "amble",
+            "limp", "come", "approach", "head",
+        ],
+    ),
+    (
+        "run",
+        &["run", "jog", "sprint", "race", "dash", "rush", "hurry"],
+    ),
+    ("jump", &["jump", "hop", "leap", "bound", "skip"]),
+    ("sit", &["sit", "seat", "perch"]),
+    ("sit_down", &["sit_down"]),
+    ("stand_up", &["stand_up", "rise", "get_up"]),
+    (
+        "stand",
+        &[
+            "stand", "idle", "stay", "wait", "stop", "remain", "rest", "pause", "balance",
+        ],
+    ),
+    (
+        "punch",
+        &[
+            "punch",
+            "box",
+            "strike",
+            "hit",
+            "jab",
+            "fight",
+            "swordplay",
+            "sword",
+        ],
+    ),
+    ("kick", &["kick"]),
+    (
+        "dance",
+        &[
+            "dance",
+            "waltz",
+            "salsa",
+            "pirouette",
+            "twirl",
+            "spin",
+            "arabesque",
+            "jete",
+        ],
+    ),
+    ("wave", &["wave", "greet", "beckon", "signal"]),
+    ("climb", &["climb", "scale", "ascend", "hang", "dangle"]),
+    (
+        "reach",
+        &[
+            "reach", "grab", "pick", "take", "push", "press", "touch", "pull", "lift", "scoop",
+            "open", "fetch",
+        ],
+    ),
+    (
+        "type",
+        &[
+            "type", "play", "use", "operate", "work", "tap", "text", "dribble", "shoot",
+        ],
+    ),
+    (
+        "call",
+        &[
+            "call", "phone", "talk", "speak", "chat", "tell", "say", "sing", "shout", "ask",
+            "answer",
+        ],
+    ),
+    ("drink", &["drink", "sip", "eat"]),
+    (
+        "look",
+        &[
+            "look", "watch", "see", "stare", "gaze", "observe", "view", "listen", "examine",
+        ],
+    ),
+    (
+        "think",
+        &["think", "ponder", "wonder", "consider", "contemplate"],
+    ),
+    ("write", &["write", "draw", "paint", "sketch", "design"]),
+    (
+        "hammer",
+        &["hammer", "saw", "nail", "chop", "serve", "build", "wash"],
+    ),
+    ("bend", &["bend", "crouch", "squat", "kneel", "stoop"]),
+    ("throw", &["throw", "toss", "pitch"]),
+    ("turn", &["turn", "rotate"]),
+];
+
+/// The canonical tag of a verb lemma (lower-cased; a plural/-ing/-ed form is tried as a fallback,
+/// though lemmatising is the caller's job).
+pub fn canonical(lemma: &str) -> Option<&'static str> {
+    let w = lemma.trim().to_ascii_lowercase().replace([' ', '-'], "_");
+    if w.is_empty() {
+        return None;
+    }
+    let find = |w: &str| {
+        VERBS
+            .iter()
+            .find(|(_, syn)| syn.contains(&w))
+            .map(|(c, _)| *c)
+    };
+    if let Some(c) = find(&w) {
+        return Some(c);
+    }
+    let stems = [
+        w.strip_suffix("ing"),
+        w.strip_suffix("es"),
+        w.strip_suffix('s'),
+        w.strip_suffix("ed"),
+        w.strip_suffix('d'),
+    ];
+    for s in stems.into_iter().flatten() {
+        for cand in [s.to_string(), format!("{s}e"), undouble(s)] {
+            if let Some(c) = find(&cand) {
+                return Some(c);
+            }
+        }
+    }
+    None
+}
+
+fn undouble(s: &str) -> String {
+    let b = s.as_bytes();
+    if b.len() >= 2 && b[b.len() - 1] == b[b.len() - 2] {
+        s[..s.len() - 1].to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// Canonical tags named in a CMU trial description ("playground - forward jumps, turn around" →
+/// jump, turn), in order of appearance, without duplicates.
+pub fn tags_of_description(description: &str) -> Vec<String> {
+    // Split camelCase names ("AttitudeWalk") into words.
+    let mut spaced = String::with_capacity(description.len() + 8);
+    let mut prev_lower = false;
+    for ch in description.chars() {
+        if ch.is_ascii_uppercase() && prev_lower {
+            spaced.push(' ');
+        }
+        prev_lower = ch.is_ascii_lowercase();
+        spaced.push(ch);
+    }
+    let lower = spaced.to_ascii_lowercase();
+    let mut tags: Vec<String> = Vec::new();
+    let mut push = |t: &str| {
+        if !tags.iter().any(|x| x == t) {
+            tags.push(t.to_string());
+        }
+    };
+    // Phrases first: they would be misread word by word.
+    for (phrase, tag) in [
+        ("sit down", "sit_down"),
+        ("stand up", "stand_up"),
+        ("get up", "stand_up"),
+        ("jumping jack", "jump"),
+        ("bend over", "bend"),
+    ] {
+        if lower.contains(phrase) {
+            push(tag);
+        }
+    }
+    for word in lower
+        .split(|c: char| !c.is_ascii_alphabetic())
+        .filter(|w| w.len() > 1)
+    {
+        // Description words that are nouns of an activity.
+        let t = match word {
+            "boxing" | "punching" => Some("punch"),
+            "basketball" => Some("type"),
+            "soccer" => Some("kick"),
+            "playground" | "around" | "forward" | "backward" | "sideways" | "up" | "down" => None,
+            w => canonical(w),
+        };
+        if let Some(t) = t {
+            push(t);
+        }
+    }
+    tags
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lemmas_and_forms() {
+        assert_eq!(canonical("walk"), Some("walk"));
+        assert_eq!(canonical("Jogging"), Some("run"));
+        assert_eq!(canonical("sits"), Some("sit"));
+        assert_eq!(canonical("punched"), Some("punch"));
+        assert_eq!(canonical("frobnicate"), None);
+        assert_eq!(canonical(""), None);
+    }
+
+    #[test]
+    fn descriptions() {
+        assert_eq!(
+            tags_of_description("playground - forward jumps, turn around"),
+            vec!["jump", "turn"]
+        );
+        assert_eq!(tags_of_description("run/jog"), vec!["run"]);
+        assert_eq!(tags_of_description("punch/strike"), vec!["punch"]);
+        assert_eq!(
+            tags_of_description("Start Walk Stop"),
+            vec!["walk", "stand"]
+        );
+    }
+}

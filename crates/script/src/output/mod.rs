@@ -1,0 +1,51 @@
+//! What a furnished scene becomes on disk: scene JSON, glTF (boxes, or the Kenney meshes when the
+//! catalogue knows model files) and PNG previews (top-down plan and a perspective view), every
+//! file written atomically.
+
+pub mod gltf;
+pub mod preview;
+
+use std::path::{Path, PathBuf};
+
+use crate::catalogue::Catalogue;
+use crate::error::ScriptError;
+use crate::scene::Scene;
+
+pub use gltf::{gltf_document, write_gltf, write_gltf_with_models};
+pub use preview::{perspective, top_down, VIEWS};
+
+/// Writes the scene as pretty JSON (atomic).
+pub fn write_json(path: &Path, scene: &Scene) -> Result<(), ScriptError> {
+    let text = serde_json::to_string_pretty(scene).map_err(|e| ScriptError::Invalid(format!("scene JSON: {e}")))?;
+    inbetween_io::write_atomic(path, text.as_bytes()).map_err(|e| ScriptError::io(path, e))
+}
+
+/// Reads a scene written by [`write_json`].
+pub fn read_json(path: &Path) -> Result<Scene, ScriptError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ScriptError::io(path, e))?;
+    serde_json::from_str(&text).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: format!("not a scene JSON: {e}") })
+}
+
+/// Writes an image as PNG (atomic).
+pub fn write_png(path: &Path, img: &image::RgbImage) -> Result<(), ScriptError> {
+    inbetween_render::write_png(path, img).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
+}
+
+/// Writes `top.png` (plan) and `view.png` (perspective from `view`) into `dir`; returns their paths.
+pub fn write_previews(dir: &Path, scene: &Scene, cat: &Catalogue, view: &str) -> Result<Vec<PathBuf>, ScriptError> {
+    let top = dir.join("top.png");
+    write_png(&top, &top_down(scene, cat))?;
+    let persp = dir.join("view.png");
+    write_png(&persp, &perspective(scene, cat, view))?;
+    Ok(vec![top, persp])
+}
+
+/// The preview colour of a category: the catalogue's, else a stable colour from its name.
+pub fn category_color(cat: &Catalogue, category: &str) -> [u8; 3] {
+    if let Some(c) = cat.get(category) {
+        return c.color;
+    }
+    let h = category.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+    let h = inbetween_core::seed::mix(h);
+    [(80 + h % 150) as u8, (80 + (h >> 8) % 150) as u8, (80 + (h >> 16) % 150) as u8]
+}

@@ -1,0 +1,166 @@
+//! The semantic scene graph (SSG, §3.2 and §4.1): object nodes, relation nodes between two objects,
+//! character nodes with their action and target, and verbal commands.
+//!
+//! The same type stores a parsed sentence (the query graph G_q) and a database scene (an element of
+//! 𝔾_db). Node ids are indices into `objects`.
+
+use serde::{Deserialize, Serialize};
+
+/// Index of an object node in [`Ssg::objects`].
+pub type NodeId = usize;
+
+/// A spatial relation between two objects (the preposition of the sentence).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Relation {
+    /// Resting on the anchor's top surface.
+    On,
+    /// Within a few tens of centimetres of the anchor, on the floor.
+    Near,
+    /// In front of the anchor (along the anchor's facing direction).
+    InFrontOf,
+    /// Beside the anchor, left or right, touching or nearly.
+    NextTo,
+    /// Under the anchor (beneath a table top).
+    Under,
+    /// Above the anchor (hanging or on the wall over it).
+    Above,
+    /// Inside the anchor's footprint (a room, a box, a ring).
+    In,
+    /// Behind the anchor.
+    Behind,
+}
+
+impl Relation {
+    pub const ALL: [Relation; 8] = [
+        Relation::On,
+        Relation::Near,
+        Relation::InFrontOf,
+        Relation::NextTo,
+        Relation::Under,
+        Relation::Above,
+        Relation::In,
+        Relation::Behind,
+    ];
+
+    /// The relation's words as written in a script ("in front of").
+    pub fn phrase(self) -> &'static str {
+        match self {
+            Relation::On => "on",
+            Relation::Near => "near",
+            Relation::InFrontOf => "in front of",
+            Relation::NextTo => "next to",
+            Relation::Under => "under",
+            Relation::Above => "above",
+            Relation::In => "in",
+            Relation::Behind => "behind",
+        }
+    }
+}
+
+/// An object node: one category, with the attributes the text gives it ("organized", "office").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ObjectNode {
+    /// Canonical catalogue category ("desk", "bed", "sofa"), after synonyms.
+    pub category: String,
+    /// Adjectives and noun modifiers ("organized", "office"), lemmatised, lower case.
+    pub attributes: Vec<String>,
+    /// How many ("two chairs" → 2). At least 1.
+    pub count: usize,
+    /// The word as written ("couch"), for messages and labels.
+    pub word: String,
+    /// Index of the sentence it came from (0-based), for incremental edits and messages.
+    pub sentence: usize,
+}
+
+/// A relation node (u, v): `active` relates to `anchor` (u.anchor = v, v.active ∋ u).
+/// "A cup on a table": active = cup, anchor = table, relation = On.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RelationNode {
+    pub relation: Relation,
+    pub active: NodeId,
+    pub anchor: NodeId,
+    pub sentence: usize,
+}
+
+/// A character node: who does what, to or with which object (§3.2, Fig. 3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CharacterNode {
+    /// As written ("Eve", "Tom", "the man", "Worker").
+    pub name: String,
+    /// Verb lemmas in order ("walk", "sit", "sing").
+    pub actions: Vec<Action>,
+    pub sentence: usize,
+}
+
+/// One verb of a character sentence with its target and manner.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Action {
+    /// Verb lemma ("walk", "sit", "punch").
+    pub verb: String,
+    /// Preposition linking the verb to its target ("to", "on", "with"), if any.
+    pub preposition: Option<String>,
+    /// Target object: an index into [`Ssg::objects`] when it is a scene object.
+    pub target: Option<NodeId>,
+    /// Adverbs ("madly", "unbelievably") and particles ("right" in "turns right").
+    pub manner: Vec<String>,
+}
+
+/// Verbal commands (§3.2): camera placement, weather, time of day.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Command {
+    /// "camera left", "camera front", "camera top", "camera close", ...
+    Camera { view: String, sentence: usize },
+    /// "weather rainy", "weather sunny", ...
+    Weather { weather: String, sentence: usize },
+    /// "time night", ...
+    Time { time: String, sentence: usize },
+}
+
+/// A semantic scene graph.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Ssg {
+    /// The room or place the sentence names ("office", "gallery", "meetingroom"), if any.
+    pub room: Option<String>,
+    pub objects: Vec<ObjectNode>,
+    pub relations: Vec<RelationNode>,
+    pub characters: Vec<CharacterNode>,
+    pub commands: Vec<Command>,
+}
+
+impl Ssg {
+    /// u.active: the relation nodes whose anchor is `id` (incoming).
+    pub fn actives_of(&self, id: NodeId) -> impl Iterator<Item = &RelationNode> {
+        self.relations.iter().filter(move |r| r.anchor == id)
+    }
+
+    /// u.anchor: the relation nodes whose active object is `id` (outgoing).
+    pub fn anchors_of(&self, id: NodeId) -> impl Iterator<Item = &RelationNode> {
+        self.relations.iter().filter(move |r| r.active == id)
+    }
+
+    /// Appends `other`, renumbering its node ids; returns the offset its ids moved by.
+    pub fn merge(&mut self, other: Ssg) -> usize {
+        let offset = self.objects.len();
+        if self.room.is_none() {
+            self.room = other.room;
+        }
+        self.objects.extend(other.objects);
+        self.relations.extend(other.relations.into_iter().map(|mut r| {
+            r.active += offset;
+            r.anchor += offset;
+            r
+        }));
+        self.characters.extend(other.characters.into_iter().map(|mut c| {
+            for a in &mut c.actions {
+                if let Some(t) = &mut a.target {
+                    *t += offset;
+                }
+            }
+            c
+        }));
+        self.commands.extend(other.commands);
+        offset
+    }
+}

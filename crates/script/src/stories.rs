@@ -1,0 +1,124 @@
+//! Built-in scripts: the paper's figure texts as written (quirks included: `\$`, `$.`, the `".`
+//! that stands for `$`, a sentence broken over lines), a demo story, and a short film script we
+//! wrote in the paper's style for a public-domain film (§5: "texts from public film scripts").
+//!
+//! The extracted paper text does not say which caption text belongs to which figure panel beyond
+//! Fig. 1; the grouping of the Fig. 5–7 texts below follows their content (iterative scenes with
+//! Susan and Tom, film-like lines, per-scene actions).
+
+/// Fig. 1: the interface example.
+pub const FIG1: &str = "'Eve walks to the house
+\"In the room, an organized office desk is near a bed\\$.\"
+\"camera front\"
+\"Eve sits on the couch. and sings with the microphone\"
+";
+
+/// Fig. 5: iterative creation with customised text (gallery and meeting room).
+pub const FIG5: &str = "\"In a gallery there is a horsesculpture and a oilpainting\\$. There is also a sculpture and a picture\\$.\"
+\"There is a blackboard in a meetingroom\\$. There is an arranged table in the meetingroom\\$......\"
+\"Susan walks to the oilpainting. Susan stands in the front of oilpainting and is looking at it.\"
+\"Susan walks to the picture and plays with the phone.\"
+\"Susan walks to the horsesculpture. Susan is thinking before the horsesculpture.\"
+\"Tom sits on a modernchair. Tom sits and calls with phone. Tom sits madly. Tom stands.\"
+\"Tom turns right. Tom stands and writes on the blackboard.\"
+";
+
+/// Fig. 6: the film-script line of the extracted figure text.
+pub const FIG6: &str = "\"The man walks unbelievably to the road.\"
+";
+
+/// Fig. 7: actions in different scenes (boxing gym, workshop, music room).
+pub const FIG7: &str = "\"There is a boxing ring above which a boxingbag hangs\". There is a stool and a desk.\". There is a bottle\"
+\"There is an organized working shop\\$. A hammer and a wood is on the table\\$. A shelf and a sofa are in the front\"
+\"There is a music room\\$. A computer and a recorder are on a desk\\$. There is a piano and a chair in front\"
+\"Worker is serving the wood
+\"Mary is punching boxingbag.\"
+\"Mary is drinking soda.\"
+\"Worker is sawing the wood.\"
+\"Anny walks to the recorder
+
+and pushes the record button.\"
+\"Worker is hammering the nail into the wood.\"
+\"Worker draws the design diagram.\"
+\"Anny sits on the chair and sings with microphone.\"
+\"Anny stands and is listening to music with the headphones.\"
+";
+
+/// The Fig. 5 and Fig. 7 texts hold several scenes each; composed as one they would crowd a single
+/// room. These are the same lines, one scene per text, with the characters that act in it.
+pub const FIG5_GALLERY: &str = "\"In a gallery there is a horsesculpture and a oilpainting\\$. There is also a sculpture and a picture\\$.\"
+\"Susan walks to the oilpainting. Susan stands in the front of oilpainting and is looking at it.\"
+\"Susan walks to the picture and plays with the phone.\"
+\"Susan walks to the horsesculpture. Susan is thinking before the horsesculpture.\"
+";
+
+/// Fig. 5, the meeting-room scene.
+pub const FIG5_MEETING_ROOM: &str = "\"There is a blackboard in a meetingroom\\$. There is an arranged table in the meetingroom\\$......\"
+\"Tom sits on a modernchair. Tom sits and calls with phone. Tom sits madly. Tom stands.\"
+\"Tom turns right. Tom stands and writes on the blackboard.\"
+";
+
+/// Fig. 7, the boxing gym.
+pub const FIG7_BOXING: &str = "\"There is a boxing ring above which a boxingbag hangs\". There is a stool and a desk.\". There is a bottle\"
+\"Mary is punching boxingbag.\"
+\"Mary is drinking soda.\"
+";
+
+/// Fig. 7, the workshop.
+pub const FIG7_WORKSHOP: &str = "\"There is an organized working shop\\$. A hammer and a wood is on the table\\$. A shelf and a sofa are in the front\"
+\"Worker is serving the wood
+\"Worker is sawing the wood.\"
+\"Worker is hammering the nail into the wood.\"
+\"Worker draws the design diagram.\"
+";
+
+/// Fig. 7, the music room.
+pub const FIG7_MUSIC_ROOM: &str = "\"There is a music room\\$. A computer and a recorder are on a desk\\$. There is a piano and a chair in front\"
+\"Anny walks to the recorder
+
+and pushes the record button.\"
+\"Anny sits on the chair and sings with microphone.\"
+\"Anny stands and is listening to music with the headphones.\"
+";
+
+/// A short demo: an office with a living-room corner, a camera command, two characters.
+pub const DEMO: &str = "# Demo script: scene lines end in $, the rest directs the characters.
+In the office, an organized desk is near a bookshelf$
+A laptop and a lamp are on the desk$
+A sofa is in front of a table, and a chair is next to the desk$
+camera front
+Eve walks to the desk and sits on the chair.
+Eve types on the laptop.
+Tom walks slowly to the sofa and sits on it.
+";
+
+/// A few lines in the paper's style for "Night of the Living Dead" (1968, public domain): the
+/// farmhouse living room. Our own wording: scene and actions only, no dialogue.
+pub const NIGHT_OF_THE_LIVING_DEAD: &str =
+    "# Night of the Living Dead (1968), the farmhouse: our own lines, no dialogue.
+In the living room, an old sofa is near a table$
+A phone is on the table$
+There is a shelf behind the sofa and a lamp is on the shelf$
+time night
+weather rainy
+Barbra walks to the sofa and sits on it.
+Ben walks quickly to the table and picks up the phone.
+Ben nails the wood onto the door.
+camera close
+Barbra stands and looks madly at the window.
+";
+
+/// All built-in texts as (name, text).
+pub fn all() -> Vec<(&'static str, &'static str)> {
+    vec![
+        ("fig1", FIG1),
+        ("fig5-gallery", FIG5_GALLERY),
+        ("fig5-meetingroom", FIG5_MEETING_ROOM),
+        ("fig6", FIG6),
+        ("fig7-boxing", FIG7_BOXING),
+        ("fig7-workshop", FIG7_WORKSHOP),
+        ("fig7-musicroom", FIG7_MUSIC_ROOM),
+        ("demo", DEMO),
+        ("night-of-the-living-dead", NIGHT_OF_THE_LIVING_DEAD),
+    ]
+}

@@ -1,0 +1,156 @@
+//! Walking a route (§4.3): arc-length timing, eased start and stop, limited turn rate, and foot
+//! locking that removes foot skate.
+
+use inbetween_core::fk::forward_clip;
+use inbetween_script::motion::locomotion::{heading_at, place_clip};
+use inbetween_script::motion::{foot_skate, lock_feet, walk_route, walk_route_stats, LockParams, MotionLibrary, Rig, WalkParams};
+
+fn arc_route() -> Vec<[f32; 2]> {
+    (0..=40)
+        .map(|i| {
+            let a = i as f32 / 40.0 * 3.0;
+            [1.0 + 2.0 * a.sin(), 1.0 + 2.0 - 2.0 * a.cos()]
+        })
+        .collect()
+}
+
+fn root_xz(m: &inbetween_core::Motion, f: usize) -> [f64; 2] {
+    let r = m.pose(f).translations[0];
+    [r.x, r.z]
+}
+
+#[test]
+fn straight_route_starts_and_stops_at_rest_and_arrives() {
+    let lib = MotionLibrary::procedural(0);
+    let route = [[1.0f32, 1.0], [1.0, 5.0]];
+    let (m, st) = walk_route_stats(&route, &lib, &WalkParams::default());
+    let n = m.num_frames();
+    assert!((st.length - 4.0).abs() < 1e-6);
+    let [x0, z0] = root_xz(&m, 0);
+    let [x1, z1] = root_xz(&m, n - 1);
+    assert!((x0 - 1.0).abs() < 0.05 && (z0 - 1.0).abs() < 0.05, "start {x0} {z0}");
+    assert!((x1 - 1.0).abs() < 0.05 && (z1 - 5.0).abs() < 0.05, "end {x1} {z1}");
+    let speed = |f: usize| {
+        let (a, b) = (root_xz(&m, f), root_xz(&m, f + 1));
+        ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt() * 30.0
+    };
+    let cycle_speed = {
+        let c = &lib.cycle("walk").unwrap().motion;
+        let (a, b) = (c.pose(0).translations[0], c.pose(c.num_frames() - 1).translations[0]);
+        (b.z - a.z) / c.duration()
+    };
+    let top = (0..n - 1).map(speed).fold(0.0, f64::max);
+    assert!(top > 0.8 * cycle_speed && top < 1.3 * cycle_speed, "top speed {top} vs cycle {cycle_speed}");
+    // Eased: no jump to full speed at the start or from it at the end.
+    for f in 0..12 {
+        assert!(speed(f) < 0.6 * cycle_speed, "frame {f}: {}", speed(f));
+    }
+    for f in n - 10..n - 1 {
+        assert!(speed(f) < 0.3 * cycle_speed, "frame {f}: {}", speed(f));
+    }
+    assert!(st.max_route_error < 0.1);
+    // Faces along the route (+Z), within the cycle's pelvis yaw sway.
+    assert!(heading_at(&m, n / 2).abs() < 0.25);
+}
+
+#[test]
+fn foot_locking_removes_skate_on_a_curved_route() {
+    let lib = MotionLibrary::procedural(0);
+    let route = arc_route();
+    let raw = walk_route(&route, &lib, &WalkParams { lock_feet: false, ..WalkParams::default() });
+    let (locked, st) = walk_route_stats(&route, &lib, &WalkParams::default());
+    let before = foot_skate(&raw);
+    let after = foot_skate(&locked);
+    println!("foot skate on a 6 m arc: {before:.2} cm/s before locking, {after:.2} cm/s after");
+    assert!((st.skate_before - before).abs() < 1e-9 && (st.skate_after - after).abs() < 1e-9);
+    assert!(before > 5.0, "the unlocked walk should skate on a curve ({before})");
+    assert!(after < 0.35 * before, "locking must cut skate by two thirds: {before} -> {after}");
+    // Locking keeps feet out of the floor and the root on the route.
+    let rig = Rig::standard();
+    let low = forward_clip(&locked)
+        .iter()
+        .map(|g| g.positions[rig.legs[0][2]].y.min(g.positions[rig.legs[1][2]].y))
+        .fold(f64::INFINITY, f64::min);
+    assert!(low > rig.ankle_height - 0.03, "ankle {low} below the floor");
+    assert!(st.max_route_error < 0.1);
+    // Locking is a post-process any clip on the rig can take.
+    let again = lock_feet(&raw, &LockParams::default());
+    assert_eq!(again, locked);
+}
+
+#[test]
+fn corners_are_turned_at_a_limited_rate() {
+    let lib = MotionLibrary::procedural(0);
+    // An A*-style route: axis-aligned segments with a right-angle corner.
+    let route = [[0.5f32, 0.5], [0.5, 3.0], [3.0, 3.0]];
+    let p = WalkParams { max_turn_rate: 2.0, ..WalkParams::default() };
+    let (m, st) = walk_route_stats(&route, &lib, &p);
+    let n = m.num_frames();
+    let [x1, z1] = root_xz(&m, n - 1);
+    assert!((x1 - 3.0).abs() < 0.05 && (z1 - 3.0).abs() < 0.05);
+    assert!(st.max_route_error < 0.05, "{}", st.max_route_error);
+    // Heading ends along +X (π/2), and never changes faster than the limit plus the pelvis sway.
+    assert!((heading_at(&m, n - 1) - std::f64::consts::FRAC_PI_2).abs() < 0.2);
+    for f in 1..n {
+        let d = inbetween_core::angle::wrap_angle(heading_at(&m, f) - heading_at(&m, f - 1));
+        assert!(d.abs() < 2.0 / 30.0 + 0.05, "frame {f}: {d}");
+    }
+    println!("corner route: skate {:.2} -> {:.2} cm/s", st.skate_before, st.skate_after);
+    assert!(st.skate_after < 0.5 * st.skate_before);
+}
+
+#[test]
+fn final_heading_and_degenerate_routes() {
+    let lib = MotionLibrary::procedural(0);
+    let p = WalkParams { final_heading: Some(std::f64::consts::PI), ..WalkParams::default() };
+    let m = walk_route(&[[0.0, 0.0], [0.0, 2.0]], &lib, &p);
+    assert!((heading_at(&m, m.num_frames() - 1).abs() - std::f64::consts::PI).abs() < 0.2);
+    // An empty library still walks (built-in cycle, rest pose as idle).
+    let empty = MotionLibrary::default();
+    let m = walk_route(&[[0.0, 0.0], [0.0, 2.0]], &empty, &WalkParams::default());
+    let r = m.pose(m.num_frames() - 1).translations[0];
+    assert!((r.z - 2.0).abs() < 0.1, "{r:?}");
+    for route in [vec![], vec![[2.0f32, 2.0]], vec![[2.0, 2.0], [2.0, 2.0]]] {
+        let m = walk_route(&route, &lib, &WalkParams::default());
+        assert!(m.num_frames() > 0);
+        let a = root_xz(&m, 0);
+        let b = root_xz(&m, m.num_frames() - 1);
+        assert!((a[0] - b[0]).abs() < 0.05 && (a[1] - b[1]).abs() < 0.05);
+    }
+}
+
+#[test]
+fn walking_is_deterministic_and_run_is_faster() {
+    let lib = MotionLibrary::procedural(0);
+    let route = arc_route();
+    let a = walk_route(&route, &lib, &WalkParams::default());
+    let b = walk_route(&route, &lib, &WalkParams::default());
+    assert_eq!(a, b);
+    let run = walk_route(&route, &lib, &WalkParams { verb: "run".into(), ..WalkParams::default() });
+    assert!(run.num_frames() < a.num_frames());
+    // A library clip can be placed in the world.
+    let sit = &lib.retrieve("sit").unwrap().motion;
+    let placed = place_clip(sit, [2.0, 3.0], 1.0);
+    let r = placed.pose(0).translations[0];
+    let r0 = sit.pose(0).translations[0];
+    assert!((glam::DVec3::new(r.x - 2.0, 0.0, r.z - 3.0).length() - glam::DVec3::new(r0.x, 0.0, r0.z).length()).abs() < 1e-9);
+    assert!((r.y - r0.y).abs() < 1e-12);
+}
+
+#[test]
+fn walks_an_astar_route_around_an_obstacle() {
+    use inbetween_script::layout::grid::{Grid, CELL};
+    let mut grid = Grid::new(5.0, 5.0, CELL);
+    grid.block_rect([2.5, 2.5], [0.8, 0.5], 0.0, 0.2);
+    let route = grid.astar([0.6, 0.6], [4.4, 4.4]).expect("a route around the table");
+    let lib = MotionLibrary::procedural(0);
+    let (m, st) = walk_route_stats(&route, &lib, &WalkParams::default());
+    println!("A* route: {} points, {:.2} m, {} frames, skate {:.2} -> {:.2} cm/s", route.len(), st.length, st.frames, st.skate_before, st.skate_after);
+    for f in 0..m.num_frames() {
+        let [x, z] = root_xz(&m, f);
+        assert!(grid.is_free_at([x as f32, z as f32]), "frame {f}: root at ({x:.2}, {z:.2}) is inside the obstacle");
+    }
+    let [x1, z1] = root_xz(&m, m.num_frames() - 1);
+    assert!((x1 - 4.4).abs() < 0.05 && (z1 - 4.4).abs() < 0.05);
+    assert!(st.skate_after < 0.5 * st.skate_before);
+}
