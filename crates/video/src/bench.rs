@@ -1,6 +1,10 @@
 //! `inbetween video bench`: the paper's measures (§6.3: M_D of Eq. 21, Δ_o of Eq. 23) on procedural
 //! and real clips, the ablations of Table 3 (w/o C_t, w/o C_d, w/o RSFNet, w/o L_d), and the wall
 //! time of each stage of the pipeline.
+//!
+//! Beyond the paper, a perceptual proxy that needs no download: SSIM (Wang et al. 2004, see
+//! [`crate::sdpf::ssim`]) of every transition of the new orders against that of the source's own
+//! adjacent pairs, on luma downscaled to at most [`SSIM_SIDE`] pixels on the longer side.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -11,7 +15,7 @@ use inbetween_io::Progress;
 use crate::frames::{procedural_clip, read_clip, Clip, ProceduralKind, ReadOptions};
 use crate::metric::{embeddings_cached, graph_from_embeddings, pixel_graph, RsfConfig, TrainOptions};
 use crate::pipeline::{analyse, resequence, Analysis, ResequenceConfig};
-use crate::sdpf::{overlap_delta_o, stability_md, SdpfParams};
+use crate::sdpf::{overlap_delta_o, ssim_planes, stability_md, transition_ssims, SdpfParams, SSIM_SIDE};
 use crate::VideoError;
 
 /// A clip of the bench.
@@ -76,10 +80,13 @@ impl VideoBenchConfig {
 
 /// The configurations of Table 3, and the full method with Eq. 20 as printed (no content term,
 /// τ = 1 on latent units).
-const CONFIGS: [&str; 6] = ["full", "w/o C_t", "w/o C_d", "w/o RSFNet", "w/o L_d", "Eq. 20 as printed"];
+/// The last two are the baselines: the shortest-path walk of Fig. 3(a) on our graph, and
+/// the same walk on plain pixel distances.
+const CONFIGS: [&str; 8] =
+    ["full", "w/o C_t", "w/o C_d", "w/o RSFNet", "w/o L_d", "Eq. 20 as printed", "SSPF (shortest path)", "SSPF on pixel distance"];
 /// The paper's Table 3 (M_D, Δ_o), same order, and its ground truth.
-const PAPER_TABLE3: [Option<(f64, f64)>; 6] =
-    [Some((0.0648, 0.706)), Some((0.118, 0.783)), Some((0.079, 0.827)), Some((0.082, 0.731)), Some((0.281, 0.816)), None];
+const PAPER_TABLE3: [Option<(f64, f64)>; 8] =
+    [Some((0.0648, 0.706)), Some((0.118, 0.783)), Some((0.079, 0.827)), Some((0.082, 0.731)), Some((0.281, 0.816)), None, None, None];
 const PAPER_GT_MD: f64 = 0.0535;
 
 struct ClipResult {
@@ -93,6 +100,39 @@ struct ClipResult {
     md_source: f64,
     /// Per configuration: (mean M_D, mean Δ_o, mean length).
     configs: Vec<(f64, f64, f64)>,
+    /// SSIM of the source's adjacent pairs `f → f + 1`.
+    ssim_source: Vec<f64>,
+    /// Per configuration: SSIM of every transition of its new orders (all starts pooled).
+    ssim_configs: Vec<Vec<f64>>,
+}
+
+/// The `p`-th quantile (p in [0, 1]) by linear interpolation between order statistics; NaN for no
+/// value.
+fn quantile(values: &[f64], p: f64) -> f64 {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let pos = p.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let (i, f) = (pos.floor() as usize, pos.fract());
+    v[i] + (v[(i + 1).min(v.len() - 1)] - v[i]) * f
+}
+
+fn mean(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        f64::NAN
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    }
+}
+
+impl ClipResult {
+    /// (mean SSIM, mean over the source's, 10th percentile) of configuration `i`.
+    fn ssim(&self, i: usize) -> (f64, f64, f64) {
+        let ours = mean(&self.ssim_configs[i]);
+        (ours, ours / mean(&self.ssim_source), quantile(&self.ssim_configs[i], 0.1))
+    }
 }
 
 fn load(clip: &BenchClip) -> Result<(Clip, String, f64), VideoError> {
@@ -114,7 +154,7 @@ fn load(clip: &BenchClip) -> Result<(Clip, String, f64), VideoError> {
 fn ablated(full: &Analysis, clip: &Clip, cfg: &VideoBenchConfig, which: &str, progress: &Progress) -> Result<Analysis, VideoError> {
     let mut a = full.clone();
     match which {
-        "w/o RSFNet" => a.graph = pixel_graph(&clip.frames, 32),
+        "w/o RSFNet" | "SSPF on pixel distance" => a.graph = pixel_graph(&clip.frames, 32),
         "w/o L_d" => {
             let opts = TrainOptions { use_distance_loss: false, ..cfg.train.clone() };
             let m = embeddings_cached(&cfg.cache_dir, &clip.frames, &cfg.rsf, &opts, progress)?;
@@ -147,27 +187,43 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
     let full = analyse(&clip, &rcfg, progress)?;
     let n = clip.len();
     let starts: Vec<usize> = (0..cfg.starts.max(1)).map(|i| (i * n) / cfg.starts.max(1) + n / (2 * cfg.starts.max(1))).map(|s| s.min(n - 1)).collect();
+    let planes = ssim_planes(&clip.frames, SSIM_SIDE);
     let mut configs = Vec::new();
+    let mut ssim_configs = Vec::new();
     let mut walk_s = 0.0;
     let mut walks = 0usize;
     for which in CONFIGS {
-        let a = if matches!(which, "w/o RSFNet" | "w/o L_d") { ablated(&full, &clip, cfg, which, progress)? } else { full.clone() };
+        let a = if matches!(which, "w/o RSFNet" | "w/o L_d" | "SSPF on pixel distance") {
+            ablated(&full, &clip, cfg, which, progress)?
+        } else {
+            full.clone()
+        };
+        let shots: Vec<usize> = (0..n).map(|i| a.info.shot_of(i)).collect();
         let (mut md, mut dq, mut len) = (0.0, 0.0, 0.0);
+        let mut ssims = Vec::new();
         for (i, &s) in starts.iter().enumerate() {
-            let (paths, secs) = resequence(&a, s, &params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64)), 1)?;
-            if which == "full" {
-                walk_s += secs;
-                walks += 1;
-            }
-            let order = &paths[0].frames;
+            let order = if which.starts_with("SSPF") {
+                crate::sdpf::sspf(&a.graph, s, cfg.length, Some(&shots))
+            } else {
+                let (paths, secs) = resequence(&a, s, &params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64)), 1)?;
+                if which == "full" {
+                    walk_s += secs;
+                    walks += 1;
+                }
+                paths[0].frames.clone()
+            };
+            let order = &order;
             md += stability_md(&clip.frames, order);
             dq += overlap_delta_o(order, n);
             len += order.len() as f64;
+            ssims.extend(transition_ssims(&planes, order)?);
         }
+        ssim_configs.push(ssims);
         let k = starts.len() as f64;
         configs.push((md / k, dq / k, len / k));
     }
     let source: Vec<usize> = (0..n).collect();
+    let ssim_source = transition_ssims(&planes, &source)?;
     let metric_note = format!("{name}: {}", full.metric_note);
     Ok(ClipResult {
         name,
@@ -179,6 +235,8 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
         metric_note,
         md_source: stability_md(&clip.frames, &source),
         configs,
+        ssim_source,
+        ssim_configs,
     })
 }
 
@@ -188,30 +246,61 @@ pub fn run(cfg: &VideoBenchConfig, progress: &Progress) -> Result<Report, VideoE
     let mut report = Report::new("video-bench", "Video engine benchmark (resequencing with SDPF, Le et al.)");
     report.table(table2(&results, cfg));
     report.table(table3(&results));
+    report.table(ssim_table(&results));
     report.table(stage_table(&results));
+    report.file("ssim.png", ssim_png(&results)?);
     Ok(report)
 }
 
 fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
     let mut t = Table::new("table2", "Table 2 analogue: stability M_D (Eq. 21) and overlap Δo (Eq. 23) per clip, full method", &[
-        "clip", "frames", "md_source", "md_ours", "md_ratio", "delta_o", "mean_length",
+        "clip", "frames", "md_source", "md_ours", "md_ratio", "delta_o", "mean_length", "ssim_source", "ssim_ours", "ssim_ratio", "ssim_p10",
     ]);
     for r in results {
         let (md, dq, len) = r.configs[0];
-        t.row([r.name.clone(), r.frames.to_string(), num(r.md_source, 4), num(md, 4), num(md / r.md_source.max(1e-12), 2), num(dq, 3), num(len, 1)]);
+        let (ss, sr, sp) = r.ssim(0);
+        t.row([
+            r.name.clone(),
+            r.frames.to_string(),
+            num(r.md_source, 4),
+            num(md, 4),
+            num(md / r.md_source.max(1e-12), 2),
+            num(dq, 3),
+            num(len, 1),
+            num(mean(&r.ssim_source), 3),
+            num(ss, 3),
+            num(sr, 3),
+            num(sp, 3),
+        ]);
     }
     t.note(format!("{} start frames per clip, target length {}; M_D = mean RMS step of pixels in [0, 1]", cfg.starts, cfg.length));
     t.note("paper (12 clips, their own): ground truth M_D 0.050, ours 0.055 (ratio 1.10), Δo 0.73; Morace et al. 0.069, Δo 0.74");
+    t.note(SSIM_NOTE);
     t
 }
 
+const SSIM_NOTE: &str = "ssim (ours; the paper reports none): mean SSIM (Wang et al. 2004, 11x11 Gaussian window, sigma 1.5, on luma at most 160 px on the longer side) of the transitions i -> i+1 of the new orders; ssim_source over the clip's own adjacent pairs; ssim_ratio = ours / source (1 = transitions as similar as real ones); ssim_p10 = 10th percentile of the new transitions (the worst jumps)";
+
 fn table3(results: &[ClipResult]) -> Table {
     let mut t = Table::new("table3", "Table 3 analogue: ablations, mean over clips", &[
-        "method", "md", "md_ratio", "delta_o", "paper_md", "paper_md_ratio", "paper_delta_o",
+        "method", "md", "md_ratio", "delta_o", "ssim", "ssim_ratio", "ssim_p10", "paper_md", "paper_md_ratio", "paper_delta_o",
     ]);
     let k = results.len().max(1) as f64;
     let gt: f64 = results.iter().map(|r| r.md_source).sum::<f64>() / k;
-    t.row(["ground truth".to_string(), num(gt, 4), "1.00".into(), "1".into(), num(PAPER_GT_MD, 4), "1.00".into(), "1".into()]);
+    let gt_ssim = results.iter().map(|r| mean(&r.ssim_source)).sum::<f64>() / k;
+    let gt_p10 = results.iter().map(|r| quantile(&r.ssim_source, 0.1)).sum::<f64>() / k;
+    t.row([
+        "ground truth".to_string(),
+        num(gt, 4),
+        "1.00".into(),
+        "1".into(),
+        num(gt_ssim, 3),
+        "1.000".into(),
+        num(gt_p10, 3),
+        num(PAPER_GT_MD, 4),
+        "1.00".into(),
+        "1".into(),
+    ]);
     for (i, name) in CONFIGS.iter().enumerate().rev() {
         let md = results.iter().map(|r| r.configs[i].0).sum::<f64>() / k;
         let ratio = results.iter().map(|r| r.configs[i].0 / r.md_source.max(1e-12)).sum::<f64>() / k;
@@ -221,12 +310,57 @@ fn table3(results: &[ClipResult]) -> Table {
             None => ["-".to_string(), "-".to_string(), "-".to_string()],
         };
         let [pm, pr, pd] = paper;
-        t.row([name.to_string(), num(md, 4), num(ratio, 2), num(dq, 3), pm, pr, pd]);
+        let ssim = |f: fn((f64, f64, f64)) -> f64| results.iter().map(|r| f(r.ssim(i))).sum::<f64>() / k;
+        let (ss, sr, sp) = (ssim(|s| s.0), ssim(|s| s.1), ssim(|s| s.2));
+        t.row([name.to_string(), num(md, 4), num(ratio, 2), num(dq, 3), num(ss, 3), num(sr, 3), num(sp, 3), pm, pr, pd]);
     }
     t.note("md_ratio: M_D of the new orders over the clip's own (lower is smoother); the paper's clips differ from ours, so compare ratios");
     t.note("w/o RSFNet: Euclidean distance of 32-pixel thumbnails; w/o L_d: the same network untrained (our backbone is not pretrained)");
     t.note("Eq. 20 as printed: the full method choosing by exp(-motion distance) in latent units, without our content term and relative temperature");
+    t.note("SSPF: the baseline of Fig. 3(a), always the nearest unvisited frame (RSFNet graph); SSPF on pixel distance: the same on 32-pixel thumbnails; the paper gives no numbers for them");
+    t.note("ssim, ssim_ratio, ssim_p10: means over the clips of Table 2's columns (ours; the paper reports no SSIM); ground truth: the clips' own adjacent pairs");
     t
+}
+
+/// SSIM per clip and method: the source's adjacent pairs, then every configuration.
+fn ssim_table(results: &[ClipResult]) -> Table {
+    let mut t = Table::new("ssim", "SSIM of transitions per clip and method (ours; not in the paper)", &[
+        "clip", "method", "transitions", "ssim", "ssim_ratio", "ssim_p10", "ssim_min",
+    ]);
+    for r in results {
+        let src = mean(&r.ssim_source);
+        let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+        t.row([
+            r.name.clone(),
+            "source (adjacent pairs)".into(),
+            r.ssim_source.len().to_string(),
+            num(src, 3),
+            "1.000".into(),
+            num(quantile(&r.ssim_source, 0.1), 3),
+            num(min(&r.ssim_source), 3),
+        ]);
+        for (i, name) in CONFIGS.iter().enumerate() {
+            let (ss, sr, sp) = r.ssim(i);
+            let v = &r.ssim_configs[i];
+            t.row([r.name.clone(), name.to_string(), v.len().to_string(), num(ss, 3), num(sr, 3), num(sp, 3), num(min(v), 3)]);
+        }
+    }
+    t.note(SSIM_NOTE);
+    t.note("transitions: pooled over the start frames; ssim_min: the worst single transition");
+    t
+}
+
+/// Box plot of the SSIM of every transition, per method, grouped by clip (`ssim.png`).
+fn ssim_png(results: &[ClipResult]) -> Result<Vec<u8>, VideoError> {
+    let groups: Vec<String> = results.iter().map(|r| r.name.clone()).collect();
+    let mut series = vec![("source".to_string(), results.iter().map(|r| r.ssim_source.clone()).collect::<Vec<_>>())];
+    for (i, name) in CONFIGS.iter().enumerate() {
+        series.push((name.to_string(), results.iter().map(|r| r.ssim_configs[i].clone()).collect()));
+    }
+    inbetween_render::rendered_bytes("ssim.png", |p| {
+        inbetween_render::plot::box_plot(p, "SSIM of transitions (source's adjacent pairs vs new orders)", "SSIM (luma, <= 160 px)", &groups, &series)
+    })
+    .map_err(|e| VideoError::Invalid(format!("ssim.png: {e}")))
 }
 
 fn stage_table(results: &[ClipResult]) -> Table {
@@ -251,13 +385,30 @@ mod tests {
     use super::*;
 
     #[test]
+    fn quantiles_interpolate_between_order_statistics() {
+        let v = [4.0, 1.0, 3.0, 2.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0];
+        assert_eq!(quantile(&v, 0.1), 2.0);
+        assert_eq!(quantile(&v, 0.0), 1.0);
+        assert_eq!(quantile(&v, 1.0), 11.0);
+        assert!((quantile(&[0.0, 1.0], 0.1) - 0.1).abs() < 1e-12);
+        assert!(quantile(&[], 0.1).is_nan());
+        assert!(mean(&[]).is_nan());
+    }
+
+    #[test]
     fn quick_bench_fills_every_table() {
         let dir = tempfile::tempdir().unwrap();
         let report = run(&VideoBenchConfig::quick(dir.path().to_path_buf()), &Progress::hidden()).unwrap();
         let text = report.to_text();
-        for needle in ["Table 2 analogue", "Table 3 analogue", "w/o C_t", "w/o L_d", "ground truth", "SDPF walk"] {
+        for needle in ["Table 2 analogue", "Table 3 analogue", "w/o C_t", "w/o L_d", "ground truth", "SDPF walk", "ssim_ratio", "source (adjacent pairs)"] {
             assert!(text.contains(needle), "{needle} missing:\n{text}");
         }
-        assert_eq!(report.tables().count(), 3);
+        assert_eq!(report.tables().count(), 4);
+        let ssim = report.tables().find(|t| t.name == "ssim").unwrap().to_csv();
+        // Header, the source's own pairs, then one row per configuration.
+        assert_eq!(ssim.lines().count(), 2 + CONFIGS.len(), "{ssim}");
+        assert!(text.contains("SSPF (shortest path)") && text.contains("SSPF on pixel distance"));
+        let written = report.write(&dir.path().join("out")).unwrap();
+        assert!(written.iter().any(|p| p.ends_with("ssim.png")));
     }
 }

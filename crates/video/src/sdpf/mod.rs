@@ -8,7 +8,9 @@
 //! - [`search`]: the walk, target length, loop closure, several distinct sequences;
 //! - [`cuts`]: scene-cut detection, so that walks stay inside a shot;
 //! - [`metrics`]: M_D (Eq. 21) and Δo (Eq. 22–23);
-//! - [`explain`](mod@explain): `--explain` text.
+//! - [`ssim`](mod@ssim): SSIM of transitions (Wang et al. 2004; not in the paper), the bench's perceptual proxy;
+//! - [`explain`](mod@explain): `--explain` text;
+//! - [`sspf`](mod@sspf): the shortest-path baseline (Fig. 3(a)).
 //!
 //! Readings of the paper where its text is ambiguous (each is documented where it is coded):
 //! - **η (Eq. 8)** is the mean of the N(N−1) off-diagonal edge weights (the paper: "Σ e_ij / N …
@@ -46,6 +48,8 @@ pub mod distill;
 pub mod explain;
 pub mod metrics;
 pub mod search;
+pub mod ssim;
+pub mod sspf;
 pub mod types;
 
 pub use cuts::{cut_scores, detect_cuts, detect_cuts_with, detect_shots, shots_from_cuts, CutParams};
@@ -53,6 +57,8 @@ pub use distill::{eta, softmax};
 pub use explain::explain;
 pub use metrics::{frame_rms, overlap, overlap_delta_o, source_md, stability_md, try_stability_md, Overlap};
 pub use search::{sdpf, several};
+pub use sspf::sspf;
+pub use ssim::{ssim, ssim_planes, transition_ssims, Plane, SSIM_SIDE};
 pub use types::{
     Candidate, CdState, MatrixMotion, MotionDistance, MotionInfo, NoMotion, Omega, Path, SdpfParams, SdpfPath, StopReason,
     Transition,
