@@ -6,13 +6,17 @@ use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use inbetween_io::Progress;
 use inbetween_script::compose::{ComposeConfig, Matcher};
-use inbetween_script::job::{read_script, run_scene, SceneJob};
+use inbetween_script::job::{read_script, run_scene, RunJob, SceneJob};
 use inbetween_script::stories;
 
 #[derive(Subcommand)]
 pub enum ScriptCommand {
     /// Compose the scene a script describes: scene.json, scene.gltf, ssg.json, top.png, view.png.
     Scene(SceneArgs),
+    /// Scene + characters: animated glTF, BVH per character, preview GIF, routes PNG, cost curves.
+    Run(RunArgs),
+    /// Re-run `run` every time the script file is saved (the paper's editing loop).
+    Watch(WatchArgs),
     /// Print the semantic scene graph of each sentence (JSON), and any problems found.
     Parse(ParseArgs),
     /// List the built-in scripts (paper captions, film lines, demo story) or print one.
@@ -62,6 +66,31 @@ pub struct SceneArgs {
 }
 
 #[derive(Args)]
+pub struct RunArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Skip the joint scene/motion optimisation (§4.3).
+    #[arg(long)]
+    pub no_optimize: bool,
+    /// Use the CMU clips and Kenney animations of ../shared/data when present (default: the
+    /// built-in procedural library).
+    #[arg(long)]
+    pub shared_motions: bool,
+    /// Width of the preview GIF in pixels (at most 480).
+    #[arg(long, default_value_t = 480)]
+    pub gif_width: u32,
+}
+
+#[derive(Args)]
+pub struct WatchArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Stop after this many runs (default: until interrupted).
+    #[arg(long)]
+    pub max_runs: Option<usize>,
+}
+
+#[derive(Args)]
 pub struct ParseArgs {
     /// Script file, or `builtin:NAME`.
     pub script: String,
@@ -87,6 +116,8 @@ pub struct BenchArgs {
 pub fn run(c: ScriptCommand) -> anyhow::Result<()> {
     match c {
         ScriptCommand::Scene(a) => scene(a),
+        ScriptCommand::Run(a) => run_story(a),
+        ScriptCommand::Watch(a) => watch(a),
         ScriptCommand::Parse(a) => parse(a),
         ScriptCommand::Stories(a) => list_stories(a),
         ScriptCommand::Bench(a) => bench(a),
@@ -107,20 +138,72 @@ fn load(script: &str) -> anyhow::Result<(String, PathBuf)> {
     Ok((read_script(path)?, path.to_path_buf()))
 }
 
-fn scene(a: SceneArgs) -> anyhow::Result<()> {
-    let (text, source) = load(&a.script)?;
+fn scene_job(a: &SceneArgs) -> SceneJob {
     let matcher = match a.matcher {
         MatcherArg::Relation => Matcher::RelationFirst,
         MatcherArg::Object => Matcher::ObjectFirst,
     };
-    let job = SceneJob {
+    SceneJob {
         out_dir: a.out.clone(),
         seed: a.seed,
-        view: a.view,
-        models: a.models,
+        view: a.view.clone(),
+        models: a.models.clone(),
         config: ComposeConfig { seed: a.seed, matcher, furnish: !a.bare },
-        semantic: a.semantic.then_some(a.model_dir),
-    };
+        semantic: a.semantic.then(|| a.model_dir.clone()),
+    }
+}
+
+fn run_job(a: &RunArgs) -> RunJob {
+    RunJob { scene: scene_job(&a.scene), optimize: !a.no_optimize, shared_motions: a.shared_motions, gif_width: a.gif_width }
+}
+
+fn print_run(source: &Path, r: &inbetween_script::job::RunReport) {
+    for d in &r.scene.diagnostics {
+        eprintln!("warning: {}: {d}", source.display());
+    }
+    for n in &r.animation.notes {
+        eprintln!("note: {}: {n}", source.display());
+    }
+    let frames = r.animation.frames();
+    println!(
+        "{}: {} objects, {} characters, {frames} frames ({:.1} s at {:.0} fps) in {:.2} s; collided boxes {} -> {}, mean contact distance {:.3} m -> {:.3} m",
+        source.display(),
+        r.animation.scene.objects.len(),
+        r.animation.characters.len(),
+        frames as f64 / r.animation.fps,
+        r.animation.fps,
+        r.seconds,
+        r.before.collided_boxes,
+        r.after.collided_boxes,
+        r.before.contact,
+        r.after.contact
+    );
+    for f in &r.files {
+        println!("  wrote {}", f.display());
+    }
+}
+
+fn run_story(a: RunArgs) -> anyhow::Result<()> {
+    let (text, source) = load(&a.scene.script)?;
+    let report = inbetween_script::job::run_story(&text, &source, &run_job(&a)).with_context(|| format!("animating {}", source.display()))?;
+    print_run(&source, &report);
+    Ok(())
+}
+
+fn watch(a: WatchArgs) -> anyhow::Result<()> {
+    let path = PathBuf::from(&a.run.scene.script);
+    println!("watching {} (Ctrl-C to stop)", path.display());
+    inbetween_script::job::watch(&path, &run_job(&a.run), a.max_runs, |outcome| match outcome {
+        Ok(r) => print_run(&path, &r),
+        Err(e) => eprintln!("error: {}: {e}", path.display()),
+    })
+    .with_context(|| format!("watching {}", path.display()))?;
+    Ok(())
+}
+
+fn scene(a: SceneArgs) -> anyhow::Result<()> {
+    let (text, source) = load(&a.script)?;
+    let job = scene_job(&a);
     let report = run_scene(&text, &source, &job).with_context(|| format!("composing {}", source.display()))?;
     for d in &report.diagnostics {
         eprintln!("warning: {}: {d}", source.display());
@@ -177,7 +260,7 @@ fn list_stories(a: StoriesArgs) -> anyhow::Result<()> {
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
     use inbetween_script::bench::{run, BenchConfig};
     let cfg = if a.quick {
-        BenchConfig { seed: a.seed, repeats: 2 }
+        BenchConfig { seed: a.seed, repeats: 2, anneal_iterations: 5 }
     } else {
         BenchConfig { seed: a.seed, ..BenchConfig::default() }
     };

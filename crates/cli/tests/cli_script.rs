@@ -67,7 +67,25 @@ fn the_quick_bench_writes_its_tables_and_box_plot() {
     let dir = tempfile::tempdir().unwrap();
     let o = inbetween().args(["script", "bench", "--quick", "-o"]).arg(dir.path()).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["speed.csv", "layout.csv", "fig8.csv", "incremental.csv", "fig8.png"] {
+    for f in ["speed.csv", "layout.csv", "fig8.csv", "incremental.csv", "stories.csv", "fig8.png", "fig12_costs.png"] {
         assert!(dir.path().join(f).is_file(), "{f} missing");
     }
+}
+
+#[test]
+fn run_writes_the_animated_story_and_watch_reruns_on_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("story.txt");
+    std::fs::write(&script, "A chair is near a desk$.\ncamera left\nEve walks to the desk and sits on the chair.\n").unwrap();
+    let out = dir.path().join("out");
+    let o = inbetween().args(["script", "run"]).arg(&script).arg("-o").arg(&out).arg("--no-optimize").arg("--gif-width").arg("160").output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["story.gltf", "Eve.bvh", "Eve.bvh.json", "story.gif", "routes.png", "scene.json"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("1 characters") && stdout.contains("frames"), "{stdout}");
+    let o = inbetween().args(["script", "watch"]).arg(&script).arg("-o").arg(dir.path().join("w")).args(["--no-optimize", "--gif-width", "160", "--max-runs", "1"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.path().join("w").join("story.gltf").is_file());
 }

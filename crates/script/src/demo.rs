@@ -29,6 +29,20 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
     for d in &report.diagnostics {
         lines.push(format!("script: note: {d}"));
     }
+    // Part 2: the characters act in the scene, after the joint optimisation (§4.3).
+    let run = crate::job::RunJob { scene: SceneJob { out_dir: out.join("story"), ..job.clone() }, optimize: true, shared_motions: false, gif_width: 320 };
+    let story = crate::job::run_story(stories::DEMO, &PathBuf::from("builtin:demo"), &run)?;
+    lines.push(format!(
+        "script: {} characters animated, {} frames ({:.1} s); joint optimisation C {:.3} -> {:.3}, mean contact distance {:.3} m -> {:.3} m -> {}",
+        story.animation.characters.len(),
+        story.animation.frames(),
+        story.animation.frames() as f64 / story.animation.fps,
+        story.before.total,
+        story.after.total,
+        story.before.contact,
+        story.after.contact,
+        out.join("story").display()
+    ));
     // The editing loop: one sentence changed, everything else stays.
     let cat = crate::job::catalogue(None)?;
     let db = crate::database::SceneDatabase::builtin(&cat, crate::job::DEFAULT_VARIATIONS, seed);

@@ -100,3 +100,95 @@ pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneRepor
     let diagnostics = notes.into_iter().chain(composition.diagnostics.iter().cloned()).collect();
     Ok(SceneReport { files, diagnostics, composition, seconds: update.seconds })
 }
+
+/// Options of a story job (`inbetween script run`): a scene job plus the characters.
+#[derive(Debug, Clone)]
+pub struct RunJob {
+    pub scene: SceneJob,
+    /// Run the joint scene/motion optimisation (§4.3, Algorithm 2).
+    pub optimize: bool,
+    /// Use the CMU clips and Kenney animations of `../shared/data` when present (else procedural).
+    pub shared_motions: bool,
+    /// Preview GIF options.
+    pub gif_width: u32,
+}
+
+/// What a story job wrote and measured.
+#[derive(Debug)]
+pub struct RunReport {
+    pub scene: SceneReport,
+    pub animation: crate::animate::Animation,
+    /// Costs before and after the optimisation (equal when it did not run).
+    pub before: crate::optimize::Costs,
+    pub after: crate::optimize::Costs,
+    pub files: Vec<PathBuf>,
+    pub seconds: f64,
+}
+
+/// Composes the scene, animates every character, optimises scene and motion together, and writes
+/// the animated glTF, a BVH per character, the preview GIF from the script's camera, the
+/// top-down routes and the cost curves (Fig. 12).
+pub fn run_story(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, ScriptError> {
+    use crate::animate::{animate, camera_pose, AnimateConfig};
+    use crate::motion::library::MotionLibrary;
+    use crate::optimize::{costs, optimize, plot_costs, OptimizeConfig};
+    let start = std::time::Instant::now();
+    let scene = run_scene(text, source, &job.scene)?;
+    let cat = catalogue(job.scene.models.as_deref())?;
+    let lib = if job.shared_motions { MotionLibrary::from_shared(64) } else { MotionLibrary::procedural(job.scene.seed) };
+    let acfg = AnimateConfig::default();
+    let ocfg = OptimizeConfig { seed: job.scene.seed, ..OptimizeConfig::default() };
+    let dir = &job.scene.out_dir;
+    let mut files = scene.files.clone();
+    let (animation, before, after) = if job.optimize {
+        let o = optimize(&scene.composition, &cat, &lib, &acfg, &ocfg);
+        let plot = dir.join("costs.png");
+        plot_costs(&plot, &o.curves)?;
+        files.push(plot);
+        (o.animation, o.before, o.after)
+    } else {
+        let a = animate(&scene.composition, &cat, &lib, &acfg);
+        let c = costs(&a, &ocfg);
+        (a, c, c)
+    };
+    let chars: Vec<(&str, &inbetween_core::Motion)> = animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let cam = |f: usize| camera_pose(&animation, f);
+    let gltf = dir.join("story.gltf");
+    output::write_animated_gltf(&gltf, &animation.scene, &cat, &chars, &cam, animation.fps)?;
+    files.push(gltf);
+    for c in &animation.characters {
+        let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
+        let bvh = dir.join(format!("{safe}.bvh"));
+        output::write_character_bvh(&bvh, &c.motion)?;
+        files.push(bvh);
+    }
+    let gif = dir.join("story.gif");
+    let opts = output::AnimPreviewOptions { width: job.gif_width, ..output::AnimPreviewOptions::default() };
+    output::render_preview_gif(&gif, &animation.scene, &cat, &chars, &cam, animation.fps, &opts)?;
+    files.push(gif);
+    let routes = dir.join("routes.png");
+    output::render_top_down_trails(&routes, &animation.scene, &cat, &chars)?;
+    files.push(routes);
+    Ok(RunReport { scene, animation, before, after, files, seconds: start.elapsed().as_secs_f64() })
+}
+
+/// `inbetween script watch`: re-runs `run` every time the script file changes (the paper's
+/// editing loop), until `max_runs` runs (None: forever). `on_run` sees each outcome; an error in
+/// one version (an empty file while saving) is reported and the loop goes on.
+pub fn watch(path: &Path, job: &RunJob, max_runs: Option<usize>, mut on_run: impl FnMut(Result<RunReport, ScriptError>)) -> Result<(), ScriptError> {
+    let mut last: Option<(std::time::SystemTime, u64)> = None;
+    let mut runs = 0;
+    loop {
+        let meta = std::fs::metadata(path).map_err(|e| ScriptError::io(path, e))?;
+        let stamp = (meta.modified().map_err(|e| ScriptError::io(path, e))?, meta.len());
+        if last != Some(stamp) {
+            last = Some(stamp);
+            on_run(read_script(path).and_then(|text| run_story(&text, path, job)));
+            runs += 1;
+            if max_runs.is_some_and(|m| runs >= m) {
+                return Ok(());
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(250));
+    }
+}

@@ -19,6 +19,7 @@
 //!
 //! Units: metres, Y up, the floor at y = 0 (glTF's convention).
 
+pub mod animate;
 pub mod bench;
 pub mod catalogue;
 pub mod compose;
@@ -29,6 +30,7 @@ pub mod job;
 pub mod layout;
 pub mod matching;
 pub mod motion;
+pub mod optimize;
 pub mod output;
 pub mod parse;
 pub mod scene;

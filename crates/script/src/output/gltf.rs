@@ -193,25 +193,7 @@ impl Doc {
 
     /// Accessors (position, normal, indices) of a box with flat faces: x, z ∈ [-½, ½], y ∈ [0, 1].
     fn unit_box(&mut self) -> (usize, usize, usize) {
-        let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
-            ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
-            ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
-            ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
-            ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
-            ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
-            ([0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
-        ];
-        let (mut pos, mut nor, mut idx) = (Vec::new(), Vec::new(), Vec::new());
-        for (n, u, v) in faces {
-            // u × v = n, so corners in (u, v) order wind counter-clockwise seen from outside.
-            let base = pos.len() as u16;
-            for (a, b) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
-                let p: [f32; 3] = std::array::from_fn(|k| n[k] * 0.5 + u[k] * a + v[k] * b);
-                pos.push([p[0], p[1] + 0.5, p[2]]);
-                nor.push(n);
-            }
-            idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-        }
+        let (pos, nor, idx) = box_geometry(0.5);
         (self.vec3s(&pos, true), self.vec3s(&nor, false), self.indices(&idx))
     }
 
@@ -503,4 +485,29 @@ pub fn write_gltf_with_models(path: &Path, scene: &Scene, cat: &Catalogue, model
     };
     inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))?;
     Ok(notes)
+}
+
+/// Positions, flat normals and triangle indices of a unit box, x, z ∈ [-½, ½] and y ∈ [-½, ½] +
+/// `lift` (0.5: standing on the origin, as scene objects; 0: centred, as bone boxes).
+pub(crate) fn box_geometry(lift: f32) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u16>) {
+    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+        ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
+    ];
+    let (mut pos, mut nor, mut idx) = (Vec::new(), Vec::new(), Vec::new());
+    for (n, u, v) in faces {
+        // u × v = n, so corners in (u, v) order wind counter-clockwise seen from outside.
+        let base = pos.len() as u16;
+        for (a, b) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+            let p: [f32; 3] = std::array::from_fn(|k| n[k] * 0.5 + u[k] * a + v[k] * b);
+            pos.push([p[0], p[1] + lift, p[2]]);
+            nor.push(n);
+        }
+        idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    (pos, nor, idx)
 }

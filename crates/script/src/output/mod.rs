@@ -2,6 +2,9 @@
 //! catalogue knows model files) and PNG previews (top-down plan and a perspective view), every
 //! file written atomically.
 
+pub mod anim_gltf;
+pub mod anim_preview;
+pub mod bvh_out;
 pub mod gltf;
 pub mod preview;
 
@@ -13,6 +16,9 @@ use crate::scene::Scene;
 
 pub use gltf::{gltf_document, write_gltf, write_gltf_with_models};
 pub use preview::{perspective, top_down, VIEWS};
+pub use anim_gltf::{animated_gltf_document, write_animated_gltf};
+pub use anim_preview::{render_preview_gif, render_top_down_trails, AnimPreviewOptions};
+pub use bvh_out::write_character_bvh;
 
 /// Writes the scene as pretty JSON (atomic).
 pub fn write_json(path: &Path, scene: &Scene) -> Result<(), ScriptError> {

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use image::RgbImage;
-use inbetween_render::canvas::{text_width, Camera3};
+use inbetween_render::canvas::{text_width, Camera3, NEAR};
 use inbetween_render::Canvas;
 
 use crate::catalogue::Catalogue;
@@ -20,6 +20,8 @@ const BACKGROUND: [u8; 3] = [255, 255, 255];
 const FLOOR: [u8; 3] = [236, 233, 226];
 const GRID: [u8; 3] = [212, 208, 200];
 const INK: [u8; 3] = [40, 40, 40];
+/// Polygons are clipped a little in front of the camera's near plane (cameras inside the room).
+const NEAR_CLIP: f64 = NEAR * 20.0;
 
 /// Fills a convex polygon given in pixels (either winding); pixel centres inside are painted.
 pub fn fill_convex(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3]) {
@@ -53,8 +55,99 @@ pub fn fill_convex(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3]) {
     }
 }
 
-fn scale_color(c: [u8; 3], k: f32) -> [u8; 3] {
+pub(crate) fn scale_color(c: [u8; 3], k: f32) -> [u8; 3] {
     c.map(|v| (v as f32 * k).round().clamp(0.0, 255.0) as u8)
+}
+
+/// Projects a planar polygon, clipped to the part in front of the near plane (Sutherland–Hodgman
+/// in camera space); None when nothing of it is in front.
+fn project_polygon(cam: &Camera3, pts: &[DVec3]) -> Option<Vec<(f32, f32)>> {
+    let near = NEAR_CLIP;
+    let c: Vec<DVec3> = pts.iter().map(|&p| cam.to_camera(p)).collect();
+    let mut out = Vec::with_capacity(c.len() + 2);
+    for i in 0..c.len() {
+        let (a, b) = (c[i], c[(i + 1) % c.len()]);
+        if a.z >= near {
+            out.push(a);
+        }
+        if (a.z >= near) != (b.z >= near) {
+            out.push(a.lerp(b, (near - a.z) / (b.z - a.z)));
+        }
+    }
+    if out.len() < 3 {
+        return None;
+    }
+    let f = cam.focal_px();
+    let (w, h) = (cam.width as f64 * 0.5, cam.height as f64 * 0.5);
+    Some(out.iter().map(|p| ((w + f * p.x / p.z) as f32, (h - f * p.y / p.z) as f32)).collect())
+}
+
+/// One object as a shaded box (faces turned away from the camera skipped).
+pub(crate) fn draw_object(cv: &mut Canvas, cam: &Camera3, o: &PlacedObject, color: [u8; 3]) {
+    let light = DVec3::new(0.4, 1.0, 0.6).normalize();
+    let c = geom::center(o);
+    let (y0, y1) = (o.position[1] as f64, o.top() as f64);
+    let foot = geom::corners(o).map(|p| (p[0] as f64, p[1] as f64));
+    let v = |k: usize, top: bool| DVec3::new(foot[k].0, if top { y1 } else { y0 }, foot[k].1);
+    let centre = DVec3::new(c[0] as f64, (y0 + y1) / 2.0, c[1] as f64);
+    let mut faces: Vec<([DVec3; 4], DVec3)> = vec![
+        ([v(0, true), v(1, true), v(2, true), v(3, true)], DVec3::Y),
+        ([v(0, false), v(1, false), v(2, false), v(3, false)], DVec3::NEG_Y),
+    ];
+    for k in 0..4 {
+        let f = [v(k, false), v((k + 1) % 4, false), v((k + 1) % 4, true), v(k, true)];
+        let fc = (f[0] + f[1] + f[2] + f[3]) / 4.0;
+        let n = fc - centre;
+        faces.push((f, DVec3::new(n.x, 0.0, n.z).normalize_or_zero()));
+    }
+    for (f, nn) in faces {
+        let fc = (f[0] + f[1] + f[2] + f[3]) / 4.0;
+        if nn.dot(cam.eye - fc) <= 0.0 {
+            continue;
+        }
+        let Some(pts) = project_polygon(cam, &f) else { continue };
+        let shade = 0.55 + 0.45 * nn.dot(light).max(0.0) as f32;
+        fill_convex(cv, &pts, scale_color(color, shade));
+        for k in 0..pts.len() {
+            cv.line(pts[k], pts[(k + 1) % pts.len()], scale_color(color, 0.45), 1.0);
+        }
+    }
+}
+
+/// Floor, grid and room edges.
+pub(crate) fn draw_room(cv: &mut Canvas, cam: &Camera3, scene: &Scene) {
+    let r = &scene.room;
+    let (w, d, h) = (r.width as f64, r.depth as f64, r.height as f64);
+    let floor = [DVec3::ZERO, DVec3::new(w, 0.0, 0.0), DVec3::new(w, 0.0, d), DVec3::new(0.0, 0.0, d)];
+    if let Some(f) = project_polygon(cam, &floor) {
+        fill_convex(cv, &f, FLOOR);
+    }
+    let seg = |cv: &mut Canvas, a: DVec3, b: DVec3, color: [u8; 3], width: f32| {
+        if let Some((p, q)) = cam.project_segment(a, b) {
+            cv.line((p.0, p.1), (q.0, q.1), color, width);
+        }
+    };
+    for k in 0..=w.floor() as usize {
+        seg(cv, DVec3::new(k as f64, 0.0, 0.0), DVec3::new(k as f64, 0.0, d), GRID, 1.0);
+    }
+    for k in 0..=d.floor() as usize {
+        seg(cv, DVec3::new(0.0, 0.0, k as f64), DVec3::new(w, 0.0, k as f64), GRID, 1.0);
+    }
+    for k in 0..4 {
+        let (a, b) = (floor[k], floor[(k + 1) % 4]);
+        seg(cv, a, b, [120, 120, 120], 1.5);
+        seg(cv, a, a + DVec3::Y * h, [190, 190, 190], 1.0);
+        seg(cv, a + DVec3::Y * h, b + DVec3::Y * h, [190, 190, 190], 1.0);
+    }
+}
+
+/// Pixel of floor point `[x, z]` (metres) on [`top_down`]'s plan (same scale and margins).
+pub fn plan_pixel(scene: &Scene, p: [f32; 2]) -> (f32, f32) {
+    let r = &scene.room;
+    let (rw, rd) = (r.width.max(0.5), r.depth.max(0.5));
+    let s = (720.0 / rw).min(540.0 / rd).clamp(20.0, 200.0);
+    let (ml, mt) = (60.0, 50.0);
+    (ml + p[0] * s, mt + p[1] * s)
 }
 
 /// A label centred at `at` on a light backdrop, moved down past labels already drawn (`taken`
@@ -90,7 +183,7 @@ pub fn top_down(scene: &Scene, cat: &Catalogue) -> RgbImage {
     let (ml, mt, mb) = (60.0, 50.0, 80.0);
     let (w, h) = ((rw * s + 2.0 * ml).ceil() as u32, (rd * s + mt + mb).ceil() as u32);
     let mut cv = Canvas::new(w, h, BACKGROUND);
-    let px = |p: [f32; 2]| (ml + p[0] * s, mt + p[1] * s);
+    let px = |p: [f32; 2]| plan_pixel(scene, p);
     cv.rect(ml, mt, rw * s, rd * s, FLOOR);
     for k in 1..rw.ceil() as usize {
         let x = ml + k as f32 * s;
@@ -173,29 +266,13 @@ pub fn perspective(scene: &Scene, cat: &Catalogue, view: &str) -> RgbImage {
     let cam = view_camera(scene, view, wpx, hpx);
     let mut cv = Canvas::new(wpx, hpx, [246, 247, 250]);
     let r = &scene.room;
-    let (w, d, h) = (r.width as f64, r.depth as f64, r.height as f64);
     let proj = |p: DVec3| cam.project(p).map(|q| (q.0, q.1));
-    let floor: Option<Vec<(f32, f32)>> = [[0.0, 0.0], [w, 0.0], [w, d], [0.0, d]].iter().map(|c| proj(DVec3::new(c[0], 0.0, c[1]))).collect();
-    if let Some(f) = floor {
-        fill_convex(&mut cv, &f, FLOOR);
-    }
     let seg = |cv: &mut Canvas, a: DVec3, b: DVec3, color: [u8; 3], width: f32| {
         if let Some((p, q)) = cam.project_segment(a, b) {
             cv.line((p.0, p.1), (q.0, q.1), color, width);
         }
     };
-    for k in 0..=w.floor() as usize {
-        seg(&mut cv, DVec3::new(k as f64, 0.0, 0.0), DVec3::new(k as f64, 0.0, d), GRID, 1.0);
-    }
-    for k in 0..=d.floor() as usize {
-        seg(&mut cv, DVec3::new(0.0, 0.0, k as f64), DVec3::new(w, 0.0, k as f64), GRID, 1.0);
-    }
-    let corners = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(w, 0.0, 0.0), DVec3::new(w, 0.0, d), DVec3::new(0.0, 0.0, d)];
-    for k in 0..4 {
-        seg(&mut cv, corners[k], corners[(k + 1) % 4], [120, 120, 120], 2.0);
-        seg(&mut cv, corners[k], corners[k] + DVec3::Y * h, [190, 190, 190], 1.0);
-        seg(&mut cv, corners[k] + DVec3::Y * h, corners[(k + 1) % 4] + DVec3::Y * h, [190, 190, 190], 1.0);
-    }
+    draw_room(&mut cv, &cam, scene);
 
     // Objects farthest first (by the view depth of their box centre).
     let depth = |o: &PlacedObject| {
@@ -204,35 +281,10 @@ pub fn perspective(scene: &Scene, cat: &Catalogue, view: &str) -> RgbImage {
     };
     let mut objs: Vec<&PlacedObject> = scene.objects.iter().collect();
     objs.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
-    let light = DVec3::new(0.4, 1.0, 0.6).normalize();
     for o in &objs {
-        let color = category_color(cat, &o.category);
+        draw_object(&mut cv, &cam, o, category_color(cat, &o.category));
         let c = geom::center(o);
-        let (y0, y1) = (o.position[1] as f64, o.top() as f64);
-        let foot = geom::corners(o).map(|p| (p[0] as f64, p[1] as f64));
-        let v = |k: usize, top: bool| DVec3::new(foot[k].0, if top { y1 } else { y0 }, foot[k].1);
-        let mut faces: Vec<[DVec3; 4]> = vec![[v(0, true), v(1, true), v(2, true), v(3, true)], [v(0, false), v(1, false), v(2, false), v(3, false)]];
-        for k in 0..4 {
-            faces.push([v(k, false), v((k + 1) % 4, false), v((k + 1) % 4, true), v(k, true)]);
-        }
-        let centre = DVec3::new(c[0] as f64, (y0 + y1) / 2.0, c[1] as f64);
-        for f in faces {
-            let fc = (f[0] + f[1] + f[2] + f[3]) / 4.0;
-            let n = (fc - centre).normalize_or_zero();
-            let nn = match () {
-                _ if (f[0].y - f[2].y).abs() < 1e-9 => DVec3::Y * (fc.y - centre.y).signum(),
-                _ => DVec3::new(n.x, 0.0, n.z).normalize_or_zero(),
-            };
-            if nn.dot(cam.eye - fc) <= 0.0 {
-                continue;
-            }
-            let Some(pts) = f.iter().map(|&p| proj(p)).collect::<Option<Vec<_>>>() else { continue };
-            let shade = 0.55 + 0.45 * nn.dot(light).max(0.0) as f32;
-            fill_convex(&mut cv, &pts, scale_color(color, shade));
-            for k in 0..4 {
-                cv.line(pts[k], pts[(k + 1) % 4], scale_color(color, 0.45), 1.2);
-            }
-        }
+        let y1 = o.top() as f64;
         // Front marker on the top face.
         let tip = geom::to_world(c, o.yaw, [0.0, o.size[2] / 2.0]);
         seg(&mut cv, DVec3::new(c[0] as f64, y1, c[1] as f64), DVec3::new(tip[0] as f64, y1, tip[1] as f64), INK, 1.5);
