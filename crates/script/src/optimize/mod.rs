@@ -16,7 +16,9 @@
 //!   Every state is re-animated (the paper's NSMGenerate: our A* + walk + blend + IK), states that
 //!   break the layout (more overlaps, unmet relations, objects outside or unreachable than at the
 //!   start, [`layout::check`]) are rejected, the rest accepted by Metropolis' rule
-//!   exp(−ΔC / T) with T = 1 − 0.002·iteration. The best state seen is returned.
+//!   exp(−ΔC / T) with T = 1 − 0.002·iteration, in units of 1 % of the initial C by default
+//!   ([`OptimizeConfig::relative_temperature`]; [`OptimizeConfig::paper`] keeps absolute units).
+//!   The best state seen is returned.
 
 use std::path::Path;
 
@@ -34,13 +36,21 @@ use crate::motion::MotionLibrary;
 use crate::scene::{PlacedObject, Scene};
 use crate::ssg::{Relation, Ssg};
 
-/// Settings of [`optimize`] (defaults: the paper's values).
+/// Default fraction of the initial cost that temperature 1 stands for (see
+/// [`OptimizeConfig::relative_temperature`]).
+pub const RELATIVE_TEMPERATURE: f64 = 0.01;
+
+/// Settings of [`optimize`] (defaults: the paper's values, except the temperature's unit).
 #[derive(Debug, Clone, PartialEq)]
 pub struct OptimizeConfig {
     pub iterations: usize,
     /// σ of the position moves (metres) and of the relative vertical-scale moves.
     pub sigma: f64,
     pub initial_temperature: f64,
+    /// When set, temperatures are in units of this fraction of the initial cost C (a difference
+    /// on purpose: with T in absolute cost units, as printed, our C of about 1–5 makes nearly every
+    /// move acceptable and the run a random walk). `None` is the paper's schedule as printed.
+    pub relative_temperature: Option<f64>,
     /// Temperature decrease per iteration.
     pub cooling: f64,
     pub lambda_d: f64,
@@ -50,9 +60,16 @@ pub struct OptimizeConfig {
     pub seed: u64,
 }
 
+impl OptimizeConfig {
+    /// Algorithm 2 exactly as printed: T = 1 − 0.002·iteration in absolute cost units.
+    pub fn paper() -> OptimizeConfig {
+        OptimizeConfig { relative_temperature: None, ..OptimizeConfig::default() }
+    }
+}
+
 impl Default for OptimizeConfig {
     fn default() -> OptimizeConfig {
-        OptimizeConfig { iterations: 100, sigma: 0.02, initial_temperature: 1.0, cooling: 0.002, lambda_d: 1.0, lambda_t: 10.0, box_size: 0.25, seed: 1 }
+        OptimizeConfig { iterations: 100, sigma: 0.02, initial_temperature: 1.0, relative_temperature: Some(RELATIVE_TEMPERATURE), cooling: 0.002, lambda_d: 1.0, lambda_t: 10.0, box_size: 0.25, seed: 1 }
     }
 }
 
@@ -356,7 +373,8 @@ pub fn optimize_scene(scene: &Scene, query: &Ssg, relations: &[(Relation, usize,
     let mut curves = CostCurves { collision: vec![before.collision], contact: vec![before.contact], total: vec![before.total], best: vec![before.total], accepted: vec![true] };
     let mut rejected_layout = 0;
     for it in 0..cfg.iterations {
-        let t = (cfg.initial_temperature - cfg.cooling * it as f64).max(1e-9);
+        let unit = cfg.relative_temperature.map_or(1.0, |f| f * before.total.max(1e-9));
+        let t = ((cfg.initial_temperature - cfg.cooling * it as f64) * unit).max(1e-12);
         let mut accepted = false;
         if !movable.is_empty() {
             let k = movable[rng.random_range(0..movable.len())];
