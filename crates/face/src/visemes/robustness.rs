@@ -22,6 +22,13 @@ fn check_all(text: &str) {
     }
 }
 
+#[test]
+fn a_quoted_whitespace_label_reads_back_the_same() {
+    // Found by the edit test: `"R"` with R replaced by a carriage return.
+    check_all("start,end,phoneme\n0,0.1,B\n0.1,0.2,\"\r\"\n0.2,0.4,AH1\n");
+    check_all("start,end,phoneme\n0,0.1,\" \"\n");
+}
+
 fn truncated(text: &str, cut: usize) -> &str {
     let mut cut = cut.min(text.len());
     while !text.is_char_boundary(cut) {

@@ -46,8 +46,10 @@ fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
 fn fields(line: &str) -> Vec<&str> {
     line.split(',')
         .map(|f| {
+            // Whitespace inside the quotes goes too: `"\r"` is an empty label (silence), as it
+            // reads back after writing.
             let f = f.trim();
-            f.strip_prefix('"').and_then(|g| g.strip_suffix('"')).unwrap_or(f)
+            f.strip_prefix('"').and_then(|g| g.strip_suffix('"')).map_or(f, str::trim)
         })
         .collect()
 }
