@@ -251,24 +251,37 @@ pub fn grouped_bar_chart(
                 .label(name.as_str())
                 .legend(move |(x, y)| Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled()));
         }
-        chart
-            .configure_series_labels()
-            .label_font((FONT, LABEL_SIZE))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
-            .margin(px(8))
-            .legend_area_size(px(30))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e)?;
-        // Group names centred under their bars, placed in pixels below the x axis.
-        let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
-        for (g, name) in groups.iter().enumerate() {
-            let (bx, by) = chart.backend_coord(&(g as f64 + 0.5, yr.start));
-            root.draw(&Text::new(name.as_str(), (bx, by + px(8)), style.clone())).map_err(e)?;
-        }
-        Ok(())
+        legend_and_groups(&mut chart, root, groups, yr.start, SeriesLabelPosition::UpperRight, title)
     })
+}
+
+/// The legend box and, under the x axis, each group's name centred on its unit-wide slot (the
+/// grouped charts: bars and box plots).
+fn legend_and_groups<'a>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>,
+    root: &DrawingArea<BitMapBackend<'a>, Shift>,
+    groups: &[String],
+    y_floor: f64,
+    position: SeriesLabelPosition,
+    title: &str,
+) -> Result<(), RenderError> {
+    let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
+    chart
+        .configure_series_labels()
+        .label_font((FONT, LABEL_SIZE))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
+        .margin(px(8))
+        .legend_area_size(px(30))
+        .position(position)
+        .draw()
+        .map_err(e)?;
+    let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+    for (g, name) in groups.iter().enumerate() {
+        let (bx, by) = chart.backend_coord(&(g as f64 + 0.5, y_floor));
+        root.draw(&Text::new(name.as_str(), (bx, by + px(8)), style.clone())).map_err(e)?;
+    }
+    Ok(())
 }
 
 /// Five-number summary (min, lower quartile, median, upper quartile, max) of `values`, with
@@ -354,22 +367,7 @@ pub fn box_plot(
                 .legend(move |(x, y)| Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled()));
             chart.draw_series(elements).map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .label_font((FONT, LABEL_SIZE))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180).stroke_width(px(1) as u32))
-            .margin(px(8))
-            .legend_area_size(px(30))
-            .position(SeriesLabelPosition::LowerLeft)
-            .draw()
-            .map_err(e)?;
-        let style = TextStyle::from((FONT, LABEL_SIZE).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
-        for (g, name) in groups.iter().enumerate() {
-            let (bx, by) = chart.backend_coord(&(g as f64 + 0.5, yr.start));
-            root.draw(&Text::new(name.as_str(), (bx, by + px(8)), style.clone())).map_err(e)?;
-        }
-        Ok(())
+        legend_and_groups(&mut chart, root, groups, yr.start, SeriesLabelPosition::LowerLeft, title)
     })
 }
 

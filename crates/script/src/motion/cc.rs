@@ -5,7 +5,7 @@
 //! source's times a rest-frame correction that maps the target bone (towards its mapped child;
 //! for branching joints a frame of up and left-right directions) onto the source bone.
 
-use super::rig::{heading_of, local_from_global, yaw, Rig, FPS};
+use super::rig::{local_from_global, Rig, FPS};
 use glam::{DMat3, DQuat, DVec3};
 use inbetween_core::fk::forward;
 use inbetween_core::{Motion, Pose, Skeleton};
@@ -122,24 +122,5 @@ pub fn retarget_cc(src: &Motion, rig: &Rig, up_z: bool, drop_first: bool) -> Res
         pose.translations[rig.hips] = convert * g.positions[src_of(rig.hips)] * scale;
         poses.push(pose);
     }
-    if poses.is_empty() {
-        return Err("no frames".into());
-    }
-    let mut lows: Vec<f64> = poses
-        .iter()
-        .map(|p| {
-            let g = forward(t, p);
-            rig.legs.iter().flat_map(|l| [g.positions[l[3]].y, g.positions[l[2]].y - rig.ankle_height]).fold(f64::INFINITY, f64::min)
-        })
-        .collect();
-    lows.sort_by(f64::total_cmp);
-    let ground = lows[lows.len() / 20];
-    let turn = yaw(-heading_of(poses[0].rotations[rig.hips]));
-    let start = poses[0].translations[rig.hips];
-    for p in &mut poses {
-        let d = p.translations[rig.hips] - DVec3::new(start.x, ground, start.z);
-        p.translations[rig.hips] = turn * d;
-        p.rotations[rig.hips] = (turn * p.rotations[rig.hips]).normalize();
-    }
-    Motion::from_poses(t.clone(), 1.0 / FPS, &poses).map_err(|e| e.to_string())
+    super::cmu::grounded(rig, t, poses)
 }

@@ -223,10 +223,15 @@ pub fn retarget(src: &Motion, rig: &Rig) -> Result<Motion, String> {
         pose.translations[rig.hips] = g.positions[map[rig.hips].expect("hips")] * scale;
         poses.push(pose);
     }
+    grounded(rig, t, poses)
+}
+
+/// Retargeted poses made into a clip that starts at the origin facing +Z, with its lowest foot
+/// points (5th percentile, so a stumble does not lift the floor) at y = 0.
+pub(crate) fn grounded(rig: &Rig, t: &Skeleton, mut poses: Vec<Pose>) -> Result<Motion, String> {
     if poses.is_empty() {
         return Err("no frames".into());
     }
-    // Ground: the 5th percentile of the lowest foot point goes to y = 0.
     let mut lows: Vec<f64> = poses
         .iter()
         .map(|p| {
