@@ -1,13 +1,15 @@
-//! `.ibk` keyframe decoder on arbitrary bytes: must never panic. The checksum rejects almost every
-//! random input, so each input is also tried as a body with its valid CRC appended, reaching the
-//! structural checks; whatever decodes is rebuilt into a clip when it is small.
+//! `.ibk` decoders on arbitrary bytes: must never panic. The checksum rejects almost every random
+//! input, so each input is also tried as a body with its valid CRC appended, reaching the
+//! structural checks. Keyframe files (versions 1–2) are rebuilt into a clip when small; sampled
+//! files (version 3) are read whole and sought at a time taken from the input.
 #![no_main]
 
-use inbetween_mocap::codec::decode;
+use inbetween_mocap::codec::{decode, read, v3};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     let _ = decode(data);
+    let _ = read(data);
     let mut file = data.to_vec();
     file.extend_from_slice(&crc32fast::hash(data).to_le_bytes());
     if let Ok(d) = decode(&file) {
@@ -16,5 +18,15 @@ fuzz_target!(|data: &[u8]| {
         if d.num_frames * d.skeleton.len() <= 20_000 {
             let _ = d.reconstruct();
         }
+    }
+    if let Ok(f) = read(&file) {
+        if f.num_frames() * f.skeleton().len() <= 20_000 {
+            let _ = f.motion();
+        }
+    }
+    if let Ok(f) = v3::File::open(&file) {
+        let time = data.first().map_or(0.0, |&b| b as f64 * f.frame_time * 0.37);
+        let (mut pose, mut scratch) = (inbetween_core::Pose::rest(&f.skeleton), v3::Scratch::default());
+        let _ = f.pose_at(time, &mut pose, &mut scratch);
     }
 });

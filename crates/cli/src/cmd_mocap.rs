@@ -16,7 +16,8 @@ use std::time::Instant;
 
 #[derive(Subcommand)]
 pub enum MocapCommand {
-    /// Pick keyframes and write them as a compact .ibk file.
+    /// Compress a clip into an .ibk file: every frame within --max-error (version 3, the default), or
+    /// keyframes (-k N, or --format v2).
     Compress(CompressArgs),
     /// Rebuild a whole clip from an .ibk file and write it as BVH.
     Decompress(DecompressArgs),
@@ -33,12 +34,17 @@ pub enum MocapCommand {
 
 #[derive(Args)]
 pub struct TrainArgs {
-    /// Policy file to write (burnpack weights; the shape goes beside it as .json).
+    /// Policy file to write (burnpack weights; the card goes beside it as .json); the pretrained
+    /// stage goes beside it as <stem>.pretrain.bpk.
     #[arg(short, long, default_value = "out/sidql_cmu.bpk")]
     pub output: PathBuf,
-    /// Train on procedural gaits (our own data, safe to commit) instead of the CMU training split.
-    #[arg(long)]
+    /// Train on procedural gaits (our own data) instead of CMU takes.
+    #[arg(long, conflicts_with = "all_takes")]
     pub procedural: bool,
+    /// Train on every CMU take of the corpus (how the committed policy was trained; the bench's
+    /// k-fold scores this recipe on held-out takes) instead of the bench's training split.
+    #[arg(long)]
+    pub all_takes: bool,
     /// Data folder: the shared corpus (default), its mocap/cmu folder, or any folder of .bvh files
     /// (searched recursively).
     #[arg(long)]
@@ -47,23 +53,30 @@ pub struct TrainArgs {
     /// (e.g. 2.54). Default: known for the corpus folders, else inferred per clip from its rest pose (the report says which and why).
     #[arg(long)]
     pub unit: Option<LengthUnit>,
-    /// Episodes (default: the preset's; `paper` runs 2000).
+    /// Hyper-parameters: `default` (pretraining on exact cost-to-go, then the paper's DQN as a
+    /// short fine-tune), `paper` (§5.2's DQN alone: lr 0.01, batch 256, memory 10 000, γ = 0.5,
+    /// target renewed every 100 updates, 2000 episodes) or `quick`.
+    #[arg(long, default_value = "default")]
+    pub preset: String,
+    /// Pretraining steps (0 skips pretraining; default: the preset's).
+    #[arg(long)]
+    pub pretrain_steps: Option<usize>,
+    /// Fine-tuning epochs of max-keys − 2 environment steps (0 skips fine-tuning; default: the preset's).
     #[arg(long)]
     pub episodes: Option<usize>,
-    /// Hyper-parameters: `paper` (§5.2: lr 0.01, batch 256, memory 10 000, γ = 0.5, target renewed
-    /// every 100 updates, 2000 episodes) or `quick` (the same with batch 64 and 300 episodes).
-    #[arg(long, default_value = "paper")]
-    pub preset: String,
-    /// Learning rate (default: the preset's; `paper` uses 0.01).
+    /// Fine-tuning learning rate (default: the preset's).
     #[arg(long)]
     pub lr: Option<f64>,
+    /// Discount factor γ of the fine-tuning targets (default: the preset's; `paper` uses 0.5).
+    #[arg(long)]
+    pub gamma: Option<f64>,
     /// Stride of the training windows (overlapping windows give more training data).
     #[arg(long, default_value_t = 10)]
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Stop after the episode during which this many minutes have passed; run the same command
-    /// again to resume (training state is checkpointed in `<output>.ckpt/`).
+    /// Stop after the epoch during which this many minutes have passed (per stage); run the same
+    /// command again to resume (training state is checkpointed in `<output>.ckpt/`).
     #[arg(long)]
     pub time_limit_min: Option<f64>,
 }
@@ -176,6 +189,14 @@ pub struct CompressArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub budget: BudgetArgs,
+    /// File format: `v3` (every frame, per-track step sizes, entropy coded; --max-error bounds the
+    /// virtual vertices 3 cm from each joint) or `v2` (keyframes; --max-error bounds the joints).
+    /// Default: v3 with --max-error, v2 with -k.
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Frames per segment of a v3 file (a pose decodes from its segment alone).
+    #[arg(long, default_value_t = inbetween_mocap::codec::v3::DEFAULT_SEGMENT_LEN)]
+    pub segment: usize,
 }
 
 #[derive(Args)]
@@ -225,17 +246,31 @@ pub struct BenchArgs {
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// A SIDQL policy written by `mocap train`. Default: the committed policy (trained on our
-    /// procedural gaits), unless --train-episodes is given.
+    /// A SIDQL policy written by `mocap train`. Default: the committed policy (trained on every
+    /// CMU take of the corpus), unless --train-episodes is given.
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Train SIDQL here first, on the CMU training split with the paper's settings, for this many
-    /// episodes (saved as out/sidql_cmu.bpk).
+    /// Train SIDQL here first, on the CMU training split (pretraining, then this many fine-tuning
+    /// epochs; saved as out/sidql_cmu.bpk).
     #[arg(long, default_value_t = 0, conflicts_with = "model")]
     pub train_episodes: usize,
     /// Also report codec compression at these max errors (cm), on the full-rate clips.
     #[arg(long, value_delimiter = ',', default_value = "1,0.1")]
     pub codec_bounds: Vec<f64>,
+    /// Error bounds (cm) of the codec table on ACL's protocol (24 fps, 40-byte raw, virtual
+    /// vertices 3 cm away) and its rate–error curve; written as acl_codec.* beside the report.
+    #[arg(long, value_delimiter = ',', default_value = "0.01,0.02,0.05,0.1,0.2,0.5,1")]
+    pub acl_bounds: Vec<f64>,
+    /// Run only the codec table on ACL's protocol (skip the keyframe-selection bench).
+    #[arg(long)]
+    pub codec_only: bool,
+    /// Frames per segment of the codec files on ACL's protocol.
+    #[arg(long, default_value_t = inbetween_mocap::codec::v3::DEFAULT_SEGMENT_LEN)]
+    pub acl_segment: usize,
+    /// Take-level k-fold of SIDQL: a policy trained per fold on the other takes, every window
+    /// scored once held out (0 skips it; a few CPU minutes at 5).
+    #[arg(long, default_value_t = 5)]
+    pub folds: usize,
 }
 
 pub fn run(c: MocapCommand) -> anyhow::Result<()> {
@@ -252,15 +287,56 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
 
 fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
+    let v3 = match (a.format.as_deref(), a.budget.k) {
+        (None, None) | (Some("v3"), None) => true,
+        (None, Some(_)) | (Some("v2"), _) => false,
+        (Some("v3"), Some(_)) => bail!("-k picks keyframes, which version 3 does not store; use --format v2 or --max-error"),
+        (Some(other), _) => bail!("unknown format '{other}'; expected v2 or v3"),
+    };
     let t = Instant::now();
-    let c = codec::compress_in(&m, a.budget.unit(&m), a.budget.budget()?, a.budget.max_gap(&m))?;
+    let (bytes, lines) = if v3 {
+        let Budget::MaxErrorCm(cm) = a.budget.budget()? else { bail!("version 3 needs --max-error LENGTH") };
+        let opts = codec::alloc::Options { segment_len: a.segment, ..codec::alloc::Options::bound(cm) };
+        let c = codec::alloc::compress_in(&m, a.budget.unit(&m), &opts)
+            .with_context(|| format!("compressing {}", a.input.display()))?;
+        let lines = compress_report_v3(&m, &c);
+        (c.bytes, lines)
+    } else {
+        let c = codec::compress_in(&m, a.budget.unit(&m), a.budget.budget()?, a.budget.max_gap(&m))
+            .with_context(|| format!("compressing {}", a.input.display()))?;
+        let lines = compress_report(&m, &c);
+        (c.bytes, lines)
+    };
     let secs = t.elapsed().as_secs_f64();
-    write_atomic(&a.output, &c.bytes).with_context(|| format!("writing {}", a.output.display()))?;
-    for l in compress_report(&m, &c) {
+    write_atomic(&a.output, &bytes).with_context(|| format!("writing {}", a.output.display()))?;
+    for l in lines {
         println!("{l}");
     }
     println!("wrote {} in {secs:.2} s", a.output.display());
     Ok(())
+}
+
+fn compress_report_v3(m: &Motion, c: &codec::alloc::Compressed) -> Vec<String> {
+    let raw = codec::raw_bytes(m);
+    let raw40 = 40 * m.skeleton.len() * m.num_frames();
+    let n = c.bytes.len() as f64;
+    vec![
+        c.unit.to_string(),
+        format!(
+            "{} frames, {} joints; version 3: {} bytes vs {} raw f32 channel bytes ({:.1}x) or {} bytes at 40 per joint and frame ({:.1}x)",
+            m.num_frames(),
+            m.skeleton.len(),
+            c.bytes.len(),
+            raw,
+            raw as f64 / n,
+            raw40,
+            raw40 as f64 / n
+        ),
+        format!(
+            "virtual-vertex error (3 cm from each joint, decoded file): max {:.4} cm, 99th percentile {:.4} cm",
+            c.max_error_cm, c.p99_error_cm
+        ),
+    ]
 }
 
 fn compress_report(m: &Motion, c: &codec::Compressed) -> Vec<String> {
@@ -288,17 +364,11 @@ fn compress_report(m: &Motion, c: &codec::Compressed) -> Vec<String> {
 
 fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
     let bytes = std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
-    let d = codec::decode(&bytes).with_context(|| format!("decoding {}", a.input.display()))?;
-    let m = d.reconstruct()?;
-    inbetween_io::write_bvh(&a.output, &m)?;
-    println!("{} (the file keeps the source's unit)", LengthUnit::infer(&d.skeleton));
-    println!(
-        "{} keys → {} frames at {:.1} fps; wrote {}",
-        d.key_frames.len(),
-        m.num_frames(),
-        m.fps(),
-        a.output.display()
-    );
+    let d = codec::read(&bytes).with_context(|| format!("decoding {}", a.input.display()))?;
+    let m = d.motion().with_context(|| format!("rebuilding the clip of {}", a.input.display()))?;
+    inbetween_io::write_bvh(&a.output, &m).with_context(|| format!("writing {}", a.output.display()))?;
+    println!("{} (the file keeps the source's unit)", LengthUnit::infer(d.skeleton()));
+    println!("{} → {} frames at {:.1} fps; wrote {}", d.describe(), m.num_frames(), m.fps(), a.output.display());
     Ok(())
 }
 
@@ -308,16 +378,20 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     println!("{unit}");
     let (rec, keys) = match &a.ibk {
         Some(p) => {
-            let d = codec::decode(&std::fs::read(p).with_context(|| format!("reading {}", p.display()))?)
+            let d = codec::read(&std::fs::read(p).with_context(|| format!("reading {}", p.display()))?)
                 .with_context(|| format!("decoding {}", p.display()))?;
-            if d.skeleton != m.skeleton || d.num_frames != m.num_frames() {
+            if *d.skeleton() != m.skeleton || d.num_frames() != m.num_frames() {
                 bail!(
                     "{} does not match {} (skeleton or frame count differ; use the same --joints/--skip-first)",
                     p.display(),
                     a.input.display()
                 );
             }
-            (d.reconstruct()?, d.key_frames.len())
+            let keys = match &d {
+                codec::IbkFile::Keys(k) => k.key_frames.len(),
+                codec::IbkFile::Samples(q) => q.num_frames,
+            };
+            (d.motion()?, keys)
         }
         None => {
             let c = codec::compress_in(&m, unit.clone(), a.budget.budget()?, a.budget.max_gap(&m))?;
@@ -353,18 +427,42 @@ impl BenchArgs {
             output_dir: self.output.clone(),
             csv: self.csv.clone(),
             plot: self.plot.clone(),
+            kfold: (self.folds > 0).then(|| bench::run::KFoldConfig { folds: self.folds, ..Default::default() }),
             ..bench::BenchConfig::default()
         }
     }
 }
 
 fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
-    let progress = inbetween_io::Progress::new(0, "mocap bench");
-    let out = bench::run(&a.config(), &progress);
+    if !a.codec_only {
+        let progress = inbetween_io::Progress::new(0, "mocap bench");
+        let out = bench::run(&a.config(), &progress);
+        progress.finish();
+        let out = out?;
+        print!("{}", out.report.to_text());
+        for p in &out.written {
+            println!("wrote {}", p.display());
+        }
+    }
+    acl_bench(&a)
+}
+
+/// The codec table on ACL's protocol (`bench::acl`), written beside the bench report.
+fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
+    let cfg = bench::acl::AclConfig {
+        data: a.data.clone(),
+        unit: a.unit,
+        bounds_cm: a.acl_bounds.clone(),
+        segment_len: a.acl_segment,
+        seed: a.seed,
+        ..Default::default()
+    };
+    let progress = inbetween_io::Progress::new(0, "codec (ACL protocol)");
+    let out = bench::acl::run(&cfg, a.output.as_deref(), &progress);
     progress.finish();
-    let out = out?;
-    print!("{}", out.report.to_text());
-    for p in &out.written {
+    let (_, report, written) = out?;
+    print!("{}", report.to_text());
+    for p in &written {
         println!("wrote {}", p.display());
     }
     Ok(())
@@ -373,11 +471,17 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
 
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
-    let (windows, data) = bench::run::training_set(a.procedural, a.data.as_deref(), a.unit, a.seed, a.stride)?;
+    let data_choice = match (a.procedural, a.all_takes) {
+        (true, _) => bench::run::TrainingData::Procedural,
+        (false, true) => bench::run::TrainingData::CmuAll,
+        (false, false) => bench::run::TrainingData::CmuSplit,
+    };
+    let (windows, data) = bench::run::training_set(data_choice, a.data.as_deref(), a.unit, a.seed, a.stride)?;
     let base = match a.preset.as_str() {
+        "default" => TrainOptions::default(),
         "quick" => TrainOptions::quick(),
         "paper" => TrainOptions::paper(),
-        other => bail!("unknown preset '{other}'; expected paper or quick"),
+        other => bail!("unknown preset '{other}'; expected default, paper or quick"),
     };
     if let Some(dir) = a.output.parent() {
         if !dir.as_os_str().is_empty() {
@@ -387,8 +491,10 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
     println!("training on {data}");
     let checkpoint_dir = a.output.with_extension("ckpt");
     let opts = TrainOptions {
+        pretrain_steps: a.pretrain_steps.unwrap_or(base.pretrain_steps),
         episodes: a.episodes.unwrap_or(base.episodes),
         lr: a.lr.unwrap_or(base.lr),
+        gamma: a.gamma.unwrap_or(base.gamma),
         seed: a.seed,
         checkpoint: Some(a.output.clone()),
         checkpoint_dir: Some(checkpoint_dir.clone()),
@@ -396,27 +502,33 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
         data,
         ..base
     };
-    let (_, report) = inbetween_mocap::dqn::train(&windows, &DqnConfig::default(), &opts)?;
-    if let Some(from) = &report.resumed_from {
+    let trained = inbetween_mocap::dqn::train(&windows, &DqnConfig::default(), &opts)?;
+    let r = &trained.report;
+    if let Some(from) = &r.resumed_from {
         println!("resumed from {}", from.display());
     }
-    if report.episodes < opts.episodes {
-        println!(
-            "stopped at the time limit after {} of {} episodes; run the same command again to resume from {}",
-            report.episodes,
-            opts.episodes,
-            checkpoint_dir.display()
-        );
+    if r.stopped_early {
+        println!("stopped at the time limit; run the same command again to resume from {}", checkpoint_dir.display());
     }
     println!(
-        "trained {} episodes, {} updates in {:.0} s; loss per 50 episodes {:?}; return per episode {:?}",
-        report.episodes,
-        report.updates,
-        report.seconds,
-        report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>(),
-        report.return_curve.iter().map(|r| format!("{r:.3}")).collect::<Vec<_>>()
+        "pretraining: {} steps in {:.0} s; loss per {} steps {:?}",
+        r.pretrain_steps,
+        r.pretrain_seconds,
+        100,
+        r.pretrain_loss.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
+    );
+    println!(
+        "fine-tuning: {} epochs, {} updates in {:.0} s; loss per 50 epochs {:?}; return per episode {:?}",
+        r.episodes,
+        r.updates,
+        r.finetune_seconds,
+        r.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>(),
+        r.return_curve.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>()
     );
     println!("wrote {}", a.output.display());
+    if trained.finetuned.is_some() {
+        println!("wrote {} (pretrained stage)", inbetween_mocap::dqn::train::pretrain_path(&a.output).display());
+    }
     Ok(())
 }
 

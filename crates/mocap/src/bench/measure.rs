@@ -1,18 +1,47 @@
-//! What the bench measures beyond the paper's Table 3: how fast the spherical reconstruction
+//! What the bench measures beyond the paper's Table 3: the angle error in the paper's units, how
+//! fast the spherical reconstruction
 //! (Eq. 9–13) runs, how it compares with our rotation (quaternion Hermite) reconstruction on the
 //! same keys, and how small the `.ibk` codec makes whole clips at an error bound.
 
 use super::{Clip, Window};
 use crate::codec::{self, Budget};
 use crate::error::{Objective, SegmentModel};
+use crate::representation::SphericalMotion;
 use crate::rotations::RotationMotion;
 use crate::Result;
+use inbetween_core::angle::wrap_angle;
+use inbetween_core::interp::hermite;
 use inbetween_core::units::UnitChoice;
 use inbetween_core::KeyframeSet;
 use inbetween_io::report::seconds_per_call;
 use inbetween_io::Progress;
 use std::collections::BTreeSet;
 use std::time::Instant;
+
+/// The mean angle error of `keys` as the paper's equations give it, read literally (Eq. 1, 9–11,
+/// 15–17, 24): φ straight from Eq. 1's atan2 in (−π, π] at every frame (no unwrapping over time),
+/// interpolated by the same cubic with the same velocities, its error |φ̂ − φ| with no wrap, and
+/// the sum divided by frames × joints (our Eq. 24 divides by frames × joints × 2, one term each
+/// for θ and φ, and takes φ unwrapped over time with wrapped differences; see
+/// [`crate::error`]). A bone whose azimuth crosses ±π between two keys is interpolated the long
+/// way round, which is what inflates this figure.
+pub fn paper_units_error(rep: &SphericalMotion, keys: &KeyframeSet) -> f64 {
+    let n = rep.num_frames;
+    let mut sum = 0.0;
+    for (a, b) in keys.segments() {
+        let h = (b - a) as f64 * rep.frame_time;
+        for f in a + 1..b {
+            let u = (f - a) as f64 / (b - a) as f64;
+            for j in (0..rep.num_joints).filter(|&j| rep.has_angles[j]) {
+                let (ia, ib, i) = (j * n + a, j * n + b, j * n + f);
+                let theta = hermite(rep.theta[ia], rep.dtheta[ia], rep.theta[ib], rep.dtheta[ib], h, u);
+                let phi = hermite(wrap_angle(rep.phi[ia]), rep.dphi[ia], wrap_angle(rep.phi[ib]), rep.dphi[ib], h, u);
+                sum += (theta - rep.theta[i]).abs() + (phi - wrap_angle(rep.phi[i])).abs();
+            }
+        }
+    }
+    sum / (n * rep.angle_joint_count().max(1)) as f64
+}
 
 /// Frames per second of the spherical reconstruction.
 #[derive(Clone, Debug, PartialEq)]
@@ -178,6 +207,31 @@ mod tests {
         let t = reconstruction_throughput(&w, 10).unwrap();
         assert!(t.frames_per_s.is_finite() && t.frames_per_s > 0.0);
         assert_eq!(t.joints.iter().copied().collect::<Vec<_>>(), [23]);
+    }
+
+    /// Without seams (φ within (−π, π] over a segment) the paper's units are ours × 2; across a
+    /// seam they are larger.
+    #[test]
+    fn paper_units_double_ours_and_grow_across_the_azimuth_seam() {
+        let (_, w) = windows();
+        let rep = &w[0].rep;
+        let keys = KeyframeSet::uniform(rep.num_frames, 5).unwrap();
+        let ours = rep.error(&keys).mean_angle;
+        let paper = paper_units_error(rep, &keys);
+        assert!(paper >= 2.0 * ours * (1.0 - 1e-9), "{paper} vs 2 × {ours}");
+        // Turn every bone's azimuth track so its first frame sits on the seam (π): any turn back
+        // crosses it. Our error is unchanged.
+        let mut turned = rep.clone();
+        let n = rep.num_frames;
+        for j in 0..rep.num_joints {
+            let shift = std::f64::consts::PI - rep.phi[j * n];
+            turned.phi[j * n..(j + 1) * n].iter_mut().for_each(|p| *p += shift);
+        }
+        assert!((turned.error(&keys).mean_angle - ours).abs() < 1e-9 * ours.max(1e-9));
+        let all = KeyframeSet::uniform(rep.num_frames, rep.num_frames).unwrap();
+        assert_eq!(paper_units_error(rep, &all), 0.0, "every frame a key: no error in any units");
+        let seams = paper_units_error(&turned, &keys);
+        assert!(seams > paper, "across the seam: {seams} vs {paper}");
     }
 
     #[test]

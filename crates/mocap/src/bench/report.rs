@@ -36,6 +36,101 @@ pub struct BenchResults {
     pub reconstructions: Vec<BothReconstructions>,
     /// One entry per error bound; empty when no clip is in CMU units.
     pub codec: Vec<CodecRatio>,
+    /// The take-level k-fold of SIDQL, when run.
+    pub kfold: Option<KFold>,
+}
+
+/// The take-level k-fold (see [`super::run::kfold`]).
+#[derive(Clone, Debug)]
+pub struct KFold {
+    /// The takes of each fold.
+    pub folds: Vec<Vec<String>>,
+    /// Pooled over every window: UC, Greedy, SIDQL pretrained, SIDQL fine-tuned, Optimal per K.
+    pub rows: Vec<KFoldRow>,
+    /// Training seconds and windows per fold.
+    pub train_seconds: Vec<f64>,
+    pub train_windows: Vec<usize>,
+    pub options: crate::dqn::TrainOptions,
+    pub stride: usize,
+}
+
+/// One selector at one K, over every window of the k-fold.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KFoldRow {
+    pub variant: String,
+    pub k: usize,
+    pub mean_angle_error: f64,
+    pub paper_units: f64,
+    pub decision_ms: f64,
+    pub windows: usize,
+}
+
+impl KFold {
+    pub fn get(&self, variant: &str, k: usize) -> Option<&KFoldRow> {
+        self.rows.iter().find(|r| r.variant == variant && r.k == k)
+    }
+
+    /// Share of the UC → Optimal gap `variant` closes at `k`, in %.
+    pub fn gap_closed(&self, variant: &str, k: usize) -> Option<f64> {
+        let (uc, opt, v) = (self.get("UC", k)?, self.get("Optimal", k)?, self.get(variant, k)?);
+        let gap = uc.mean_angle_error - opt.mean_angle_error;
+        (gap > 0.0).then(|| 100.0 * (uc.mean_angle_error - v.mean_angle_error) / gap)
+    }
+
+    /// The table: error per K, gap closed per K, paper units, decision ms.
+    pub fn table(&self, ks: &[usize]) -> Table {
+        let windows = self.rows.first().map(|r| r.windows).unwrap_or(0);
+        let mut headers = vec!["method".to_string()];
+        headers.extend(ks.iter().map(|k| format!("K={k}")));
+        headers.extend(ks.iter().map(|k| format!("gap closed K={k}")));
+        headers.extend(ks.iter().map(|k| format!("paper units K={k}")));
+        headers.push(format!("decision ms (K={})", ks.iter().map(|k| k.to_string()).collect::<Vec<_>>().join("/")));
+        let h: Vec<&str> = headers.iter().map(String::as_str).collect();
+        let mut t = Table::new(
+            "kfold",
+            &format!("Table 3, take-level {}-fold: every one of {windows} windows scored by a policy that never saw its take (mean angle error, rad)", self.folds.len()),
+            &h,
+        );
+        let mut names: Vec<&str> = Vec::new();
+        for r in &self.rows {
+            if !names.contains(&r.variant.as_str()) {
+                names.push(&r.variant);
+            }
+        }
+        for v in names {
+            let mut cells = vec![v.to_string()];
+            cells.extend(ks.iter().map(|&k| self.get(v, k).map(|r| num(r.mean_angle_error, 4)).unwrap_or_default()));
+            cells.extend(ks.iter().map(|&k| match (v, self.gap_closed(v, k)) {
+                ("UC" | "Optimal", _) | (_, None) => String::new(),
+                (_, Some(g)) => format!("{} %", num(g, 1)),
+            }));
+            cells.extend(ks.iter().map(|&k| self.get(v, k).map(|r| num(r.paper_units, 4)).unwrap_or_default()));
+            cells.push(ks.iter().filter_map(|&k| self.get(v, k)).map(|r| fmt_ms(r.decision_ms)).collect::<Vec<_>>().join(" / "));
+            t.row(cells);
+        }
+        let paper: Vec<String> = ks
+            .iter()
+            .filter_map(|&k| {
+                let (uc, g, s) = (paper_value(Method::Uc, k)?, paper_value(Method::Greedy, k)?, paper_value(Method::Sidql, k)?);
+                Some(format!("{} % at K={k}", num(100.0 * (uc - s) / (uc - g), 1)))
+            })
+            .collect();
+        t.note(format!("gap closed: (UC − method) / (UC − Optimal); the paper's SIDQL closes {} of its UC → Greedy gap (it has no Optimal)", paper.join(", ")));
+        t.note(format!(
+            "folds: takes dealt into {} groups (seeded); per fold a policy trained from scratch on the other takes' windows at stride {} ({} windows on average), {:.0} s of training per fold on average (both stages)",
+            self.folds.len(),
+            self.stride,
+            self.train_windows.iter().sum::<usize>() / self.train_windows.len().max(1),
+            self.train_seconds.iter().sum::<f64>() / self.train_seconds.len().max(1) as f64
+        ));
+        let o = &self.options;
+        t.note(format!(
+            "training: K drawn per episode in {}..={}; pretraining {} steps × {} states on exact cost-to-go (lr {}); fine-tuning {} epochs of the paper's DQN (lr {}, γ = {}, batch {}, memory {}, target every {} updates)",
+            o.min_keys, o.max_keys, o.pretrain_steps, o.pretrain_batch, o.pretrain_lr, o.episodes, o.lr, o.gamma, o.batch, o.memory, o.target_every
+        ));
+        t.note("paper units: no division by 2, φ from atan2 at every frame (not unwrapped over time), |Δφ| not wrapped (bench::measure::paper_units_error)");
+        t
+    }
 }
 
 impl BenchResults {
@@ -94,6 +189,7 @@ impl BenchResults {
         let mut headers = vec!["method".to_string()];
         for k in &self.ks {
             headers.push(format!("K={k} ours"));
+            headers.push("paper units".into());
             headers.push("paper".into());
         }
         let ks_label = self.ks.iter().map(|k| k.to_string()).collect::<Vec<_>>().join("/");
@@ -107,6 +203,9 @@ impl BenchResults {
                 let ours: Vec<String> =
                     splits.iter().filter_map(|s| self.row(s, m, k)).map(|r| num(r.mean_angle_error, 4)).collect();
                 cells.push(ours.join(" / "));
+                let units: Vec<String> =
+                    splits.iter().filter_map(|s| self.row(s, m, k)).map(|r| num(r.paper_units, 4)).collect();
+                cells.push(units.join(" / "));
                 cells.push(paper_value(m, k).map(|v| num(v, 4)).unwrap_or_default());
             }
             let ms: Vec<String> =
@@ -126,8 +225,12 @@ impl BenchResults {
         let ours = splits.iter().map(|s| label(s)).collect::<Vec<_>>().join(" / ");
         t.note(format!("ours: {ours}; Eq. 24 over 60-frame windows at 30 fps, 23 major joints"));
         t.note("paper: the SIDQL paper's Table 3 (CMU test set) and §5.4's decision times (Greedy 0.9 s, SIDQL 0.004 s at K=5)");
+        t.note("paper units: the same keys scored as the paper's equations read literally: no division by 2 (θ and φ terms), φ from atan2 at every frame (not unwrapped over time) and |Δφ| not wrapped, so bones crossing the ±π azimuth seam between keys count the long way round");
         t.note(format!("decision ms: selection time per window on the {} split, this machine", splits[0]));
         t.note(format!("SIDQL: {}", self.policy));
+        if self.policy.contains("every CMU take") {
+            t.note("SIDQL here saw every take in training (these rows are not held out; the k-fold table is); its keys are checked against uniform keys by their exact cost and replaced when worse");
+        }
         t
     }
 
@@ -219,6 +322,9 @@ impl BenchResults {
         let mut r = Report::new("report", "mocap bench: keyframe selection on CMU motion capture (SIDQL paper §5)");
         r.text(self.header());
         r.table(self.table3());
+        if let Some(k) = &self.kfold {
+            r.table(k.table(&self.ks));
+        }
         r.table(self.positions());
         r.table(self.reconstructions());
         if self.codec.is_empty() {
@@ -291,6 +397,7 @@ pub fn rows_table(rows: &[Row]) -> Table {
             "split",
             "windows",
             "paper_mean_angle_error",
+            "paper_units_angle_error",
         ],
     );
     for r in rows {
@@ -304,6 +411,7 @@ pub fn rows_table(rows: &[Row]) -> Table {
             r.split.clone(),
             r.windows.to_string(),
             paper_value(r.method, r.k).map(|v| format!("{v}")).unwrap_or_default(),
+            format!("{:.6}", r.paper_units),
         ]);
     }
     t
@@ -323,6 +431,7 @@ mod tests {
             max_cm: 100.0 * angle,
             decision_ms: angle,
             windows: if split == "test" { 2 } else { 9 },
+            paper_units: 3.0 * angle,
         }
     }
 
@@ -354,6 +463,7 @@ mod tests {
             throughput: Throughput { k: 10, frames_per_s: 1234.4, joints: [23].into() },
             reconstructions: vec![],
             codec: vec![],
+            kfold: None,
         }
     }
 
@@ -362,15 +472,15 @@ mod tests {
         let t = results(true).table3();
         assert_eq!(
             t.headers,
-            ["method", "K=5 ours", "paper", "K=10 ours", "paper", "decision ms (K=5/10)", "paper ms (K=5)"]
+            ["method", "K=5 ours", "paper units", "paper", "K=10 ours", "paper units", "paper", "decision ms (K=5/10)", "paper ms (K=5)"]
         );
         assert_eq!(t.rows.len(), 3, "only the methods measured");
-        assert_eq!(t.rows[0][..3], ["UC", "0.0210 / 0.0200", "0.0945"]);
+        assert_eq!(t.rows[0][..4], ["UC", "0.0210 / 0.0200", "0.0630 / 0.0600", "0.0945"]);
         assert_eq!(t.rows[1][0], "Greedy");
-        assert_eq!(t.rows[1][6], "900");
-        assert_eq!(t.rows[2][2], "", "the paper has no optimal row");
+        assert_eq!(t.rows[1][8], "900");
+        assert_eq!(t.rows[2][3], "", "the paper has no optimal row");
         let md = t.to_markdown();
-        assert!(md.contains("| UC | 0.0210 / 0.0200 | 0.0945 | 0.0110 / 0.0100 | 0.0490 |"), "{md}");
+        assert!(md.contains("| UC | 0.0210 / 0.0200 | 0.0630 / 0.0600 | 0.0945 | 0.0110 / 0.0100 | 0.0330 / 0.0300 | 0.0490 |"), "{md}");
     }
 
     #[test]
@@ -409,6 +519,6 @@ mod tests {
         assert!(png.starts_with(b"\x89PNG") && png.len() > 1000);
         let csv = std::fs::read_to_string(dir.path().join("mocap_bench.csv")).unwrap();
         assert_eq!(csv.lines().count(), 1 + 12);
-        assert!(csv.contains("\nuc,5,0.020000,0.2000,2.0000,0.0200,all,9,0.0945\n"), "{csv}");
+        assert!(csv.contains("\nuc,5,0.020000,0.2000,2.0000,0.0200,all,9,0.0945,0.060000\n"), "{csv}");
     }
 }

@@ -1,6 +1,8 @@
 //! `inbetween mocap bench` as one library call: read the corpus, cut it by the paper's protocol,
 //! get a SIDQL policy (committed, from a file, or trained here on the training split), score every
-//! selector on all windows and on the test split, add the extra measurements, and write the report.
+//! selector on all windows and on the test split, run the take-level k-fold (a policy trained per
+//! fold, every window scored once by a policy that never saw its take), add the extra
+//! measurements, and write the report.
 
 use super::measure::{both_reconstructions, codec_ratio, reconstruction_throughput};
 use super::report::BenchResults;
@@ -8,6 +10,7 @@ use super::{
     clip_windows, describe_sources, evaluate_with_progress, split_clips, training_windows, Clip, Method, PolicyFn,
     Protocol, Window,
 };
+use super::report::{KFold, KFoldRow};
 use crate::dqn::{DqnConfig, SidqlPolicy, TrainOptions};
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
@@ -24,9 +27,25 @@ pub enum PolicyChoice {
     Committed,
     /// A policy written by `inbetween mocap train`.
     File(PathBuf),
-    /// Train here on the training split (windows at stride 10, the paper's settings) for this many
-    /// episodes, and save the policy to `output`.
+    /// Train here on the training split (windows at stride 10, [`TrainOptions::default`] with this
+    /// many fine-tuning epochs), and save the policy to `output`.
     Train { episodes: usize, output: PathBuf },
+}
+
+/// The take-level k-fold: takes dealt into `folds` groups (seeded shuffle); for each, a policy
+/// is trained on the other groups' takes (windows at `stride`) with `train` and scored on the
+/// group's windows.
+#[derive(Clone, Debug)]
+pub struct KFoldConfig {
+    pub folds: usize,
+    pub stride: usize,
+    pub train: TrainOptions,
+}
+
+impl Default for KFoldConfig {
+    fn default() -> KFoldConfig {
+        KFoldConfig { folds: 5, stride: 10, train: TrainOptions { progress: false, ..TrainOptions::default() } }
+    }
 }
 
 /// What `inbetween mocap bench` runs and where it writes.
@@ -50,6 +69,8 @@ pub struct BenchConfig {
     pub csv: Option<PathBuf>,
     /// Also write the bar chart here.
     pub plot: Option<PathBuf>,
+    /// The take-level k-fold of SIDQL (None: skipped).
+    pub kfold: Option<KFoldConfig>,
 }
 
 impl Default for BenchConfig {
@@ -65,6 +86,7 @@ impl Default for BenchConfig {
             output_dir: None,
             csv: None,
             plot: None,
+            kfold: Some(KFoldConfig::default()),
         }
     }
 }
@@ -106,12 +128,21 @@ pub fn data_dir(data: Option<&Path>) -> Result<PathBuf> {
     }
 }
 
-/// SIDQL's training windows and their description in words (written in the policy's card):
-/// 24 procedural gaits, or the CMU training split of the corpus in `data` (the test split held out
-/// by the bench protocol with `seed`).
-pub fn training_set(procedural: bool, data: Option<&Path>, unit: Option<LengthUnit>, seed: u64, stride: usize) -> Result<(Vec<SphericalMotion>, String)> {
+/// Which windows SIDQL trains on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrainingData {
+    /// 24 procedural gaits (our own data).
+    Procedural,
+    /// The CMU training split of the bench protocol (its test split held out).
+    CmuSplit,
+    /// Every CMU take of the corpus (the committed policy; the bench's k-fold is its held-out score).
+    CmuAll,
+}
+
+/// SIDQL's training windows and their description in words (written in the policy's card).
+pub fn training_set(data_choice: TrainingData, data: Option<&Path>, unit: Option<LengthUnit>, seed: u64, stride: usize) -> Result<(Vec<SphericalMotion>, String)> {
     let protocol = Protocol { seed, ..Protocol::paper() };
-    if procedural {
+    if data_choice == TrainingData::Procedural {
         let clips = super::procedural_clips(seed, 24);
         let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
         let p = Protocol { skip_first_frame: false, ..protocol };
@@ -122,6 +153,11 @@ pub fn training_set(procedural: bool, data: Option<&Path>, unit: Option<LengthUn
     let dir = data_dir(data)?;
     let clips = crate::corpus::load(&dir, unit)?.clips;
     let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
+    if data_choice == TrainingData::CmuAll {
+        let windows = super::training_windows(&clips, &names, &protocol, stride)?;
+        let data = format!("every CMU take of the corpus ({} takes), {} windows of 60 frames at stride {stride}", clips.len(), windows.len());
+        return Ok((windows, data));
+    }
     let (train, test) = super::split_clips(&names, &protocol);
     let windows = super::training_windows(&clips, &train, &protocol, stride)?;
     let data = format!(
@@ -129,6 +165,72 @@ pub fn training_set(procedural: bool, data: Option<&Path>, unit: Option<LengthUn
         windows.len()
     );
     Ok((windows, data))
+}
+
+/// Deals the takes that have windows into `folds` groups: sorted, shuffled with `seed`, dealt in
+/// turn.
+pub fn fold_takes(all: &[Window], folds: usize, seed: u64) -> Vec<Vec<String>> {
+    use rand::seq::SliceRandom;
+    use rand::SeedableRng;
+    let mut names: Vec<String> = all.iter().map(|w| w.clip.clone()).collect::<BTreeSet<_>>().into_iter().collect();
+    names.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
+    let folds = folds.clamp(1, names.len().max(1));
+    let mut out = vec![Vec::new(); folds];
+    for (i, n) in names.into_iter().enumerate() {
+        out[i % folds].push(n);
+    }
+    out
+}
+
+/// The take-level k-fold ([`KFoldConfig`]): per fold, train on the other takes and score UC,
+/// Greedy, both SIDQL stages and Optimal on the fold's windows; rows pooled over every window.
+pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldConfig, ks: &[usize], progress: &Progress) -> Result<KFold> {
+    let groups = fold_takes(all, cfg.folds, protocol.seed);
+    progress.phase(groups.len() as u64, "k-fold");
+    let variants = ["UC", "Greedy", "SIDQL pretrained", "SIDQL fine-tuned", "SIDQL fine-tuned, checked against UC", "Optimal"];
+    // (variant, k) → sums over windows of angle, paper units, seconds; windows.
+    let mut sums = vec![(0.0, 0.0, 0.0, 0usize); variants.len() * ks.len()];
+    let (mut train_seconds, mut train_windows) = (Vec::new(), Vec::new());
+    for (i, test) in groups.iter().enumerate() {
+        progress.set_message(format!("fold {}/{}: training", i + 1, groups.len()));
+        let train: Vec<String> = groups.iter().enumerate().filter(|(j, _)| *j != i).flat_map(|(_, g)| g.clone()).collect();
+        let windows = training_windows(clips, &train, protocol, cfg.stride)?;
+        let opts = TrainOptions { seed: inbetween_core::seed::derive(protocol.seed, i as u64), data: format!("fold {i}"), ..cfg.train.clone() };
+        let trained = crate::dqn::train(&windows, &DqnConfig::default(), &opts)?;
+        train_seconds.push(trained.report.seconds);
+        train_windows.push(windows.len());
+        let held: Vec<Window> = all.iter().filter(|w| test.contains(&w.clip)).cloned().collect();
+        progress.set_message(format!("fold {}/{}: scoring {} windows", i + 1, groups.len(), held.len()));
+        let mut add = |v: usize, rows: Vec<super::Row>| {
+            for r in rows {
+                let ki = ks.iter().position(|&k| k == r.k).expect("a K of the bench");
+                let s = &mut sums[v * ks.len() + ki];
+                let w = r.windows as f64;
+                (s.0, s.1, s.2, s.3) = (s.0 + r.mean_angle_error * w, s.1 + r.paper_units * w, s.2 + r.decision_ms * w, s.3 + r.windows);
+            }
+        };
+        let seed = protocol.seed;
+        for (v, m) in [(0, Method::Uc), (1, Method::Greedy), (5, Method::Optimal)] {
+            add(v, super::evaluate("fold", &held, &[m], ks, seed, None)?);
+        }
+        let finetuned = trained.finetuned.as_ref().unwrap_or(&trained.pretrained);
+        for (v, p) in [(2, &trained.pretrained), (3, finetuned)] {
+            let f = |rep: &SphericalMotion, k: usize| p.select_unchecked(rep, k);
+            add(v, super::evaluate("fold", &held, &[Method::Sidql], ks, seed, Some(&f))?);
+        }
+        let checked = |rep: &SphericalMotion, k: usize| finetuned.select(rep, k);
+        add(4, super::evaluate("fold", &held, &[Method::Sidql], ks, seed, Some(&checked))?);
+        progress.inc(1);
+    }
+    let mut rows = Vec::new();
+    for (v, name) in variants.iter().enumerate() {
+        for (ki, &k) in ks.iter().enumerate() {
+            let s = sums[v * ks.len() + ki];
+            let n = s.3.max(1) as f64;
+            rows.push(KFoldRow { variant: name.to_string(), k, mean_angle_error: s.0 / n, paper_units: s.1 / n, decision_ms: s.2 / n, windows: s.3 });
+        }
+    }
+    Ok(KFold { folds: groups, rows, train_seconds, train_windows, options: cfg.train.clone(), stride: cfg.stride })
 }
 
 /// Every measurement of the bench, no files written.
@@ -162,6 +264,10 @@ pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
     if !test_windows.is_empty() {
         rows.extend(evaluate_with_progress("test", &test_windows, &Method::ALL, &cfg.ks, seed, pf, progress)?);
     }
+    let kfold = match &cfg.kfold {
+        Some(k) => Some(kfold(clips, &all, protocol, k, &cfg.ks, progress)?),
+        None => None,
+    };
     progress.phase(1, "throughput");
     let throughput = reconstruction_throughput(&all, 10)?;
     progress.phase(all.len() as u64, "reconstruct");
@@ -195,6 +301,7 @@ pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
         throughput,
         reconstructions,
         codec,
+        kfold,
     })
 }
 
@@ -234,26 +341,29 @@ fn policy(
                 episodes: *episodes,
                 seed: cfg.protocol.seed,
                 data: format!("CMU training split {train:?}, {} windows at stride 10", train_windows.len()),
-                ..TrainOptions::paper()
+                ..TrainOptions::default()
             };
             progress.phase(1, "SIDQL");
-            progress.set_message(format!("training {} episodes on {} windows", opts.episodes, train_windows.len()));
-            let (policy, report) = crate::dqn::train(&train_windows, &DqnConfig::default(), &opts)?;
+            progress.set_message(format!("training on {} windows", train_windows.len()));
+            let trained = crate::dqn::train(&train_windows, &DqnConfig::default(), &opts)?;
             if let Some(parent) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
                 std::fs::create_dir_all(parent)
                     .map_err(|source| MocapError::Io { path: parent.display().to_string(), source })?;
             }
+            let policy = trained.finetuned.unwrap_or(trained.pretrained);
             policy.save(output)?;
+            let r = &trained.report;
             let log = vec![
                 format!(
-                    "trained {} episodes on {} windows of the training split in {:.0} s, {} updates, loss per 50 episodes {:?}",
-                    opts.episodes,
+                    "trained on {} windows of the training split: pretraining {} steps in {:.0} s, fine-tuning {} epochs ({} updates) in {:.0} s",
                     train_windows.len(),
-                    report.seconds,
-                    report.updates,
-                    report.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
+                    r.pretrain_steps,
+                    r.pretrain_seconds,
+                    r.episodes,
+                    r.updates,
+                    r.finetune_seconds
                 ),
-                format!("saved {} (weights trained on CMU data: keep out of the repository)", output.display()),
+                format!("saved {}", output.display()),
             ];
             let text = format!("trained here, {} (trained on: {})", output.display(), policy.info.trained_on);
             Ok((policy, text, log))
@@ -284,6 +394,7 @@ mod tests {
             codec_bounds_cm: vec![1.0],
             output_dir: Some(dir.path().join("report")),
             csv: Some(dir.path().join("rows.csv")),
+            kfold: Some(KFoldConfig { folds: 2, stride: 30, train: TrainOptions { pretrain_steps: 100, pretrain_batch: 4, episodes: 4, batch: 8, progress: false, ..TrainOptions::default() } }),
             ..BenchConfig::default()
         };
         let progress = Progress::hidden();
@@ -291,9 +402,13 @@ mod tests {
         let r = &out.results;
         assert_eq!((r.takes, r.windows, r.test_windows, r.test.len()), (2, 4, 2, 1));
         assert_eq!(r.rows.len(), 2 * 5 * 2, "two splits, five methods, two K");
-        assert!(r.policy.starts_with("the committed policy (trained on: 24 procedural gaits"), "{}", r.policy);
+        assert!(r.policy.starts_with("the committed policy (trained on: every CMU take"), "{}", r.policy);
+        let kf = r.kfold.as_ref().unwrap();
+        assert_eq!(kf.folds.len(), 2);
+        assert_eq!(kf.rows.len(), 6 * 2, "six selectors, two K");
+        assert!(kf.rows.iter().all(|row| row.windows == 4), "every window scored once: {:?}", kf.rows);
         assert_eq!(r.codec.len(), 1);
-        assert_eq!(out.written.len(), 2 + 5 + 1 + 1, "txt, md, five CSVs, the chart, rows.csv");
+        assert_eq!(out.written.len(), 2 + 6 + 1 + 1, "txt, md, six CSVs, the chart, rows.csv");
         let csv = std::fs::read_to_string(dir.path().join("rows.csv")).unwrap();
         assert_eq!(csv, std::fs::read_to_string(dir.path().join("report/mocap_bench.csv")).unwrap());
         let text = std::fs::read_to_string(dir.path().join("report/report.txt")).unwrap();
@@ -309,7 +424,42 @@ mod tests {
         let mut p = inbetween_core::procedural::GaitParams::walk();
         p.frames = 40;
         inbetween_io::write_bvh(&short.join("w.bvh"), &inbetween_core::procedural::gait(&p)).unwrap();
-        let e = run(&BenchConfig { data: Some(short), ..BenchConfig::default() }, &progress).unwrap_err().to_string();
+        let e = run(&BenchConfig { data: Some(short), kfold: None, ..BenchConfig::default() }, &progress).unwrap_err().to_string();
         assert!(e.contains("long enough") && e.contains("short"), "{e}");
+    }
+}
+
+/// Training the committed policy and the k-fold from the test harness (the library calls
+/// `inbetween mocap train --all-takes` and `inbetween mocap bench` make), for machines where the
+/// CLI is not built: `INBETWEEN_SIDQL_OUT=crates/mocap/weights/sidql.bpk cargo test -p
+/// inbetween-mocap --lib committed_recipe -- --ignored --nocapture`.
+#[cfg(test)]
+mod recipe {
+    use super::*;
+
+    #[test]
+    #[ignore]
+    fn committed_recipe_trains_on_every_take() {
+        let Some(out) = std::env::var_os("INBETWEEN_SIDQL_OUT").map(PathBuf::from) else {
+            println!("skipped: set INBETWEEN_SIDQL_OUT to the policy file to write");
+            return;
+        };
+        inbetween_io::data::with_shared_data("SIDQL training", |dir| {
+            let (windows, data) = training_set(TrainingData::CmuAll, Some(&dir), None, 0, 10).unwrap();
+            let opts = TrainOptions { checkpoint: Some(out.clone()), data, progress: false, ..TrainOptions::default() };
+            let t = crate::dqn::train(&windows, &DqnConfig::default(), &opts).unwrap();
+            println!("{:?}", t.report);
+        });
+    }
+
+    #[test]
+    #[ignore]
+    fn kfold_of_the_default_recipe() {
+        inbetween_io::data::with_shared_data("SIDQL k-fold", |dir| {
+            let corpus = crate::corpus::load(&dir, None).unwrap();
+            let all = windows(&corpus.clips, &Protocol::paper(), &Progress::hidden()).unwrap();
+            let k = kfold(&corpus.clips, &all, &Protocol::paper(), &KFoldConfig::default(), &[5, 10, 15], &Progress::hidden()).unwrap();
+            println!("{}", k.table(&[5, 10, 15]).to_text());
+        });
     }
 }

@@ -1,31 +1,40 @@
-//! The keyframe MDP of §4.1. State: the window's motion, the current keyframe mask and each frame's
-//! current reconstruction error (a function of the mask, given to the network so it need not learn
-//! the reconstruction). Action: make one non-key frame a keyframe. Reward (Eq. 21–22): the change of
-//! the normalised relative error ε(s) = (E(s₀) − E(s)) / E(s₀), where s₀ keeps only the first and last
-//! frame; ε reaches 1 when every frame is a key.
+//! The keyframe MDP of §4.1. State: the window's motion, the current keyframe mask, each frame's
+//! current reconstruction error and the budget left, K − |keys|. Action: make one non-key frame a
+//! keyframe. Reward (Eq. 21–22): the change of the normalised relative error ε(s) = (E(s₀) − E(s)) /
+//! E(s₀), where s₀ keeps only the first and last frame.
 //!
 //! The state is laid out per frame (`frames × INPUTS`): each frame's row describes that frame as a
 //! candidate action, from quantities that mean the same on any skeleton and at any frame rate (errors
 //! relative to the current E(s), speeds in m/s and rad/s). The Q-network reads every row with the
-//! same weights (see [`super::model`]), so one policy serves windows of any length up to 64 and any
-//! skeleton. The last input of every row is E(s)/E(s₀), the scale of the rewards still to come.
+//! same weights (see [`super::model`]), so one policy serves windows of any length up to 64, any
+//! skeleton and any K. Each row carries the candidate's exact one-step gain c(a,f) + c(f,b) − c(a,b)
+//! (a, b: the keys around candidate f; c: a segment's cost), read from a table of segment costs:
+//! filled once per window for training, filled on demand (only segments that start or end at a
+//! key) when a policy selects. The last input of every row is E(s)/E(s₀), the scale of the rewards
+//! still to come.
 
-use crate::error::{Scratch, SegmentModel};
+use crate::error::SegmentModel;
 use crate::representation::{direction, SphericalMotion};
+use crate::select::angle_segment_costs;
+use crate::select::optimal::AngleFrames;
 use crate::{MocapError, Result};
 use glam::DVec3;
 
 /// Frames on each side of a candidate whose mask and error its row carries.
-pub const CONTEXT: usize = 4;
+pub const CONTEXT: usize = 2;
 /// Per-frame motion descriptors (see [`motion_descriptors`]).
 const MOTION_INPUTS: usize = 5;
-/// Candidate's segment: distance to the previous and next key, the segment's share of E(s₀), its
-/// largest frame error, whether the candidate is a key already.
+/// Candidate's segment: distance to the previous and next key, the segment's share of E(s), its
+/// largest frame error, where the candidate sits in it.
 const SEGMENT_INPUTS: usize = 5;
-/// Episode progress: keys so far, current E(s)/E(s₀) (last, see [`SCALE_INPUT`]).
-const GLOBAL_INPUTS: usize = 2;
+/// One-step gain: the two halves' costs, the gain (all ÷ E(s)), the gain ÷ the window's best gain,
+/// the segment's best gain ÷ the window's best.
+const GAIN_INPUTS: usize = 5;
+/// Episode: keys so far, budget left, budget left × the segment's share of the window, E(s)/E(s₀)
+/// (last, see [`SCALE_INPUT`]).
+const GLOBAL_INPUTS: usize = 4;
 /// Inputs per frame row.
-pub const INPUTS: usize = 3 * (2 * CONTEXT + 1) + SEGMENT_INPUTS + MOTION_INPUTS + GLOBAL_INPUTS;
+pub const INPUTS: usize = 3 * (2 * CONTEXT + 1) + SEGMENT_INPUTS + GAIN_INPUTS + MOTION_INPUTS + GLOBAL_INPUTS;
 /// Index of E(s)/E(s₀) in a row: the Q-network scales its output by it.
 pub const SCALE_INPUT: usize = INPUTS - 1;
 /// Largest window a mask can hold.
@@ -33,15 +42,37 @@ pub const MAX_FRAMES: usize = 64;
 
 /// One training or test window, prepared for the network.
 pub struct EnvWindow {
-    pub rep: SphericalMotion,
+    frames_model: AngleFrames,
+    n: usize,
     /// [`motion_descriptors`] of every frame.
     motion: Vec<[f32; MOTION_INPUTS]>,
+    /// Every segment's cost (`n × n`), or None: computed on demand in [`StateScratch`].
+    costs: Option<Vec<f64>>,
     /// E(s₀): the angle error sum with only the first and last frame as keys.
     pub e0: f64,
 }
 
+/// Buffers a state build reuses, and the on-demand segment costs of a window without a table.
+#[derive(Clone, Debug, Default)]
+pub struct StateScratch {
+    term: Vec<f64>,
+    buf: Vec<f64>,
+    /// Per-frame errors under the current mask.
+    pub errs: Vec<f64>,
+    /// On-demand costs (NaN: not yet computed) of the window last prepared with [`EnvWindow::scratch`].
+    lazy: Vec<f64>,
+}
+
 impl EnvWindow {
-    pub fn new(rep: SphericalMotion) -> Result<EnvWindow> {
+    /// A window with its whole segment-cost table (for training: every step is look-ups).
+    pub fn new(rep: &SphericalMotion) -> Result<EnvWindow> {
+        let mut w = Self::lazy(rep)?;
+        w.costs = Some(angle_segment_costs(rep));
+        Ok(w)
+    }
+
+    /// A window whose segment costs are computed when first needed (for selection).
+    pub fn lazy(rep: &SphericalMotion) -> Result<EnvWindow> {
         let n = rep.num_frames;
         if !(3..=MAX_FRAMES).contains(&n) {
             return Err(MocapError::Model(format!("SIDQL takes windows of 3 to {MAX_FRAMES} frames, got {n}")));
@@ -49,14 +80,50 @@ impl EnvWindow {
         if rep.angle_joint_count() == 0 {
             return Err(MocapError::Model("SIDQL needs a skeleton with at least one bone".into()));
         }
-        let motion = (0..n).map(|f| motion_descriptors(&rep, f)).collect();
+        let motion = (0..n).map(|f| motion_descriptors(rep, f)).collect();
+        let frames_model = AngleFrames::new(rep);
         let mut s = rep.scratch();
         let e0 = rep.segment_cost(0, n - 1, &mut s).angle_sum;
-        Ok(EnvWindow { rep, motion, e0 })
+        Ok(EnvWindow { frames_model, n, motion, costs: None, e0 })
     }
 
     pub fn frames(&self) -> usize {
-        self.rep.num_frames
+        self.n
+    }
+
+    /// The full cost table, when the window has one.
+    pub fn cost_table(&self) -> Option<&[f64]> {
+        self.costs.as_deref()
+    }
+
+    /// Buffers for this window's states (on-demand costs reset).
+    pub fn scratch(&self) -> StateScratch {
+        StateScratch {
+            term: vec![0.0; self.frames_model.joints()],
+            buf: vec![0.0; self.n],
+            errs: vec![0.0; self.n],
+            lazy: if self.costs.is_some() { Vec::new() } else { vec![f64::NAN; self.n * self.n] },
+        }
+    }
+
+    /// Makes `scratch` fit this window (windows of a training set share one).
+    pub fn fit_scratch(&self, scratch: &mut StateScratch) {
+        scratch.term.resize(scratch.term.len().max(self.frames_model.joints()), 0.0);
+        scratch.buf.resize(scratch.buf.len().max(self.n), 0.0);
+        scratch.errs.resize(scratch.errs.len().max(self.n), 0.0);
+    }
+
+    /// The cost of segment `(a, b)`.
+    fn cost(&self, a: usize, b: usize, s: &mut StateScratch) -> f64 {
+        let n = self.n;
+        if let Some(c) = &self.costs {
+            return c[a * n + b];
+        }
+        let slot = a * n + b;
+        if s.lazy[slot].is_nan() {
+            s.lazy[slot] = self.frames_model.segment(a, b, &mut s.buf, &mut s.term);
+        }
+        s.lazy[slot]
     }
 
     /// The starting mask: first and last frame.
@@ -64,60 +131,109 @@ impl EnvWindow {
         1 | 1 << (self.frames() - 1)
     }
 
-    /// Per-frame angle error under `mask` and the total E(s).
-    pub fn frame_errors(&self, mask: u64, scratch: &mut Scratch, out: &mut [f64]) -> f64 {
-        let n = self.frames();
-        let keys: Vec<usize> = (0..n).filter(|&f| mask >> f & 1 == 1).collect();
-        out.iter_mut().for_each(|e| *e = 0.0);
+    /// Per-frame angle error under `mask` into `s.errs` and the total E(s) (the sum of its
+    /// segments' costs, each summed in frame order: the numbers of [`SegmentModel::error`]).
+    pub fn frame_errors(&self, mask: u64, s: &mut StateScratch) -> f64 {
+        let n = self.n;
+        s.errs[..n].iter_mut().for_each(|e| *e = 0.0);
         let mut total = 0.0;
-        for w in keys.windows(2) {
-            for (f, slot) in out.iter_mut().enumerate().take(w[1]).skip(w[0] + 1) {
-                *slot = self.rep.frame_cost(w[0], w[1], f, scratch).angle_sum;
-                total += *slot;
+        let mut a = 0;
+        for b in (1..n).filter(|&f| mask >> f & 1 == 1) {
+            if b > a + 1 {
+                self.frames_model.eval(a, b, a + 1, b, &mut s.errs[a + 1..b], &mut s.term);
             }
+            total += s.errs[a + 1..b].iter().fold(0.0, |acc, t| acc + t);
+            a = b;
         }
         total
     }
 
-    /// Appends the state for `mask` (`frames × INPUTS`, frame-major) to `out`. Returns E(s).
-    pub fn state(&self, mask: u64, scratch: &mut Scratch, out: &mut Vec<f32>) -> f64 {
-        let n = self.frames();
-        let mut errs = vec![0.0; n];
-        let total = self.frame_errors(mask, scratch, &mut errs);
+    /// E(s) of `mask` from the cost table (the same number as [`EnvWindow::frame_errors`]).
+    pub fn error(&self, mask: u64, s: &mut StateScratch) -> f64 {
+        let mut total = 0.0;
+        let mut a = 0;
+        for b in (1..self.n).filter(|&f| mask >> f & 1 == 1) {
+            total += self.cost(a, b, s);
+            a = b;
+        }
+        total
+    }
+
+    /// Appends the state for `mask` with `budget` keys still to add (`frames × INPUTS`,
+    /// frame-major) to `out`. Returns E(s).
+    pub fn state(&self, mask: u64, budget: usize, s: &mut StateScratch, out: &mut Vec<f32>) -> f64 {
+        let n = self.n;
+        let total = self.frame_errors(mask, s);
         let e0 = self.e0.max(1e-12);
         // Errors relative to the current E(s), so the average frame is about 1 at every step: a
         // step late in an episode looks like an early one, only the reward scale differs.
         let now = total.max(1e-12 * e0);
-        let rel: Vec<f32> = errs.iter().map(|e| (e * n as f64 / now).min(50.0) as f32).collect();
         let is_key = |f: usize| mask >> f & 1 == 1;
+        let rel = |e: f64| (e * n as f64 / now).min(50.0) as f32;
+        // One-step gains of every candidate, and the best per segment and overall.
+        let mut gains = [0.0f64; MAX_FRAMES];
+        let mut halves = [(0.0f64, 0.0f64); MAX_FRAMES];
+        let mut seg_of = [(0usize, 0usize); MAX_FRAMES];
+        let mut best_in_seg = [0.0f64; MAX_FRAMES];
+        let mut best = 0.0f64;
+        let mut a = 0;
+        for b in (1..n).filter(|&f| is_key(f)) {
+            let whole = if b > a + 1 { self.cost(a, b, s) } else { 0.0 };
+            let mut seg_best = 0.0f64;
+            for f in a + 1..b {
+                let (l, r) = (self.cost(a, f, s), self.cost(f, b, s));
+                gains[f] = whole - l - r;
+                halves[f] = (l, r);
+                seg_of[f] = (a, b);
+                seg_best = seg_best.max(gains[f]);
+            }
+            for slot in &mut best_in_seg[a + 1..b] {
+                *slot = seg_best;
+            }
+            best = best.max(seg_best);
+            seg_of[a] = (a, a);
+            a = b;
+        }
+        seg_of[n - 1] = (n - 1, n - 1);
+        let best = best.max(1e-12 * now);
         let keys = mask.count_ones() as f32;
         let progress = (total / e0) as f32;
-        let (mut prev, mut seg) = (0usize, Segment::default());
         for f in 0..n {
-            if is_key(f) {
-                prev = f;
-            }
-            if f == prev {
-                let next = (f + 1..n).find(|&g| is_key(g)).unwrap_or(f);
-                seg = Segment::of(&errs, prev, next, now);
-            }
             for d in -(CONTEXT as isize)..=CONTEXT as isize {
                 match f.checked_add_signed(d).filter(|&g| g < n) {
-                    Some(g) => out.extend_from_slice(&[is_key(g) as u8 as f32, rel[g], 0.0]),
+                    Some(g) => out.extend_from_slice(&[is_key(g) as u8 as f32, rel(s.errs[g]), 0.0]),
                     None => out.extend_from_slice(&[0.0, 0.0, 1.0]),
                 }
             }
-            let key_here = is_key(f);
-            let (to_prev, to_next) = if key_here { (0, 0) } else { (f - seg.start, seg.end - f) };
-            out.extend_from_slice(&[
-                to_prev as f32 / 30.0,
-                to_next as f32 / 30.0,
-                if key_here { 0.0 } else { seg.share },
-                if key_here { 0.0 } else { seg.max_rel },
-                key_here as u8 as f32,
-            ]);
+            if is_key(f) {
+                out.extend(std::iter::repeat_n(0.0, SEGMENT_INPUTS + GAIN_INPUTS));
+            } else {
+                let (a, b) = seg_of[f];
+                let inner = &s.errs[a + 1..b];
+                let seg_sum = inner.iter().sum::<f64>();
+                let seg_max = inner.iter().copied().fold(0.0, f64::max);
+                let (l, r) = halves[f];
+                out.extend_from_slice(&[
+                    (f - a) as f32 / 30.0,
+                    (b - f) as f32 / 30.0,
+                    (seg_sum / now) as f32,
+                    rel(seg_max),
+                    (f - a) as f32 / (b - a) as f32,
+                    (l / now) as f32,
+                    (r / now) as f32,
+                    (gains[f] / now) as f32,
+                    (gains[f] / best) as f32,
+                    (best_in_seg[f] / best) as f32,
+                ]);
+            }
             out.extend_from_slice(&self.motion[f]);
-            out.extend_from_slice(&[keys / 16.0, progress]);
+            let (a, b) = seg_of[f];
+            out.extend_from_slice(&[
+                keys / 16.0,
+                budget as f32 / 16.0,
+                budget as f32 * (b - a) as f32 / (n - 1) as f32,
+                progress,
+            ]);
         }
         total
     }
@@ -125,31 +241,6 @@ impl EnvWindow {
     /// Reward of going from error `e_before` to `e_after` (Eq. 22).
     pub fn reward(&self, e_before: f64, e_after: f64) -> f32 {
         ((e_before - e_after) / self.e0.max(1e-12)) as f32
-    }
-}
-
-/// The keys around a run of in-between frames and what that run costs now.
-#[derive(Default, Clone, Copy)]
-struct Segment {
-    start: usize,
-    end: usize,
-    /// The segment's error as a share of E(s).
-    share: f32,
-    /// Its worst frame, scaled like the per-frame errors.
-    max_rel: f32,
-}
-
-impl Segment {
-    fn of(errs: &[f64], start: usize, end: usize, total: f64) -> Segment {
-        let inner = &errs[(start + 1).min(end)..end];
-        let sum: f64 = inner.iter().sum();
-        let max = inner.iter().copied().fold(0.0, f64::max);
-        Segment {
-            start,
-            end,
-            share: (sum / total) as f32,
-            max_rel: (max * errs.len() as f64 / total).min(50.0) as f32,
-        }
     }
 }
 
@@ -194,42 +285,75 @@ mod tests {
     use super::*;
     use crate::representation::JointFilter;
     use inbetween_core::procedural::{gait, GaitParams};
+    use inbetween_core::KeyframeSet;
 
-    fn window(frames: usize) -> EnvWindow {
+    fn rep(frames: usize) -> SphericalMotion {
         let m = JointFilter::paper().apply(&gait(&GaitParams { frames, fps: 30.0, ..GaitParams::walk() }));
-        EnvWindow::new(SphericalMotion::from_motion(&m).unwrap()).unwrap()
+        SphericalMotion::from_motion(&m).unwrap()
     }
+
+    const GAIN: usize = 3 * (2 * CONTEXT + 1) + SEGMENT_INPUTS;
 
     #[test]
     fn state_rows_describe_each_candidate() {
-        let w = window(20);
-        let mut s = w.rep.scratch();
+        let w = EnvWindow::new(&rep(20)).unwrap();
+        let mut s = w.scratch();
         let mut out = Vec::new();
-        let e = w.state(w.initial_mask(), &mut s, &mut out);
+        let e = w.state(w.initial_mask(), 7, &mut s, &mut out);
         assert_eq!(out.len(), 20 * INPUTS);
         assert!((e - w.e0).abs() < 1e-9 * w.e0.max(1.0), "the start state's error is E(s₀)");
         assert!(out.iter().all(|v| v.is_finite()));
-        let row = |f: usize| &out[f * INPUTS..(f + 1) * INPUTS];
+        let row = |out: &[f32], f: usize| out[f * INPUTS..(f + 1) * INPUTS].to_vec();
         let centre = 3 * CONTEXT;
         // Frame 0 is a key with zero error; its left context lies outside the window.
-        assert_eq!(&row(0)[centre..centre + 3], &[1.0, 0.0, 0.0]);
-        assert_eq!(&row(0)[0..3], &[0.0, 0.0, 1.0]);
-        // Frame 10 is 10 frames from either key and its segment holds all of E(s₀).
-        let seg = &row(10)[3 * (2 * CONTEXT + 1)..];
-        assert_eq!(seg[0], 10.0 / 30.0);
-        assert_eq!(seg[1], 9.0 / 30.0);
+        assert_eq!(&row(&out, 0)[centre..centre + 3], &[1.0, 0.0, 0.0]);
+        assert_eq!(&row(&out, 0)[0..3], &[0.0, 0.0, 1.0]);
+        // Frame 10 is 10 frames from the first key, 9 from the last, and its segment holds all of E(s₀).
+        let seg = &row(&out, 10)[3 * (2 * CONTEXT + 1)..];
+        assert_eq!((seg[0], seg[1]), (10.0 / 30.0, 9.0 / 30.0));
         assert!((seg[2] - 1.0).abs() < 1e-5);
+        // The budget is in every row.
+        assert_eq!(row(&out, 3)[INPUTS - 3], 7.0 / 16.0);
         // Adding a key at 10 splits it.
         let mut after = Vec::new();
-        let e2 = w.state(w.initial_mask() | 1 << 10, &mut s, &mut after);
+        let e2 = w.state(w.initial_mask() | 1 << 10, 6, &mut s, &mut after);
         assert!(e2 < e);
         assert_eq!(after[10 * INPUTS + centre], 1.0);
         assert!(w.reward(e, e2) > 0.0);
     }
 
+    /// The gain in each row is c(a,f) + c(f,b) − c(a,b) of the model's own segment costs, with
+    /// and without a cost table, and E(s) is the model's error.
+    #[test]
+    fn one_step_gains_are_the_direct_segment_costs() {
+        let r = rep(30);
+        let (full, lazy) = (EnvWindow::new(&r).unwrap(), EnvWindow::lazy(&r).unwrap());
+        let mask = full.initial_mask() | 1 << 9 | 1 << 20;
+        let mut ms = r.scratch();
+        let c = |a: usize, b: usize, ms: &mut crate::error::Scratch| r.segment_cost(a, b, ms).angle_sum;
+        for w in [&full, &lazy] {
+            let mut s = w.scratch();
+            let mut out = Vec::new();
+            let e = w.state(mask, 3, &mut s, &mut out);
+            let keys = KeyframeSet::new(vec![9, 20], 30).unwrap();
+            let want_e = r.error(&keys).mean_angle * (30 * r.angle_terms_per_frame()) as f64;
+            assert!((e - want_e).abs() <= 1e-12 * want_e, "{e} vs {want_e}");
+            assert_eq!(w.error(mask, &mut s).to_bits(), e.to_bits());
+            for (f, (a, b)) in [(4, (0, 9)), (12, (9, 20)), (25, (20, 29))] {
+                let direct = c(a, b, &mut ms) - c(a, f, &mut ms) - c(f, b, &mut ms);
+                let got = out[f * INPUTS + GAIN + 2] as f64 * e;
+                assert!((got - direct).abs() <= 1e-5 * direct.abs().max(1e-3 * e), "frame {f}: {got} vs {direct}");
+                let left = out[f * INPUTS + GAIN] as f64 * e;
+                assert!((left - c(a, f, &mut ms)).abs() <= 1e-5 * e, "frame {f}");
+            }
+            // The best candidate's gain reads 1 relative to the window's best.
+            let best = (0..30).map(|f| out[f * INPUTS + GAIN + 3]).fold(f32::MIN, f32::max);
+            assert!((best - 1.0).abs() < 1e-6, "{best}");
+        }
+    }
+
     #[test]
     fn rejects_windows_a_mask_cannot_hold() {
-        let m = JointFilter::paper().apply(&gait(&GaitParams { frames: 70, fps: 30.0, ..GaitParams::walk() }));
-        assert!(EnvWindow::new(SphericalMotion::from_motion(&m).unwrap()).is_err());
+        assert!(EnvWindow::new(&rep(70)).is_err());
     }
 }

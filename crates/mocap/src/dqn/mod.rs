@@ -8,6 +8,6 @@ pub mod policy;
 pub mod replay;
 pub mod train;
 
-pub use model::{DqnConfig, QNet};
+pub use model::{DqnConfig, QNet, QRuntime};
 pub use policy::{PolicyInfo, SidqlPolicy};
-pub use train::{train, TrainOptions, TrainReport};
+pub use train::{train, TrainOptions, TrainReport, Trained};

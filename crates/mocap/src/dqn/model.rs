@@ -18,6 +18,7 @@ use burn::nn::{Linear, LinearConfig};
 use burn::tensor::activation::relu;
 use burn::tensor::{Device, Tensor};
 use inbetween_nn::burn;
+use inbetween_nn::runtime::Dense;
 use serde::{Deserialize, Serialize};
 
 /// Shape of the network; stored beside the weights so a checkpoint says what it fits.
@@ -31,7 +32,7 @@ pub struct DqnConfig {
 
 impl Default for DqnConfig {
     fn default() -> Self {
-        DqnConfig { inputs_per_frame: INPUTS, hidden: [64, 64, 32] }
+        DqnConfig { inputs_per_frame: INPUTS, hidden: [32, 32, 16] }
     }
 }
 
@@ -71,5 +72,47 @@ impl QNet {
         let h = relu(self.hidden1.forward(h));
         let h = relu(self.hidden2.forward(h));
         self.out.forward(h).reshape([batch, frames])
+    }
+}
+
+/// The Q-network's layers as plain-Rust dense layers (`inbetween_nn::runtime`), for selection:
+/// no tensors, no allocation once the buffers have their size.
+#[derive(Clone, Debug)]
+pub struct QRuntime {
+    layers: [Dense; 4],
+}
+
+/// Buffers of [`QRuntime::forward_unscaled`].
+#[derive(Clone, Debug, Default)]
+pub struct QBuffers {
+    a: Vec<f32>,
+    b: Vec<f32>,
+}
+
+impl QRuntime {
+    pub fn new(net: &QNet) -> QRuntime {
+        QRuntime {
+            layers: [
+                Dense::from_linear(&net.feature),
+                Dense::from_linear(&net.hidden1),
+                Dense::from_linear(&net.hidden2),
+                Dense::from_linear(&net.out),
+            ],
+        }
+    }
+
+    /// [`QNet::forward_unscaled`] of `rows` rows of `INPUTS` values, into `out[..rows]`.
+    pub fn forward_unscaled(&self, x: &[f32], rows: usize, buf: &mut QBuffers, out: &mut [f32]) {
+        let (cur, next) = (&mut buf.a, &mut buf.b);
+        let last = self.layers.len() - 1;
+        for (i, layer) in self.layers.iter().enumerate() {
+            next.resize(rows * layer.n_out, 0.0);
+            layer.forward(if i == 0 { x } else { cur.as_slice() }, next, rows);
+            if i < last {
+                next.iter_mut().for_each(|v| *v = v.max(0.0));
+            }
+            std::mem::swap(cur, next);
+        }
+        out[..rows].copy_from_slice(&cur[..rows]);
     }
 }

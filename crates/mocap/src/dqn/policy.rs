@@ -2,10 +2,9 @@
 //! through the shared [`inbetween_nn::weights`] format (`sidql.bpk` + its `sidql.json` card, kind
 //! [`POLICY_KIND`]).
 
-use super::env::{EnvWindow, INPUTS};
-use super::model::{DqnConfig, QNet};
+use super::env::{EnvWindow, StateScratch, INPUTS};
+use super::model::{DqnConfig, QBuffers, QNet, QRuntime};
 use super::train::TrainOptions;
-use crate::error::SegmentModel;
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -16,7 +15,8 @@ use std::path::Path;
 
 /// Kind and architecture version written in a policy's weights card.
 pub const POLICY_KIND: &str = "mocap-sidql";
-pub const POLICY_FORMAT: u32 = 1;
+/// 2: rows carry the one-step gain and the budget left (format 1 policies are refused by name).
+pub const POLICY_FORMAT: u32 = 2;
 
 /// What a policy's card says: the network shape and how it was trained.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,13 +60,14 @@ impl PolicyInfo {
 pub struct SidqlPolicy {
     pub info: PolicyInfo,
     net: QNet,
+    runtime: QRuntime,
     device: Device,
 }
 
 impl SidqlPolicy {
     /// A policy from a trained network (moved to the inference device).
     pub fn new(info: PolicyInfo, net: QNet) -> SidqlPolicy {
-        SidqlPolicy { info, net, device: inbetween_nn::backend::cpu() }
+        SidqlPolicy { info, runtime: QRuntime::new(&net), net, device: inbetween_nn::backend::cpu() }
     }
 
     /// Writes the weights (`path`, burnpack) and their card (`path` with `.json`).
@@ -79,9 +80,9 @@ impl SidqlPolicy {
         Self::from_weights(&Weights::from_path(path)?)
     }
 
-    /// The committed policy (`crates/mocap/weights/sidql.bpk`, trained by `inbetween mocap train
-    /// --procedural` on our own gaits), compiled into the binary so the bench and the tools run from
-    /// any folder.
+    /// The committed policy (`crates/mocap/weights/sidql.bpk`, trained by `inbetween mocap train`
+    /// on every CMU take of the corpus; its card says how), compiled into the binary so the bench
+    /// and the tools run from any folder.
     pub fn committed() -> Result<SidqlPolicy> {
         let w = Weights::embedded(
             "crates/mocap/weights/sidql.bpk",
@@ -102,7 +103,12 @@ impl SidqlPolicy {
         }
         let device = inbetween_nn::backend::cpu();
         let net = w.load_into(info.config.init(&device))?;
-        Ok(SidqlPolicy { info, net, device })
+        Ok(SidqlPolicy { info, runtime: QRuntime::new(&net), net, device })
+    }
+
+    /// The network's layers for plain-Rust inference.
+    pub fn runtime(&self) -> &QRuntime {
+        &self.runtime
     }
 
     /// Q-values `[batch × frames]` of states laid out `[batch, frames, INPUTS]`.
@@ -111,24 +117,67 @@ impl SidqlPolicy {
     }
 
     /// Chooses `k` keys for a window: starting from the end keys, repeatedly the frame with the
-    /// highest Q-value among the non-keys.
+    /// highest Q-value among the non-keys, the budget left in the state.
     pub fn select(&self, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
         crate::select::check_k(rep.num_frames, k)?;
         if k <= 2 {
             return Ok(KeyframeSet::new(vec![0, rep.num_frames - 1], rep.num_frames)?);
         }
-        let w = EnvWindow::new(rep.clone())?;
-        let mut mask = w.initial_mask();
-        let mut scratch = rep.scratch();
-        let mut state = Vec::with_capacity(w.frames() * INPUTS);
-        while (mask.count_ones() as usize) < k {
-            state.clear();
-            w.state(mask, &mut scratch, &mut state);
-            let q = q_values(&self.net, &state, 1, w.frames(), &self.device);
-            mask |= 1 << best_action(&q, mask, w.frames());
+        let w = EnvWindow::lazy(rep)?;
+        let mut s = w.scratch();
+        let mut mask = rollout(&self.runtime, &w, k, &mut s, &mut Rollout::default());
+        // Checked exactly against uniform keys (K − 1 segment costs): never worse than UC.
+        let uniform = KeyframeSet::uniform(w.frames(), k)?;
+        let uniform_mask = uniform.frames().iter().fold(0u64, |m, &f| m | 1 << f);
+        if w.error(uniform_mask, &mut s) < w.error(mask, &mut s) {
+            mask = uniform_mask;
         }
         Ok(KeyframeSet::new((0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect(), w.frames())?)
     }
+
+    /// The network's own keys, without the check against uniform keys of [`SidqlPolicy::select`].
+    pub fn select_unchecked(&self, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
+        crate::select::check_k(rep.num_frames, k)?;
+        if k <= 2 {
+            return Ok(KeyframeSet::new(vec![0, rep.num_frames - 1], rep.num_frames)?);
+        }
+        let w = EnvWindow::lazy(rep)?;
+        let mask = rollout(&self.runtime, &w, k, &mut w.scratch(), &mut Rollout::default());
+        Ok(KeyframeSet::new((0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect(), w.frames())?)
+    }
+}
+
+/// Buffers of [`rollout`].
+#[derive(Clone, Debug, Default)]
+pub struct Rollout {
+    state: Vec<f32>,
+    rows: Vec<f32>,
+    index: Vec<usize>,
+    q: Vec<f32>,
+    buffers: QBuffers,
+}
+
+/// The mask of `k` keys `net` chooses greedily on window `w` (only non-key rows are evaluated).
+pub fn rollout(net: &QRuntime, w: &EnvWindow, k: usize, s: &mut StateScratch, r: &mut Rollout) -> u64 {
+    let n = w.frames();
+    let mut mask = w.initial_mask();
+    while (mask.count_ones() as usize) < k {
+        let budget = k - mask.count_ones() as usize;
+        r.state.clear();
+        w.state(mask, budget, s, &mut r.state);
+        r.rows.clear();
+        r.index.clear();
+        for f in (0..n).filter(|&f| mask >> f & 1 == 0) {
+            r.rows.extend_from_slice(&r.state[f * INPUTS..(f + 1) * INPUTS]);
+            r.index.push(f);
+        }
+        r.q.resize(r.index.len(), 0.0);
+        net.forward_unscaled(&r.rows, r.index.len(), &mut r.buffers, &mut r.q);
+        // Every row shares the scale E(s)/E(s₀): the unscaled values rank the actions alike.
+        let best = (0..r.index.len()).fold(0, |b, i| if r.q[i] > r.q[b] { i } else { b });
+        mask |= 1 << r.index[best];
+    }
+    mask
 }
 
 /// Q-values `[batch × frames]` of states laid out `[batch, frames, INPUTS]`.
@@ -137,27 +186,43 @@ pub(crate) fn q_values(net: &QNet, states: &[f32], batch: usize, frames: usize, 
     net.forward(x).into_data().try_to_vec::<f32>().expect("f32 Q-values")
 }
 
-/// The non-key frame with the highest Q-value.
-pub(crate) fn best_action(q: &[f32], mask: u64, frames: usize) -> usize {
-    (0..frames).filter(|&f| mask >> f & 1 == 0).max_by(|&a, &b| q[a].total_cmp(&q[b])).expect("a non-key frame remains")
-}
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::SegmentModel;
     use inbetween_core::procedural::{gait, GaitParams};
 
     #[test]
     fn committed_policy_serves_any_skeleton_and_window_length() {
         let policy = SidqlPolicy::committed().unwrap();
-        assert!(policy.info.trained_on.contains("procedural"), "{}", policy.info.trained_on);
+        assert!(policy.info.trained_on.contains("CMU"), "{}", policy.info.trained_on);
         let m = gait(&GaitParams { frames: 40, fps: 30.0, ..GaitParams::walk() });
-        // All 31 joints (the policy was trained on 23) and 40 frames (trained on 60).
+        // All 31 joints (the policy was trained on 22–23) and 40 frames (trained on 60).
         let rep = SphericalMotion::from_motion(&m).unwrap();
         let keys = policy.select(&rep, 6).unwrap();
         assert_eq!(keys.len(), 6);
         let two = KeyframeSet::new(vec![], 40).unwrap();
         assert!(rep.error(&keys).mean_angle < 0.5 * rep.error(&two).mean_angle);
+    }
+
+    /// The committed policy against uniform keys on every 60-frame window of the corpus (the
+    /// bench's protocol): never worse at K = 5, 10, 15.
+    #[test]
+    fn committed_policy_never_loses_to_uniform_keys_on_the_cmu_windows() {
+        use crate::bench::{clip_windows, evaluate, Method, Protocol};
+        inbetween_io::data::with_shared_data("SIDQL policy real-data test", |dir| {
+            let corpus = crate::corpus::load(&dir, None).unwrap();
+            let windows: Vec<_> = corpus.clips.iter().flat_map(|c| clip_windows(c, &Protocol::paper()).unwrap()).collect();
+            assert!(windows.len() >= 100, "{} windows", windows.len());
+            let policy = SidqlPolicy::committed().unwrap();
+            let f = |rep: &SphericalMotion, k: usize| policy.select(rep, k);
+            let rows = evaluate("all", &windows, &[Method::Uc, Method::Sidql], &[5, 10, 15], 0, Some(&f)).unwrap();
+            for k in [5, 10, 15] {
+                let get = |m: Method| rows.iter().find(|r| r.method == m && r.k == k).unwrap().mean_angle_error;
+                assert!(get(Method::Sidql) <= get(Method::Uc), "K={k}: SIDQL {} vs UC {}", get(Method::Sidql), get(Method::Uc));
+            }
+        });
     }
 
     #[test]

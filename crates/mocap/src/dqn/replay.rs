@@ -15,6 +15,9 @@ pub struct Transition {
     pub reward: f32,
     pub next_mask: u64,
     pub done: bool,
+    /// The episode's K (keys at its end): the budget left is `k − |mask|`.
+    #[serde(default)]
+    pub k: usize,
 }
 
 mod f32_bits {
@@ -69,7 +72,7 @@ mod tests {
 
     #[test]
     fn oldest_is_replaced_when_full() {
-        let t = |w| Transition { window: w, mask: 0, action: 0, reward: 0.0, next_mask: 0, done: false };
+        let t = |w| Transition { window: w, mask: 0, action: 0, reward: 0.0, next_mask: 0, done: false, k: 5 };
         let mut r = Replay::new(3);
         for w in 0..5 {
             r.push(t(w));

@@ -7,15 +7,19 @@
 //! - [`optimal`](mod@optimal): the exact minimum of the total error for `k` keys, a dynamic programme over the
 //!   per-segment costs (beyond the paper); never worse than Greedy. [`optimal_spherical`] gives the same
 //!   keys on one clip in about a millisecond (only the objective is tabulated, hopeless segments dropped).
+//! - [`cost_to_go`](mod@cost_to_go): the least error reachable from any key set with any number of keys
+//!   left (SIDQL's pretraining targets).
 //! - [`error_bounded`]: the fewest keys keeping every frame's error under a bound, also exact.
 //! - [`sidql`](mod@sidql): the paper's deep Q-network policy (§4).
 
+pub mod cost_to_go;
 pub mod greedy;
 pub mod optimal;
 pub mod random;
 pub mod sidql;
 pub mod uniform;
 
+pub use cost_to_go::{angle_segment_costs, completion_values, cost_to_go};
 pub use greedy::greedy;
 pub use optimal::{error_bounded, optimal, optimal_spherical};
 pub use random::random;

@@ -137,7 +137,8 @@ impl FrameObjective for ModelFrames<'_> {
 /// by the Hermite cubic of `reconstruct::segment_frame`, against the source, with the same
 /// floating-point operations in the same order (each frame sums its joints in joint order). Joints
 /// are the vector lanes: the source is copied frame-major.
-struct AngleFrames {
+#[derive(Clone, Debug)]
+pub(crate) struct AngleFrames {
     /// Angle-carrying joints.
     m: usize,
     /// θ, θ̇, φ, φ̇ of the angle-carrying joints, frame-major (`[frame * m + joint]`).
@@ -150,7 +151,7 @@ struct AngleFrames {
 }
 
 impl AngleFrames {
-    fn new(rep: &SphericalMotion) -> AngleFrames {
+    pub(crate) fn new(rep: &SphericalMotion) -> AngleFrames {
         let n = rep.num_frames;
         let angled: Vec<usize> = (0..rep.num_joints).filter(|&j| rep.has_angles[j]).collect();
         let pick = |v: &[f64]| (0..n).flat_map(|f| angled.iter().map(move |&j| v[j * n + f])).collect();
@@ -167,28 +168,48 @@ impl AngleFrames {
 }
 
 impl FrameObjective for AngleFrames {
-    /// Uses AVX2 where the CPU has it (checked at run time): the same operations on wider vectors,
-    /// so the same numbers.
     fn frames(&mut self, a: usize, b: usize, lo: usize, hi: usize, out: &mut [f64]) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { self.frames_avx2(a, b, lo, hi, out) };
-            return;
-        }
-        self.frames_with(a, b, lo, hi, out);
+        let mut term = std::mem::take(&mut self.term);
+        self.eval(a, b, lo, hi, out, &mut term);
+        self.term = term;
     }
 }
 
 impl AngleFrames {
+    /// Angle-carrying joints: the length of the `term` buffer [`AngleFrames::eval`] needs.
+    pub(crate) fn joints(&self) -> usize {
+        self.m
+    }
+
+    /// The angle error of frames `lo..hi` reconstructed from keys `a < lo ≤ hi ≤ b`, into
+    /// `out[f − lo]`, with `term` (at least [`AngleFrames::joints`] long) as scratch. Uses AVX2
+    /// where the CPU has it (checked at run time): the same operations on wider vectors, so the
+    /// same numbers.
+    pub(crate) fn eval(&self, a: usize, b: usize, lo: usize, hi: usize, out: &mut [f64], term: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            unsafe { self.frames_avx2(a, b, lo, hi, out, term) };
+            return;
+        }
+        self.frames_with(a, b, lo, hi, out, term);
+    }
+
+    /// The cost of segment `(a, b)`: its frames' errors summed in frame order (the same number as
+    /// [`SegmentModel::segment_cost`]'s `angle_sum`). `buf` holds at least `b − a` values.
+    pub(crate) fn segment(&self, a: usize, b: usize, buf: &mut [f64], term: &mut [f64]) -> f64 {
+        self.eval(a, b, a + 1, b, &mut buf[..b - a - 1], term);
+        buf[..b - a - 1].iter().fold(0.0, |s, t| s + t)
+    }
+
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn frames_avx2(&mut self, a: usize, b: usize, lo: usize, hi: usize, out: &mut [f64]) {
-        self.frames_with(a, b, lo, hi, out);
+    fn frames_avx2(&self, a: usize, b: usize, lo: usize, hi: usize, out: &mut [f64], term: &mut [f64]) {
+        self.frames_with(a, b, lo, hi, out, term);
     }
 
     #[inline(always)]
-    fn frames_with(&mut self, a: usize, b: usize, lo: usize, hi: usize, out: &mut [f64]) {
+    fn frames_with(&self, a: usize, b: usize, lo: usize, hi: usize, out: &mut [f64], term: &mut [f64]) {
         let m = self.m;
         fn row(v: &[f64], m: usize, f: usize) -> &[f64] {
             &v[f * m..][..m]
@@ -196,7 +217,7 @@ impl AngleFrames {
         let at = |v, f| row(v, m, f);
         let (ta, tva, tb, tvb) = (at(&self.theta, a), at(&self.dtheta, a), at(&self.theta, b), at(&self.dtheta, b));
         let (pa, pva, pb, pvb) = (at(&self.phi, a), at(&self.dphi, a), at(&self.phi, b), at(&self.dphi, b));
-        let term = &mut self.term[..m];
+        let term = &mut term[..m];
         // As `segment_frame` computes them.
         let h = (b - a) as f64 * self.frame_time;
         for (f, o) in (lo..hi).zip(out.iter_mut()) {
@@ -648,7 +669,8 @@ mod tests {
             let (mut plain, mut auto) = (vec![0.0; n], vec![0.0; n]);
             for a in 0..n {
                 for b in a + 2..n {
-                    frames.frames_with(a, b, a + 1, b, &mut plain[a + 1..b]);
+                    let mut term = vec![0.0; frames.joints()];
+                    frames.frames_with(a, b, a + 1, b, &mut plain[a + 1..b], &mut term);
                     frames.frames(a, b, a + 1, b, &mut auto[a + 1..b]);
                     for f in a + 1..b {
                         let want = rep.frame_cost(a, b, f, s).angle_sum;

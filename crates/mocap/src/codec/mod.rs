@@ -24,6 +24,10 @@
 //! known before keys are chosen ([`quantised_model`]): [`compress`] chooses keys against exactly
 //! what the decoder rebuilds, and its error bound holds for the decoded file.
 
+pub mod alloc;
+mod bits;
+pub mod v3;
+
 use crate::rotations::{reconstruct_from_keys, KeyPose, RotationMotion};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
@@ -33,7 +37,7 @@ use inbetween_core::{Channel, Joint, KeyframeSet, Motion, Skeleton};
 use std::f64::consts::PI;
 
 pub const MAGIC: &[u8; 4] = b"IBK\0";
-/// The version [`encode`] writes.
+/// The keyframe version [`encode`] writes ([`v3`] writes version 3, the sampled format).
 pub const VERSION: u16 = 2;
 /// The oldest version [`decode`] reads.
 pub const OLDEST_VERSION: u16 = 1;
@@ -219,6 +223,13 @@ impl<'a> Reader<'a> {
     pub fn remaining(&self) -> usize {
         self.bytes.len() - self.pos
     }
+    /// Bytes read so far.
+    pub fn pos(&self) -> usize {
+        self.pos
+    }
+    pub fn skip(&mut self, n: usize, what: &str) -> Result<()> {
+        self.take(n, what).map(|_| ())
+    }
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8]> {
         if self.bytes.len() - self.pos < n {
             return Err(MocapError::Codec(format!(
@@ -345,8 +356,9 @@ pub fn read_scaled_key(r: &mut Reader, skeleton: &Skeleton) -> Result<KeyPose> {
     read_key(r, skeleton, scale)
 }
 
-/// Decodes an `.ibk` file (version 1 or 2), checking magic, version, checksum and every length.
-pub fn decode(bytes: &[u8]) -> Result<Decoded> {
+/// Checks what every `.ibk` file shares: the magic bytes, a version in `oldest..=newest` and the
+/// checksum. Returns the version and the body (the file less its checksum).
+pub(crate) fn check_envelope(bytes: &[u8], oldest: u16, newest: u16) -> Result<(u16, &[u8])> {
     if bytes.len() < 4 || &bytes[..4] != MAGIC {
         return Err(MocapError::Codec("not an .ibk file: expected the magic bytes \"IBK\\0\" at byte 0".into()));
     }
@@ -355,11 +367,11 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
     }
     let body = &bytes[..bytes.len() - 4];
     let stored = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("4 bytes"));
-    let mut r = Reader { bytes: body, pos: 4 };
-    let version = r.u16("version")?;
-    if !(OLDEST_VERSION..=VERSION).contains(&version) {
+    let version = u16::from_le_bytes([bytes[4], bytes[5]]);
+    if !(oldest..=newest).contains(&version) {
+        let hint = if version == v3::VERSION { " (a version 3 file holds samples, not keys: read it with codec::read)" } else { "" };
         return Err(MocapError::Codec(format!(
-            "unsupported .ibk version {version}; this build reads versions {OLDEST_VERSION} to {VERSION}"
+            "unsupported .ibk version {version}; this reader reads versions {oldest} to {newest}{hint}"
         )));
     }
     if crc32fast::hash(body) != stored {
@@ -368,6 +380,67 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
             crc32fast::hash(body)
         )));
     }
+    Ok((version, body))
+}
+
+/// Any `.ibk` file: keys (versions 1 and 2) or samples (version 3).
+#[derive(Clone, Debug)]
+pub enum IbkFile {
+    Keys(Decoded),
+    Samples(v3::Quantised),
+}
+
+impl IbkFile {
+    /// The whole clip.
+    pub fn motion(&self) -> Result<Motion> {
+        match self {
+            IbkFile::Keys(d) => d.reconstruct(),
+            IbkFile::Samples(q) => q.motion(),
+        }
+    }
+
+    pub fn skeleton(&self) -> &Skeleton {
+        match self {
+            IbkFile::Keys(d) => &d.skeleton,
+            IbkFile::Samples(q) => &q.skeleton,
+        }
+    }
+
+    pub fn num_frames(&self) -> usize {
+        match self {
+            IbkFile::Keys(d) => d.num_frames,
+            IbkFile::Samples(q) => q.num_frames,
+        }
+    }
+
+    /// What the file holds, in words (for the command line).
+    pub fn describe(&self) -> String {
+        match self {
+            IbkFile::Keys(d) => format!("version 2 or older: {} keys of {} frames", d.key_frames.len(), d.num_frames),
+            IbkFile::Samples(q) => format!(
+                "version 3: {} frames in segments of {}, compressed to {} cm (virtual vertices 3 cm from each bone)",
+                q.num_frames, q.segment_len, q.bound_cm
+            ),
+        }
+    }
+}
+
+/// Reads any `.ibk` file this build knows (versions 1 to 3).
+pub fn read(bytes: &[u8]) -> Result<IbkFile> {
+    let (version, _) = check_envelope(bytes, OLDEST_VERSION, v3::VERSION)?;
+    if version == v3::VERSION {
+        Ok(IbkFile::Samples(v3::decode(bytes)?))
+    } else {
+        Ok(IbkFile::Keys(decode(bytes)?))
+    }
+}
+
+/// Decodes a keyframe `.ibk` file (version 1 or 2), checking magic, version, checksum and every
+/// length. Version 3 files hold samples: [`read`] reads every version.
+pub fn decode(bytes: &[u8]) -> Result<Decoded> {
+    let body = check_envelope(bytes, OLDEST_VERSION, VERSION)?.1;
+    let mut r = Reader { bytes: body, pos: 6 };
+    let version = u16::from_le_bytes([bytes[4], bytes[5]]);
     r.u16("reserved")?;
     let frame_time = r.f64("frame time")?;
     let num_frames = r.u32("frame count")? as usize;
