@@ -79,6 +79,11 @@ pub struct RunArgs {
     /// Width of the preview GIF in pixels (at most 480).
     #[arg(long, default_value_t = 480)]
     pub gif_width: u32,
+    /// Also write story_skinned.gltf (+ story_skinned.png): every character as a skinned Kenney
+    /// blocky character (found next to --models or in ../shared/data); story.gltf keeps the stick
+    /// figures.
+    #[arg(long)]
+    pub skinned: bool,
 }
 
 #[derive(Args)]
@@ -178,6 +183,15 @@ fn print_run(source: &Path, r: &inbetween_script::job::RunReport) {
         r.before.contact,
         r.after.contact
     );
+    if !r.full {
+        let list = |v: &[String]| if v.is_empty() { "none".to_string() } else { v.join(", ") };
+        println!(
+            "  edit re-solved characters: {} (kept as they were: {}); objects re-optimised: {}",
+            list(&r.resolved_characters),
+            list(&r.kept_characters),
+            list(&r.resolved_objects)
+        );
+    }
     for f in &r.files {
         println!("  wrote {}", f.display());
     }
@@ -187,6 +201,24 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let (text, source) = load(&a.scene.script)?;
     let report = inbetween_script::job::run_story(&text, &source, &run_job(&a)).with_context(|| format!("animating {}", source.display()))?;
     print_run(&source, &report);
+    if a.skinned {
+        skinned(&a, &report)?;
+    }
+    Ok(())
+}
+
+/// `--skinned`: the skinned Kenney outputs next to the story's (after them, so a missing asset
+/// folder leaves the stick-figure outputs written).
+fn skinned(a: &RunArgs, r: &inbetween_script::job::RunReport) -> anyhow::Result<()> {
+    let models = a.scene.models.as_deref();
+    let cat = inbetween_script::job::catalogue(models)?;
+    let s = inbetween_script::output::skinned::write_skinned_story(&a.scene.out, &r.animation, &cat, models).context("writing the skinned characters")?;
+    for n in &s.notes {
+        println!("  {n}");
+    }
+    for f in &s.files {
+        println!("  wrote {}", f.display());
+    }
     Ok(())
 }
 
@@ -194,7 +226,14 @@ fn watch(a: WatchArgs) -> anyhow::Result<()> {
     let path = PathBuf::from(&a.run.scene.script);
     println!("watching {} (Ctrl-C to stop)", path.display());
     inbetween_script::job::watch(&path, &run_job(&a.run), a.max_runs, |outcome| match outcome {
-        Ok(r) => print_run(&path, &r),
+        Ok(r) => {
+            print_run(&path, &r);
+            if a.run.skinned {
+                if let Err(e) = skinned(&a.run, &r) {
+                    eprintln!("error: {}: {e:#}", path.display());
+                }
+            }
+        }
         Err(e) => eprintln!("error: {}: {e}", path.display()),
     })
     .with_context(|| format!("watching {}", path.display()))?;

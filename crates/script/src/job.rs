@@ -9,6 +9,7 @@ use crate::database::SceneDatabase;
 use crate::error::Diagnostic;
 use crate::output;
 use crate::session::Session;
+use crate::animate::incremental::StorySession;
 use crate::ScriptError;
 
 /// Variations per hand-authored room in the default database.
@@ -63,21 +64,18 @@ pub fn read_script(path: &Path) -> Result<String, ScriptError> {
     Ok(text)
 }
 
-/// Composes `text` (read from `source`, named in messages) and writes every output into the job's
-/// folder.
-pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneReport, ScriptError> {
-    if crate::script::split(text).is_empty() {
-        return Err(ScriptError::Empty { path: source.to_path_buf() });
-    }
+/// The catalogue for one script: with Kenney models when asked, and taught the script's unknown
+/// words through sentence embeddings with `--semantic` (the replacements come back as notes).
+fn script_catalogue(text: &str, job: &SceneJob) -> Result<(Catalogue, Vec<Diagnostic>), ScriptError> {
     let cat = catalogue(job.models.as_deref())?;
-    let (cat, notes) = match &job.semantic {
-        Some(dir) => crate::semantic::teach_unknown_words(text, &cat, dir.as_deref())?,
-        None => (cat, Vec::new()),
-    };
-    let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, job.seed);
-    let mut session = Session::new(cat, db, ComposeConfig { seed: job.seed, ..job.config.clone() });
-    let update = session.update(text);
-    let composition = update.composition;
+    match &job.semantic {
+        Some(dir) => crate::semantic::teach_unknown_words(text, &cat, dir.as_deref()),
+        None => Ok((cat, Vec::new())),
+    }
+}
+
+/// Writes the scene outputs (scene.json, ssg.json, scene.gltf, previews) of a composition.
+fn write_scene(composition: &Composition, cat: &Catalogue, job: &SceneJob) -> Result<Vec<PathBuf>, ScriptError> {
     let dir = &job.out_dir;
     std::fs::create_dir_all(dir).map_err(|e| ScriptError::io(dir, e))?;
     let mut files = Vec::new();
@@ -89,14 +87,29 @@ pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneRepor
     inbetween_io::write_atomic(&ssg, &ssg_text).map_err(|e| ScriptError::io(&ssg, e))?;
     files.push(ssg);
     let gltf = dir.join("scene.gltf");
-    output::write_gltf(&gltf, &composition.scene, session.catalogue())?;
+    output::write_gltf(&gltf, &composition.scene, cat)?;
     files.push(gltf);
     let view = job
         .view
         .clone()
         .or_else(|| composition.scene.camera.last().cloned())
         .unwrap_or_else(|| "front".to_string());
-    files.extend(output::write_previews(dir, &composition.scene, session.catalogue(), &view)?);
+    files.extend(output::write_previews(dir, &composition.scene, cat, &view)?);
+    Ok(files)
+}
+
+/// Composes `text` (read from `source`, named in messages) and writes every output into the job's
+/// folder.
+pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneReport, ScriptError> {
+    if crate::script::split(text).is_empty() {
+        return Err(ScriptError::Empty { path: source.to_path_buf() });
+    }
+    let (cat, notes) = script_catalogue(text, job)?;
+    let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, job.seed);
+    let mut session = Session::new(cat, db, ComposeConfig { seed: job.seed, ..job.config.clone() });
+    let update = session.update(text);
+    let composition = update.composition;
+    let files = write_scene(&composition, session.catalogue(), job)?;
     let diagnostics = notes.into_iter().chain(composition.diagnostics.iter().cloned()).collect();
     Ok(SceneReport { files, diagnostics, composition, seconds: update.seconds })
 }
@@ -123,38 +136,66 @@ pub struct RunReport {
     pub after: crate::optimize::Costs,
     pub files: Vec<PathBuf>,
     pub seconds: f64,
+    /// Whether this run solved everything afresh (`run`, and the first run of `watch`); later
+    /// runs of `watch` re-solve only what the edit touched.
+    pub full: bool,
+    /// Characters animated anew in this run, and those whose motion the edit left as it was.
+    pub resolved_characters: Vec<String>,
+    pub kept_characters: Vec<String>,
+    /// Objects the optimisation could move in this run (the others kept their places).
+    pub resolved_objects: Vec<String>,
+}
+
+/// A story session for a job (see [`StorySession`]): its catalogue, the scene database, the
+/// motion library and the settings of animation and optimisation. `notes`: the catalogue's
+/// notes (words read through embeddings).
+pub fn story_session(text: &str, job: &RunJob) -> Result<(StorySession, Vec<Diagnostic>), ScriptError> {
+    use crate::animate::AnimateConfig;
+    use crate::motion::library::MotionLibrary;
+    use crate::optimize::OptimizeConfig;
+    let (cat, notes) = script_catalogue(text, &job.scene)?;
+    let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, job.scene.seed);
+    let lib = if job.shared_motions { MotionLibrary::from_shared(64) } else { MotionLibrary::procedural(job.scene.seed) };
+    let ocfg = job.optimize.then(|| OptimizeConfig { seed: job.scene.seed, ..OptimizeConfig::default() });
+    let compose = ComposeConfig { seed: job.scene.seed, ..job.scene.config.clone() };
+    Ok((StorySession::new(cat, db, compose, lib, AnimateConfig::default(), ocfg), notes))
 }
 
 /// Composes the scene, animates every character, optimises scene and motion together, and writes
 /// the animated glTF, a BVH per character, the preview GIF from the script's camera, the
 /// top-down routes and the cost curves (Fig. 12).
 pub fn run_story(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, ScriptError> {
-    use crate::animate::{animate, camera_pose, AnimateConfig};
-    use crate::motion::library::MotionLibrary;
-    use crate::optimize::{costs, optimize, plot_costs, OptimizeConfig};
+    if crate::script::split(text).is_empty() {
+        return Err(ScriptError::Empty { path: source.to_path_buf() });
+    }
+    let (mut session, notes) = story_session(text, job)?;
+    run_story_in(&mut session, notes, text, source, job)
+}
+
+/// [`run_story`] in a session: only the first version of a story is solved in full; a later one
+/// re-solves only the characters and objects its edit touches.
+pub fn run_story_in(session: &mut StorySession, notes: Vec<Diagnostic>, text: &str, source: &Path, job: &RunJob) -> Result<RunReport, ScriptError> {
+    use crate::animate::camera_pose;
+    use crate::optimize::plot_costs;
     let start = std::time::Instant::now();
-    let scene = run_scene(text, source, &job.scene)?;
-    let cat = catalogue(job.scene.models.as_deref())?;
-    let lib = if job.shared_motions { MotionLibrary::from_shared(64) } else { MotionLibrary::procedural(job.scene.seed) };
-    let acfg = AnimateConfig::default();
-    let ocfg = OptimizeConfig { seed: job.scene.seed, ..OptimizeConfig::default() };
+    if crate::script::split(text).is_empty() {
+        return Err(ScriptError::Empty { path: source.to_path_buf() });
+    }
+    let u = session.update(text);
+    let cat = session.catalogue();
+    let scene_files = write_scene(&u.scene.composition, cat, &job.scene)?;
+    let mut files = scene_files.clone();
     let dir = &job.scene.out_dir;
-    let mut files = scene.files.clone();
-    let (animation, before, after) = if job.optimize {
-        let o = optimize(&scene.composition, &cat, &lib, &acfg, &ocfg);
+    if let Some(curves) = &u.curves {
         let plot = dir.join("costs.png");
-        plot_costs(&plot, &o.curves)?;
+        plot_costs(&plot, curves)?;
         files.push(plot);
-        (o.animation, o.before, o.after)
-    } else {
-        let a = animate(&scene.composition, &cat, &lib, &acfg);
-        let c = costs(&a, &ocfg);
-        (a, c, c)
-    };
+    }
+    let animation = u.animation;
     let chars: Vec<(&str, &inbetween_core::Motion)> = animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let cam = |f: usize| camera_pose(&animation, f);
     let gltf = dir.join("story.gltf");
-    output::write_animated_gltf(&gltf, &animation.scene, &cat, &chars, &cam, animation.fps)?;
+    output::write_animated_gltf(&gltf, &animation.scene, cat, &chars, &cam, animation.fps)?;
     files.push(gltf);
     for c in &animation.characters {
         let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
@@ -164,26 +205,56 @@ pub fn run_story(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, S
     }
     let gif = dir.join("story.gif");
     let opts = output::AnimPreviewOptions { width: job.gif_width, ..output::AnimPreviewOptions::default() };
-    output::render_preview_gif(&gif, &animation.scene, &cat, &chars, &cam, animation.fps, &opts)?;
+    output::render_preview_gif(&gif, &animation.scene, cat, &chars, &cam, animation.fps, &opts)?;
     files.push(gif);
     let routes = dir.join("routes.png");
-    output::render_top_down_trails(&routes, &animation.scene, &cat, &chars)?;
+    output::render_top_down_trails(&routes, &animation.scene, cat, &chars)?;
     files.push(routes);
-    Ok(RunReport { scene, animation, before, after, files, seconds: start.elapsed().as_secs_f64() })
+    let composition = u.scene.composition;
+    let diagnostics = notes.into_iter().chain(composition.diagnostics.iter().cloned()).collect();
+    let scene = SceneReport { files: scene_files, composition, diagnostics, seconds: u.scene.seconds };
+    Ok(RunReport {
+        scene,
+        animation,
+        before: u.before,
+        after: u.after,
+        files,
+        seconds: start.elapsed().as_secs_f64(),
+        full: u.full,
+        resolved_characters: u.resolved_characters,
+        kept_characters: u.kept_characters,
+        resolved_objects: u.resolved_objects,
+    })
 }
 
 /// `inbetween script watch`: re-runs `run` every time the script file changes (the paper's
-/// editing loop), until `max_runs` runs (None: forever). `on_run` sees each outcome; an error in
-/// one version (an empty file while saving) is reported and the loop goes on.
+/// editing loop), until `max_runs` runs (None: forever). One [`StorySession`] lives across the
+/// runs, so a later version re-solves only the characters and objects its edit touches (with
+/// `--semantic` the catalogue depends on the text, and every run starts afresh). `on_run` sees
+/// each outcome; an error in one version (an empty file while saving) is reported and the loop
+/// goes on.
 pub fn watch(path: &Path, job: &RunJob, max_runs: Option<usize>, mut on_run: impl FnMut(Result<RunReport, ScriptError>)) -> Result<(), ScriptError> {
     let mut last: Option<(std::time::SystemTime, u64)> = None;
     let mut runs = 0;
+    let mut session: Option<StorySession> = None;
     loop {
         let meta = std::fs::metadata(path).map_err(|e| ScriptError::io(path, e))?;
         let stamp = (meta.modified().map_err(|e| ScriptError::io(path, e))?, meta.len());
         if last != Some(stamp) {
             last = Some(stamp);
-            on_run(read_script(path).and_then(|text| run_story(&text, path, job)));
+            let outcome = read_script(path).and_then(|text| {
+                let notes = match (&mut session, &job.scene.semantic) {
+                    (Some(_), None) => Vec::new(),
+                    _ => {
+                        let (s, notes) = story_session(&text, job)?;
+                        session = Some(s);
+                        notes
+                    }
+                };
+                let s = session.as_mut().expect("a session was just made");
+                run_story_in(s, notes, &text, path, job)
+            });
+            on_run(outcome);
             runs += 1;
             if max_runs.is_some_and(|m| runs >= m) {
                 return Ok(());

@@ -101,7 +101,7 @@ fn walking_roots_stay_out_of_floor_objects() {
 }
 
 #[test]
-fn camera_follows_the_first_character_inside_the_room() {
+fn front_camera_frames_the_characters_from_inside_the_room() {
     let (_comp, anim) = demo();
     assert_eq!(anim.camera.len(), 1);
     assert_eq!(anim.camera[0].view, "front");
@@ -110,7 +110,9 @@ fn camera_follows_the_first_character_inside_the_room() {
     for f in (0..anim.frames()).step_by(17) {
         let (eye, target, fov) = camera_pose(&anim, f);
         assert!(eye[0] >= 0.0 && eye[0] <= room.width && eye[2] >= 0.0 && eye[2] <= room.depth && eye[1] <= room.height);
-        assert!(target[1] > 0.6 && target[1] < 1.6, "chest height {}", target[1]);
+        // The first character's chest, or on the axis of a two-shot, which frames both heads in
+        // the upper third (so it aims below them).
+        assert!(target[1] > 0.3 && target[1] < 1.7, "target height {}", target[1]);
         assert!(eye[2] >= target[2] - 1e-3, "front camera looks towards -z");
         assert!(fov > 20.0 && fov < 90.0);
     }

@@ -2,7 +2,7 @@
 //! synonyms, CMU tagging and loading on the real corpus when present.
 
 use inbetween_core::fk::forward_clip;
-use inbetween_script::motion::{ClipSource, MotionLibrary, Rig};
+use inbetween_script::motion::{walk_route_stats, ClipSource, MotionLibrary, Rig, WalkParams};
 
 #[test]
 fn procedural_library_needs_no_files_and_stands_on_the_floor() {
@@ -173,5 +173,29 @@ fn kenney_characters_add_clips_when_present() {
         assert!(fwd > 0.25 && up > 0.2, "kick reaches {fwd} forward, {up} up");
         let all = MotionLibrary::from_shared(10);
         assert!(all.clips.len() >= lib.clips.len());
+    });
+}
+
+#[test]
+fn captured_walks_give_locomotion_its_cycle() {
+    inbetween_io::data::with_shared_data("CMU mocap walks", |data| {
+        let dir = data.join("mocap/cmu");
+        if !dir.join("iclone_cc/002_01.bvh").is_file() {
+            println!("skipped: no data at {}", dir.join("iclone_cc/002_01.bvh").display());
+            return;
+        }
+        let lib = MotionLibrary::with_cmu(&dir, 40).expect("index reads");
+        let cycle = lib.cycle("walk").expect("a walk cycle");
+        assert!(cycle.is_captured(), "{}", cycle.name);
+        assert!(cycle.has_tag("cycle") && cycle.has_tag("cmu"));
+        let seconds = cycle.motion.num_frames() as f64 * cycle.motion.frame_time;
+        assert!((0.8..=1.6).contains(&seconds), "{}: {seconds} s", cycle.name);
+        // Walking an L-shaped route on captured steps: locking keeps skate low.
+        let route = [[0.0, 0.0], [0.0, 3.0], [2.5, 3.0]];
+        let (_, captured) = walk_route_stats(&route, &lib, &WalkParams::default());
+        let (_, procedural) = walk_route_stats(&route, &MotionLibrary::procedural(0), &WalkParams::default());
+        println!("{}: {seconds:.2} s; skate {:.1} → {:.1} cm/s (procedural cycle {:.1} → {:.1})", cycle.name, captured.skate_before, captured.skate_after, procedural.skate_before, procedural.skate_after);
+        assert!(captured.skate_after < 10.0, "{captured:?}");
+        assert!(captured.max_route_error < 0.3, "{captured:?}");
     });
 }

@@ -1,8 +1,11 @@
 //! Camera commands ("camera left", "camera front", ...) as shots over the animation, and the
-//! camera placed for a frame: relative to the first character and the room, looking at the
-//! character's chest, inside the room or on its boundary.
+//! camera placed for a frame. With one character: relative to it and the room, looking at its
+//! chest. With two or more: a two-shot of the first two placed in the camera engine's Toric
+//! space ([`inbetween_camera::toric`]: both heads at fixed screen positions), on the side of the
+//! pair the command names; "top" and "wide" keep the room-relative placement.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
+use inbetween_camera::toric::{to_pose, Lens, Toric};
 use inbetween_core::fk::forward;
 
 use super::{Animation, CameraShot};
@@ -62,18 +65,111 @@ pub fn view_at(anim: &Animation, frame: usize) -> &str {
         .unwrap_or("front")
 }
 
-/// Camera for a frame: (eye, target, vertical field of view in degrees). The target is the first
+/// Camera for a frame: (eye, target, vertical field of view in degrees). With two or more
+/// characters, a Toric two-shot when one fits in the room (see the module doc). Otherwise the target is the first
 /// character's chest (the room's centre at chest height without characters); the eye sits 3 m
 /// from it towards the named side of the room (front: +z, the door wall; back: −z; left: −x;
 /// right: +x), 2.2 m above for "top"-like views, 1.3 m away for "close", at the front wall's top
 /// corner side for "wide", clamped into the room.
 pub fn camera_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) {
+    if let Some(shot) = two_shot(anim, frame) {
+        return shot;
+    }
+    room_pose(anim, frame)
+}
+
+/// Vertical field of view of two-shots (degrees) and the preview's aspect ratio.
+const TWO_SHOT_FOV: f64 = 50.0;
+const TWO_SHOT_ASPECT: f64 = 1.5;
+/// Frames either side averaged for the two-shot targets, so the camera does not bob with the
+/// characters' steps.
+const TARGET_SMOOTHING: usize = 10;
+/// Closest the two heads may be for a two-shot, metres.
+const MIN_PAIR_DISTANCE: f64 = 0.3;
+
+/// A character's head at a frame, averaged over ±[`TARGET_SMOOTHING`] frames.
+fn smoothed_head(track: &super::CharacterTrack, frame: usize) -> Option<DVec3> {
+    let n = track.motion.num_frames();
+    if n == 0 {
+        return None;
+    }
+    let rig = Rig::try_of(track.motion.skeleton.clone()).ok()?;
+    let f = frame.min(n - 1);
+    let range = f.saturating_sub(TARGET_SMOOTHING)..=(f + TARGET_SMOOTHING).min(n - 1);
+    let count = range.clone().count() as f64;
+    let sum: DVec3 = range.map(|k| forward(&rig.skeleton, &track.motion.pose(k)).positions[rig.head]).sum();
+    Some(sum / count)
+}
+
+/// The Toric framing of a view (A: the first character, B: the second): both heads in the upper
+/// third, A left of B, `spread` times the default distance apart on screen, θ on the arc by the view (front/back/left/right: the symmetric two-shot;
+/// close: over A's shoulder), the camera lifted 15° above the pair.
+fn framing(view: &str, lens: &Lens, spread: f64) -> Toric {
+    let (pa, pb) = match view {
+        "close" => (DVec2::new(-0.45 * spread, 0.3), DVec2::new(0.3 * spread, 0.3)),
+        _ => (DVec2::new(-0.3 * spread, 0.3), DVec2::new(0.3 * spread, 0.3)),
+    };
+    let toric = Toric { pa, pb, theta: 0.0, phi: 15f64.to_radians() };
+    let max = toric.theta_max(lens);
+    let theta = if view == "close" { 0.3 * max } else { 0.5 * max };
+    Toric { theta, ..toric }
+}
+
+/// How far a camera position lies on the named side of the pair (front: +z, back: −z, left: −x,
+/// right: +x; close and others: front); a two-shot must be on that side (score > 0).
+fn side_score(view: &str, eye: DVec3, mid: DVec3) -> f64 {
+    let d = eye - mid;
+    match view {
+        "back" => -d.z,
+        "left" => -d.x,
+        "right" => d.x,
+        _ => d.z,
+    }
+}
+
+/// Two-shot of the first two characters through the camera engine, or None (fewer than two
+/// characters, a "top"/"wide" view, heads too close, or no framing that puts the camera inside
+/// the room on the named side).
+fn two_shot(anim: &Animation, frame: usize) -> Option<([f32; 3], [f32; 3], f32)> {
+    let view = view_at(anim, frame);
+    if anim.characters.len() < 2 || view == "top" || view == "wide" {
+        return None;
+    }
+    let a = smoothed_head(&anim.characters[0], frame)?;
+    let b = smoothed_head(&anim.characters[1], frame)?;
+    if a.distance(b) < MIN_PAIR_DISTANCE {
+        return None;
+    }
+    let lens = Lens { fovy: TWO_SHOT_FOV.to_radians(), aspect: TWO_SHOT_ASPECT };
+    let room = &anim.scene.room;
+    let inside = |p: DVec3| p.x >= 0.0 && p.x <= room.width as f64 && p.z >= 0.0 && p.z <= room.depth as f64 && p.y > 0.1 && p.y < room.height as f64;
+    let mid = (a + b) * 0.5;
+    // Tightest framing whose camera fits in the room: heads further apart on screen bring the
+    // camera closer. Swapping A and B puts the camera on the other side of the pair.
+    let pose = [1.0, 1.6, 2.2].into_iter().find_map(|spread| {
+        let toric = framing(view, &lens, spread);
+        [(a, b), (b, a)]
+            .into_iter()
+            .filter_map(|(p, q)| to_pose(&toric, p, q, &lens).ok())
+            .filter(|c| inside(c.position) && side_score(view, c.position, mid) > 0.0)
+            .max_by(|x, y| side_score(view, x.position, mid).total_cmp(&side_score(view, y.position, mid)))
+    })?;
+    // The look-at target: the point of the viewing axis level with the pair (roll is dropped).
+    let target = pose.position + pose.forward() * (mid - pose.position).dot(pose.forward()).max(0.5);
+    let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
+    Some((f(pose.position), f(target), TWO_SHOT_FOV as f32))
+}
+
+/// The room-relative placement around the first character (see [`camera_pose`]).
+fn room_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) {
     let room = &anim.scene.room;
     let chest = match anim.characters.first() {
         Some(c) if c.motion.num_frames() > 0 => {
-            let rig = Rig::of(c.motion.skeleton.clone());
             let f = frame.min(c.motion.num_frames() - 1);
-            forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1]
+            match Rig::try_of(c.motion.skeleton.clone()) {
+                Ok(rig) => forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1],
+                Err(_) => c.motion.pose(f).translations[0] + DVec3::Y * 0.3,
+            }
         }
         _ => DVec3::new(room.width as f64 / 2.0, 1.3, room.depth as f64 / 2.0),
     };
@@ -92,4 +188,74 @@ pub fn camera_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) 
     };
     let eye = [eye[0].clamp(0.0, w), eye[1].clamp(0.05, h), eye[2].clamp(0.0, d)];
     (eye, t, fov)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::animate::{CameraShot, CharacterTrack};
+    use crate::motion::rig::{yaw, FPS};
+    use crate::scene::{Room, Scene};
+    use inbetween_camera::toric::CameraPose;
+    use inbetween_core::Motion;
+
+    fn standing_at(rig: &Rig, x: f64, z: f64, heading: f64, frames: usize) -> Motion {
+        let mut p = rig.standing();
+        p.translations[rig.hips].x += x;
+        p.translations[rig.hips].z += z;
+        p.rotations[rig.hips] = (yaw(heading) * p.rotations[rig.hips]).normalize();
+        Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, &vec![p; frames]).unwrap()
+    }
+
+    fn two_people(view: &str) -> Animation {
+        let rig = Rig::standard();
+        let room = Room { name: "room".into(), width: 6.0, depth: 5.0, height: 2.8 };
+        let track = |name: &str, x: f64| CharacterTrack { name: name.into(), motion: standing_at(&rig, x, 2.5, 0.0, 40), segments: Vec::new() };
+        Animation {
+            fps: FPS,
+            scene: Scene { room, objects: Vec::new(), camera: Vec::new(), weather: None },
+            characters: vec![track("Eve", 2.0), track("Bob", 3.5)],
+            camera: vec![CameraShot { view: view.into(), start: 0, end: 40 }],
+            notes: Vec::new(),
+        }
+    }
+
+    fn head(anim: &Animation, c: usize, f: usize) -> DVec3 {
+        let rig = Rig::standard();
+        forward(&rig.skeleton, &anim.characters[c].motion.pose(f)).positions[rig.head]
+    }
+
+    /// Screen positions of both heads for the returned (eye, target), in the two-shot lens.
+    fn screen(anim: &Animation, f: usize) -> (DVec2, DVec2, DVec3) {
+        let (eye, target, fov) = camera_pose(anim, f);
+        let (eye, target) = (DVec3::from(eye.map(f64::from)), DVec3::from(target.map(f64::from)));
+        let pose = CameraPose::look_at(eye, target);
+        let lens = Lens { fovy: (fov as f64).to_radians(), aspect: TWO_SHOT_ASPECT };
+        (pose.project(&lens, head(anim, 0, f)).unwrap(), pose.project(&lens, head(anim, 1, f)).unwrap(), eye)
+    }
+
+    #[test]
+    fn two_characters_are_framed_together_from_the_named_side() {
+        for (view, side) in [("front", DVec3::Z), ("back", DVec3::NEG_Z)] {
+            let anim = two_people(view);
+            let (a, b, eye) = screen(&anim, 20);
+            for p in [a, b] {
+                assert!(p.x.abs() < 0.9 && p.y.abs() < 0.9, "{view}: head off screen at {p:?}");
+            }
+            assert!((a.x - b.x).abs() > 0.3, "{view}: heads overlap on screen ({a:?}, {b:?})");
+            let mid = (head(&anim, 0, 20) + head(&anim, 1, 20)) * 0.5;
+            assert!((eye - mid).dot(side) > 0.5, "{view}: camera at {eye:?} not on the {side:?} side of {mid:?}");
+            let room = &anim.scene.room;
+            assert!(eye.x >= 0.0 && eye.x <= room.width as f64 && eye.z >= 0.0 && eye.z <= room.depth as f64);
+        }
+    }
+
+    #[test]
+    fn one_character_or_a_top_view_keeps_the_room_camera() {
+        let mut anim = two_people("top");
+        assert_eq!(camera_pose(&anim, 5), room_pose(&anim, 5));
+        anim.camera[0].view = "front".into();
+        anim.characters.truncate(1);
+        assert_eq!(camera_pose(&anim, 5), room_pose(&anim, 5));
+    }
 }

@@ -15,19 +15,23 @@
 //!   contacts with [`reach_contacts`] (two-bone IK, clamped when out of reach: the gap left is
 //!   what the contact cost of [`crate::optimize`] measures).
 //!
-//! Several characters are planned in order, all starting at frame 0 near the door (at least
-//! [`PASSING_DISTANCE`] apart): a later character's grid blocks where earlier ones end up, and
-//! each of its walks waits in place (up to 5 s, in 1/3 s steps) until it keeps
-//! [`PASSING_DISTANCE`] from the earlier characters' roots frame by frame (else the least close
-//! wait is kept and a note says so). Earlier characters do not see later ones: one may walk
-//! through a later character standing still.
+//! Several characters all start at frame 0 near the door (at least [`PASSING_DISTANCE`] apart);
+//! a later character's grid blocks where earlier ones end up. [`crowd`] then keeps every pair of
+//! roots [`PASSING_DISTANCE`] apart at every frame, standing and sitting included (prioritised
+//! planning over space-time reservations: waits and detours, the later character yielding
+//! first), and notes what it cannot solve. [`incremental::StorySession`] re-solves only the
+//! characters (and the objects they touch) an edit changes.
 //!
 //! Segments are joined with a short cross-fade. Camera commands become [`CameraShot`]s and
 //! [`camera_pose`] places the camera for a frame.
 
 mod camera;
+pub mod crowd;
+pub mod incremental;
 
 pub use camera::{camera_pose, camera_shots};
+pub use crowd::{min_clearance, Clearance};
+pub(crate) use crowd::{WalkChoice, WalkInfo};
 
 use std::collections::HashMap;
 
@@ -215,7 +219,7 @@ pub fn contacts_of(scene: &Scene, cat: &Catalogue, obj: usize, kind: ContactKind
 }
 
 /// A character's actions with their sentence, grouped by name in order of appearance.
-fn characters(query: &Ssg) -> Vec<(String, Vec<(usize, crate::ssg::Action)>)> {
+pub(crate) fn characters(query: &Ssg) -> Vec<(String, Actions)> {
     let mut out: Vec<(String, Vec<(usize, crate::ssg::Action)>)> = Vec::new();
     let mut nodes: Vec<&crate::ssg::CharacterNode> = query.characters.iter().collect();
     nodes.sort_by_key(|c| c.sentence);
@@ -246,12 +250,14 @@ struct Builder<'a> {
     cfg: &'a AnimateConfig,
     frames: Vec<Pose>,
     segments: Vec<Segment>,
-    /// Root (x, z) per frame of the characters animated before (they stay at their last
-    /// position afterwards).
-    others: &'a [Vec<[f32; 2]>],
+    /// Per walk (in order): how long to wait first and which route to take (set by
+    /// [`crowd::separate`]; the default walks at once along the A* route).
+    choices: &'a [WalkChoice],
+    /// The walks made so far.
+    walks: Vec<WalkInfo>,
 }
 
-/// Closest approach (metres) between two walkers' roots that [`Builder::walk`] accepts.
+/// Closest approach (metres) between two characters' roots that [`crowd::separate`] accepts.
 pub const PASSING_DISTANCE: f32 = 0.5;
 
 fn smooth(t: f64) -> f64 {
@@ -345,13 +351,18 @@ impl<'a> Builder<'a> {
         st.pos = at;
     }
 
-    /// Walks along a route to `to`, turning to `final_heading`.
+    /// Walks along a route to `to`, turning to `final_heading`, after waiting in place as this
+    /// walk's [`WalkChoice`] says.
     #[allow(clippy::too_many_arguments)]
     fn walk(&mut self, st: &mut State, grid: &Grid, to: [f32; 2], final_heading: f64, verb: &str, speed: Option<f64>, cache: &mut WalkCache, notes: &mut Vec<String>, name: &str) {
-        let route = route(grid, st.pos, to).unwrap_or_else(|| {
-            notes.push(format!("{name}: no route from ({:.2}, {:.2}) to ({:.2}, {:.2}); walking straight", st.pos[0], st.pos[1], to[0], to[1]));
-            vec![st.pos, to]
-        });
+        let choice = self.choices.get(self.walks.len()).cloned().unwrap_or_default();
+        let route = match choice.route {
+            Some(r) => r,
+            None => route(grid, st.pos, to).unwrap_or_else(|| {
+                notes.push(format!("{name}: no route from ({:.2}, {:.2}) to ({:.2}, {:.2}); walking straight", st.pos[0], st.pos[1], to[0], to[1]));
+                vec![st.pos, to]
+            }),
+        };
         let params = WalkParams {
             verb: if self.lib.cycle(verb).is_some() { verb.to_string() } else { "walk".into() },
             speed,
@@ -361,50 +372,21 @@ impl<'a> Builder<'a> {
             ..WalkParams::default()
         };
         let m = cache.walk(&route, self.lib, &params);
-        let mut poses = m.poses();
-        // Wait (idle in place) until the walk keeps clear of the characters animated before.
-        if !self.others.is_empty() {
-            let root = |p: &Pose| {
-                let r = p.translations[self.rig.hips];
-                [r.x as f32, r.z as f32]
-            };
-            let path: Vec<[f32; 2]> = poses.iter().map(root).collect();
-            let t0 = self.frames.len();
-            // Waiting `d` frames at the start, then walking: the root at each frame from t0.
-            let at = |d: usize, k: usize| if k < d { path[0] } else { path[k - d] };
-            // Closest approach to the others when waiting `d` frames first.
-            let closest = |d: usize| {
-                (0..d + path.len())
-                    .flat_map(|k| self.others.iter().filter(|o| !o.is_empty()).map(move |o| dist2(o[(t0 + k).min(o.len() - 1)], at(d, k))))
-                    .fold(f32::INFINITY, f32::min)
-                    .sqrt()
-            };
-            let mut best = (0usize, closest(0));
-            for d in (10..=150).step_by(10) {
-                if best.1 >= PASSING_DISTANCE {
-                    break;
-                }
-                let c = closest(d);
-                if c > best.1 + 1e-3 {
-                    best = (d, c);
-                }
-            }
-            if best.1 < PASSING_DISTANCE {
-                notes.push(format!("{name}: passes {:.2} m from another character on the way to ({:.2}, {:.2})", best.1, to[0], to[1]));
-            }
-            if best.0 > 0 {
-                let idle = self.idle_clip();
-                let mut wait = self.looped(&idle, st.pos, st.heading, best.0);
-                wait.extend(poses);
-                poses = wait;
-            }
+        let wait_start = self.frames.len();
+        if choice.wait > 0 {
+            let idle = self.idle_clip();
+            let wait = self.looped(&idle, st.pos, st.heading, choice.wait);
+            self.append(wait);
         }
+        let poses = m.poses();
         if let Some(last) = poses.last() {
             let r = last.translations[self.rig.hips];
             st.pos = [r.x as f32, r.z as f32];
         }
-        st.heading = final_heading;
+        let walk_start = self.frames.len();
         self.append(poses);
+        self.walks.push(WalkInfo { wait_start, walk_start, end: self.frames.len(), route, params });
+        st.heading = final_heading;
     }
 }
 
@@ -463,216 +445,305 @@ fn heading_to(a: [f32; 2], b: [f32; 2], default: f64) -> f64 {
 
 /// The animation with a walk cache (the optimiser re-animates many nearly equal scenes).
 pub(crate) fn animate_cached(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: &MotionLibrary, cfg: &AnimateConfig, cache: &mut WalkCache) -> Animation {
-    let rig = Rig::standard();
+    animate_planned(scene, query, cat, lib, cfg, cache, &HashMap::new()).animation
+}
+
+/// The scene, query and settings one character is built in.
+pub(crate) struct Ctx<'a> {
+    pub scene: &'a Scene,
+    pub query: &'a Ssg,
+    pub cat: &'a Catalogue,
+    pub lib: &'a MotionLibrary,
+    pub cfg: &'a AnimateConfig,
+    pub rig: Rig,
+}
+
+/// A character's actions with the sentence each comes from.
+pub(crate) type Actions = Vec<(usize, crate::ssg::Action)>;
+
+/// Everything needed to rebuild one character with other walk choices, and what it built.
+#[derive(Debug, Clone)]
+pub(crate) struct CharacterPlan {
+    pub actions: Actions,
+    pub start: [f32; 2],
+    /// Where the characters planned before end up (blocked in `grid`).
+    pub blocked_by: Vec<[f32; 2]>,
+    /// The character's occupancy grid (objects plus `blocked_by`).
+    pub grid: Grid,
+    pub choices: Vec<WalkChoice>,
+    pub track: CharacterTrack,
+    /// Root (x, z) per frame.
+    pub traj: Vec<[f32; 2]>,
+    pub walks: Vec<WalkInfo>,
+    /// (sentence, first frame) of every action, for the camera cuts.
+    pub marks: Vec<(usize, usize)>,
+    pub notes: Vec<String>,
+    /// Where it ends: the stand point, and the seat when seated (later characters keep clear).
+    pub end_spots: Vec<[f32; 2]>,
+}
+
+/// What [`animate_planned`] returns.
+pub(crate) struct Planned {
+    pub animation: Animation,
+    pub plans: Vec<CharacterPlan>,
+    /// Per character: built (or rebuilt) in this call rather than taken from `frozen`.
+    pub resolved: Vec<bool>,
+    /// Character builds per character (the crowd repair rebuilds a character per change).
+    pub builds: Vec<usize>,
+}
+
+/// Animates every character: each built on its own timeline (later characters' grids block
+/// where earlier ones end up), then [`crowd::separate`] adds waits and detours until every pair
+/// of roots keeps [`PASSING_DISTANCE`] at every frame. A character found in `frozen` (by lower-case
+/// name) whose start and blocked spots are unchanged is taken as it is, and only rebuilt when a
+/// conflict cannot be solved otherwise.
+pub(crate) fn animate_planned(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: &MotionLibrary, cfg: &AnimateConfig, cache: &mut WalkCache, frozen: &HashMap<String, CharacterPlan>) -> Planned {
+    let ctx = Ctx { scene, query, cat, lib, cfg, rig: Rig::standard() };
     let base_grid = Grid::from_objects(&scene.room, &scene.objects, grid::CELL, grid::WALKER_RADIUS);
-    let mut notes = Vec::new();
-    let mut tracks = Vec::new();
+    let mut plans: Vec<CharacterPlan> = Vec::new();
+    let mut names = Vec::new();
+    let (mut resolved, mut builds) = (Vec::new(), Vec::new());
     // Where earlier characters end up: later characters' routes keep clear of them.
     let mut occupied: Vec<[f32; 2]> = Vec::new();
-    let mut trajectories: Vec<Vec<[f32; 2]>> = Vec::new();
-    // (sentence, first frame) of every action, for the camera cuts.
-    let mut marks: Vec<(usize, usize)> = Vec::new();
     for (ci, (name, actions)) in characters(query).into_iter().enumerate() {
         let mut g = base_grid.clone();
         for p in &occupied {
-            g.block_rect(*p, [0.0, 0.0], 0.0, 0.35);
+            g.block_rect(*p, [0.0, 0.0], 0.0, PASSING_DISTANCE + grid::CELL);
         }
-        let door = layout::door(&scene.room);
-        let side = if ci % 2 == 0 { 1.0 } else { -1.0 };
-        let want = [door[0] + side * cfg.start_spacing * ci.div_ceil(2) as f32, door[1]];
-        let mut gs = g.clone();
-        for t in &trajectories {
-            if let Some(p) = t.first() {
-                gs.block_rect(*p, [0.0, 0.0], 0.0, PASSING_DISTANCE);
+        let starts: Vec<[f32; 2]> = plans.iter().map(|p| p.start).collect();
+        let start = start_spot(scene, cfg, &base_grid, &g, &starts, ci);
+        let plan = match frozen.get(&name.to_lowercase()) {
+            Some(p) if p.start == start && p.blocked_by == occupied && p.actions == actions => {
+                resolved.push(false);
+                builds.push(0);
+                CharacterPlan { grid: g, ..p.clone() }
             }
-        }
-        // The free cell nearest the door spot that is reachable from the door and clear of
-        // the characters already placed there.
-        let door_reach = g.nearest_free(door).map(|c| g.reachable_from(c));
-        let mut best: Option<(f32, [f32; 2])> = None;
-        for j in 0..gs.nz {
-            for i in 0..gs.nx {
-                let ok = !gs.is_blocked((i, j)) && door_reach.as_ref().is_none_or(|r| r[j * g.nx + i]);
-                let c = gs.center((i, j));
-                if ok && best.is_none_or(|(d, _)| dist2(c, want) < d) {
-                    best = Some((dist2(c, want), c));
-                }
+            _ => {
+                resolved.push(true);
+                builds.push(1);
+                build_character(&ctx, &name, actions, start, g, occupied.clone(), Vec::new(), cache)
             }
-        }
-        let start = best.map(|b| b.1).or_else(|| base_grid.nearest_free(want).map(|c| g.center(c))).unwrap_or([scene.room.width / 2.0, scene.room.depth / 2.0]);
-        let mut st = State { pos: start, heading: std::f64::consts::PI, seated: None };
-        let mut b = Builder { rig: rig.clone(), lib, fallback: None, cfg, frames: Vec::new(), segments: Vec::new(), others: &trajectories };
-        for (sentence, a) in &actions {
-            marks.push((*sentence, b.frames.len()));
-            let obj = a.target.and_then(|t| object_of_node(scene, query, t));
-            if a.target.is_some() && obj.is_none() {
-                notes.push(format!("{name}: the target of \"{}\" is not in the scene", a.verb));
-            }
-            let verb = crate::motion::verbs::canonical(&a.verb).unwrap_or(a.verb.as_str()).to_string();
-            let slow = a.manner.iter().any(|m| matches!(m.as_str(), "slowly" | "carefully" | "gently" | "lazily"));
-            let speed = slow.then_some(cfg.slow_speed);
-            let locomotion = lib.cycle(&verb).is_some() || verb == "walk" || verb == "run";
-            if locomotion {
-                b.stand_up(&mut st, scene);
-                let start = b.frames.len();
-                let (to, h) = match obj {
-                    Some(o) => {
-                        let to = stand_point(scene, cat, &g, o, st.pos);
-                        (to, heading_to(to, geom::center(&scene.objects[o]), st.heading))
-                    }
-                    None => {
-                        let f = [st.heading.sin() as f32, st.heading.cos() as f32];
-                        let p = [st.pos[0] + 2.0 * f[0], st.pos[1] + 2.0 * f[1]];
-                        let to = g.nearest_free(p).map(|c| g.center(c)).unwrap_or(st.pos);
-                        (to, st.heading)
-                    }
-                };
-                b.walk(&mut st, &g, to, h, &verb, speed, cache, &mut notes, &name);
-                b.push_segment(&verb, start, obj, scene, obj.into_iter().collect(), Vec::new());
-                continue;
-            }
-            if verb == "sit" || verb == "sit_down" {
-                let seat = obj.and_then(|o| {
-                    let seats = contacts_of(scene, cat, o, ContactKind::Seat);
-                    seats.into_iter().min_by(|p, q| dist2([p[0], p[2]], st.pos).total_cmp(&dist2([q[0], q[2]], st.pos))).map(|s| (o, s))
-                });
-                match (seat, st.seated) {
-                    (Some((o, s)), seated) if seated.is_none_or(|(_, _, so)| so != o) => {
-                        b.stand_up(&mut st, scene);
-                        let yaw = scene.objects[o].yaw as f64;
-                        let sp = seat_point();
-                        let f = [yaw.sin(), yaw.cos()];
-                        // The sit-down clip's seat lies `-sp.z` behind where it starts.
-                        let at = [s[0] + (-sp.z * f[0]) as f32, s[2] + (-sp.z * f[1]) as f32];
-                        let start = b.frames.len();
-                        b.walk(&mut st, &g, at, yaw, "walk", speed, cache, &mut notes, &name);
-                        b.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
-                        let start = b.frames.len();
-                        let clip = b.named("procedural sit down");
-                        let mut poses = place_clip(&clip, st.pos, yaw).poses();
-                        let n = poses.len().max(2);
-                        let dy = s[1] as f64 - SEAT_HEIGHT;
-                        b.lift(&mut poses, |k| dy * smooth(k as f64 / (n - 1) as f64));
-                        b.append(poses);
-                        let seated_from = b.frames.len();
-                        let hold = (cfg.min_action_seconds * FPS).round() as usize;
-                        let poses = b.seated(st.pos, s, yaw, hold.max(1));
-                        b.append(poses);
-                        st.seated = Some((st.pos, s, o));
-                        let hips = JointContact { joint: ContactJoint::Hips, kind: ContactKind::Seat, point: [s[0], s[1] + PELVIS_ABOVE_SEAT as f32, s[2]], start: seated_from, end: b.frames.len() };
-                        b.push_segment("sit", start, Some(o), scene, vec![o], vec![hips]);
-                    }
-                    _ => {
-                        if seat.is_none() && obj.is_some() {
-                            notes.push(format!("{name}: nothing to sit on in {}", scene.objects[obj.unwrap_or(0)].label));
-                        }
-                        // Already seated (or no seat): hold.
-                        let start = b.frames.len();
-                        let n = (cfg.min_action_seconds * FPS).round() as usize;
-                        let poses = match st.seated {
-                            Some((at, s, _)) => b.seated(at, s, st.heading, n),
-                            None => {
-                                let idle = b.idle_clip();
-                                b.looped(&idle, st.pos, st.heading, n)
-                            }
-                        };
-                        b.append(poses);
-                        let touching = st.seated.map(|s| vec![s.2]).unwrap_or_default();
-                        b.push_segment("sit", start, obj, scene, touching, Vec::new());
-                    }
-                }
-                continue;
-            }
-            if verb == "stand_up" || (verb == "stand" && st.seated.is_some()) {
-                b.stand_up(&mut st, scene);
-                continue;
-            }
-            // Turning on the spot.
-            let turn = if verb == "turn" {
-                if a.manner.iter().any(|m| m == "right") {
-                    Some(-std::f64::consts::FRAC_PI_2)
-                } else if a.manner.iter().any(|m| m == "left") {
-                    Some(std::f64::consts::FRAC_PI_2)
-                } else {
-                    Some(std::f64::consts::PI)
-                }
-            } else {
-                None
-            };
-            if let (Some(dh), None) = (turn, st.seated) {
-                let start = b.frames.len();
-                let to = st.heading + dh;
-                let m = cache.walk(&[st.pos], lib, &WalkParams { initial_heading: Some(st.heading), final_heading: Some(to), lock_feet: cfg.lock_feet, ..WalkParams::default() });
-                b.append(m.poses());
-                st.heading = to;
-                b.push_segment("turn", start, obj, scene, Vec::new(), Vec::new());
-                continue;
-            }
-            // An action in place, over the idle or seated lower body.
-            let action = lib.retrieve(&verb).filter(|c| c.motion.skeleton == rig.skeleton).map(|c| c.motion.clone());
-            if action.is_none() && verb != "stand" && verb != "idle" {
-                notes.push(format!("{name}: no clip for \"{}\"; standing instead", a.verb));
-            }
-            let clip_len = action.as_ref().map(|m| m.num_frames()).unwrap_or(0).max(1);
-            let min = (cfg.min_action_seconds * FPS).round() as usize;
-            let n = clip_len * min.div_ceil(clip_len).max(1);
-            // A standing character walks up to a target out of reach first.
-            if let (Some(o), None) = (obj, st.seated) {
-                let to = stand_point(scene, cat, &g, o, st.pos);
-                if dist2(to, st.pos) > cfg.approach_distance * cfg.approach_distance {
-                    let start = b.frames.len();
-                    let h = heading_to(to, geom::center(&scene.objects[o]), st.heading);
-                    b.walk(&mut st, &g, to, h, "walk", speed, cache, &mut notes, &name);
-                    b.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
-                }
-            }
-            // Face the target when standing.
-            if let (Some(o), None) = (obj, st.seated) {
-                st.heading = heading_to(st.pos, geom::center(&scene.objects[o]), st.heading);
-            }
-            let base = match st.seated {
-                Some((at, s, _)) => b.seated(at, s, st.heading, n),
-                None => {
-                    let idle = b.idle_clip();
-                    b.looped(&idle, st.pos, st.heading, n)
-                }
-            };
-            let base = crate::motion::rig::clip(&rig, &base);
-            let mut m = match &action {
-                Some(act) => blend_upper(&base, act, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 }),
-                None => base,
-            };
-            let start = b.frames.len();
-            let mut contacts = Vec::new();
-            if let (Some(o), true) = (obj, cfg.reach) {
-                let (ik, jc) = hand_contacts(&rig, &m, scene, cat, o, start);
-                if !ik.is_empty() {
-                    m = reach_contacts(&m, &ik).0;
-                }
-                contacts = jc;
-            }
-            b.append(m.poses());
-            let mut touching: Vec<usize> = obj.into_iter().collect();
-            touching.extend(st.seated.map(|s| s.2));
-            b.push_segment(&verb, start, obj, scene, touching, contacts);
-        }
-        if b.frames.is_empty() {
-            let idle = b.idle_clip();
-            let poses = b.looped(&idle, st.pos, st.heading, (cfg.min_action_seconds * FPS).round() as usize);
-            b.append(poses);
-        }
-        occupied.push(st.pos);
-        if let Some((_, s, _)) = st.seated {
-            occupied.push([s[0], s[2]]);
-        }
-        let motion = crate::motion::rig::clip(&rig, &b.frames);
-        let traj: Vec<[f32; 2]> = b.frames.iter().map(|p| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32]).collect();
-        tracks.push(CharacterTrack { name, motion, segments: b.segments });
-        trajectories.push(traj);
+        };
+        occupied.extend(plan.end_spots.iter().copied());
+        names.push(name);
+        plans.push(plan);
     }
+    let crowd_notes = crowd::separate(&ctx, &names, &mut plans, &mut resolved, &mut builds, cache);
+    let mut notes: Vec<String> = plans.iter().flat_map(|p| p.notes.iter().cloned()).collect();
+    notes.extend(crowd_notes);
+    let marks: Vec<(usize, usize)> = plans.iter().flat_map(|p| p.marks.iter().copied()).collect();
+    let tracks = plans.iter().map(|p| p.track.clone()).collect();
     let mut anim = Animation { fps: FPS, scene: scene.clone(), characters: tracks, camera: Vec::new(), notes };
     anim.camera = camera_shots(&anim, query, &marks);
-    anim
+    Planned { animation: anim, plans, resolved, builds }
+}
+
+/// Where character `ci` starts: along the door wall, `start_spacing` apart on alternating sides,
+/// on the free cell nearest that spot that is reachable from the door and at least
+/// [`PASSING_DISTANCE`] from the characters placed before (`starts`).
+fn start_spot(scene: &Scene, cfg: &AnimateConfig, base_grid: &Grid, g: &Grid, starts: &[[f32; 2]], ci: usize) -> [f32; 2] {
+    let door = layout::door(&scene.room);
+    let side = if ci.is_multiple_of(2) { 1.0 } else { -1.0 };
+    let want = [door[0] + side * cfg.start_spacing * ci.div_ceil(2) as f32, door[1]];
+    let mut gs = g.clone();
+    for p in starts {
+        gs.block_rect(*p, [0.0, 0.0], 0.0, PASSING_DISTANCE);
+    }
+    let door_reach = g.nearest_free(door).map(|c| g.reachable_from(c));
+    let mut best: Option<(f32, [f32; 2])> = None;
+    for j in 0..gs.nz {
+        for i in 0..gs.nx {
+            let ok = !gs.is_blocked((i, j)) && door_reach.as_ref().is_none_or(|r| r[j * g.nx + i]);
+            let c = gs.center((i, j));
+            if ok && best.is_none_or(|(d, _)| dist2(c, want) < d) {
+                best = Some((dist2(c, want), c));
+            }
+        }
+    }
+    best.map(|b| b.1).or_else(|| base_grid.nearest_free(want).map(|c| g.center(c))).unwrap_or([scene.room.width / 2.0, scene.room.depth / 2.0])
+}
+
+/// Builds one character's timeline from `start` on its grid `g`, walking as `choices` say.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f32; 2], g: Grid, blocked_by: Vec<[f32; 2]>, choices: Vec<WalkChoice>, cache: &mut WalkCache) -> CharacterPlan {
+    let (scene, query, cat, lib, cfg, rig) = (ctx.scene, ctx.query, ctx.cat, ctx.lib, ctx.cfg, &ctx.rig);
+    let mut notes = Vec::new();
+    let mut marks = Vec::new();
+    let mut st = State { pos: start, heading: std::f64::consts::PI, seated: None };
+    let mut b = Builder { rig: rig.clone(), lib, fallback: None, cfg, frames: Vec::new(), segments: Vec::new(), choices: &choices, walks: Vec::new() };
+    for (sentence, a) in &actions {
+        marks.push((*sentence, b.frames.len()));
+        let obj = a.target.and_then(|t| object_of_node(scene, query, t));
+        if a.target.is_some() && obj.is_none() {
+            notes.push(format!("{name}: the target of \"{}\" is not in the scene", a.verb));
+        }
+        let verb = crate::motion::verbs::canonical(&a.verb).unwrap_or(a.verb.as_str()).to_string();
+        let slow = a.manner.iter().any(|m| matches!(m.as_str(), "slowly" | "carefully" | "gently" | "lazily"));
+        let speed = slow.then_some(cfg.slow_speed);
+        let locomotion = lib.cycle(&verb).is_some() || verb == "walk" || verb == "run";
+        if locomotion {
+            b.stand_up(&mut st, scene);
+            let start = b.frames.len();
+            let (to, h) = match obj {
+                Some(o) => {
+                    let to = stand_point(scene, cat, &g, o, st.pos);
+                    (to, heading_to(to, geom::center(&scene.objects[o]), st.heading))
+                }
+                None => {
+                    let f = [st.heading.sin() as f32, st.heading.cos() as f32];
+                    let p = [st.pos[0] + 2.0 * f[0], st.pos[1] + 2.0 * f[1]];
+                    let to = g.nearest_free(p).map(|c| g.center(c)).unwrap_or(st.pos);
+                    (to, st.heading)
+                }
+            };
+            b.walk(&mut st, &g, to, h, &verb, speed, cache, &mut notes, name);
+            b.push_segment(&verb, start, obj, scene, obj.into_iter().collect(), Vec::new());
+            continue;
+        }
+        if verb == "sit" || verb == "sit_down" {
+            let seat = obj.and_then(|o| {
+                let seats = contacts_of(scene, cat, o, ContactKind::Seat);
+                seats.into_iter().min_by(|p, q| dist2([p[0], p[2]], st.pos).total_cmp(&dist2([q[0], q[2]], st.pos))).map(|s| (o, s))
+            });
+            match (seat, st.seated) {
+                (Some((o, s)), seated) if seated.is_none_or(|(_, _, so)| so != o) => {
+                    b.stand_up(&mut st, scene);
+                    let yaw = scene.objects[o].yaw as f64;
+                    let sp = seat_point();
+                    let f = [yaw.sin(), yaw.cos()];
+                    // The sit-down clip's seat lies `-sp.z` behind where it starts.
+                    let at = [s[0] + (-sp.z * f[0]) as f32, s[2] + (-sp.z * f[1]) as f32];
+                    let start = b.frames.len();
+                    b.walk(&mut st, &g, at, yaw, "walk", speed, cache, &mut notes, name);
+                    b.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
+                    let start = b.frames.len();
+                    let clip = b.named("procedural sit down");
+                    let mut poses = place_clip(&clip, st.pos, yaw).poses();
+                    let n = poses.len().max(2);
+                    let dy = s[1] as f64 - SEAT_HEIGHT;
+                    b.lift(&mut poses, |k| dy * smooth(k as f64 / (n - 1) as f64));
+                    b.append(poses);
+                    let seated_from = b.frames.len();
+                    let hold = (cfg.min_action_seconds * FPS).round() as usize;
+                    let poses = b.seated(st.pos, s, yaw, hold.max(1));
+                    b.append(poses);
+                    st.seated = Some((st.pos, s, o));
+                    let hips = JointContact { joint: ContactJoint::Hips, kind: ContactKind::Seat, point: [s[0], s[1] + PELVIS_ABOVE_SEAT as f32, s[2]], start: seated_from, end: b.frames.len() };
+                    b.push_segment("sit", start, Some(o), scene, vec![o], vec![hips]);
+                }
+                _ => {
+                    if seat.is_none() && obj.is_some() {
+                        notes.push(format!("{name}: nothing to sit on in {}", scene.objects[obj.unwrap_or(0)].label));
+                    }
+                    // Already seated (or no seat): hold.
+                    let start = b.frames.len();
+                    let n = (cfg.min_action_seconds * FPS).round() as usize;
+                    let poses = match st.seated {
+                        Some((at, s, _)) => b.seated(at, s, st.heading, n),
+                        None => {
+                            let idle = b.idle_clip();
+                            b.looped(&idle, st.pos, st.heading, n)
+                        }
+                    };
+                    b.append(poses);
+                    let touching = st.seated.map(|s| vec![s.2]).unwrap_or_default();
+                    b.push_segment("sit", start, obj, scene, touching, Vec::new());
+                }
+            }
+            continue;
+        }
+        if verb == "stand_up" || (verb == "stand" && st.seated.is_some()) {
+            b.stand_up(&mut st, scene);
+            continue;
+        }
+        // Turning on the spot.
+        let turn = if verb == "turn" {
+            if a.manner.iter().any(|m| m == "right") {
+                Some(-std::f64::consts::FRAC_PI_2)
+            } else if a.manner.iter().any(|m| m == "left") {
+                Some(std::f64::consts::FRAC_PI_2)
+            } else {
+                Some(std::f64::consts::PI)
+            }
+        } else {
+            None
+        };
+        if let (Some(dh), None) = (turn, st.seated) {
+            let start = b.frames.len();
+            let to = st.heading + dh;
+            let m = cache.walk(&[st.pos], lib, &WalkParams { initial_heading: Some(st.heading), final_heading: Some(to), lock_feet: cfg.lock_feet, ..WalkParams::default() });
+            b.append(m.poses());
+            st.heading = to;
+            b.push_segment("turn", start, obj, scene, Vec::new(), Vec::new());
+            continue;
+        }
+        // An action in place, over the idle or seated lower body.
+        let action = lib.retrieve(&verb).filter(|c| c.motion.skeleton == rig.skeleton).map(|c| c.motion.clone());
+        if action.is_none() && verb != "stand" && verb != "idle" {
+            notes.push(format!("{name}: no clip for \"{}\"; standing instead", a.verb));
+        }
+        let clip_len = action.as_ref().map(|m| m.num_frames()).unwrap_or(0).max(1);
+        let min = (cfg.min_action_seconds * FPS).round() as usize;
+        let n = clip_len * min.div_ceil(clip_len).max(1);
+        // A standing character walks up to a target out of reach first.
+        if let (Some(o), None) = (obj, st.seated) {
+            let to = stand_point(scene, cat, &g, o, st.pos);
+            if dist2(to, st.pos) > cfg.approach_distance * cfg.approach_distance {
+                let start = b.frames.len();
+                let h = heading_to(to, geom::center(&scene.objects[o]), st.heading);
+                b.walk(&mut st, &g, to, h, "walk", speed, cache, &mut notes, name);
+                b.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
+            }
+        }
+        // Face the target when standing.
+        if let (Some(o), None) = (obj, st.seated) {
+            st.heading = heading_to(st.pos, geom::center(&scene.objects[o]), st.heading);
+        }
+        let base = match st.seated {
+            Some((at, s, _)) => b.seated(at, s, st.heading, n),
+            None => {
+                let idle = b.idle_clip();
+                b.looped(&idle, st.pos, st.heading, n)
+            }
+        };
+        let base = crate::motion::rig::clip(rig, &base);
+        let mut m = match &action {
+            Some(act) => blend_upper(&base, act, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 }),
+            None => base,
+        };
+        let start = b.frames.len();
+        let mut contacts = Vec::new();
+        if let (Some(o), true) = (obj, cfg.reach) {
+            let (ik, jc) = hand_contacts(rig, &m, scene, cat, o, start);
+            if !ik.is_empty() {
+                m = reach_contacts(&m, &ik).0;
+            }
+            contacts = jc;
+        }
+        b.append(m.poses());
+        let mut touching: Vec<usize> = obj.into_iter().collect();
+        touching.extend(st.seated.map(|s| s.2));
+        b.push_segment(&verb, start, obj, scene, touching, contacts);
+    }
+    if b.frames.is_empty() {
+        let idle = b.idle_clip();
+        let poses = b.looped(&idle, st.pos, st.heading, (cfg.min_action_seconds * FPS).round() as usize);
+        b.append(poses);
+    }
+    if b.frames.is_empty() {
+        let idle = b.idle_clip();
+        let poses = b.looped(&idle, st.pos, st.heading, (cfg.min_action_seconds * FPS).round() as usize);
+        b.append(poses);
+    }
+    let mut end_spots = vec![st.pos];
+    if let Some((_, s, _)) = st.seated {
+        end_spots.push([s[0], s[2]]);
+    }
+    let motion = crate::motion::rig::clip(rig, &b.frames);
+    let traj: Vec<[f32; 2]> = b.frames.iter().map(|p| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32]).collect();
+    let walks = b.walks;
+    let track = CharacterTrack { name: name.to_string(), motion, segments: b.segments };
+    CharacterPlan { actions, start, blocked_by, grid: g, choices, track, traj, walks, marks, notes, end_spots }
 }
 
 /// IK contacts (wrist targets) and cost contacts for a hand action on object `o`: keys take both

@@ -107,6 +107,16 @@ const ROWS: &[Row] = &[
     ("car", &["automobile", "vehicle"], "vehicle", [1.8, 1.5, 4.5], Floor, true, [60, 80, 160], &[(Grip, [0.9, 1.0, 0.5])]),
 ];
 
+/// Lowest table a seated person puts their legs under, metres.
+const KNEE_HEIGHT: f32 = 0.6;
+
+/// Whether a category is a table with room for legs below its top (class "table", at least knee
+/// high: desk, table, dining table, workbench), so its collision model is a top slab on four legs
+/// rather than a solid block (see `optimize::boxes`).
+pub fn has_leg_room(category: &str) -> bool {
+    ROWS.iter().any(|r| r.0 == category && r.2 == "table" && r.3[1] >= KNEE_HEIGHT)
+}
+
 fn room(name: &str, synonyms: &[&str], size: [f32; 3]) -> RoomKind {
     RoomKind {
         name: name.to_string(),
@@ -282,6 +292,16 @@ mod tests {
             "street",
         ] {
             assert!(c.resolve_room(r).is_some(), "{r}");
+        }
+    }
+
+    #[test]
+    fn desks_and_tables_have_leg_room_but_cabinets_and_low_tables_do_not() {
+        for c in ["desk", "table", "diningtable", "workbench"] {
+            assert!(has_leg_room(c), "{c}");
+        }
+        for c in ["counter", "coffeetable", "nightstand", "sofa", "chair", "no-such-thing"] {
+            assert!(!has_leg_room(c), "{c}");
         }
     }
 

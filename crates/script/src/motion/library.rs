@@ -145,8 +145,31 @@ impl MotionLibrary {
                 Err(e) => lib.skipped.push((trial.clip_id.clone(), e.to_string())),
             }
         }
+        lib.add_captured_cycles(&rig);
         lib.load_seconds = t0.elapsed().as_secs_f64();
         Ok(lib)
+    }
+
+    /// For walk and run: the best-looping gait cycle cut from the loaded CMU clips of that action
+    /// ([`super::cycle::extract_cycle`]), added as a `cycle` clip so locomotion loops captured
+    /// steps (mocap ranks before the procedural cycle). Returns the cycles added.
+    pub fn add_captured_cycles(&mut self, rig: &Rig) -> usize {
+        let mut added = 0;
+        for verb in ["walk", "run"] {
+            let best = self
+                .clips
+                .iter()
+                .filter(|c| c.is_captured() && c.tags.first().is_some_and(|t| t == verb))
+                .filter_map(|c| super::cycle::extract_cycle(&c.motion, rig).map(|(m, cut)| (c, m, cut)))
+                .min_by(|a, b| a.2.seam.total_cmp(&b.2.seam));
+            let Some((clip, motion, cut)) = best else { continue };
+            let name = format!("{} {verb} cycle (frames {}–{})", clip.name, cut.start, cut.start + cut.period);
+            let source = clip.source.clone();
+            let tags = [verb, "cycle", "loop", "locomotion", "cmu"].map(String::from).to_vec();
+            self.clips.push(LibraryClip { name, tags, motion, source });
+            added += 1;
+        }
+        added
     }
 
     /// Adds the named animations of the Kenney blocky characters in `dir` (every `.glb`, sorted;

@@ -4,6 +4,7 @@
 //! - [`library`]: template actions indexed by tags (built-in procedural clips, CMU BVH when the
 //!   shared corpus is present: cgspeed BVH via [`cmu`], iClone/Character Creator BVH via [`cc`],
 //!   Kenney blocky characters via [`kenney`]), retrieved by verb lemma ([`verbs`]);
+//! - [`cycle`]: gait cycles cut from captured walks (loopable, along +Z) for locomotion;
 //! - [`locomotion`]: walking a route (A* on the layout's occupancy grid) with eased start/stop,
 //!   limited turn rate and foot locking; [`locomotion::foot_skate`] measures skate;
 //! - [`blend`]: upper body of an action on the lower body of locomotion, then contact IK;
@@ -13,6 +14,7 @@
 pub mod blend;
 pub mod cc;
 pub mod cmu;
+pub mod cycle;
 pub mod ik;
 pub mod kenney;
 pub mod library;

@@ -47,44 +47,36 @@ impl Rig {
         Rig::of(skeleton())
     }
 
-    /// Indices on a skeleton with the standard joint names (panics on another layout).
+    /// Indices on a skeleton with the standard joint names (panics on another layout: use
+    /// [`Rig::try_of`] for skeletons that did not come from this module).
     pub fn of(skeleton: Skeleton) -> Rig {
+        Rig::try_of(skeleton).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Indices on a skeleton with the standard joint names, or which joint is missing.
+    pub fn try_of(skeleton: Skeleton) -> Result<Rig, String> {
         let f = |n: &str| {
-            skeleton
-                .find(n)
-                .unwrap_or_else(|| panic!("joint {n} missing"))
+            skeleton.find(n).ok_or_else(|| {
+                format!("not the common rig: joint {n} missing (the skeleton has {} joints)", skeleton.joints().len())
+            })
         };
-        let legs = ["Left", "Right"].map(|s| {
-            [
-                f(&format!("{s}UpLeg")),
-                f(&format!("{s}Leg")),
-                f(&format!("{s}Foot")),
-                f(&format!("{s}ToeBase")),
-            ]
-        });
-        let arms = ["Left", "Right"].map(|s| {
-            [
-                f(&format!("{s}Shoulder")),
-                f(&format!("{s}Arm")),
-                f(&format!("{s}ForeArm")),
-                f(&format!("{s}Hand")),
-            ]
-        });
+        let limb = |names: [&str; 4]| -> Result<[usize; 4], String> {
+            Ok([f(names[0])?, f(names[1])?, f(names[2])?, f(names[3])?])
+        };
+        let legs = [
+            limb(["LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase"])?,
+            limb(["RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"])?,
+        ];
+        let arms = [
+            limb(["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand"])?,
+            limb(["RightShoulder", "RightArm", "RightForeArm", "RightHand"])?,
+        ];
+        let (hips, lower_back, spine1, neck, head) = (f("Hips")?, f("LowerBack")?, f("Spine1")?, f("Neck")?, f("Head")?);
         let mut rest = Pose::rest(&skeleton);
-        rest.translations[0] = DVec3::new(0.0, hip_height(), 0.0);
+        rest.translations[hips] = DVec3::new(0.0, hip_height(), 0.0);
         let g = forward(&skeleton, &rest);
         let ankle_height = g.positions[legs[0][2]].y;
-        Rig {
-            hips: f("Hips"),
-            lower_back: f("LowerBack"),
-            spine1: f("Spine1"),
-            neck: f("Neck"),
-            head: f("Head"),
-            legs,
-            arms,
-            ankle_height,
-            skeleton,
-        }
+        Ok(Rig { hips, lower_back, spine1, neck, head, legs, arms, ankle_height, skeleton })
     }
 
     /// True for the joints of the upper body: `LowerBack` and everything below it (§4.2, "joints

@@ -1,7 +1,8 @@
 //! Joint optimisation of scene layout and character motion (§4.3, Algorithm 2).
 //!
 //! - Collision cost C_D (Eq. 1): every object is tiled into small boxes (about
-//!   [`OptimizeConfig::box_size`] on a side); the body is a set of spheres on the skeleton (at
+//!   [`OptimizeConfig::box_size`] on a side; a table with leg room is a thin top on four legs,
+//!   [`boxes`]); the body is a set of spheres on the skeleton (at
 //!   the joints and bone midpoints, radius by body part). n_c(o) counts the boxes of object `o`
 //!   any sphere touches over the whole animation, leaving out objects the current segment may
 //!   touch (its target, the seat sat on) and flat objects (rugs); C_D = mean over collided
@@ -19,6 +20,8 @@
 //!   exp(−ΔC / T) with T = 1 − 0.002·iteration, in units of 1 % of the initial C by default
 //!   ([`OptimizeConfig::relative_temperature`]; [`OptimizeConfig::paper`] keeps absolute units).
 //!   The best state seen is returned.
+
+pub mod boxes;
 
 use std::path::Path;
 
@@ -113,7 +116,7 @@ pub struct Optimized {
     pub curves: CostCurves,
     /// Indices of the objects the annealing could move.
     pub movable: Vec<usize>,
-    /// Moves rejected for breaking the layout.
+    /// Moves rejected for breaking the layout (or refused by the incremental editor).
     pub rejected_layout: usize,
 }
 
@@ -151,20 +154,15 @@ fn body_spheres(rig: &Rig, g: &inbetween_core::fk::GlobalPose, out: &mut Vec<(DV
     }
 }
 
-/// An object's box tiling: counts per axis and box size per axis (its own frame).
-fn tiling(o: &PlacedObject, b: f32) -> ([usize; 3], [f32; 3]) {
-    let n = o.size.map(|s| ((s / b).ceil() as usize).max(1));
-    (n, [o.size[0] / n[0] as f32, o.size[1] / n[1] as f32, o.size[2] / n[2] as f32])
-}
-
-/// C_D (Eq. 1) and the number of touched boxes and objects over the whole animation.
+/// C_D (Eq. 1) and the number of touched boxes and objects over the whole animation. Objects are
+/// approximated by the small boxes of [`boxes::object_boxes`] (tables keep leg room).
 pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
     let objs = &anim.scene.objects;
-    let tiles: Vec<([usize; 3], [f32; 3])> = objs.iter().map(|o| tiling(o, box_size)).collect();
-    let mut hit: Vec<Vec<bool>> = tiles.iter().map(|(n, _)| vec![false; n[0] * n[1] * n[2]]).collect();
+    let model: Vec<Vec<boxes::LocalBox>> = objs.iter().map(|o| boxes::object_boxes(o, box_size)).collect();
+    let mut hit: Vec<Vec<bool>> = model.iter().map(|b| vec![false; b.len()]).collect();
     let mut spheres = Vec::new();
     for c in &anim.characters {
-        let rig = Rig::of(c.motion.skeleton.clone());
+        let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
         let mut seg = 0;
         for f in 0..c.motion.num_frames() {
             while seg + 1 < c.segments.len() && f >= c.segments[seg].end {
@@ -178,7 +176,6 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
                 if touching.contains(&i) || o.top() < crate::layout::grid::FLAT {
                     continue;
                 }
-                let (n, cell) = tiles[i];
                 let half = [o.size[0] / 2.0, o.size[2] / 2.0];
                 for &(p, r) in &spheres {
                     let r = r as f32;
@@ -188,28 +185,9 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
                     if (0..3).any(|k| q[k] < -r || q[k] > o.size[k] + r) {
                         continue;
                     }
-                    let range = |k: usize| {
-                        let lo = (((q[k] - r) / cell[k]).floor().max(0.0) as usize).min(n[k] - 1);
-                        let hi = (((q[k] + r) / cell[k]).floor().max(0.0) as usize).min(n[k] - 1);
-                        lo..=hi
-                    };
-                    for a in range(0) {
-                        for b in range(1) {
-                            for cc in range(2) {
-                                // Sphere–box distance.
-                                let d2: f32 = [a, b, cc]
-                                    .iter()
-                                    .enumerate()
-                                    .map(|(k, &idx)| {
-                                        let (lo, hi) = (idx as f32 * cell[k], (idx + 1) as f32 * cell[k]);
-                                        let d = (lo - q[k]).max(0.0).max(q[k] - hi);
-                                        d * d
-                                    })
-                                    .sum();
-                                if d2 < r * r {
-                                    hit[i][(cc * n[1] + b) * n[0] + a] = true;
-                                }
-                            }
+                    for (b, flag) in model[i].iter().zip(hit[i].iter_mut()) {
+                        if !*flag && boxes::distance2(q, b) < r * r {
+                            *flag = true;
                         }
                     }
                 }
@@ -366,6 +344,16 @@ pub fn optimize_scene(scene: &Scene, query: &Ssg, relations: &[(Relation, usize,
     let anim0 = animate_cached(scene, query, cat, lib, acfg, &mut cache);
     let before = costs(&anim0, cfg);
     let movable = movable_objects(&anim0, relations, cat);
+    anneal(scene, relations, cfg, anim0, before, movable, &mut |s: &Scene| Some(animate_cached(s, query, cat, lib, acfg, &mut cache)))
+}
+
+/// The annealing of Algorithm 2 from `scene` (animated as `anim0`, with costs `before`), moving
+/// only the objects in `movable`; `animate` animates a disturbed scene, or refuses it (None: the
+/// move is rejected like one that breaks the layout). The incremental editor
+/// ([`crate::animate::incremental`]) restricts `movable` to the objects of the characters it
+/// re-solves.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn anneal(scene: &Scene, relations: &[(Relation, usize, usize)], cfg: &OptimizeConfig, anim0: Animation, before: Costs, movable: Vec<usize>, animate: &mut dyn FnMut(&Scene) -> Option<Animation>) -> Optimized {
     let base_violations = layout::check(&scene.room, &scene.objects, relations);
     let mut rng = inbetween_core::seed::rng(cfg.seed);
     let mut cur = (scene.clone(), before);
@@ -385,19 +373,19 @@ pub fn optimize_scene(scene: &Scene, query: &Ssg, relations: &[(Relation, usize,
             let mut cand = cur.0.clone();
             disturb(&mut cand.objects, k, dx, dz, s);
             let v = layout::check(&cand.room, &cand.objects, relations);
-            if no_worse(&v, &base_violations) {
-                let anim = animate_cached(&cand, query, cat, lib, acfg, &mut cache);
-                let c = costs(&anim, cfg);
-                let delta = c.total - cur.1.total;
-                if delta <= 0.0 || u < (-delta / t).exp() {
-                    accepted = true;
-                    if c.total < best.1.total {
-                        best = (anim, c);
+            match no_worse(&v, &base_violations).then(|| animate(&cand)).flatten() {
+                Some(anim) => {
+                    let c = costs(&anim, cfg);
+                    let delta = c.total - cur.1.total;
+                    if delta <= 0.0 || u < (-delta / t).exp() {
+                        accepted = true;
+                        if c.total < best.1.total {
+                            best = (anim, c);
+                        }
+                        cur = (cand, c);
                     }
-                    cur = (cand, c);
                 }
-            } else {
-                rejected_layout += 1;
+                None => rejected_layout += 1,
             }
         }
         curves.collision.push(cur.1.collision);
@@ -435,8 +423,7 @@ pub fn collisions_by_object(anim: &Animation, box_size: f32) -> Vec<(String, usi
                 }
             }
             let (_, nc, _) = collision_cost(&one, box_size);
-            let (n, _) = tiling(o, box_size);
-            (nc > 0).then(|| (o.label.clone(), nc, n[0] * n[1] * n[2]))
+            (nc > 0).then(|| (o.label.clone(), nc, boxes::object_boxes(o, box_size).len()))
         })
         .collect()
 }

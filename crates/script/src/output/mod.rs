@@ -7,6 +7,7 @@ pub mod anim_preview;
 pub mod bvh_out;
 pub mod gltf;
 pub mod preview;
+pub mod skinned;
 
 use std::path::{Path, PathBuf};
 
