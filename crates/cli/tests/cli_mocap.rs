@@ -28,7 +28,17 @@ fn compress_decompress_preview_and_corrupt_input() {
     let dir = tempfile::tempdir().unwrap();
     let bvh = walk_bvh(dir.path());
     let ibk = dir.path().join("walk.ibk").to_string_lossy().into_owned();
-    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "-o", &ibk]);
+    // Version 3 (the default): every frame, variable step; the bound holds on virtual vertices.
+    let v3 = dir.path().join("walk3.ibk").to_string_lossy().into_owned();
+    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "-o", &v3]);
+    assert!(o.status.success() && text(&o).contains("version 3"), "{}", text(&o));
+    assert!(max_cm(&text(&o)) <= 1.0, "{}", text(&o));
+    let out3 = dir.path().join("rec3.bvh").to_string_lossy().into_owned();
+    let o = inbetween(&["mocap", "decompress", &v3, "-o", &out3]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(inbetween_io::read_bvh(Path::new(&out3)).unwrap().num_frames(), 90);
+    // Version 2 keeps keyframes.
+    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "--format", "v2", "-o", &ibk]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("bytes per key"), "{}", text(&o));
     assert!(text(&o).contains("length unit: CMU units (5.6444 cm) (rest-pose height 26.7 units"), "{}", text(&o));
@@ -82,7 +92,7 @@ fn compress_infers_the_unit_of_any_rig_and_accepts_an_override() {
         let bvh = dir.path().join(format!("{name}.bvh"));
         inbetween_io::write_bvh(&bvh, &scaled).unwrap();
         let ibk = dir.path().join(format!("{name}.ibk")).to_string_lossy().into_owned();
-        let o = inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "-o", &ibk]);
+        let o = inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "--format", "v2", "-o", &ibk]);
         assert!(o.status.success(), "{}", text(&o));
         assert!(text(&o).contains(&format!("length unit: {unit} (rest-pose height")), "{}", text(&o));
         reports.push(text(&o));
@@ -95,7 +105,7 @@ fn compress_infers_the_unit_of_any_rig_and_accepts_an_override() {
     let bvh = dir.path().join("cmu.bvh");
     let out = dir.path().join("o.ibk").to_string_lossy().into_owned();
     let o =
-        inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "--unit", "cm", "-o", &out]);
+        inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "--unit", "cm", "--format", "v2", "-o", &out]);
     assert!(o.status.success() && text(&o).contains("length unit: cm (given with --unit)"), "{}", text(&o));
     assert!(keys(&text(&o)) < keys(&reports[0]), "{}", text(&o));
     let o =
@@ -234,10 +244,10 @@ fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
     for method in ["rc", "uc", "greedy", "sidql", "optimal"] {
         assert!(table.lines().any(|l| l.starts_with(&format!("{method},5,"))), "{method} missing:\n{table}");
     }
-    // Without --model the bench uses the committed policy (trained on our procedural gaits).
+    // Without --model the bench uses the committed policy (trained on the CMU takes).
     let o = inbetween(&["mocap", "bench", "--data", data.to_str().unwrap(), "--codec-bounds", "1"]);
     assert!(o.status.success(), "{}", text(&o));
-    assert!(text(&o).contains("committed policy (trained on: 24 procedural gaits"), "{}", text(&o));
+    assert!(text(&o).contains("committed policy (trained on: every CMU take"), "{}", text(&o));
     let o = inbetween(&["mocap", "bench", "--data", dir.path().join("none").to_str().unwrap()]);
     assert!(!o.status.success(), "{}", text(&o));
     // One clip: no test split, so the table and the chart use all windows.
