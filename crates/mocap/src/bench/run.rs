@@ -264,9 +264,10 @@ pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
     if !test_windows.is_empty() {
         rows.extend(evaluate_with_progress("test", &test_windows, &Method::ALL, &cfg.ks, seed, pf, progress)?);
     }
+    // A k-fold needs at least two takes with windows (one to train on, one to test).
     let kfold = match &cfg.kfold {
-        Some(k) => Some(kfold(clips, &all, protocol, k, &cfg.ks, progress)?),
-        None => None,
+        Some(k) if fold_takes(&all, k.folds, seed).len() >= 2 => Some(kfold(clips, &all, protocol, k, &cfg.ks, progress)?),
+        _ => None,
     };
     progress.phase(1, "throughput");
     let throughput = reconstruction_throughput(&all, 10)?;
