@@ -65,14 +65,15 @@ pub fn look_rotation(eye: Vec3, target: Vec3) -> Quat {
     Quat::from_mat3(&Mat3::from_cols(r, u, -f)).normalize()
 }
 
-/// Appends binary data and accessors to an existing document and its buffer.
-struct Appender<'a> {
-    doc: &'a mut Value,
-    bin: &'a mut Vec<u8>,
+/// Appends binary data and accessors to an existing document and its buffer (also used by
+/// [`super::skinned`]).
+pub(crate) struct Appender<'a> {
+    pub(crate) doc: &'a mut Value,
+    pub(crate) bin: &'a mut Vec<u8>,
 }
 
 impl Appender<'_> {
-    fn push(&mut self, key: &str, v: Value) -> usize {
+    pub(crate) fn push(&mut self, key: &str, v: Value) -> usize {
         if !self.doc.get(key).is_some_and(Value::is_array) {
             self.doc[key] = json!([]);
         }
@@ -81,7 +82,7 @@ impl Appender<'_> {
         a.len() - 1
     }
 
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+    pub(crate) fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }

@@ -32,7 +32,7 @@ use inbetween_render::canvas::Camera3;
 use inbetween_render::Canvas;
 use serde_json::{json, Value};
 
-use super::anim_gltf::{animated_gltf_document, CameraFn};
+use super::anim_gltf::{animated_gltf_document, Appender, CameraFn};
 use super::gltf::{base64, glb_bytes};
 use super::preview::{draw_object, draw_room, fill_convex, scale_color};
 use crate::catalogue::Catalogue;
@@ -389,34 +389,8 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
     })
 }
 
-/// Appends views and accessors to a document and its buffer.
-struct Out<'a> {
-    doc: &'a mut Value,
-    bin: &'a mut Vec<u8>,
-}
-
-impl Out<'_> {
-    fn push(&mut self, key: &str, v: Value) -> usize {
-        if !self.doc.get(key).is_some_and(Value::is_array) {
-            self.doc[key] = json!([]);
-        }
-        let a = self.doc[key].as_array_mut().expect("array just ensured");
-        a.push(v);
-        a.len() - 1
-    }
-
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
-        if let Some(t) = target {
-            v["target"] = json!(t);
-        }
-        self.bin.extend_from_slice(bytes);
-        self.push("bufferViews", v)
-    }
-
+/// Typed accessors on top of the animated document's appender.
+impl Appender<'_> {
     /// An accessor over fresh bytes: `kind` is the glTF type, `component` its component type.
     fn accessor(&mut self, bytes: &[u8], target: Option<u32>, component: u32, count: usize, kind: &str, bounds: Option<(Vec<f32>, Vec<f32>)>) -> usize {
         let view = self.view(bytes, target);
@@ -428,7 +402,7 @@ impl Out<'_> {
         self.push("accessors", acc)
     }
 
-    fn floats(&mut self, values: &[f32], width: usize, kind: &str, target: Option<u32>, bounds: bool) -> usize {
+    fn typed_floats(&mut self, values: &[f32], width: usize, kind: &str, target: Option<u32>, bounds: bool) -> usize {
         let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
         let b = bounds.then(|| {
             let (mut lo, mut hi) = (vec![f32::MAX; width], vec![f32::MIN; width]);
@@ -619,7 +593,7 @@ fn compact(doc: &mut Value, key: &str, used: impl Fn(&Value) -> BTreeSet<u64>, f
 
 /// Adds one skinned body to the document: texture, material, mesh, skin over the joint nodes
 /// `first..first + joints`, and a scene-root node holding mesh and skin.
-fn add_body(out: &mut Out, name: &str, body: &SkinnedBody, first: usize) -> Result<(), ScriptError> {
+fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) -> Result<(), ScriptError> {
     let joints = body.bind.len();
     if body.joints.iter().any(|&j| j as usize >= joints) {
         return Err(ScriptError::Invalid(format!("character '{name}': a vertex is bound to a joint past the skeleton's {joints}")));
@@ -640,10 +614,10 @@ fn add_body(out: &mut Out, name: &str, body: &SkinnedBody, first: usize) -> Resu
         out.push("extensionsUsed", json!("KHR_materials_unlit"));
     }
     let flat3 = |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.to_array()).collect() };
-    let pos = out.floats(&flat3(&body.positions), 3, "VEC3", Some(34962), true);
-    let nor = out.floats(&flat3(&body.normals), 3, "VEC3", Some(34962), false);
+    let pos = out.typed_floats(&flat3(&body.positions), 3, "VEC3", Some(34962), true);
+    let nor = out.typed_floats(&flat3(&body.normals), 3, "VEC3", Some(34962), false);
     let uv: Vec<f32> = body.uvs.iter().flatten().copied().collect();
-    let uv = out.floats(&uv, 2, "VEC2", Some(34962), false);
+    let uv = out.typed_floats(&uv, 2, "VEC2", Some(34962), false);
     let count = body.positions.len();
     // JOINTS_0: unsigned byte when the skeleton allows (4-byte elements keep vertex alignment).
     let (jbytes, jtype): (Vec<u8>, u32) = if joints <= 256 {
@@ -653,7 +627,7 @@ fn add_body(out: &mut Out, name: &str, body: &SkinnedBody, first: usize) -> Resu
     };
     let jacc = out.accessor(&jbytes, Some(34962), jtype, count, "VEC4", None);
     let w: Vec<f32> = (0..count).flat_map(|_| [1.0, 0.0, 0.0, 0.0]).collect();
-    let wacc = out.floats(&w, 4, "VEC4", Some(34962), false);
+    let wacc = out.typed_floats(&w, 4, "VEC4", Some(34962), false);
     let idx = if count <= u16::MAX as usize {
         let b: Vec<u8> = body.indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
         out.accessor(&b, Some(34963), 5123, body.indices.len(), "SCALAR", None)
@@ -662,7 +636,7 @@ fn add_body(out: &mut Out, name: &str, body: &SkinnedBody, first: usize) -> Resu
         out.accessor(&b, Some(34963), 5125, body.indices.len(), "SCALAR", None)
     };
     let ibm: Vec<f32> = body.inverse_bind().iter().flat_map(|m| m.to_cols_array()).collect();
-    let ibm = out.floats(&ibm, 16, "MAT4", None, false);
+    let ibm = out.typed_floats(&ibm, 16, "MAT4", None, false);
     let mesh = out.push(
         "meshes",
         json!({"name": format!("{name} body"), "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv, "JOINTS_0": jacc, "WEIGHTS_0": wacc}, "indices": idx, "material": material}]}),
@@ -723,7 +697,7 @@ pub fn skinned_gltf_document(
     }
     remove_nodes(&mut doc, &drop);
     let shift = |i: usize| i - drop.range(..i).count();
-    let mut out = Out { doc: &mut doc, bin: &mut bin };
+    let mut out = Appender { doc: &mut doc, bin: &mut bin };
     for (((name, _), body), &(_, first)) in characters.iter().zip(bodies).zip(&found) {
         if let Some(b) = body {
             add_body(&mut out, name, b, shift(first))?;
