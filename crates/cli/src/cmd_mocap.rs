@@ -53,8 +53,9 @@ pub struct TrainArgs {
     /// (e.g. 2.54). Default: known for the corpus folders, else inferred per clip from its rest pose (the report says which and why).
     #[arg(long)]
     pub unit: Option<LengthUnit>,
-    /// Hyper-parameters: `default` (pretraining on exact cost-to-go, then the paper's DQN as a
-    /// short fine-tune), `paper` (§5.2's DQN alone: lr 0.01, batch 256, memory 10 000, γ = 0.5,
+    /// Hyper-parameters: `default` (no pretraining: the network starts as greedy by exact gain;
+    /// then the paper's DQN as a short, gentle fine-tune; `--pretrain-steps 3000` adds pretraining
+    /// on exact cost-to-go), `paper` (§5.2's DQN alone: lr 0.01, batch 256, memory 10 000, γ = 0.5,
     /// target renewed every 100 updates, 2000 episodes) or `quick`.
     #[arg(long, default_value = "default")]
     pub preset: String,

@@ -107,6 +107,8 @@ pub struct CodecRow {
     pub decompress_mb_s: f64,
     /// Mean µs to decode one pose at a random time (file opened once).
     pub pose_us: f64,
+    /// Mean µs per pose when playing the clip forwards at 60 Hz (one scratch, as an engine does).
+    pub playback_us: f64,
 }
 
 impl CodecRow {
@@ -170,6 +172,7 @@ struct TakeResult {
     compress_s: f64,
     decompress_s: f64,
     pose_s: f64,
+    playback_s: f64,
 }
 
 fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<TakeResult> {
@@ -178,7 +181,7 @@ fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<Tak
     let c = alloc::compress_in(&t.motion, t.unit.clone(), &opts)?;
     let compress_s = start.elapsed().as_secs_f64();
     let errors = c.errors_cm.clone();
-    let (mut decompress_s, mut pose_s) = (0.0, 0.0);
+    let (mut decompress_s, mut pose_s, mut playback_s) = (0.0, 0.0, 0.0);
     if timed {
         decompress_s = seconds_per_call(1, 3, || {
             let f = v3::File::open(&c.bytes).expect("a file just written opens");
@@ -196,8 +199,16 @@ fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<Tak
             std::hint::black_box(&pose);
         });
         pose_s = per_round / times.len() as f64;
+        let ticks: Vec<f64> = (0..).map(|k| k as f64 / 60.0).take_while(|&t| t <= duration).collect();
+        let per_play = seconds_per_call(1, 3, || {
+            for &time in &ticks {
+                file.pose_at(time, &mut pose, &mut sc).expect("a valid file seeks");
+            }
+            std::hint::black_box(&pose);
+        });
+        playback_s = per_play / ticks.len() as f64;
     }
-    Ok(TakeResult { bytes: c.bytes.len(), errors_max: c.max_error_cm, errors, compress_s, decompress_s, pose_s })
+    Ok(TakeResult { bytes: c.bytes.len(), errors_max: c.max_error_cm, errors, compress_s, decompress_s, pose_s, playback_s })
 }
 
 /// Runs the protocol: every group at every bound (timings single-threaded, so MB/s is per core).
@@ -238,6 +249,7 @@ pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
             let mb = raw as f64 / 1e6;
             let timed = b == cfg.headline_cm;
             let seeks: f64 = rs.iter().map(|r| r.pose_s).sum::<f64>() / rs.len().max(1) as f64;
+            let plays: f64 = rs.iter().map(|r| r.playback_s).sum::<f64>() / rs.len().max(1) as f64;
             rows.push(CodecRow {
                 group: group.clone(),
                 bound_cm: b,
@@ -251,6 +263,7 @@ pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
                 compress_mb_s: mb / secs(|r| r.compress_s).max(1e-12),
                 decompress_mb_s: if timed { mb / secs(|r| r.decompress_s).max(1e-12) } else { f64::NAN },
                 pose_us: if timed { seeks * 1e6 } else { f64::NAN },
+                playback_us: if timed { plays * 1e6 } else { f64::NAN },
             });
         }
     }
@@ -326,7 +339,7 @@ impl AclResults {
             &format!("Codec (.ibk version 3) on ACL's protocol: {} fps, raw = 40 bytes per bone per sample, virtual vertices 3 cm from each bone", self.fps),
             &[
                 "takes", "bound cm", "frames", "bone samples", "raw bytes", "bytes", "ratio", "max error cm", "p99 error cm",
-                "compress MB/s", "decompress MB/s", "µs per pose",
+                "compress MB/s", "decompress MB/s", "µs per pose", "µs per pose, playback",
             ],
         );
         t.row([
@@ -340,6 +353,7 @@ impl AclResults {
             format!("{ACL_MAX_CM}"),
             format!("{ACL_P99_CM}"),
             format!("~{ACL_COMPRESS_MB_S}"),
+            String::new(),
             String::new(),
             String::new(),
         ]);
@@ -358,12 +372,13 @@ impl AclResults {
                 num(r.compress_mb_s, 1),
                 opt(r.decompress_mb_s, 1),
                 opt(r.pose_us, 2),
+                opt(r.playback_us, 2),
             ]);
         }
         t.note("ratio: 40 bytes × bones × samples / .ibk bytes (the whole file: header, skeleton with joint names, offsets, checksum)");
         t.note("errors: each joint's largest of three vertices 3 cm along its local axes, object space, decoded file vs source; p99 over every joint of every frame");
         t.note(format!(
-            "speeds: raw MB per second on one core; decompress = open + decode every pose; µs per pose = one pose at a random time (two frames, slerp), file opened once; timed at {} cm only",
+            "speeds: raw MB per second on one core; decompress = open + decode every pose; µs per pose = one pose at a random time (two frames, slerp), file opened once; playback = every 1/60 s from the start with one scratch (each frame decoded once); timed at {} cm only",
             self.headline_cm
         ));
         t.note("ACL's bound column: its threshold setting; its errors are measured, ours are bounded by the bound column");
@@ -464,6 +479,7 @@ mod tests {
         assert!(fine.max_error_cm <= 0.05 && coarse.max_error_cm <= 0.5);
         assert!(coarse.ratio() > fine.ratio() && fine.ratio() > 5.0, "{r:?}");
         assert!(fine.pose_us > 0.0 && fine.decompress_mb_s > 0.0 && coarse.pose_us.is_nan());
+        assert!(fine.playback_us > 0.0 && coarse.playback_us.is_nan());
         assert_eq!(fine.takes, 2);
         assert_eq!(fine.raw_bytes, 40 * 31 * fine.frames);
         assert_eq!(r.baselines.len(), 6);

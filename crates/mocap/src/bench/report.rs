@@ -45,7 +45,7 @@ pub struct BenchResults {
 pub struct KFold {
     /// The takes of each fold.
     pub folds: Vec<Vec<String>>,
-    /// Pooled over every window: UC, Greedy, SIDQL pretrained, SIDQL fine-tuned, Optimal per K.
+    /// Pooled over every window: UC, Greedy, SIDQL before and after fine-tuning, Optimal per K.
     pub rows: Vec<KFoldRow>,
     /// Training seconds and windows per fold.
     pub train_seconds: Vec<f64>,

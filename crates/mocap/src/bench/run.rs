@@ -187,7 +187,7 @@ pub fn fold_takes(all: &[Window], folds: usize, seed: u64) -> Vec<Vec<String>> {
 pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldConfig, ks: &[usize], progress: &Progress) -> Result<KFold> {
     let groups = fold_takes(all, cfg.folds, protocol.seed);
     progress.phase(groups.len() as u64, "k-fold");
-    let variants = ["UC", "Greedy", "SIDQL pretrained", "SIDQL fine-tuned", "SIDQL fine-tuned, checked against UC", "Optimal"];
+    let variants = ["UC", "Greedy", "SIDQL before fine-tuning", "SIDQL fine-tuned", "SIDQL fine-tuned, checked against UC", "Optimal"];
     // (variant, k) → sums over windows of angle, paper units, seconds; windows.
     let mut sums = vec![(0.0, 0.0, 0.0, 0usize); variants.len() * ks.len()];
     let (mut train_seconds, mut train_windows) = (Vec::new(), Vec::new());

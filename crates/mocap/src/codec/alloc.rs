@@ -168,6 +168,8 @@ struct Context {
     start_codes: Vec<u8>,
     shell: f64,
     bound: f64,
+    /// What the search compares squared errors with: the bound less a little, squared.
+    bound_sq: f64,
 }
 
 /// A segment's chosen step codes and quantised values.
@@ -229,6 +231,7 @@ impl Context {
             start_codes: Vec::new(),
             shell,
             bound,
+            bound_sq: (bound * (1.0 - 1e-9)).powi(2),
         };
         ctx.start_codes = ctx.safe_codes();
         ctx
@@ -290,6 +293,13 @@ impl Context {
         let raw = &self.raw[f * self.skeleton.len() + j];
         let v = shell_vertices(pos, rot, self.shell);
         (1..4).map(|a| (v[a] - raw[a]).length()).fold(0.0, f64::max)
+    }
+
+    /// The square of [`Context::vertex_error`] (what the search compares, without roots).
+    fn vertex_error_sq(&self, f: usize, j: usize, pos: DVec3, rot: DQuat) -> f64 {
+        let raw = &self.raw[f * self.skeleton.len() + j];
+        let v = shell_vertices(pos, rot, self.shell);
+        (1..4).map(|a| (v[a] - raw[a]).length_squared()).fold(0.0, f64::max)
     }
 
     /// Errors of every joint of every frame of a decoded clip.
@@ -378,6 +388,8 @@ struct Segment<'a> {
     /// len × joints: object-space transforms.
     orot: Vec<DQuat>,
     opos: Vec<DVec3>,
+    /// The frame where the last try failed.
+    hot: usize,
 }
 
 impl<'a> Segment<'a> {
@@ -393,6 +405,7 @@ impl<'a> Segment<'a> {
             ltr: (0..len).flat_map(|_| ctx.skeleton.joints().iter().map(|j| j.offset)).collect(),
             orot: vec![DQuat::IDENTITY; len * nj],
             opos: vec![DVec3::ZERO; len * nj],
+            hot: 0,
         };
         for t in 0..nt {
             let (mut q, mut v) = (vec![[0; 3]; len], vec![DVec3::ZERO; len]);
@@ -455,7 +468,7 @@ impl<'a> Segment<'a> {
             };
             pos[a] = p;
             rot[a] = r;
-            if self.ctx.vertex_error(self.start + i, j, p, r) > self.ctx.bound * (1.0 - 1e-9) {
+            if self.ctx.vertex_error_sq(self.start + i, j, p, r) > self.ctx.bound_sq {
                 return false;
             }
         }
@@ -505,13 +518,15 @@ impl<'a> Segment<'a> {
         }
         let m = joints.len();
         let (mut pos, mut rot) = (vec![DVec3::ZERO; self.len * m], vec![DQuat::IDENTITY; self.len * m]);
-        for i in 0..self.len {
+        // The frame that failed last is checked first: most tries that fail, fail there.
+        for i in (self.hot..self.len).chain(0..self.hot) {
             let over = (tr.kind == TrackKind::Rotation).then(|| (tr.joint, rotvec_to_quat(v[i])));
             let (p, r) = (&mut pos[i * m..(i + 1) * m], &mut rot[i * m..(i + 1) * m]);
             if !self.fk_check(i, joints, over, p, r) {
                 for (i, x) in saved_tr.iter().enumerate() {
                     self.ltr[i * nj + tr.joint] = *x;
                 }
+                self.hot = i;
                 return false;
             }
         }

@@ -120,11 +120,34 @@ impl<'a> BitReader<'a> {
         Ok(())
     }
 
+    /// Tops the buffer up to at least 56 bits when the bytes are there: eight bytes at once
+    /// away from the end. Bits above `n` may already hold the next bytes (loaded again at the
+    /// same place by the next top-up, so OR-ing them twice changes nothing).
+    #[inline]
+    fn top_up(&mut self) {
+        if self.pos + 8 <= self.bytes.len() {
+            let w = u64::from_le_bytes(self.bytes[self.pos..self.pos + 8].try_into().expect("8 bytes"));
+            self.acc |= w << self.n;
+            let take = (63 - self.n) / 8;
+            self.pos += take as usize;
+            self.n += take * 8;
+        } else {
+            while self.n <= 56 && self.pos < self.bytes.len() {
+                self.acc |= (self.bytes[self.pos] as u64) << self.n;
+                self.pos += 1;
+                self.n += 8;
+            }
+        }
+    }
+
     /// Reads `count` (≤ 32) bits.
     pub fn get(&mut self, count: u32, what: &str) -> Result<u64> {
         debug_assert!(count <= 32);
-        while self.n < count {
-            self.refill(what)?;
+        if self.n < count {
+            self.top_up();
+            while self.n < count {
+                self.refill(what)?;
+            }
         }
         let v = self.acc & ((1u64 << count) - 1);
         self.acc >>= count;
@@ -142,13 +165,41 @@ impl<'a> BitReader<'a> {
         }
     }
 
+    /// Where the reader stands, to [`BitReader::resume`] later on the same bytes.
+    pub fn state(&self) -> (usize, u64, u32) {
+        (self.pos, self.acc, self.n)
+    }
+
+    /// A reader over `bytes` at a `state` an earlier reader over the same bytes returned.
+    pub fn resume(bytes: &'a [u8], base: usize, (pos, acc, n): (usize, u64, u32)) -> BitReader<'a> {
+        BitReader { bytes, base, pos: pos.min(bytes.len()), acc, n }
+    }
+
     /// Bytes read so far.
     pub fn bytes_used(&self) -> usize {
         self.pos - self.n as usize / 8
     }
 
     /// Reads a Rice code of parameter `k`: the unary part is counted a word at a time.
+    #[inline]
     pub fn rice(&mut self, k: u32, what: &str) -> Result<u64> {
+        if self.n < 56 {
+            self.top_up();
+        }
+        // Fast path: the whole code is in the buffer.
+        let ones = self.acc.trailing_ones();
+        if (ones as u64) < ESCAPE && ones + 1 + k <= self.n {
+            let v = ((ones as u64) << k) | ((self.acc >> (ones + 1)) & ((1u64 << k) - 1));
+            let used = ones + 1 + k;
+            self.acc = if used >= 64 { 0 } else { self.acc >> used };
+            self.n -= used;
+            return Ok(v);
+        }
+        self.rice_slow(k, what)
+    }
+
+    #[cold]
+    fn rice_slow(&mut self, k: u32, what: &str) -> Result<u64> {
         let mut q = 0;
         while q < ESCAPE {
             if self.n == 0 {

@@ -6,7 +6,8 @@
 //! ```text
 //! magic "IBK\0" | version u16 = 3 | reserved u16
 //! frame_time f64 | num_frames u32 | segment_len u16 | cm_per_unit f64 | bound_cm f64
-//! skeleton (as in version 2)
+//! skeleton: raw length u32 | deflated length u32 | deflated (length format u8: 1 = every
+//!           offset a zig-zag varint of micro-units, 0 = f64; then the joints as in version 2)
 //! tracks: one per joint with rotation channels (rotation vector), then one per joint with
 //!         position channels (translation), in joint order: per track  kind u8:
 //!         0 animated | 1 constant, followed by 3×f32
@@ -30,7 +31,7 @@
 //! channels their skeleton offset.
 
 use super::bits::{unzigzag, zigzag, BitReader, BitWriter};
-use super::{read_skeleton, write_skeleton, Reader, MAGIC, MAX_FRAME_JOINTS};
+use super::{read_compact_skeleton, write_compact_skeleton, Reader, MAGIC, MAX_FRAME_JOINTS};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::rotation::rotvec_to_quat;
@@ -177,8 +178,10 @@ fn choose_code(vals: &[i64]) -> (CompCode, u64) {
         return (CompCode { mode: 0, k: 0 }, 2);
     }
     let mut best = (CompCode::default(), u64::MAX);
+    let mut us = Vec::with_capacity(vals.len());
     for mode in [1u8, 2] {
-        let us: Vec<u64> = (1..vals.len()).map(|i| zigzag(residual(vals, i, mode))).collect();
+        us.clear();
+        us.extend((1..vals.len()).map(|i| zigzag(residual(vals, i, mode))));
         for k in 0..24u32 {
             let bits: u64 = 7 + us.iter().map(|&u| super::bits::rice_bits(u, k)).sum::<u64>();
             if bits < best.1 {
@@ -237,7 +240,7 @@ pub fn encode(qz: &Quantised) -> Vec<u8> {
     out.extend_from_slice(&(qz.segment_len as u16).to_le_bytes());
     out.extend_from_slice(&qz.cm_per_unit.to_le_bytes());
     out.extend_from_slice(&qz.bound_cm.to_le_bytes());
-    write_skeleton(&mut out, &qz.skeleton);
+    write_compact_skeleton(&mut out, &qz.skeleton);
     for c in &qz.constants {
         match c {
             None => out.push(0),
@@ -281,6 +284,8 @@ pub struct File<'a> {
     data: &'a [u8],
     /// Byte of the file where the data block starts (for messages).
     data_at: usize,
+    /// The file's checksum (with the data's address, what a [`Scratch`] cursor belongs to).
+    crc: u32,
 }
 
 /// Decoding state of one component within a segment.
@@ -292,7 +297,9 @@ struct CompState {
     prev2: i64,
 }
 
-/// Reusable buffers of [`File::pose_at`] (no allocation per call).
+/// Reusable buffers of [`File::pose_at`] (no allocation per call), and where its decoding
+/// stopped: a later time in the same segment continues from there, so playing a clip forwards
+/// decodes each frame once.
 #[derive(Default)]
 pub struct Scratch {
     comps: Vec<CompState>,
@@ -300,6 +307,17 @@ pub struct Scratch {
     steps: Vec<f64>,
     a: Vec<DVec3>,
     b: Vec<DVec3>,
+    cursor: Option<Cursor>,
+}
+
+/// The segment and frame whose values `Scratch::comps` hold, and the reader's state after them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Cursor {
+    /// The file: its data's address and length and its checksum.
+    file: (usize, usize, u32),
+    seg: usize,
+    frame: usize,
+    reader: (usize, u64, u32),
 }
 
 impl<'a> File<'a> {
@@ -326,7 +344,7 @@ impl<'a> File<'a> {
                 "invalid header: frame time {frame_time}, {num_frames} frames, segments of {segment_len} frames (1 to {MAX_SEGMENT_LEN}), {cm_per_unit} cm per unit, bound {bound_cm} cm"
             )));
         }
-        let skeleton = read_skeleton(&mut r)?;
+        let skeleton = read_compact_skeleton(&mut r)?;
         let poses = num_frames as u64 * skeleton.len() as u64;
         let limit = MAX_FRAME_JOINTS.min(POSES_PER_BYTE * bytes.len() as u64);
         if poses > limit {
@@ -388,7 +406,8 @@ impl<'a> File<'a> {
         let data_at = r.pos();
         let data = &body[data_at..];
         let animated = (0..tracks.len()).filter(|&t| constants[t].is_none()).collect();
-        Ok(File { skeleton, frame_time, num_frames, segment_len, cm_per_unit, bound_cm, tracks, constants, animated, offsets, data, data_at })
+        let crc = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("the envelope holds a checksum"));
+        Ok(File { skeleton, frame_time, num_frames, segment_len, cm_per_unit, bound_cm, tracks, constants, animated, offsets, data, data_at, crc })
     }
 
     pub fn num_segments(&self) -> usize {
@@ -399,6 +418,7 @@ impl<'a> File<'a> {
     fn segment_header(&self, seg: usize, sc: &mut Scratch) -> Result<BitReader<'a>> {
         let (a, b) = (self.offsets[seg], self.offsets[seg + 1]);
         let mut r = BitReader::new(&self.data[a..b], self.data_at + a);
+        sc.cursor = None;
         sc.comps.clear();
         sc.steps.clear();
         sc.codes.clear();
@@ -467,10 +487,19 @@ impl<'a> File<'a> {
         let i = f - seg * self.segment_len;
         let seg_end = ((seg + 1) * self.segment_len).min(self.num_frames);
         let last = if want_next && f + 1 < seg_end { i + 1 } else { i };
-        let mut r = self.segment_header(seg, sc)?;
-        for j in 1..=last {
+        let key = (self.data.as_ptr() as usize, self.data.len(), self.crc);
+        let (a0, b0) = (self.offsets[seg], self.offsets[seg + 1]);
+        // Continue where the last call stopped when it stopped in this segment at or before
+        // the last frame wanted (its state then holds that frame's predecessor too).
+        let (mut r, from) = match sc.cursor.filter(|c| c.file == key && c.seg == seg && c.frame <= last) {
+            Some(c) => (BitReader::resume(&self.data[a0..b0], self.data_at + a0, c.reader), c.frame + 1),
+            None => (self.segment_header(seg, sc)?, 1),
+        };
+        sc.cursor = None;
+        for j in from..=last {
             self.next_frame(&mut r, j, sc)?;
         }
+        sc.cursor = Some(Cursor { file: key, seg, frame: last, reader: r.state() });
         let (mut a, mut b) = (std::mem::take(&mut sc.a), std::mem::take(&mut sc.b));
         if last > i {
             self.values_into(sc, true, &mut a);
@@ -485,7 +514,8 @@ impl<'a> File<'a> {
     /// The local pose at `time` seconds (clamped to the clip): the two frames around it, rotations
     /// by spherical linear interpolation and translations linearly (as ACL samples). Decodes at
     /// most one segment and the header of the next: O(joints × segment length), whatever the
-    /// clip's length.
+    /// clip's length; with the same `sc`, a later time in the same segment only decodes the
+    /// frames after the last one decoded (playback forwards: O(joints) per pose).
     pub fn pose_at(&self, time: f64, out: &mut Pose, sc: &mut Scratch) -> Result<()> {
         let x = if time.is_finite() { (time / self.frame_time).clamp(0.0, (self.num_frames - 1) as f64) } else { 0.0 };
         let f = (x.floor() as usize).min(self.num_frames - 1);
@@ -658,6 +688,35 @@ mod tests {
         file.pose_at(f64::INFINITY, &mut pose, &mut sc).unwrap();
         file.pose_at(1e9, &mut pose, &mut sc).unwrap();
         assert_eq!(pose.translations, qz.pose(qz.num_frames - 1).translations);
+    }
+
+    /// A scratch that continues from its last frame gives the poses a fresh one gives, for
+    /// playback forwards at 60 Hz and for times in random order.
+    #[test]
+    fn a_reused_scratch_gives_the_poses_of_a_fresh_one() {
+        use rand::{Rng, SeedableRng};
+        let qz = quantised();
+        let bytes = encode(&qz);
+        let file = File::open(&bytes).unwrap();
+        let duration = (qz.num_frames - 1) as f64 * qz.frame_time;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let forwards = (0..).map(|k| k as f64 / 60.0).take_while(|&t| t <= duration + 0.05);
+        let random: Vec<f64> = (0..200).map(|_| rng.random::<f64>() * duration).collect();
+        let (mut pose, mut sc) = (Pose::rest(&qz.skeleton), Scratch::default());
+        let mut fresh = Pose::rest(&qz.skeleton);
+        for t in forwards.chain(random) {
+            file.pose_at(t, &mut pose, &mut sc).unwrap();
+            file.pose_at(t, &mut fresh, &mut Scratch::default()).unwrap();
+            assert_eq!(pose, fresh, "time {t}");
+        }
+        // A scratch used on another file starts over there.
+        let mut other = qz.clone();
+        other.q.iter_mut().for_each(|v| v[0] += 1);
+        let other_bytes = encode(&other);
+        let other_file = File::open(&other_bytes).unwrap();
+        other_file.pose_at(0.1, &mut pose, &mut sc).unwrap();
+        other_file.pose_at(0.1, &mut fresh, &mut Scratch::default()).unwrap();
+        assert_eq!(pose, fresh);
     }
 
     #[test]

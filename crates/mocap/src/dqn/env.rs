@@ -37,6 +37,8 @@ const GLOBAL_INPUTS: usize = 4;
 pub const INPUTS: usize = 3 * (2 * CONTEXT + 1) + SEGMENT_INPUTS + GAIN_INPUTS + MOTION_INPUTS + GLOBAL_INPUTS;
 /// Index of E(s)/E(s₀) in a row: the Q-network scales its output by it.
 pub const SCALE_INPUT: usize = INPUTS - 1;
+/// Index of the candidate's one-step gain ÷ E(s) in a row: the Q-network learns a correction to it.
+pub const GAIN_INPUT: usize = 3 * (2 * CONTEXT + 1) + SEGMENT_INPUTS + 2;
 /// Largest window a mask can hold.
 pub const MAX_FRAMES: usize = 64;
 
@@ -292,7 +294,7 @@ mod tests {
         SphericalMotion::from_motion(&m).unwrap()
     }
 
-    const GAIN: usize = 3 * (2 * CONTEXT + 1) + SEGMENT_INPUTS;
+    const GAIN: usize = GAIN_INPUT - 2;
 
     #[test]
     fn state_rows_describe_each_candidate() {

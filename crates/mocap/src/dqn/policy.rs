@@ -15,8 +15,9 @@ use std::path::Path;
 
 /// Kind and architecture version written in a policy's weights card.
 pub const POLICY_KIND: &str = "mocap-sidql";
-/// 2: rows carry the one-step gain and the budget left (format 1 policies are refused by name).
-pub const POLICY_FORMAT: u32 = 2;
+/// 2: rows carry the one-step gain and the budget left; 3: the network outputs a correction to
+/// that gain (older policies are refused by name).
+pub const POLICY_FORMAT: u32 = 3;
 
 /// What a policy's card says: the network shape and how it was trained.
 #[derive(Clone, Debug, PartialEq)]
