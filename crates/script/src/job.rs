@@ -195,7 +195,7 @@ pub fn run_story_in(session: &mut StorySession, notes: Vec<Diagnostic>, text: &s
     let chars: Vec<(&str, &inbetween_core::Motion)> = animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let cam = |f: usize| camera_pose(&animation, f);
     let gltf = dir.join("story.gltf");
-    output::write_animated_gltf(&gltf, &animation.scene, cat, &chars, &cam, animation.fps)?;
+    output::write_story_gltf(&gltf, &animation, cat, &cam)?;
     files.push(gltf);
     for c in &animation.characters {
         let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
@@ -204,7 +204,19 @@ pub fn run_story_in(session: &mut StorySession, notes: Vec<Diagnostic>, text: &s
         files.push(bvh);
     }
     let gif = dir.join("story.gif");
-    let opts = output::AnimPreviewOptions { width: job.gif_width, ..output::AnimPreviewOptions::default() };
+    let moving = (0..animation.scene.objects.len())
+        .filter(|&i| crate::animate::carried_from(&animation, i).is_some())
+        .map(|i| {
+            let poses = (0..animation.frames())
+                .map(|f| {
+                    let (p, q) = crate::animate::object_pose(&animation, i, f);
+                    ([p.x as f32, p.y as f32, p.z as f32], crate::motion::rig::heading_of(q) as f32)
+                })
+                .collect();
+            (i, poses)
+        })
+        .collect();
+    let opts = output::AnimPreviewOptions { width: job.gif_width, moving, ..output::AnimPreviewOptions::default() };
     output::render_preview_gif(&gif, &animation.scene, cat, &chars, &cam, animation.fps, &opts)?;
     files.push(gif);
     let routes = dir.join("routes.png");

@@ -14,7 +14,7 @@ fn blend_keeps_lower_body_from_locomotion_and_upper_body_from_action() {
     let walk = walk_route(&[[0.0, 0.0], [0.0, 4.0]], &lib, &WalkParams::default());
     let action = &lib.retrieve("call").unwrap().motion;
     let params = BlendParams { start: 20, end: Some(80), blend_in: 6, blend_out: 6, looping: true, action_offset: 0 };
-    let out = blend_upper(&walk, action, &params);
+    let out = blend_upper(&walk, action, &params).unwrap();
     assert_eq!(out.num_frames(), walk.num_frames());
     for f in 0..out.num_frames() {
         let (o, w) = (out.pose(f), walk.pose(f));
@@ -62,9 +62,9 @@ fn seated_typing_meets_the_keyboard() {
     let lib = MotionLibrary::procedural(0);
     let rig = Rig::standard();
     // Sit on a chair at (2, 1) facing +X, type on a keyboard 0.38 m in front at desk height.
-    let sit = place_clip(&lib.retrieve("sit").unwrap().motion, [2.0, 1.0], std::f64::consts::FRAC_PI_2);
+    let sit = place_clip(&lib.retrieve("sit").unwrap().motion, [2.0, 1.0], std::f64::consts::FRAC_PI_2).unwrap();
     let typing = &lib.retrieve("type").unwrap().motion;
-    let blended = blend_upper(&sit, typing, &BlendParams::default());
+    let blended = blend_upper(&sit, typing, &BlendParams::default()).unwrap();
     let g0 = forward(&blended.skeleton, &blended.pose(0));
     let pelvis = g0.positions[rig.hips];
     let keys = [DVec3::new(pelvis.x + 0.38, 0.72, pelvis.z + 0.12), DVec3::new(pelvis.x + 0.38, 0.72, pelvis.z - 0.12)];
@@ -73,7 +73,7 @@ fn seated_typing_meets_the_keyboard() {
         Contact { limb: Limb::LeftArm, target: keys[1], window: window.clone() },
         Contact { limb: Limb::RightArm, target: keys[0], window },
     ];
-    let (out, worst) = reach_contacts(&blended, &contacts);
+    let (out, worst) = reach_contacts(&blended, &contacts).unwrap();
     assert!(worst < 1e-6, "hands miss the keyboard by {worst}");
     for f in [0, 20, 45, out.num_frames() - 1] {
         let g = forward(&out.skeleton, &out.pose(f));

@@ -59,8 +59,8 @@ fn foot_locking_removes_skate_on_a_curved_route() {
     let route = arc_route();
     let raw = walk_route(&route, &lib, &WalkParams { lock_feet: false, ..WalkParams::default() });
     let (locked, st) = walk_route_stats(&route, &lib, &WalkParams::default());
-    let before = foot_skate(&raw);
-    let after = foot_skate(&locked);
+    let before = foot_skate(&raw).unwrap();
+    let after = foot_skate(&locked).unwrap();
     println!("foot skate on a 6 m arc: {before:.2} cm/s before locking, {after:.2} cm/s after");
     assert!((st.skate_before - before).abs() < 1e-9 && (st.skate_after - after).abs() < 1e-9);
     assert!(before > 5.0, "the unlocked walk should skate on a curve ({before})");
@@ -74,7 +74,7 @@ fn foot_locking_removes_skate_on_a_curved_route() {
     assert!(low > rig.ankle_height - 0.03, "ankle {low} below the floor");
     assert!(st.max_route_error < 0.1);
     // Locking is a post-process any clip on the rig can take.
-    let again = lock_feet(&raw, &LockParams::default());
+    let again = lock_feet(&raw, &LockParams::default()).unwrap();
     assert_eq!(again, locked);
 }
 
@@ -130,7 +130,7 @@ fn walking_is_deterministic_and_run_is_faster() {
     assert!(run.num_frames() < a.num_frames());
     // A library clip can be placed in the world.
     let sit = &lib.retrieve("sit").unwrap().motion;
-    let placed = place_clip(sit, [2.0, 3.0], 1.0);
+    let placed = place_clip(sit, [2.0, 3.0], 1.0).unwrap();
     let r = placed.pose(0).translations[0];
     let r0 = sit.pose(0).translations[0];
     assert!((glam::DVec3::new(r.x - 2.0, 0.0, r.z - 3.0).length() - glam::DVec3::new(r0.x, 0.0, r0.z).length()).abs() < 1e-9);
@@ -153,4 +153,38 @@ fn walks_an_astar_route_around_an_obstacle() {
     let [x1, z1] = root_xz(&m, m.num_frames() - 1);
     assert!((x1 - 4.4).abs() < 0.05 && (z1 - 4.4).abs() < 0.05);
     assert!(st.skate_after < 0.5 * st.skate_before);
+}
+
+#[test]
+fn a_foreign_skeleton_gives_an_error_naming_the_missing_joint_not_a_panic() {
+    use inbetween_core::{Motion, Pose};
+    use inbetween_script::animate::crowd::root_track;
+    use inbetween_script::motion::locomotion::detect_contacts;
+    use inbetween_script::motion::{blend_upper, reach_contacts, BlendParams, Contact, Limb};
+    // The common rig without its left toe: every helper that needs the feet must say so.
+    let rig = Rig::standard();
+    let (sk, _) = rig.skeleton.filter(|_, j| j.name != "LeftToeBase");
+    assert!(sk.find("LeftToeBase").is_none() && sk.find("LeftFoot").is_some());
+    let mut pose = Pose::rest(&sk);
+    pose.translations[0].y = 0.9;
+    let m = Motion::from_poses(sk.clone(), 1.0 / 30.0, &[pose.clone(), pose]).unwrap();
+    let contact = Contact { limb: Limb::RightArm, target: glam::DVec3::new(0.3, 1.0, 0.3), window: BlendParams::default() };
+    let errors = [
+        ("foot_skate", foot_skate(&m).err()),
+        ("lock_feet", lock_feet(&m, &LockParams::default()).err()),
+        ("detect_contacts", detect_contacts(&m, &LockParams::default()).err()),
+        ("place_clip", place_clip(&m, [1.0, 1.0], 0.5).err()),
+        ("blend_upper", blend_upper(&m, &m, &BlendParams::default()).err()),
+        ("reach_contacts", reach_contacts(&m, &[contact]).err()),
+        ("root_track", root_track(&m).err()),
+    ];
+    for (what, e) in errors {
+        let msg = e.unwrap_or_else(|| panic!("{what} accepted a skeleton without LeftToeBase")).to_string();
+        eprintln!("{what}: {msg}");
+        assert!(msg.contains("LeftToeBase"), "{what}: {msg}");
+    }
+    // Two clips on different skeletons cannot be blended.
+    let walk = walk_route(&[[0.0, 0.0], [1.0, 0.0]], &MotionLibrary::procedural(0), &WalkParams::default());
+    let msg = blend_upper(&walk, &m, &BlendParams::default()).unwrap_err().to_string();
+    assert!(msg.contains("one skeleton"), "{msg}");
 }

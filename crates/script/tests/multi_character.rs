@@ -10,6 +10,7 @@ use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, query_graph, ComposeConfig, ComposeInput};
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::motion::MotionLibrary;
+use inbetween_script::optimize::{optimize, OptimizeConfig};
 use inbetween_script::parse::parse_script;
 use inbetween_script::scene::{Origin, PlacedObject, Room, Scene};
 use inbetween_script::stories;
@@ -45,7 +46,7 @@ fn dist(a: [f32; 2], b: [f32; 2]) -> f32 {
 
 /// The smallest root distance over every frame, every pair (each holds its last position).
 fn closest(anim: &Animation) -> f32 {
-    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().map(|c| root_track(&c.motion)).collect();
+    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().map(|c| root_track(&c.motion).unwrap()).collect();
     let frames = trajs.iter().map(Vec::len).max().unwrap();
     let at = |t: &Vec<[f32; 2]>, f: usize| t[f.min(t.len() - 1)];
     let mut best = f32::INFINITY;
@@ -76,7 +77,7 @@ fn three_characters_crossing_the_room_keep_their_distance_at_every_frame() {
     // Everyone still gets where they were sent.
     for (ch, target) in anim.characters.iter().zip(["table", "desk", "bookshelf"]) {
         let o = anim.scene.find(target).unwrap();
-        let end = *root_track(&ch.motion).last().unwrap();
+        let end = *root_track(&ch.motion).unwrap().last().unwrap();
         let gap = dist(end, [o.position[0], o.position[2]]);
         assert!(gap < 1.2, "{} ends {gap:.2} m from the {target}", ch.name);
     }
@@ -90,8 +91,8 @@ fn a_character_standing_still_is_not_walked_through() {
     let objects = vec![object("bookshelf", "bookshelf", 0.8, 4.6, std::f32::consts::PI), object("table", "table", 4.5, 1.5, 0.0)];
     let anim = animate_in(objects, "Eve walks to the bookshelf.\nTom waves.\n");
     eprintln!("notes: {:?}", anim.notes);
-    let eve = root_track(&anim.characters[0].motion);
-    let tom = root_track(&anim.characters[1].motion);
+    let eve = root_track(&anim.characters[0].motion).unwrap();
+    let tom = root_track(&anim.characters[1].motion).unwrap();
     let tom_spot = tom[0];
     // Tom never moves from his spot (the wave is in place).
     assert!(tom.iter().all(|p| dist(*p, tom_spot) < 0.1), "Tom stays where he started");
@@ -111,17 +112,37 @@ fn a_character_standing_still_is_not_walked_through() {
 }
 
 #[test]
-fn the_builtin_two_character_stories_keep_their_characters_apart() {
+fn every_builtin_story_keeps_its_characters_apart() {
+    // Night of the Living Dead: Ben's spot at the table used to lie beside Barbra's sofa (0.008 m
+    // at frame 269); stand points and seats now keep clear of where earlier characters stand or
+    // sit, so every pair keeps the passing distance on every built-in text.
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let lib = MotionLibrary::procedural(0);
-    for (name, text) in [("demo", stories::DEMO), ("night-of-the-living-dead", stories::NIGHT_OF_THE_LIVING_DEAD)] {
+    let mut pairs = 0;
+    for (name, text) in stories::all() {
         let parsed = parse_script(text, &cat);
         let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
         let anim = animate(&comp, &cat, &lib, &AnimateConfig::default());
-        let c = min_clearance(&anim).expect("two characters");
+        let Some(c) = min_clearance(&anim) else { continue };
+        pairs += 1;
         eprintln!("{name}: closest {:.3} m at frame {}; notes {:?}", c.metres, c.frame, anim.notes);
-        // Either the distance holds, or a note names the pair and the distance.
-        assert!(c.metres >= PASSING_DISTANCE || anim.notes.iter().any(|n| n.contains(&format!("{:.2} m close", c.metres))), "{name}: {:.3} m without a note", c.metres);
+        assert!(c.metres >= PASSING_DISTANCE, "{name}: {} and {} come {:.3} m close at frame {}", anim.characters[c.a].name, anim.characters[c.b].name, c.metres, c.frame);
+        assert!((closest(&anim) - c.metres).abs() < 1e-6);
+        assert!(anim.notes.iter().all(|n| !n.contains(" m close")), "{name}: {:?}", anim.notes);
     }
+    assert!(pairs >= 2, "the demo and the film lines have two characters each");
+}
+
+#[test]
+fn night_of_the_living_dead_keeps_its_characters_apart_after_the_optimisation() {
+    // The bench's setting (seed 1, the annealing re-animates every state it tries).
+    let cat = builtin();
+    let db = SceneDatabase::builtin(&cat, inbetween_script::job::DEFAULT_VARIATIONS, 1);
+    let parsed = parse_script(stories::NIGHT_OF_THE_LIVING_DEAD, &cat);
+    let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig { seed: 1, ..ComposeConfig::default() });
+    let o = optimize(&comp, &cat, &MotionLibrary::procedural(1), &AnimateConfig::default(), &OptimizeConfig { iterations: 30, ..OptimizeConfig::default() });
+    let c = min_clearance(&o.animation).expect("two characters");
+    eprintln!("closest {:.3} m at frame {}; C {:.3} -> {:.3}; notes {:?}", c.metres, c.frame, o.before.total, o.after.total, o.animation.notes);
+    assert!(c.metres >= PASSING_DISTANCE, "{:.3} m at frame {}", c.metres, c.frame);
 }

@@ -20,21 +20,11 @@ use inbetween_script::output::{
     animated_gltf_document, render_preview_gif, render_top_down_trails, write_animated_gltf, write_character_bvh, AnimPreviewOptions,
 };
 use inbetween_script::motion::{walk_route, MotionLibrary, WalkParams};
-use inbetween_script::scene::{Origin, PlacedObject, Room, Scene};
+use inbetween_script::scene::{Room, Scene};
 use serde_json::Value;
 
-fn obj(label: &str, category: &str, position: [f32; 3], yaw: f32, size: [f32; 3]) -> PlacedObject {
-    PlacedObject {
-        label: label.into(),
-        category: category.into(),
-        attributes: vec![],
-        position,
-        yaw,
-        size,
-        support: None,
-        origin: Origin::Script { sentence: 0, node: 0 },
-    }
-}
+mod common;
+use common::{accessor_floats, check_buffers, obj};
 
 fn scene() -> Scene {
     Scene {
@@ -58,37 +48,6 @@ fn walk() -> Motion {
 fn camera(f: usize) -> ([f32; 3], [f32; 3], f32) {
     let x = 1.5 + 0.01 * f as f32;
     ([x, 2.4, 8.5], [2.5, 0.8, 2.0], 45.0)
-}
-
-fn accessor_floats(doc: &Value, bin: &[u8], acc: usize) -> Vec<f32> {
-    let a = &doc["accessors"][acc];
-    let v = &doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-    let width = match a["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        t => panic!("type {t}"),
-    };
-    assert_eq!(a["componentType"], 5126);
-    let start = v["byteOffset"].as_u64().unwrap_or(0) as usize + a["byteOffset"].as_u64().unwrap_or(0) as usize;
-    let n = a["count"].as_u64().unwrap() as usize * width;
-    assert!(start + 4 * n <= bin.len());
-    (0..n).map(|k| f32::from_le_bytes(bin[start + 4 * k..start + 4 * k + 4].try_into().unwrap())).collect()
-}
-
-/// Buffers, views and accessors are consistent; POSITION and animation inputs have bounds.
-fn check_buffers(doc: &Value, bin: &[u8]) {
-    assert_eq!(doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize, bin.len());
-    for v in doc["bufferViews"].as_array().unwrap() {
-        let end = v["byteOffset"].as_u64().unwrap_or(0) + v["byteLength"].as_u64().unwrap();
-        assert!(end as usize <= bin.len());
-    }
-    for m in doc["meshes"].as_array().unwrap() {
-        for p in m["primitives"].as_array().unwrap() {
-            let a = &doc["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
-            assert!(a["min"].is_array() && a["max"].is_array(), "POSITION without bounds: {a}");
-        }
-    }
 }
 
 fn parents_by_node(doc: &Value) -> HashMap<usize, usize> {

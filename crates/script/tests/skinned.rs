@@ -21,6 +21,9 @@ use inbetween_script::output::skinned::{
 use inbetween_script::scene::{Room, Scene};
 use serde_json::{json, Value};
 
+mod common;
+use common::{accessor_bytes, accessor_floats};
+
 /// Positions, normals, uvs and u8 indices of a mesh.
 type MeshData = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u8>);
 
@@ -160,30 +163,6 @@ fn test_motion(rig: &Rig) -> Motion {
 
 // ---------- reading back our own document ----------
 
-fn f32s(doc: &Value, bin: &[u8], acc: usize) -> Vec<f32> {
-    let a = &doc["accessors"][acc];
-    assert_eq!(a["componentType"], 5126);
-    let comps = match a["type"].as_str().unwrap() {
-        "SCALAR" => 1,
-        "VEC2" => 2,
-        "VEC3" => 3,
-        "VEC4" => 4,
-        "MAT4" => 16,
-        t => panic!("type {t}"),
-    };
-    let v = &doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-    let off = v["byteOffset"].as_u64().unwrap() as usize;
-    let n = a["count"].as_u64().unwrap() as usize * comps;
-    (0..n).map(|i| f32::from_le_bytes(bin[off + 4 * i..off + 4 * i + 4].try_into().unwrap())).collect()
-}
-
-fn u8s(doc: &Value, bin: &[u8], acc: usize) -> Vec<u8> {
-    let a = &doc["accessors"][acc];
-    let v = &doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
-    let off = v["byteOffset"].as_u64().unwrap() as usize;
-    bin[off..off + 4 * a["count"].as_u64().unwrap() as usize].to_vec()
-}
-
 /// World matrices of every node at animation key `k` (channels sampled at that key; nodes without
 /// channels keep their own TRS).
 fn node_worlds(doc: &Value, bin: &[u8], k: usize) -> Vec<Mat4> {
@@ -202,7 +181,7 @@ fn node_worlds(doc: &Value, bin: &[u8], k: usize) -> Vec<Mat4> {
     for ch in anim["channels"].as_array().unwrap() {
         let Some(node) = ch["target"]["node"].as_u64() else { continue };
         let s = &anim["samplers"][ch["sampler"].as_u64().unwrap() as usize];
-        let out = f32s(doc, bin, s["output"].as_u64().unwrap() as usize);
+        let out = accessor_floats(doc, bin, s["output"].as_u64().unwrap() as usize);
         match ch["target"]["path"].as_str().unwrap() {
             "translation" if out.len() >= 3 * (k + 1) => trs[node as usize].0 = Vec3::from_slice(&out[3 * k..3 * k + 3]),
             "rotation" if out.len() >= 4 * (k + 1) => trs[node as usize].1 = Quat::from_slice(&out[4 * k..4 * k + 4]),
@@ -234,10 +213,10 @@ fn doc_skinned(doc: &Value, bin: &[u8], k: usize) -> Vec<Vec3> {
     let node = doc["nodes"].as_array().unwrap().iter().find(|n| n.get("skin").is_some()).unwrap();
     let skin = &doc["skins"][node["skin"].as_u64().unwrap() as usize];
     let prim = &doc["meshes"][node["mesh"].as_u64().unwrap() as usize]["primitives"][0];
-    let pos = f32s(doc, bin, prim["attributes"]["POSITION"].as_u64().unwrap() as usize);
-    let w = f32s(doc, bin, prim["attributes"]["WEIGHTS_0"].as_u64().unwrap() as usize);
-    let j = u8s(doc, bin, prim["attributes"]["JOINTS_0"].as_u64().unwrap() as usize);
-    let ibm = f32s(doc, bin, skin["inverseBindMatrices"].as_u64().unwrap() as usize);
+    let pos = accessor_floats(doc, bin, prim["attributes"]["POSITION"].as_u64().unwrap() as usize);
+    let w = accessor_floats(doc, bin, prim["attributes"]["WEIGHTS_0"].as_u64().unwrap() as usize);
+    let j = accessor_bytes(doc, bin, prim["attributes"]["JOINTS_0"].as_u64().unwrap() as usize);
+    let ibm = accessor_floats(doc, bin, skin["inverseBindMatrices"].as_u64().unwrap() as usize);
     let joints: Vec<usize> = skin["joints"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as usize).collect();
     let worlds = node_worlds(doc, bin, k);
     let mats: Vec<Mat4> = joints.iter().enumerate().map(|(i, &n)| worlds[n] * Mat4::from_cols_slice(&ibm[16 * i..16 * i + 16])).collect();
@@ -393,10 +372,10 @@ fn check_document(doc: &Value, bin: &[u8], body: &SkinnedBody, m: &Motion) {
     let attr = &prim["attributes"];
     let jacc = &doc["accessors"][attr["JOINTS_0"].as_u64().unwrap() as usize];
     assert_eq!((jacc["componentType"].as_u64().unwrap(), jacc["type"].as_str().unwrap()), (5121, "VEC4"));
-    let w = f32s(doc, bin, attr["WEIGHTS_0"].as_u64().unwrap() as usize);
+    let w = accessor_floats(doc, bin, attr["WEIGHTS_0"].as_u64().unwrap() as usize);
     assert!(w.chunks(4).all(|q| (q.iter().sum::<f32>() - 1.0).abs() < 1e-6 && q.iter().all(|x| *x >= 0.0)));
     let pacc = &doc["accessors"][attr["POSITION"].as_u64().unwrap() as usize];
-    let pos = f32s(doc, bin, attr["POSITION"].as_u64().unwrap() as usize);
+    let pos = accessor_floats(doc, bin, attr["POSITION"].as_u64().unwrap() as usize);
     for k in 0..3 {
         let lo = pos.iter().skip(k).step_by(3).copied().fold(f32::MAX, f32::min);
         let hi = pos.iter().skip(k).step_by(3).copied().fold(f32::MIN, f32::max);

@@ -210,7 +210,7 @@ mod tests {
     fn two_people(view: &str) -> Animation {
         let rig = Rig::standard();
         let room = Room { name: "room".into(), width: 6.0, depth: 5.0, height: 2.8 };
-        let track = |name: &str, x: f64| CharacterTrack { name: name.into(), motion: standing_at(&rig, x, 2.5, 0.0, 40), segments: Vec::new() };
+        let track = |name: &str, x: f64| CharacterTrack { name: name.into(), motion: standing_at(&rig, x, 2.5, 0.0, 40), segments: Vec::new(), props: Vec::new() };
         Animation {
             fps: FPS,
             scene: Scene { room, objects: Vec::new(), camera: Vec::new(), weather: None },

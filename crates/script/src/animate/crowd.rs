@@ -68,21 +68,23 @@ fn dist(a: [f32; 2], b: [f32; 2]) -> f32 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-/// Root (x, z) of every frame of a motion.
-pub fn root_track(m: &inbetween_core::Motion) -> Vec<[f32; 2]> {
-    let rig = Rig::of(m.skeleton.clone());
-    (0..m.num_frames())
+/// Root (x, z) of every frame of a motion; an error names the joint missing when it is not on the
+/// common rig.
+pub fn root_track(m: &inbetween_core::Motion) -> Result<Vec<[f32; 2]>, crate::ScriptError> {
+    let rig = Rig::for_motion(m, "a root track")?;
+    Ok((0..m.num_frames())
         .map(|f| {
             let r = m.pose(f).translations[rig.hips];
             [r.x as f32, r.z as f32]
         })
-        .collect()
+        .collect())
 }
 
 /// The minimum distance between any two characters' roots over every frame of the animation
-/// (a character holds its last position after its track ends); None with fewer than two.
+/// (a character holds its last position after its track ends); None with fewer than two (a
+/// character not on the common rig has no root track and is left out).
 pub fn min_clearance(anim: &Animation) -> Option<Clearance> {
-    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().map(|c| root_track(&c.motion)).filter(|t| !t.is_empty()).collect();
+    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().filter_map(|c| root_track(&c.motion).ok()).filter(|t| !t.is_empty()).collect();
     closest(&trajs, &[])
 }
 
@@ -157,7 +159,7 @@ pub(crate) fn separate(ctx: &Ctx, names: &[String], plans: &mut [CharacterPlan],
         match fix {
             Some((x, choices)) => {
                 let p = &plans[x];
-                plans[x] = build_character(ctx, &names[x], p.actions.clone(), p.start, p.grid.clone(), p.blocked_by.clone(), choices, cache);
+                plans[x] = build_character(ctx, &names[x], p.actions.clone(), p.start, p.grid.clone(), p.blocked_by.clone(), p.avoid.clone(), choices, cache);
                 resolved[x] = true;
                 builds[x] += 1;
                 accepted.retain(|&(p, q, _, _)| p != x && q != x);

@@ -288,6 +288,9 @@ fn remap(plan: &CharacterPlan, old: &Scene, new: &Scene, new_index: &[Option<usi
         s.target = s.object.map(|i| new.objects[i].label.clone());
         s.touching = s.touching.iter().map(|&i| map(i)).collect::<Option<Vec<usize>>>()?;
     }
+    for c in &mut p.track.props {
+        c.object = map(c.object)?;
+    }
     if p.marks.len() != actions.len() {
         return None;
     }

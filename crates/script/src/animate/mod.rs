@@ -4,16 +4,23 @@
 //! order) one timeline is built on the common rig ([`crate::motion::rig`]):
 //! - "walk to X": an A* route on the layout's occupancy grid ([`Grid::astar`]) from where the
 //!   character stands (the first start at the room's door, [`layout::door`]) to the free cell
-//!   nearest X's stand point (its `Stand` contact, else a point just past its front), walked with
+//!   nearest X's stand point (its `Stand` contact, else a point just past a side of its support,
+//!   `stand_point`), walked with
 //!   [`walk_route`] (foot locking), ending turned towards X;
 //! - "sit on X": walk to the point in front of X's seat contact, the sit-down clip placed so the
 //!   pelvis lands on the seat (height corrected with the legs re-solved), then a seated loop;
 //! - any other verb: when standing further than [`AnimateConfig::approach_distance`] from the
 //!   target's stand point, a walk there first; then the library clip ([`MotionLibrary::retrieve`]) looped to at least
 //!   [`AnimateConfig::min_action_seconds`], its upper body blended over the idle (or seated)
-//!   lower body with [`blend_upper`], hands moved to the target's `Keys`/`Grip`/`Top`/`Strike`
-//!   contacts with [`reach_contacts`] (two-bone IK, clamped when out of reach: the gap left is
-//!   what the contact cost of [`crate::optimize`] measures).
+//!   lower body with [`crate::motion::blend_upper`], hands moved to the target's `Keys`/`Grip`/`Top`/`Strike`
+//!   contacts with [`crate::motion::reach_contacts`] (two-bone IK, clamped when out of reach: the gap left is
+//!   what the contact cost of [`crate::optimize`] measures);
+//! - a small prop used in the hand ("sings with the microphone", "picks up the phone"): walked to
+//!   (a seated character stands up and sits down again), picked up with the reach clip, then
+//!   carried: it follows the right hand ([`CarriedProp`], [`object_pose`]) through the action.
+//!
+//! Stand points and seats keep clear of every spot an earlier character stands or sits at, so
+//! two characters never share one.
 //!
 //! Several characters all start at frame 0 near the door (at least [`PASSING_DISTANCE`] apart);
 //! a later character's grid blocks where earlier ones end up. [`crowd`] then keeps every pair of
@@ -35,7 +42,7 @@ pub(crate) use crowd::{WalkChoice, WalkInfo};
 
 use std::collections::HashMap;
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use inbetween_core::fk::forward;
 use inbetween_core::motion::interpolate_pose;
 use inbetween_core::{Motion, Pose};
@@ -44,10 +51,11 @@ use crate::catalogue::{Catalogue, ContactKind};
 use crate::compose::Composition;
 use crate::layout::{self, geom, grid, grid::Grid};
 use crate::motion::ik::{solve_limb, Limb, PELVIS_ABOVE_SEAT};
-use crate::motion::locomotion::place_clip;
+use crate::motion::blend::{blend_upper_on, reach_contacts_on};
+use crate::motion::locomotion::place_clip_on;
 use crate::motion::procedural::{seat_point, SEAT_HEIGHT};
 use crate::motion::rig::{Rig, FPS};
-use crate::motion::{blend_upper, reach_contacts, walk_route, BlendParams, Contact, MotionLibrary, WalkParams};
+use crate::motion::{walk_route, BlendParams, Contact, MotionLibrary, WalkParams};
 use crate::scene::{Origin, Scene};
 use crate::ssg::{NodeId, Ssg};
 
@@ -99,6 +107,79 @@ pub struct CharacterTrack {
     /// Common rig skeleton, metres, world placement, [`FPS`].
     pub motion: Motion,
     pub segments: Vec<Segment>,
+    /// Small props the character picks up and carries (see [`CarriedProp`]).
+    pub props: Vec<CarriedProp>,
+}
+
+/// A small prop a character holds (beyond the paper, whose scene is static): it rests at its
+/// scene pose until frame `from`, when the hand closes on it, then follows that hand joint to the
+/// end (held after the track ends).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CarriedProp {
+    /// Index into [`Scene::objects`].
+    pub object: usize,
+    /// Joint of the character's skeleton it follows (the right hand).
+    pub joint: usize,
+    /// First frame it is in the hand.
+    pub from: usize,
+    /// The prop's base point and rotation in the joint's frame: its grip point sits at the joint.
+    pub offset: DVec3,
+    pub rotation: DQuat,
+}
+
+impl CarriedProp {
+    /// The prop's base point (world metres) and rotation at `frame` of the carrying `track`, None
+    /// before it is picked up.
+    pub fn pose_at(&self, track: &CharacterTrack, frame: usize) -> Option<(DVec3, DQuat)> {
+        let n = track.motion.num_frames();
+        if frame < self.from || n == 0 || self.joint >= track.motion.skeleton.len() {
+            return None;
+        }
+        let g = forward(&track.motion.skeleton, &track.motion.pose(frame.min(n - 1)));
+        let (p, q) = (g.positions[self.joint], g.rotations[self.joint]);
+        Some((p + q * self.offset, (q * self.rotation).normalize()))
+    }
+}
+
+/// Where object `obj` is at `frame`: its base point and rotation, carried by a character's hand
+/// or at rest in the scene.
+pub fn object_pose(anim: &Animation, obj: usize, frame: usize) -> (DVec3, DQuat) {
+    for c in &anim.characters {
+        for p in c.props.iter().filter(|p| p.object == obj) {
+            if let Some(pose) = p.pose_at(c, frame) {
+                return pose;
+            }
+        }
+    }
+    let o = &anim.scene.objects[obj];
+    (DVec3::new(o.position[0] as f64, o.position[1] as f64, o.position[2] as f64), DQuat::from_rotation_y(o.yaw as f64))
+}
+
+/// The first frame from which object `obj` is in someone's hand, if it ever is.
+pub fn carried_from(anim: &Animation, obj: usize) -> Option<usize> {
+    anim.characters.iter().flat_map(|c| c.props.iter()).filter(|p| p.object == obj).map(|p| p.from).min()
+}
+
+/// Verb lemmas that take an object into the hand.
+const TAKE_VERBS: &[&str] = &["pick", "take", "grab", "hold", "carry", "fetch", "lift", "get", "collect", "bring", "raise"];
+
+/// Largest side (metres) of an object one hand carries.
+const PROP_SIZE: f32 = 0.45;
+
+/// Horizontal distance (metres) from the root within which a hand picks a prop up without walking.
+const PICK_REACH: f32 = 0.55;
+
+/// Whether acting on `obj` with `verb` (lemma; `canonical` its library tag) carries it: a small
+/// object that rests on a surface, has a grip and carries nothing, and a verb that takes it
+/// ("picks up the phone") or uses it in the hand ("sings with the microphone", "drinks soda").
+fn carries(verb: &str, canonical: &str, preposition: Option<&str>, scene: &Scene, cat: &Catalogue, obj: usize) -> bool {
+    let o = &scene.objects[obj];
+    let Some(c) = cat.get(&o.category) else { return false };
+    let small = c.support == crate::catalogue::Support::Surface && o.size.iter().all(|&v| v <= PROP_SIZE);
+    let grip = c.contacts.iter().any(|p| p.kind == ContactKind::Grip);
+    let free = !scene.objects.iter().any(|x| x.support == Some(obj));
+    let held = TAKE_VERBS.contains(&verb) || preposition == Some("with") || matches!(canonical, "drink" | "call");
+    small && grip && free && held
 }
 
 /// A camera view held over frames `[start, end)`.
@@ -255,6 +336,10 @@ struct Builder<'a> {
     choices: &'a [WalkChoice],
     /// The walks made so far.
     walks: Vec<WalkInfo>,
+    /// Seat points (x, z) sat on.
+    seats: Vec<[f32; 2]>,
+    /// Props picked up so far.
+    props: Vec<CarriedProp>,
 }
 
 /// Closest approach (metres) between two characters' roots that [`crowd::separate`] accepts.
@@ -296,7 +381,7 @@ impl<'a> Builder<'a> {
 
     /// `n` frames of a looped clip with its origin placed at `at`, facing `heading`.
     fn looped(&self, clip: &Motion, at: [f32; 2], heading: f64, n: usize) -> Vec<Pose> {
-        let placed = place_clip(clip, at, heading).poses();
+        let placed = place_clip_on(&self.rig, clip, at, heading).poses();
         (0..n).map(|k| placed[k % placed.len()].clone()).collect()
     }
 
@@ -341,7 +426,7 @@ impl<'a> Builder<'a> {
     fn stand_up(&mut self, st: &mut State, scene: &Scene) {
         let Some((at, seat, obj)) = st.seated.take() else { return };
         let clip = self.named("procedural stand up");
-        let mut poses = place_clip(&clip, at, st.heading).poses();
+        let mut poses = place_clip_on(&self.rig, &clip, at, st.heading).poses();
         let n = poses.len().max(2);
         let dy = seat[1] as f64 - SEAT_HEIGHT;
         self.lift(&mut poses, |k| dy * (1.0 - smooth(k as f64 / (n - 1) as f64)));
@@ -349,6 +434,118 @@ impl<'a> Builder<'a> {
         self.append(poses);
         self.push_segment("stand_up", start, Some(obj), scene, vec![obj], Vec::new());
         st.pos = at;
+    }
+
+    /// Walks to the point in front of seat `s` of object `o`, sits down (pelvis onto the seat) and
+    /// stays seated `hold` frames: a "walk" and a "sit" segment, the latter with the hips contact.
+    #[allow(clippy::too_many_arguments)]
+    fn sit_on(&mut self, st: &mut State, scene: &Scene, g: &Grid, o: usize, s: [f32; 3], hold: usize, speed: Option<f64>, cache: &mut WalkCache, notes: &mut Vec<String>, name: &str) {
+        let yaw = scene.objects[o].yaw as f64;
+        let sp = seat_point();
+        let f = [yaw.sin(), yaw.cos()];
+        // The sit-down clip's seat lies `-sp.z` behind where it starts.
+        let at = [s[0] + (-sp.z * f[0]) as f32, s[2] + (-sp.z * f[1]) as f32];
+        let start = self.frames.len();
+        self.walk(st, g, at, yaw, "walk", speed, cache, notes, name);
+        self.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
+        let start = self.frames.len();
+        let clip = self.named("procedural sit down");
+        let mut poses = place_clip_on(&self.rig, &clip, st.pos, yaw).poses();
+        let n = poses.len().max(2);
+        let dy = s[1] as f64 - SEAT_HEIGHT;
+        self.lift(&mut poses, |k| dy * smooth(k as f64 / (n - 1) as f64));
+        self.append(poses);
+        let seated_from = self.frames.len();
+        let poses = self.seated(st.pos, s, yaw, hold.max(1));
+        self.append(poses);
+        st.seated = Some((st.pos, s, o));
+        self.seats.push([s[0], s[2]]);
+        let hips = JointContact { joint: ContactJoint::Hips, kind: ContactKind::Seat, point: [s[0], s[1] + PELVIS_ABOVE_SEAT as f32, s[2]], start: seated_from, end: self.frames.len() };
+        self.push_segment("sit", start, Some(o), scene, vec![o], vec![hips]);
+    }
+
+    /// Picks up prop `o` with the right hand: from where the character is when the grip is within
+    /// [`PICK_REACH`], else (standing up first if seated) after walking to the prop, and back to
+    /// the seat afterwards. The reach clip plays with the wrist brought onto the grip by IK (the
+    /// root lowered, legs bent, for a prop low down); at the frame the hand is there the prop is
+    /// taken ([`CarriedProp`]), and a "pick_up" segment measures the wrist on the grip.
+    #[allow(clippy::too_many_arguments)]
+    fn pick_up(&mut self, st: &mut State, scene: &Scene, cat: &Catalogue, g: &Grid, o: usize, avoid: &[[f32; 2]], speed: Option<f64>, cache: &mut WalkCache, notes: &mut Vec<String>, name: &str) {
+        let Some(grip) = contacts_of(scene, cat, o, ContactKind::Grip).into_iter().next() else { return };
+        let gxz = [grip[0], grip[2]];
+        let seat_before = st.seated;
+        if dist2(gxz, st.pos) > PICK_REACH * PICK_REACH {
+            self.stand_up(st, scene);
+            let to = stand_point(scene, cat, g, o, st.pos, avoid);
+            let start = self.frames.len();
+            let h = heading_to(to, gxz, st.heading);
+            self.walk(st, g, to, h, "walk", speed, cache, notes, name);
+            self.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
+        }
+        if st.seated.is_none() {
+            st.heading = heading_to(st.pos, gxz, st.heading);
+        }
+        let rig = self.rig.clone();
+        let clip = match self.lib.retrieve("reach").filter(|c| c.motion.skeleton == rig.skeleton) {
+            Some(c) => c.motion.clone(),
+            None => self.named("procedural reach"),
+        };
+        let n = clip.num_frames().max(30);
+        let base = match st.seated {
+            Some((at, s, _)) => self.seated(at, s, st.heading, n),
+            None => {
+                let idle = self.idle_clip();
+                self.looped(&idle, st.pos, st.heading, n)
+            }
+        };
+        let base = crate::motion::rig::clip(&rig, &base);
+        let m = blend_upper_on(&rig, &base, &clip, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: false, action_offset: 0 });
+        // The hand closes at frame `grab`: IK weight rises to 1 there and falls after.
+        let grab = n / 2;
+        let bump = |k: usize| if k <= grab { smooth(k as f64 / grab as f64) } else { smooth((n - 1 - k) as f64 / (n - 1 - grab) as f64) };
+        let mut poses = m.poses();
+        if st.seated.is_none() {
+            // For a prop below the hands' reach (a microphone on the floor) bend the knees and
+            // lean the back forward, about the character's left axis.
+            let low = ((0.75 - grip[1] as f64) / 0.6).clamp(0.0, 1.0);
+            self.lift(&mut poses, |k| -0.5 * low * bump(k));
+            let left = DVec3::new(st.heading.cos(), 0.0, -st.heading.sin());
+            for (k, p) in poses.iter_mut().enumerate() {
+                let lean = 0.9 * low * bump(k);
+                if lean > 1e-4 {
+                    let gl = forward(&rig.skeleton, p);
+                    let parent = rig.skeleton.parent(rig.lower_back).map_or(DQuat::IDENTITY, |j| gl.rotations[j]);
+                    let want = DQuat::from_axis_angle(left, lean) * gl.rotations[rig.lower_back];
+                    p.rotations[rig.lower_back] = crate::motion::rig::local_from_global(parent, want);
+                }
+            }
+        }
+        let m = crate::motion::rig::clip(&rig, &poses);
+        let window = BlendParams { start: 0, end: Some(n), blend_in: grab, blend_out: n - grab, looping: false, action_offset: 0 };
+        let target = DVec3::new(grip[0] as f64, grip[1] as f64, grip[2] as f64);
+        let m = reach_contacts_on(&rig, &m, &[Contact { limb: Limb::RightArm, target, window }]).0;
+        // The prop's grip goes to the hand joint; its rotation relative to the hand stays as it
+        // was at the grab.
+        let hand = rig.arms[1][3];
+        let gp = forward(&rig.skeleton, &m.pose(grab));
+        let wq = gp.rotations[hand];
+        let obj = &scene.objects[o];
+        let q_obj = DQuat::from_rotation_y(obj.yaw as f64);
+        let base_point = DVec3::new(obj.position[0] as f64, obj.position[1] as f64, obj.position[2] as f64);
+        let rotation = (wq.inverse() * q_obj).normalize();
+        let grip_from_base = q_obj.inverse() * (target - base_point);
+        let offset = -(rotation * grip_from_base);
+        let start = self.frames.len();
+        self.append(m.poses());
+        self.props.push(CarriedProp { object: o, joint: hand, from: start + grab, offset, rotation });
+        let contact = JointContact { joint: ContactJoint::RightWrist, kind: ContactKind::Grip, point: grip, start: start + grab.saturating_sub(2), end: start + grab + 3 };
+        let mut touching = vec![o];
+        touching.extend(st.seated.map(|s| s.2));
+        self.push_segment("pick_up", start, Some(o), scene, touching, vec![contact]);
+        // Back to the seat it left.
+        if let (Some((_, s, so)), None) = (seat_before, st.seated) {
+            self.sit_on(st, scene, g, so, s, 10, speed, cache, notes, name);
+        }
     }
 
     /// Walks along a route to `to`, turning to `final_heading`, after waiting in place as this
@@ -405,28 +602,80 @@ fn route(grid: &Grid, from: [f32; 2], to: [f32; 2]) -> Option<Vec<[f32; 2]>> {
     Some(path)
 }
 
-/// Where to stand to use an object: its stand contact, else a point just past its front edge;
-/// the free cell nearest to it.
-fn stand_point(scene: &Scene, cat: &Catalogue, grid: &Grid, obj: usize, from: [f32; 2]) -> [f32; 2] {
+/// Extra margin (metres) beyond [`PASSING_DISTANCE`] kept between a stand point and the spots
+/// where earlier characters stand or sit.
+const SPOT_MARGIN: f32 = 0.1;
+
+/// Where to stand to use an object: its stand contact, else a point just past one of the four
+/// sides of its support (the side nearest the object first, the front preferred); each candidate
+/// also shifted sideways along its side, and moved to the nearest free cell reachable from `from`.
+/// The candidate chosen keeps clear of `avoid` (where earlier characters stand or sit: two
+/// characters never share a spot), then stays close to the object, then to `from`.
+fn stand_point(scene: &Scene, cat: &Catalogue, grid: &Grid, obj: usize, from: [f32; 2], avoid: &[[f32; 2]]) -> [f32; 2] {
     let o = &scene.objects[obj];
-    let mut candidates: Vec<[f32; 2]> = contacts_of(scene, cat, obj, ContactKind::Stand).iter().map(|p| [p[0], p[2]]).collect();
-    if candidates.is_empty() {
-        // An object on a surface is used from its support's front.
-        let base = o.support.map(|s| &scene.objects[s]).unwrap_or(o);
-        let f = geom::forward(base.yaw);
-        let out = base.size[2] / 2.0 + grid::WALKER_RADIUS + 0.1;
-        let c = geom::to_world(geom::center(base), base.yaw, [geom::to_local(geom::center(base), base.yaw, geom::center(o))[0], 0.0]);
-        candidates.push([c[0] + f[0] * out, c[1] + f[1] * out]);
+    // (point, where the character would ideally be for it, extra cost of the side).
+    let mut candidates: Vec<([f32; 2], [f32; 2], f32)> = Vec::new();
+    let stands: Vec<[f32; 2]> = contacts_of(scene, cat, obj, ContactKind::Stand).iter().map(|p| [p[0], p[2]]).collect();
+    for p in &stands {
+        let side = [o.yaw.cos(), -o.yaw.sin()];
+        for shift in [0.0f32, -0.4, 0.4, -0.8, 0.8] {
+            candidates.push(([p[0] + side[0] * shift, p[1] + side[1] * shift], *p, 0.0));
+        }
     }
+    if stands.is_empty() {
+        // An object on a surface is used from its support's sides.
+        let base = o.support.map(|s| &scene.objects[s]).unwrap_or(o);
+        let local = geom::to_local(geom::center(base), base.yaw, geom::center(o));
+        let (hw, hd) = (base.size[0] / 2.0, base.size[2] / 2.0);
+        let out = grid::WALKER_RADIUS + 0.1;
+        // (point on the side nearest the object, outward normal, along-side axis, half length, penalty)
+        let sides = [
+            ([local[0].clamp(-hw, hw), hd], [0.0, 1.0], [1.0, 0.0], hw, 0.0),
+            ([local[0].clamp(-hw, hw), -hd], [0.0, -1.0], [1.0, 0.0], hw, 0.15),
+            ([hw, local[1].clamp(-hd, hd)], [1.0, 0.0], [0.0, 1.0], hd, 0.15),
+            ([-hw, local[1].clamp(-hd, hd)], [-1.0, 0.0], [0.0, 1.0], hd, 0.15),
+        ];
+        // Keys (keyboard, laptop, piano) are used from the side they face.
+        let keys = cat.get(&o.category).is_some_and(|c| c.contacts.iter().any(|p| p.kind == ContactKind::Keys));
+        let (fs, fc) = (o.yaw - base.yaw).sin_cos();
+        for (at, n, along, half, penalty) in sides {
+            if keys && n[0] * fs + n[1] * fc < 0.7 {
+                continue;
+            }
+            let ideal = [at[0] + n[0] * out, at[1] + n[1] * out];
+            for shift in [0.0f32, -0.4, 0.4] {
+                let q = [ideal[0] + along[0] * shift, ideal[1] + along[1] * shift];
+                // Stay beside the side (a shift past its end would stand at a corner).
+                if shift != 0.0 && (q[0] * along[0] + q[1] * along[1]).abs() > half + 0.05 {
+                    continue;
+                }
+                let world_ideal = geom::to_world(geom::center(base), base.yaw, ideal);
+                // The side nearest the object keeps the hands' reach short.
+                let reach = dist2(world_ideal, geom::center(o)).sqrt();
+                candidates.push((geom::to_world(geom::center(base), base.yaw, q), world_ideal, penalty + reach));
+            }
+        }
+    }
+    let reach = grid.cell_of(from).filter(|c| !grid.is_blocked(*c)).or_else(|| grid.nearest_free(from)).map(|c| grid.reachable_from(c));
+    let snap = |p: [f32; 2]| -> Option<[f32; 2]> {
+        let p = if grid.is_free_at(p) { p } else { grid.center(grid.nearest_free(p)?) };
+        let ok = match (&reach, grid.cell_of(p)) {
+            (Some(r), Some((i, j))) => r[j * grid.nx + i],
+            _ => true,
+        };
+        ok.then_some(p)
+    };
+    let crowd = |p: [f32; 2]| avoid.iter().map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2(p, *a).sqrt()).max(0.0)).sum::<f32>();
     let best = candidates
         .into_iter()
-        .min_by(|a, b| dist2(*a, from).total_cmp(&dist2(*b, from)))
-        .unwrap_or(geom::center(o));
-    if grid.is_free_at(best) {
-        best
-    } else {
-        grid.nearest_free(best).map(|c| grid.center(c)).unwrap_or(best)
-    }
+        .filter_map(|(p, ideal, penalty)| {
+            let q = snap(p)?;
+            let cost = 10.0 * crowd(q) + dist2(q, ideal).sqrt() + penalty + 0.01 * dist2(q, from).sqrt();
+            Some((cost, q))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|b| b.1);
+    best.unwrap_or_else(|| grid.nearest_free(geom::center(o)).map(|c| grid.center(c)).unwrap_or(geom::center(o)))
 }
 
 fn dist2(a: [f32; 2], b: [f32; 2]) -> f32 {
@@ -480,6 +729,11 @@ pub(crate) struct CharacterPlan {
     pub notes: Vec<String>,
     /// Where it ends: the stand point, and the seat when seated (later characters keep clear).
     pub end_spots: Vec<[f32; 2]>,
+    /// Every spot it stands or sits at (start, walk ends, seats): later characters' stand points
+    /// keep clear of them.
+    pub spots: Vec<[f32; 2]>,
+    /// The earlier characters' spots this one's stand points keep clear of.
+    pub avoid: Vec<[f32; 2]>,
 }
 
 /// What [`animate_planned`] returns.
@@ -505,6 +759,8 @@ pub(crate) fn animate_planned(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: 
     let (mut resolved, mut builds) = (Vec::new(), Vec::new());
     // Where earlier characters end up: later characters' routes keep clear of them.
     let mut occupied: Vec<[f32; 2]> = Vec::new();
+    // Every spot earlier characters stand or sit at: later stand points keep clear of them.
+    let mut spots: Vec<[f32; 2]> = Vec::new();
     for (ci, (name, actions)) in characters(query).into_iter().enumerate() {
         let mut g = base_grid.clone();
         for p in &occupied {
@@ -513,7 +769,7 @@ pub(crate) fn animate_planned(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: 
         let starts: Vec<[f32; 2]> = plans.iter().map(|p| p.start).collect();
         let start = start_spot(scene, cfg, &base_grid, &g, &starts, ci);
         let plan = match frozen.get(&name.to_lowercase()) {
-            Some(p) if p.start == start && p.blocked_by == occupied && p.actions == actions => {
+            Some(p) if p.start == start && p.blocked_by == occupied && p.avoid == spots && p.actions == actions => {
                 resolved.push(false);
                 builds.push(0);
                 CharacterPlan { grid: g, ..p.clone() }
@@ -521,10 +777,11 @@ pub(crate) fn animate_planned(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: 
             _ => {
                 resolved.push(true);
                 builds.push(1);
-                build_character(&ctx, &name, actions, start, g, occupied.clone(), Vec::new(), cache)
+                build_character(&ctx, &name, actions, start, g, occupied.clone(), spots.clone(), Vec::new(), cache)
             }
         };
         occupied.extend(plan.end_spots.iter().copied());
+        spots.extend(plan.spots.iter().copied());
         names.push(name);
         plans.push(plan);
     }
@@ -565,12 +822,12 @@ fn start_spot(scene: &Scene, cfg: &AnimateConfig, base_grid: &Grid, g: &Grid, st
 
 /// Builds one character's timeline from `start` on its grid `g`, walking as `choices` say.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f32; 2], g: Grid, blocked_by: Vec<[f32; 2]>, choices: Vec<WalkChoice>, cache: &mut WalkCache) -> CharacterPlan {
+pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f32; 2], g: Grid, blocked_by: Vec<[f32; 2]>, avoid: Vec<[f32; 2]>, choices: Vec<WalkChoice>, cache: &mut WalkCache) -> CharacterPlan {
     let (scene, query, cat, lib, cfg, rig) = (ctx.scene, ctx.query, ctx.cat, ctx.lib, ctx.cfg, &ctx.rig);
     let mut notes = Vec::new();
     let mut marks = Vec::new();
     let mut st = State { pos: start, heading: std::f64::consts::PI, seated: None };
-    let mut b = Builder { rig: rig.clone(), lib, fallback: None, cfg, frames: Vec::new(), segments: Vec::new(), choices: &choices, walks: Vec::new() };
+    let mut b = Builder { rig: rig.clone(), lib, fallback: None, cfg, frames: Vec::new(), segments: Vec::new(), choices: &choices, walks: Vec::new(), seats: Vec::new(), props: Vec::new() };
     for (sentence, a) in &actions {
         marks.push((*sentence, b.frames.len()));
         let obj = a.target.and_then(|t| object_of_node(scene, query, t));
@@ -586,7 +843,7 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
             let start = b.frames.len();
             let (to, h) = match obj {
                 Some(o) => {
-                    let to = stand_point(scene, cat, &g, o, st.pos);
+                    let to = stand_point(scene, cat, &g, o, st.pos, &avoid);
                     (to, heading_to(to, geom::center(&scene.objects[o]), st.heading))
                 }
                 None => {
@@ -603,33 +860,16 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
         if verb == "sit" || verb == "sit_down" {
             let seat = obj.and_then(|o| {
                 let seats = contacts_of(scene, cat, o, ContactKind::Seat);
-                seats.into_iter().min_by(|p, q| dist2([p[0], p[2]], st.pos).total_cmp(&dist2([q[0], q[2]], st.pos))).map(|s| (o, s))
+                // The nearest seat, away from where earlier characters stand or sit.
+                let crowd = |p: &[f32; 3]| avoid.iter().map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2([p[0], p[2]], *a).sqrt()).max(0.0)).sum::<f32>();
+                let cost = |p: &[f32; 3]| 10.0 * crowd(p) + dist2([p[0], p[2]], st.pos).sqrt();
+                seats.into_iter().min_by(|p, q| cost(p).total_cmp(&cost(q))).map(|s| (o, s))
             });
             match (seat, st.seated) {
                 (Some((o, s)), seated) if seated.is_none_or(|(_, _, so)| so != o) => {
                     b.stand_up(&mut st, scene);
-                    let yaw = scene.objects[o].yaw as f64;
-                    let sp = seat_point();
-                    let f = [yaw.sin(), yaw.cos()];
-                    // The sit-down clip's seat lies `-sp.z` behind where it starts.
-                    let at = [s[0] + (-sp.z * f[0]) as f32, s[2] + (-sp.z * f[1]) as f32];
-                    let start = b.frames.len();
-                    b.walk(&mut st, &g, at, yaw, "walk", speed, cache, &mut notes, name);
-                    b.push_segment("walk", start, Some(o), scene, vec![o], Vec::new());
-                    let start = b.frames.len();
-                    let clip = b.named("procedural sit down");
-                    let mut poses = place_clip(&clip, st.pos, yaw).poses();
-                    let n = poses.len().max(2);
-                    let dy = s[1] as f64 - SEAT_HEIGHT;
-                    b.lift(&mut poses, |k| dy * smooth(k as f64 / (n - 1) as f64));
-                    b.append(poses);
-                    let seated_from = b.frames.len();
                     let hold = (cfg.min_action_seconds * FPS).round() as usize;
-                    let poses = b.seated(st.pos, s, yaw, hold.max(1));
-                    b.append(poses);
-                    st.seated = Some((st.pos, s, o));
-                    let hips = JointContact { joint: ContactJoint::Hips, kind: ContactKind::Seat, point: [s[0], s[1] + PELVIS_ABOVE_SEAT as f32, s[2]], start: seated_from, end: b.frames.len() };
-                    b.push_segment("sit", start, Some(o), scene, vec![o], vec![hips]);
+                    b.sit_on(&mut st, scene, &g, o, s, hold, speed, cache, &mut notes, name);
                 }
                 _ => {
                     if seat.is_none() && obj.is_some() {
@@ -677,6 +917,15 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
             b.push_segment("turn", start, obj, scene, Vec::new(), Vec::new());
             continue;
         }
+        // A small prop used in the hand is picked up first and then carried: the action plays
+        // with it in the hand, not with the hand on its resting place.
+        let carried = obj.filter(|&o| carries(&a.verb, &verb, a.preposition.as_deref(), scene, cat, o));
+        if let Some(o) = carried {
+            if !b.props.iter().any(|p| p.object == o) {
+                b.pick_up(&mut st, scene, cat, &g, o, &avoid, speed, cache, &mut notes, name);
+            }
+        }
+        let hands_on = if carried.is_some() { None } else { obj };
         // An action in place, over the idle or seated lower body.
         let action = lib.retrieve(&verb).filter(|c| c.motion.skeleton == rig.skeleton).map(|c| c.motion.clone());
         if action.is_none() && verb != "stand" && verb != "idle" {
@@ -686,8 +935,8 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
         let min = (cfg.min_action_seconds * FPS).round() as usize;
         let n = clip_len * min.div_ceil(clip_len).max(1);
         // A standing character walks up to a target out of reach first.
-        if let (Some(o), None) = (obj, st.seated) {
-            let to = stand_point(scene, cat, &g, o, st.pos);
+        if let (Some(o), None) = (hands_on, st.seated) {
+            let to = stand_point(scene, cat, &g, o, st.pos, &avoid);
             if dist2(to, st.pos) > cfg.approach_distance * cfg.approach_distance {
                 let start = b.frames.len();
                 let h = heading_to(to, geom::center(&scene.objects[o]), st.heading);
@@ -696,7 +945,7 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
             }
         }
         // Face the target when standing.
-        if let (Some(o), None) = (obj, st.seated) {
+        if let (Some(o), None) = (hands_on, st.seated) {
             st.heading = heading_to(st.pos, geom::center(&scene.objects[o]), st.heading);
         }
         let base = match st.seated {
@@ -708,15 +957,15 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
         };
         let base = crate::motion::rig::clip(rig, &base);
         let mut m = match &action {
-            Some(act) => blend_upper(&base, act, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 }),
+            Some(act) => blend_upper_on(rig, &base, act, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 }),
             None => base,
         };
         let start = b.frames.len();
         let mut contacts = Vec::new();
-        if let (Some(o), true) = (obj, cfg.reach) {
+        if let (Some(o), true) = (hands_on, cfg.reach) {
             let (ik, jc) = hand_contacts(rig, &m, scene, cat, o, start);
             if !ik.is_empty() {
-                m = reach_contacts(&m, &ik).0;
+                m = reach_contacts_on(rig, &m, &ik).0;
             }
             contacts = jc;
         }
@@ -742,8 +991,11 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
     let motion = crate::motion::rig::clip(rig, &b.frames);
     let traj: Vec<[f32; 2]> = b.frames.iter().map(|p| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32]).collect();
     let walks = b.walks;
-    let track = CharacterTrack { name: name.to_string(), motion, segments: b.segments };
-    CharacterPlan { actions, start, blocked_by, grid: g, choices, track, traj, walks, marks, notes, end_spots }
+    let track = CharacterTrack { name: name.to_string(), motion, segments: b.segments, props: b.props };
+    let mut spots = vec![start];
+    spots.extend(walks.iter().filter_map(|w| traj.get(w.end.saturating_sub(1)).copied()));
+    spots.extend(b.seats.iter().copied());
+    CharacterPlan { actions, start, blocked_by, grid: g, choices, track, traj, walks, marks, notes, end_spots, spots, avoid }
 }
 
 /// IK contacts (wrist targets) and cost contacts for a hand action on object `o`: keys take both

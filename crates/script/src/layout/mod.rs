@@ -362,7 +362,24 @@ impl<'a, R: Rng> Solver<'a, R> {
             self.place(i);
             self.repair(i);
         }
+        self.settle_pinned_supports();
         self.finish()
+    }
+
+    /// Pinned items are placed first, not in support order, so one resting on a surface pinned
+    /// after it found no support when placed: look again once everything stands (an edit's
+    /// re-run must give the same supports as the first run).
+    fn settle_pinned_supports(&mut self) {
+        for i in 0..self.p.items.len() {
+            if self.p.items[i].pinned.is_none() {
+                continue;
+            }
+            let Some((position, yaw)) = self.poses[i].as_ref().filter(|o| o.support.is_none()).map(|o| (o.position, o.yaw)) else { continue };
+            let support = self.support_at(i, position, yaw);
+            if let Some(o) = self.poses[i].as_mut() {
+                o.support = support;
+            }
+        }
     }
 
     /// Relations with `i` as the active end that are live and unmet.

@@ -5,6 +5,7 @@
 
 use super::ik::{solve_limb, Limb};
 use super::rig::{heading_of, local_from_global, yaw, Rig};
+use crate::error::ScriptError;
 use glam::DVec3;
 use inbetween_core::fk::forward;
 use inbetween_core::Motion;
@@ -80,13 +81,22 @@ impl BlendParams {
 /// (`LowerBack`) takes the action's orientation relative to the action's heading, re-expressed
 /// under the locomotion's heading, so the torso follows where the walker faces; the other upper
 /// joints take the action's local rotations. Both clips must be on the same skeleton and rate;
-/// the result has the locomotion's length.
-pub fn blend_upper(locomotion: &Motion, action: &Motion, params: &BlendParams) -> Motion {
-    assert_eq!(
-        locomotion.skeleton, action.skeleton,
-        "blend_upper needs both clips on the common skeleton"
-    );
-    let rig = Rig::of(locomotion.skeleton.clone());
+/// the result has the locomotion's length. An error says when the skeletons differ or names the
+/// joint of the common rig missing.
+pub fn blend_upper(locomotion: &Motion, action: &Motion, params: &BlendParams) -> Result<Motion, ScriptError> {
+    if locomotion.skeleton != action.skeleton {
+        return Err(ScriptError::Invalid(format!(
+            "blending an action over locomotion needs both clips on one skeleton (the locomotion has {} joints, the action {})",
+            locomotion.skeleton.len(),
+            action.skeleton.len()
+        )));
+    }
+    let rig = Rig::for_motion(locomotion, "blending an action over locomotion")?;
+    Ok(blend_upper_on(&rig, locomotion, action, params))
+}
+
+/// [`blend_upper`] for two clips known to be on `rig`.
+pub(crate) fn blend_upper_on(rig: &Rig, locomotion: &Motion, action: &Motion, params: &BlendParams) -> Motion {
     let mask = rig.upper_body_mask();
     let n = locomotion.num_frames();
     let na = action.num_frames();
@@ -133,9 +143,14 @@ pub struct Contact {
 
 /// Meets contact points with two-bone IK (§4.2 "IK is used …", §4.3 contact cost made zero):
 /// at each frame the limb end moves from where the motion puts it towards the contact by the
-/// window's weight. Returns the clip and the largest remaining distance at full weight (m).
-pub fn reach_contacts(m: &Motion, contacts: &[Contact]) -> (Motion, f64) {
-    let rig = Rig::of(m.skeleton.clone());
+/// window's weight. Returns the clip and the largest remaining distance at full weight (m); an
+/// error names the joint missing when `m` is not on the common rig.
+pub fn reach_contacts(m: &Motion, contacts: &[Contact]) -> Result<(Motion, f64), ScriptError> {
+    Ok(reach_contacts_on(&Rig::for_motion(m, "reaching contacts")?, m, contacts))
+}
+
+/// [`reach_contacts`] on a motion known to be on `rig`.
+pub(crate) fn reach_contacts_on(rig: &Rig, m: &Motion, contacts: &[Contact]) -> (Motion, f64) {
     let n = m.num_frames();
     let mut worst: f64 = 0.0;
     let poses: Vec<_> = (0..n)
@@ -146,9 +161,9 @@ pub fn reach_contacts(m: &Motion, contacts: &[Contact]) -> (Motion, f64) {
                 if w <= 0.0 {
                     continue;
                 }
-                let end = c.limb.chain(&rig)[2];
+                let end = c.limb.chain(rig)[2];
                 let now = forward(&rig.skeleton, &p).positions[end];
-                let err = solve_limb(&rig, &mut p, c.limb, now.lerp(c.target, w), None);
+                let err = solve_limb(rig, &mut p, c.limb, now.lerp(c.target, w), None);
                 if w >= 1.0 {
                     worst = worst.max(err);
                 }

@@ -8,6 +8,7 @@
 use super::ik::{solve_limb, Limb};
 use super::library::MotionLibrary;
 use super::rig::{clip, heading_of, wrap, yaw, Rig, FPS};
+use crate::error::ScriptError;
 use glam::DVec3;
 use inbetween_core::fk::{forward, forward_clip};
 use inbetween_core::motion::interpolate_pose;
@@ -334,9 +335,9 @@ pub fn walk_route_stats(
         push(&mut frames, &mut t, l, path.at(len), h);
     }
     let raw = clip(&rig, &frames);
-    let before = foot_skate(&raw);
+    let before = foot_skate_on(&rig, &raw);
     let out = if params.lock_feet {
-        lock_feet(&raw, &LockParams::default())
+        lock_feet_on(&rig, &raw, &LockParams::default())
     } else {
         raw
     };
@@ -345,7 +346,7 @@ pub fn walk_route_stats(
         frames: out.num_frames(),
         seconds: out.duration(),
         skate_before: before,
-        skate_after: foot_skate(&out),
+        skate_after: foot_skate_on(&rig, &out),
         max_route_error: route_err,
     };
     (out, stats)
@@ -399,9 +400,14 @@ fn hspeed(a: DVec3, b: DVec3, dt: f64) -> f64 {
 
 /// Foot contacts (left, right) per frame by ankle height and horizontal speed, with runs
 /// shorter than `min_frames` removed.
-pub fn detect_contacts(m: &Motion, p: &LockParams) -> [Vec<bool>; 2] {
-    let rig = Rig::of(m.skeleton.clone());
-    let a = ankles(m, &rig);
+/// An error names the joint missing when `m` is not on the common rig.
+pub fn detect_contacts(m: &Motion, p: &LockParams) -> Result<[Vec<bool>; 2], ScriptError> {
+    Ok(detect_contacts_on(&Rig::for_motion(m, "foot-contact detection")?, m, p))
+}
+
+/// [`detect_contacts`] on a motion known to be on `rig`.
+pub(crate) fn detect_contacts_on(rig: &Rig, m: &Motion, p: &LockParams) -> [Vec<bool>; 2] {
+    let a = ankles(m, rig);
     let n = a.len();
     let dt = m.frame_time;
     [0, 1].map(|k| {
@@ -437,14 +443,19 @@ pub fn detect_contacts(m: &Motion, p: &LockParams) -> [Vec<bool>; 2] {
 /// Foot locking: each detected contact is pinned at the mean floor position of its ankle at rest
 /// ankle height (faded in/out over `blend_frames`), the root is lowered where a leg could not
 /// reach, and both legs are re-solved with two-bone IK (ankles keep their global orientation).
-pub fn lock_feet(m: &Motion, p: &LockParams) -> Motion {
-    let rig = Rig::of(m.skeleton.clone());
+/// An error names the joint missing when `m` is not on the common rig.
+pub fn lock_feet(m: &Motion, p: &LockParams) -> Result<Motion, ScriptError> {
+    Ok(lock_feet_on(&Rig::for_motion(m, "foot locking")?, m, p))
+}
+
+/// [`lock_feet`] on a motion known to be on `rig`.
+pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
     let n = m.num_frames();
     if n == 0 {
         return m.clone();
     }
-    let contacts = detect_contacts(m, p);
-    let a = ankles(m, &rig);
+    let contacts = detect_contacts_on(rig, m, p);
+    let a = ankles(m, rig);
     let mut targets: Vec<[Option<DVec3>; 2]> = vec![[None, None]; n];
     for k in 0..2 {
         let c = &contacts[k];
@@ -530,7 +541,7 @@ pub fn lock_feet(m: &Motion, p: &LockParams) -> Motion {
         poses[f].translations[rig.hips].y -= smooth[f].max(0.0);
         for (k, limb) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
             if let Some(t) = targets[f][k] {
-                solve_limb(&rig, &mut poses[f], limb, t, None);
+                solve_limb(rig, &mut poses[f], limb, t, None);
             }
         }
     }
@@ -544,9 +555,14 @@ pub const SKATE_HEIGHT: f64 = 0.02;
 /// Foot skate in **cm/s**: mean horizontal ankle speed over the frames where that ankle is within
 /// [`SKATE_HEIGHT`] of its rest height (both feet pooled; 0 when no foot touches the floor).
 /// Contact is judged by height alone, so locking cannot hide skate by changing the detection.
-pub fn foot_skate(m: &Motion) -> f64 {
-    let rig = Rig::of(m.skeleton.clone());
-    let a = ankles(m, &rig);
+/// An error names the joint missing when `m` is not on the common rig.
+pub fn foot_skate(m: &Motion) -> Result<f64, ScriptError> {
+    Ok(foot_skate_on(&Rig::for_motion(m, "foot skate")?, m))
+}
+
+/// [`foot_skate`] on a motion known to be on `rig`.
+pub(crate) fn foot_skate_on(rig: &Rig, m: &Motion) -> f64 {
+    let a = ankles(m, rig);
     let (mut sum, mut count) = (0.0, 0usize);
     for f in 1..a.len() {
         for (&now, &before) in a[f].iter().zip(&a[f - 1]) {
@@ -566,8 +582,13 @@ pub fn foot_skate(m: &Motion) -> f64 {
 
 /// A library clip placed in the world: its first frame's root moved to floor point `at` and
 /// turned to heading `heading` (the clip starts facing +Z at the origin).
-pub fn place_clip(m: &Motion, at: [f32; 2], heading: f64) -> Motion {
-    let rig = Rig::of(m.skeleton.clone());
+/// An error names the joint missing when `m` is not on the common rig.
+pub fn place_clip(m: &Motion, at: [f32; 2], heading: f64) -> Result<Motion, ScriptError> {
+    Ok(place_clip_on(&Rig::for_motion(m, "placing a clip")?, m, at, heading))
+}
+
+/// [`place_clip`] for a clip known to be on `rig`.
+pub(crate) fn place_clip_on(rig: &Rig, m: &Motion, at: [f32; 2], heading: f64) -> Motion {
     let q = yaw(heading);
     let off = DVec3::new(at[0] as f64, 0.0, at[1] as f64);
     let poses: Vec<Pose> = m

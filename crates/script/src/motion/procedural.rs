@@ -48,7 +48,9 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
     p.fps = FPS;
     p.frames = period as usize * cycles;
     let base = scale_motion(&gait(&p), M_PER_CMU);
-    let rig = Rig::of(base.skeleton.clone());
+    // `gait` builds core's standard skeleton, which scaled to metres is the common rig's.
+    let rig = Rig::standard();
+    debug_assert!(rig.skeleton == base.skeleton);
     let speed = p.speed * M_PER_CMU;
     let stride = speed / p.cycle_hz;
     let n = base.num_frames();

@@ -53,6 +53,12 @@ impl Rig {
         Rig::try_of(skeleton).unwrap_or_else(|e| panic!("{e}"))
     }
 
+    /// The rig of a motion's skeleton for `what` (a helper's task, for the message), or an error
+    /// naming the joint missing.
+    pub fn for_motion(m: &Motion, what: &str) -> Result<Rig, crate::error::ScriptError> {
+        Rig::try_of(m.skeleton.clone()).map_err(|e| crate::error::ScriptError::Invalid(format!("{what} needs the common rig's joints: {e}")))
+    }
+
     /// Indices on a skeleton with the standard joint names, or which joint is missing.
     pub fn try_of(skeleton: Skeleton) -> Result<Rig, String> {
         let f = |n: &str| {

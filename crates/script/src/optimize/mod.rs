@@ -160,6 +160,8 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
     let objs = &anim.scene.objects;
     let model: Vec<Vec<boxes::LocalBox>> = objs.iter().map(|o| boxes::object_boxes(o, box_size)).collect();
     let mut hit: Vec<Vec<bool>> = model.iter().map(|b| vec![false; b.len()]).collect();
+    // A prop in someone's hand has left its place: from then on nothing collides with it there.
+    let carried: Vec<usize> = (0..objs.len()).map(|i| crate::animate::carried_from(anim, i).unwrap_or(usize::MAX)).collect();
     let mut spheres = Vec::new();
     for c in &anim.characters {
         let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
@@ -173,7 +175,7 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
             body_spheres(&rig, &g, &mut spheres);
             for (i, o) in objs.iter().enumerate() {
                 // Flat objects (rugs) are walked on, not into.
-                if touching.contains(&i) || o.top() < crate::layout::grid::FLAT {
+                if touching.contains(&i) || o.top() < crate::layout::grid::FLAT || f >= carried[i] {
                     continue;
                 }
                 let half = [o.size[0] / 2.0, o.size[2] / 2.0];
@@ -208,11 +210,12 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
 }
 
 /// C_T (Eq. 2): mean distance (metres) from each contact joint's mean position over its window
-/// to its contact point, over all pairs of the animation; and the number of pairs.
+/// to its contact point, over all pairs of the animation; and the number of pairs. A character not
+/// on the common rig has no contact joints and is left out, as in [`collision_cost`].
 pub fn contact_cost(anim: &Animation) -> (f64, usize) {
     let (mut sum, mut count) = (0.0, 0usize);
     for c in &anim.characters {
-        let rig = Rig::of(c.motion.skeleton.clone());
+        let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
         let sk = &rig.skeleton;
         let finger = |side: &str, hand: usize| sk.find(&format!("{side}HandIndex1")).or_else(|| sk.find(&format!("{side}FingerBase"))).unwrap_or(hand);
         let (lh, rh) = (rig.arms[0][3], rig.arms[1][3]);
@@ -421,6 +424,7 @@ pub fn collisions_by_object(anim: &Animation, box_size: f32) -> Vec<(String, usi
                 for s in &mut c.segments {
                     s.touching = if s.touching.contains(&i) { vec![0] } else { Vec::new() };
                 }
+                c.props = c.props.iter().filter(|p| p.object == i).map(|p| crate::animate::CarriedProp { object: 0, ..p.clone() }).collect();
             }
             let (_, nc, _) = collision_cost(&one, box_size);
             (nc > 0).then(|| (o.label.clone(), nc, boxes::object_boxes(o, box_size).len()))

@@ -346,7 +346,59 @@ pub fn write_animated_gltf(
     fps: f64,
 ) -> Result<(), ScriptError> {
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
-    let (mut doc, bin, _notes) = animated_gltf_document(scene, cat, characters, camera, fps, &lookup)?;
+    let (doc, bin, _notes) = animated_gltf_document(scene, cat, characters, camera, fps, &lookup)?;
+    write_document(path, doc, bin)
+}
+
+/// [`write_animated_gltf`] of a story: also the props its characters carry
+/// ([`crate::animate::CarriedProp`]) get translation and rotation channels on their object nodes,
+/// so they rest until picked up and then follow the hand.
+pub fn write_story_gltf(path: &Path, anim: &crate::animate::Animation, cat: &Catalogue, camera: &CameraFn) -> Result<(), ScriptError> {
+    let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
+    let (mut doc, mut bin, _notes) = animated_gltf_document(&anim.scene, cat, &chars, camera, anim.fps, &lookup)?;
+    let n = animation_frames(&chars, anim.fps);
+    add_prop_channels(&mut doc, &mut bin, anim, n);
+    write_document(path, doc, bin)
+}
+
+/// Channels moving every carried prop's object node (the scene's node named by its label) over
+/// frames `0..n` at the animation's rate.
+pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate::animate::Animation, n: usize) {
+    let carried: Vec<usize> = (0..anim.scene.objects.len()).filter(|&i| crate::animate::carried_from(anim, i).is_some()).collect();
+    if carried.is_empty() || n == 0 {
+        return;
+    }
+    let mut a = Appender { doc, bin };
+    let t: Vec<f32> = (0..n).map(|f| (f as f64 / anim.fps) as f32).collect();
+    let input = a.floats(&t, 1, true, None);
+    for i in carried {
+        let label = anim.scene.objects[i].label.as_str();
+        // Object nodes come first in the document (before the characters' joints).
+        let Some(node) = a.doc["nodes"].as_array().and_then(|ns| ns.iter().position(|x| x["name"] == label)) else { continue };
+        let poses: Vec<(DVec3, DQuat)> = (0..n).map(|f| crate::animate::object_pose(anim, i, f)).collect();
+        let pos: Vec<f32> = poses.iter().flat_map(|(p, _)| [p.x as f32, p.y as f32, p.z as f32]).collect();
+        let rot = continuous_quats(poses.iter().map(|(_, q)| q.as_quat()));
+        for (values, width, path) in [(pos, 3, "translation"), (rot, 4, "rotation")] {
+            let output = a.floats(&values, width, false, None);
+            let samplers = a.doc["animations"][0]["samplers"].as_array_mut().map_or(0, |s| {
+                s.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+                s.len() - 1
+            });
+            if let Some(c) = a.doc["animations"][0]["channels"].as_array_mut() {
+                c.push(json!({"sampler": samplers, "target": {"node": node, "path": path}}));
+            }
+        }
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    doc["buffers"] = json!([{"byteLength": bin.len()}]);
+}
+
+/// Writes a document with its buffer as `.glb` (by extension) or `.gltf` with an embedded buffer,
+/// atomically.
+pub(crate) fn write_document(path: &Path, mut doc: Value, bin: Vec<u8>) -> Result<(), ScriptError> {
     let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     let bytes = if glb {
         glb_bytes(&doc, &bin)

@@ -29,6 +29,9 @@ const SKY: [u8; 3] = [246, 247, 250];
 pub const MAX_GIF_WIDTH: u32 = 480;
 pub const MAX_GIF_FPS: f64 = 10.0;
 
+/// An object's base point and yaw per story frame (see [`AnimPreviewOptions::moving`]).
+pub type ObjectTrack = Vec<([f32; 3], f32)>;
+
 /// How to draw the preview GIF.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AnimPreviewOptions {
@@ -44,11 +47,14 @@ pub struct AnimPreviewOptions {
     pub labels: bool,
     /// Text before the frame counter in the title (e.g. the story's name); None: the room's name.
     pub title: Option<String>,
+    /// Objects that move (props carried by a hand): index into the scene's objects, then base
+    /// point and yaw per story frame (the last one held). Empty: every object stays put.
+    pub moving: Vec<(usize, ObjectTrack)>,
 }
 
 impl Default for AnimPreviewOptions {
     fn default() -> Self {
-        AnimPreviewOptions { width: MAX_GIF_WIDTH, height: None, max_fps: MAX_GIF_FPS, max_frames: 600, labels: true, title: None }
+        AnimPreviewOptions { width: MAX_GIF_WIDTH, height: None, max_fps: MAX_GIF_FPS, max_frames: 600, labels: true, title: None, moving: Vec::new() }
     }
 }
 
@@ -122,8 +128,14 @@ fn draw_frame(scene: &Scene, cat: &Catalogue, figs: &[Figure], cam: &Camera3, fr
     let mut cv = Canvas::new(cam.width, cam.height, SKY);
     draw_room(&mut cv, cam, scene);
     let t = frame as f64 / fps;
-    let mut items: Vec<(f64, Item)> = scene
-        .objects
+    // Carried props where the hand has them at this frame.
+    let mut placed = scene.objects.clone();
+    for (i, track) in &opts.moving {
+        if let (Some(o), Some(&(p, yaw))) = (placed.get_mut(*i), track.get(frame).or(track.last())) {
+            (o.position, o.yaw) = (p, yaw);
+        }
+    }
+    let mut items: Vec<(f64, Item)> = placed
         .iter()
         .map(|o| {
             let c = geom::center(o);

@@ -17,7 +17,7 @@ use crate::scene::Scene;
 
 pub use gltf::{gltf_document, write_gltf, write_gltf_with_models};
 pub use preview::{perspective, top_down, VIEWS};
-pub use anim_gltf::{animated_gltf_document, write_animated_gltf};
+pub use anim_gltf::{animated_gltf_document, write_animated_gltf, write_story_gltf};
 pub use anim_preview::{render_preview_gif, render_top_down_trails, AnimPreviewOptions};
 pub use bvh_out::write_character_bvh;
 

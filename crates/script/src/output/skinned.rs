@@ -878,7 +878,11 @@ pub fn write_skinned_story(dir: &Path, anim: &crate::animate::Animation, cat: &C
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
     let cam = |f: usize| crate::animate::camera_pose(anim, f);
     let gltf = dir.join(SKINNED_GLTF);
-    write_skinned_gltf(&gltf, &anim.scene, cat, &chars, &refs, &cam, anim.fps)?;
+    // As `write_skinned_gltf`, with the carried props moving as in story.gltf.
+    let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
+    let (mut doc, mut bin, _) = skinned_gltf_document(&anim.scene, cat, &chars, &refs, &cam, anim.fps, &lookup)?;
+    super::anim_gltf::add_prop_channels(&mut doc, &mut bin, anim, super::anim_gltf::animation_frames(&chars, anim.fps));
+    super::anim_gltf::write_document(&gltf, doc, bin)?;
     let png = dir.join(SKINNED_PNG);
     let frames = super::anim_gltf::animation_frames(&chars, anim.fps);
     let img = render_skinned_frame(&anim.scene, cat, &chars, &refs, &cam, anim.fps, frames / 2, (640, 480));
