@@ -13,7 +13,7 @@ use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
 use inbetween_core::Motion;
 use serde_json::{json, Value};
 
-use super::gltf::{base64, glb_bytes, gltf_document};
+use super::gltf::{gltf_document, write_document};
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::scene::Scene;
@@ -396,15 +396,3 @@ pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate
     doc["buffers"] = json!([{"byteLength": bin.len()}]);
 }
 
-/// Writes a document with its buffer as `.glb` (by extension) or `.gltf` with an embedded buffer,
-/// atomically.
-pub(crate) fn write_document(path: &Path, mut doc: Value, bin: Vec<u8>) -> Result<(), ScriptError> {
-    let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    let bytes = if glb {
-        glb_bytes(&doc, &bin)
-    } else {
-        doc["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64(&bin)));
-        doc.to_string().into_bytes()
-    };
-    inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))
-}

@@ -475,7 +475,14 @@ pub fn write_gltf_with_models(path: &Path, scene: &Scene, cat: &Catalogue, model
         let p = models_dir?.join(format!("{stem}.glb"));
         p.is_file().then_some(p)
     };
-    let (mut doc, bin, notes) = gltf_document(scene, cat, &lookup);
+    let (doc, bin, notes) = gltf_document(scene, cat, &lookup);
+    write_document(path, doc, bin)?;
+    Ok(notes)
+}
+
+/// Writes a document with its buffer as `.glb` (by extension) or `.gltf` with an embedded buffer,
+/// atomically.
+pub(crate) fn write_document(path: &Path, mut doc: Value, bin: Vec<u8>) -> Result<(), ScriptError> {
     let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     let bytes = if glb {
         glb_bytes(&doc, &bin)
@@ -483,8 +490,7 @@ pub fn write_gltf_with_models(path: &Path, scene: &Scene, cat: &Catalogue, model
         doc["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64(&bin)));
         doc.to_string().into_bytes()
     };
-    inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))?;
-    Ok(notes)
+    inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))
 }
 
 /// Positions, flat normals and triangle indices of a unit box, x, z ∈ [-½, ½] and y ∈ [-½, ½] +

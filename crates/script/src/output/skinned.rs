@@ -33,7 +33,7 @@ use inbetween_render::Canvas;
 use serde_json::{json, Value};
 
 use super::anim_gltf::{animated_gltf_document, Appender, CameraFn};
-use super::gltf::{base64, glb_bytes};
+use super::gltf::write_document;
 use super::preview::{draw_object, draw_room, fill_convex, scale_color};
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
@@ -724,15 +724,8 @@ pub fn write_skinned_gltf(
     fps: f64,
 ) -> Result<(), ScriptError> {
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
-    let (mut doc, bin, _) = skinned_gltf_document(scene, cat, characters, bodies, camera, fps, &lookup)?;
-    let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    let bytes = if glb {
-        glb_bytes(&doc, &bin)
-    } else {
-        doc["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64(&bin)));
-        doc.to_string().into_bytes()
-    };
-    inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))
+    let (doc, bin, _) = skinned_gltf_document(scene, cat, characters, bodies, camera, fps, &lookup)?;
+    write_document(path, doc, bin)
 }
 
 /// A body's colour lookup: its texture (wrapping like glTF's default REPEAT sampler) or its base
@@ -882,7 +875,7 @@ pub fn write_skinned_story(dir: &Path, anim: &crate::animate::Animation, cat: &C
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
     let (mut doc, mut bin, _) = skinned_gltf_document(&anim.scene, cat, &chars, &refs, &cam, anim.fps, &lookup)?;
     super::anim_gltf::add_prop_channels(&mut doc, &mut bin, anim, super::anim_gltf::animation_frames(&chars, anim.fps));
-    super::anim_gltf::write_document(&gltf, doc, bin)?;
+    write_document(&gltf, doc, bin)?;
     let png = dir.join(SKINNED_PNG);
     let frames = super::anim_gltf::animation_frames(&chars, anim.fps);
     let img = render_skinned_frame(&anim.scene, cat, &chars, &refs, &cam, anim.fps, frames / 2, (640, 480));
