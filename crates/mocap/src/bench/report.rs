@@ -129,6 +129,7 @@ impl KFold {
             o.min_keys, o.max_keys, o.pretrain_steps, o.pretrain_batch, o.pretrain_lr, o.episodes, o.lr, o.gamma, o.batch, o.memory, o.target_every
         ));
         t.note("paper units: no division by 2, φ from atan2 at every frame (not unwrapped over time), |Δφ| not wrapped (bench::measure::paper_units_error)");
+        t.note("SIDQL rows without \"checked\" are the network's keys alone; checked: replaced by uniform keys when those cost less; refined: then each key moved to the best frame between its neighbours until none moves (select::refine); the default policy does both");
         t
     }
 }
@@ -229,7 +230,7 @@ impl BenchResults {
         t.note(format!("decision ms: selection time per window on the {} split, this machine", splits[0]));
         t.note(format!("SIDQL: {}", self.policy));
         if self.policy.contains("every CMU take") {
-            t.note("SIDQL here saw every take in training (these rows are not held out; the k-fold table is); its keys are checked against uniform keys by their exact cost and replaced when worse");
+            t.note("SIDQL here saw every take in training (these rows are not held out; the k-fold table is); its keys are checked against uniform keys by their exact cost and replaced when worse, then refined (each key moved to the best frame between its neighbours until none moves)");
         }
         t
     }

@@ -11,7 +11,7 @@ use super::{
     Protocol, Window,
 };
 use super::report::{KFold, KFoldRow};
-use crate::dqn::{DqnConfig, SidqlPolicy, TrainOptions};
+use crate::dqn::{DqnConfig, Finish, SidqlPolicy, TrainOptions};
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
 use inbetween_core::units::{LengthUnit, UnitChoice};
@@ -187,7 +187,16 @@ pub fn fold_takes(all: &[Window], folds: usize, seed: u64) -> Vec<Vec<String>> {
 pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldConfig, ks: &[usize], progress: &Progress) -> Result<KFold> {
     let groups = fold_takes(all, cfg.folds, protocol.seed);
     progress.phase(groups.len() as u64, "k-fold");
-    let variants = ["UC", "Greedy", "SIDQL before fine-tuning", "SIDQL fine-tuned", "SIDQL fine-tuned, checked against UC", "Optimal"];
+    let variants = [
+        "UC",
+        "Greedy",
+        "SIDQL before fine-tuning",
+        "SIDQL fine-tuned",
+        "SIDQL fine-tuned, checked against UC",
+        "SIDQL before fine-tuning, checked and refined",
+        "SIDQL fine-tuned, checked and refined (default)",
+        "Optimal",
+    ];
     // (variant, k) → sums over windows of angle, paper units, seconds; windows.
     let mut sums = vec![(0.0, 0.0, 0.0, 0usize); variants.len() * ks.len()];
     let (mut train_seconds, mut train_windows) = (Vec::new(), Vec::new());
@@ -210,16 +219,21 @@ pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldCon
             }
         };
         let seed = protocol.seed;
-        for (v, m) in [(0, Method::Uc), (1, Method::Greedy), (5, Method::Optimal)] {
+        for (v, m) in [(0, Method::Uc), (1, Method::Greedy), (7, Method::Optimal)] {
             add(v, super::evaluate("fold", &held, &[m], ks, seed, None)?);
         }
         let finetuned = trained.finetuned.as_ref().unwrap_or(&trained.pretrained);
-        for (v, p) in [(2, &trained.pretrained), (3, finetuned)] {
-            let f = |rep: &SphericalMotion, k: usize| p.select_unchecked(rep, k);
+        let policies = [
+            (2, &trained.pretrained, Finish::NetworkAlone),
+            (3, finetuned, Finish::NetworkAlone),
+            (4, finetuned, Finish::CheckedAgainstUc),
+            (5, &trained.pretrained, Finish::CheckedAndRefined),
+            (6, finetuned, Finish::CheckedAndRefined),
+        ];
+        for (v, p, finish) in policies {
+            let f = |rep: &SphericalMotion, k: usize| p.select_with(rep, k, finish);
             add(v, super::evaluate("fold", &held, &[Method::Sidql], ks, seed, Some(&f))?);
         }
-        let checked = |rep: &SphericalMotion, k: usize| finetuned.select(rep, k);
-        add(4, super::evaluate("fold", &held, &[Method::Sidql], ks, seed, Some(&checked))?);
         progress.inc(1);
     }
     let mut rows = Vec::new();
@@ -406,7 +420,7 @@ mod tests {
         assert!(r.policy.starts_with("the committed policy (trained on: every CMU take"), "{}", r.policy);
         let kf = r.kfold.as_ref().unwrap();
         assert_eq!(kf.folds.len(), 2);
-        assert_eq!(kf.rows.len(), 6 * 2, "six selectors, two K");
+        assert_eq!(kf.rows.len(), 8 * 2, "eight selectors, two K");
         assert!(kf.rows.iter().all(|row| row.windows == 4), "every window scored once: {:?}", kf.rows);
         assert_eq!(r.codec.len(), 1);
         assert_eq!(out.written.len(), 2 + 6 + 1 + 1, "txt, md, six CSVs, the chart, rows.csv");

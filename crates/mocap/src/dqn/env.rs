@@ -116,7 +116,7 @@ impl EnvWindow {
     }
 
     /// The cost of segment `(a, b)`.
-    fn cost(&self, a: usize, b: usize, s: &mut StateScratch) -> f64 {
+    pub fn cost(&self, a: usize, b: usize, s: &mut StateScratch) -> f64 {
         let n = self.n;
         if let Some(c) = &self.costs {
             return c[a * n + b];

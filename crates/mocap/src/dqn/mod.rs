@@ -9,5 +9,5 @@ pub mod replay;
 pub mod train;
 
 pub use model::{DqnConfig, QNet, QRuntime};
-pub use policy::{PolicyInfo, SidqlPolicy};
+pub use policy::{Finish, PolicyInfo, SidqlPolicy};
 pub use train::{train, TrainOptions, TrainReport, Trained};

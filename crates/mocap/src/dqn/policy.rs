@@ -6,6 +6,7 @@ use super::env::{EnvWindow, StateScratch, INPUTS};
 use super::model::{DqnConfig, QBuffers, QNet, QRuntime};
 use super::train::TrainOptions;
 use crate::representation::SphericalMotion;
+use crate::select::refine_keys;
 use crate::{MocapError, Result};
 use burn::tensor::{Device, Tensor, TensorData};
 use inbetween_core::KeyframeSet;
@@ -117,9 +118,15 @@ impl SidqlPolicy {
         q_values(&self.net, states, batch, frames, &self.device)
     }
 
-    /// Chooses `k` keys for a window: starting from the end keys, repeatedly the frame with the
-    /// highest Q-value among the non-keys, the budget left in the state.
+    /// Chooses `k` keys for a window: the network's keys ([`Finish::NetworkAlone`]), checked
+    /// against uniform keys and refined ([`Finish::CheckedAndRefined`]).
     pub fn select(&self, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
+        self.select_with(rep, k, Finish::CheckedAndRefined)
+    }
+
+    /// Chooses `k` keys: starting from the end keys, repeatedly the frame with the highest Q-value
+    /// among the non-keys, the budget left in the state; then `finish`.
+    pub fn select_with(&self, rep: &SphericalMotion, k: usize, finish: Finish) -> Result<KeyframeSet> {
         crate::select::check_k(rep.num_frames, k)?;
         if k <= 2 {
             return Ok(KeyframeSet::new(vec![0, rep.num_frames - 1], rep.num_frames)?);
@@ -127,25 +134,37 @@ impl SidqlPolicy {
         let w = EnvWindow::lazy(rep)?;
         let mut s = w.scratch();
         let mut mask = rollout(&self.runtime, &w, k, &mut s, &mut Rollout::default());
-        // Checked exactly against uniform keys (K − 1 segment costs): never worse than UC.
-        let uniform = KeyframeSet::uniform(w.frames(), k)?;
-        let uniform_mask = uniform.frames().iter().fold(0u64, |m, &f| m | 1 << f);
-        if w.error(uniform_mask, &mut s) < w.error(mask, &mut s) {
-            mask = uniform_mask;
+        if finish != Finish::NetworkAlone {
+            // Checked exactly against uniform keys (K − 1 segment costs): never worse than UC.
+            let uniform = KeyframeSet::uniform(w.frames(), k)?;
+            let uniform_mask = uniform.frames().iter().fold(0u64, |m, &f| m | 1 << f);
+            if w.error(uniform_mask, &mut s) < w.error(mask, &mut s) {
+                mask = uniform_mask;
+            }
         }
-        Ok(KeyframeSet::new((0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect(), w.frames())?)
+        let mut keys: Vec<usize> = (0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect();
+        if finish == Finish::CheckedAndRefined {
+            refine_keys(&mut keys, |a, b| w.cost(a, b, &mut s));
+        }
+        Ok(KeyframeSet::new(keys, w.frames())?)
     }
 
-    /// The network's own keys, without the check against uniform keys of [`SidqlPolicy::select`].
+    /// The network's own keys ([`Finish::NetworkAlone`]).
     pub fn select_unchecked(&self, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
-        crate::select::check_k(rep.num_frames, k)?;
-        if k <= 2 {
-            return Ok(KeyframeSet::new(vec![0, rep.num_frames - 1], rep.num_frames)?);
-        }
-        let w = EnvWindow::lazy(rep)?;
-        let mask = rollout(&self.runtime, &w, k, &mut w.scratch(), &mut Rollout::default());
-        Ok(KeyframeSet::new((0..w.frames()).filter(|&f| mask >> f & 1 == 1).collect(), w.frames())?)
+        self.select_with(rep, k, Finish::NetworkAlone)
     }
+}
+
+/// What [`SidqlPolicy::select_with`] does with the network's keys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Finish {
+    /// The keys as the network chose them (the paper's policy).
+    NetworkAlone,
+    /// Replaced by uniform keys when those cost less (exactly, K − 1 segment costs).
+    CheckedAgainstUc,
+    /// Checked, then each key moved to the best frame between its neighbours until none moves
+    /// ([`crate::select::refine`]): never worse than either. The default.
+    CheckedAndRefined,
 }
 
 /// Buffers of [`rollout`].
@@ -205,6 +224,29 @@ mod tests {
         assert_eq!(keys.len(), 6);
         let two = KeyframeSet::new(vec![], 40).unwrap();
         assert!(rep.error(&keys).mean_angle < 0.5 * rep.error(&two).mean_angle);
+    }
+
+    /// Each finishing step only lowers the exact error: network alone ≥ checked (and uniform keys
+    /// ≥ checked) ≥ checked and refined, at every K, on gaits the policy never saw.
+    #[test]
+    fn checking_and_refining_never_raise_the_error() {
+        let policy = SidqlPolicy::committed().unwrap();
+        let mut refined_better = 0;
+        for (i, params) in [GaitParams::walk(), GaitParams::run()].into_iter().enumerate() {
+            let m = gait(&GaitParams { frames: 60, fps: 30.0, turn_rate: 0.4, ..params.jittered(i as u64, 0.3) });
+            let rep = SphericalMotion::from_motion(&m).unwrap();
+            for k in [3, 5, 10, 15] {
+                let err = |finish: Finish| rep.error(&policy.select_with(&rep, k, finish).unwrap()).mean_angle;
+                let (alone, checked, refined) = (err(Finish::NetworkAlone), err(Finish::CheckedAgainstUc), err(Finish::CheckedAndRefined));
+                let uniform = rep.error(&KeyframeSet::uniform(60, k).unwrap()).mean_angle;
+                let tol = 1e-12;
+                assert!(checked <= alone + tol && checked <= uniform + tol, "K={k}: {checked} vs {alone}, {uniform}");
+                assert!(refined <= checked + tol, "K={k}: refined {refined} vs checked {checked}");
+                assert_eq!(policy.select(&rep, k).unwrap(), policy.select_with(&rep, k, Finish::CheckedAndRefined).unwrap());
+                refined_better += usize::from(refined < checked - tol);
+            }
+        }
+        assert!(refined_better > 0, "refinement moved no key on 8 windows");
     }
 
     /// The committed policy against uniform keys on every 60-frame window of the corpus (the

@@ -9,6 +9,8 @@
 //!   keys on one clip in about a millisecond (only the objective is tabulated, hopeless segments dropped).
 //! - [`cost_to_go`](mod@cost_to_go): the least error reachable from any key set with any number of keys
 //!   left (SIDQL's pretraining targets).
+//! - [`refine`](mod@refine): moves each key of a set to the best frame between its neighbours until none
+//!   moves (beyond the paper); SIDQL finishes its keys with it.
 //! - [`error_bounded`]: the fewest keys keeping every frame's error under a bound, also exact.
 //! - [`sidql`](mod@sidql): the paper's deep Q-network policy (§4).
 
@@ -16,6 +18,7 @@ pub mod cost_to_go;
 pub mod greedy;
 pub mod optimal;
 pub mod random;
+pub mod refine;
 pub mod sidql;
 pub mod uniform;
 
@@ -23,6 +26,7 @@ pub use cost_to_go::{angle_segment_costs, completion_values, cost_to_go};
 pub use greedy::greedy;
 pub use optimal::{error_bounded, optimal, optimal_spherical};
 pub use random::random;
+pub use refine::refine_keys;
 pub use uniform::uniform;
 
 use crate::{MocapError, Result};
