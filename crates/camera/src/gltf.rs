@@ -4,71 +4,19 @@
 
 use crate::dataset::Scene;
 use crate::infer::CameraTrack;
+use inbetween_io::gltf_buffer::{data_uri, ElementType, GltfBuffer};
 use serde_json::json;
-
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for chunk in bytes.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
-        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-        for i in 0..4 {
-            if i <= chunk.len() {
-                out.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
-
-/// Accumulates binary data and the accessors describing it.
-struct Builder {
-    bin: Vec<u8>,
-    views: Vec<serde_json::Value>,
-    accessors: Vec<serde_json::Value>,
-}
-
-impl Builder {
-    /// Adds float data with `width` components per element; returns the accessor index.
-    fn floats(&mut self, values: &[f32], width: usize, with_bounds: bool) -> usize {
-        let offset = self.bin.len();
-        for v in values {
-            self.bin.extend_from_slice(&v.to_le_bytes());
-        }
-        self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": values.len() * 4}));
-        let kind = match width {
-            1 => "SCALAR",
-            3 => "VEC3",
-            _ => "VEC4",
-        };
-        let mut acc = json!({"bufferView": self.views.len() - 1, "componentType": 5126, "count": values.len() / width, "type": kind});
-        if with_bounds {
-            let (mut lo, mut hi) = (vec![f32::MAX; width], vec![f32::MIN; width]);
-            for e in values.chunks(width) {
-                for k in 0..width {
-                    lo[k] = lo[k].min(e[k]);
-                    hi[k] = hi[k].max(e[k]);
-                }
-            }
-            acc["min"] = json!(lo);
-            acc["max"] = json!(hi);
-        }
-        self.accessors.push(acc);
-        self.accessors.len() - 1
-    }
-}
 
 /// The glTF document (JSON) of `track` over `scene`.
 pub fn camera_gltf(track: &CameraTrack, scene: &Scene) -> serde_json::Value {
-    let mut b = Builder { bin: Vec::new(), views: Vec::new(), accessors: Vec::new() };
+    // Animation data only: views without a target, bounds on the time input as the spec asks.
+    let mut b = GltfBuffer::default();
     let times: Vec<f32> = track.frames.iter().map(|f| (f.frame as f64 / track.fps) as f32).collect();
-    let t_acc = b.floats(&times, 1, true);
+    let t_acc = b.floats(&times, ElementType::Scalar, true, None);
     let pos: Vec<f32> = track.frames.iter().flat_map(|f| f.pose.position.to_array().map(|v| v as f32)).collect();
     let rot: Vec<f32> = track.frames.iter().flat_map(|f| f.pose.rotation.to_array().map(|v| v as f32)).collect();
-    let p_acc = b.floats(&pos, 3, false);
-    let r_acc = b.floats(&rot, 4, false);
+    let p_acc = b.floats(&pos, ElementType::Vec3, false, None);
+    let r_acc = b.floats(&rot, ElementType::Vec4, false, None);
     let mut nodes = vec![json!({"name": "camera", "camera": 0})];
     let mut samplers = vec![
         json!({"input": t_acc, "output": p_acc, "interpolation": "LINEAR"}),
@@ -80,7 +28,7 @@ pub fn camera_gltf(track: &CameraTrack, scene: &Scene) -> serde_json::Value {
     ];
     for (i, c) in scene.characters.iter().enumerate() {
         let tgt: Vec<f32> = track.frames.iter().flat_map(|f| c.frame(f.frame).target().to_array().map(|v| v as f32)).collect();
-        let acc = b.floats(&tgt, 3, false);
+        let acc = b.floats(&tgt, ElementType::Vec3, false, None);
         nodes.push(json!({"name": format!("target {}", c.name)}));
         samplers.push(json!({"input": t_acc, "output": acc, "interpolation": "LINEAR"}));
         channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": i + 1, "path": "translation"}}));
@@ -93,7 +41,7 @@ pub fn camera_gltf(track: &CameraTrack, scene: &Scene) -> serde_json::Value {
         "nodes": nodes,
         "cameras": [{"type": "perspective", "perspective": {"yfov": lens.fovy, "aspectRatio": lens.aspect, "znear": 0.05, "zfar": 500.0}}],
         "animations": [{"name": format!("camera ({})", track.style), "samplers": samplers, "channels": channels}],
-        "buffers": [{"byteLength": b.bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&b.bin))}],
+        "buffers": [{"byteLength": b.bin.len(), "uri": data_uri(&b.bin)}],
         "bufferViews": b.views,
         "accessors": b.accessors,
     })
@@ -108,14 +56,6 @@ pub fn write_gltf(path: &std::path::Path, track: &CameraTrack, scene: &Scene) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn base64_matches_known_values() {
-        assert_eq!(base64(b"Man"), "TWFu");
-        assert_eq!(base64(b"Ma"), "TWE=");
-        assert_eq!(base64(b"M"), "TQ==");
-        assert_eq!(base64(b""), "");
-    }
 
     #[test]
     fn gltf_has_consistent_accessors() {

@@ -9,6 +9,7 @@ pub mod asf;
 pub mod bvh;
 pub mod data;
 pub mod fsutil;
+pub mod gltf_buffer;
 mod lexer;
 pub mod progress;
 pub mod report;

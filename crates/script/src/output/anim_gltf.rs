@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
 use inbetween_core::Motion;
+use inbetween_io::gltf_buffer::{self, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
 use serde_json::{json, Value};
 
 use super::gltf::{gltf_document, write_document};
@@ -82,55 +83,30 @@ impl Appender<'_> {
         a.len() - 1
     }
 
+    /// Adds `bytes` as a bufferView (4-byte aligned, see [`gltf_buffer::append_view`]).
     pub(crate) fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
-        if let Some(t) = target {
-            v["target"] = json!(t);
-        }
-        self.bin.extend_from_slice(bytes);
+        let v = gltf_buffer::append_view(self.bin, bytes, target);
         self.push("bufferViews", v)
     }
 
-    /// Float accessor with `width` components per element (1, 3 or 4).
-    fn floats(&mut self, values: &[f32], width: usize, bounds: bool, target: Option<u32>) -> usize {
-        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let view = self.view(&bytes, target);
-        let kind = match width {
-            1 => "SCALAR",
-            2 => "VEC2",
-            3 => "VEC3",
-            _ => "VEC4",
-        };
-        let mut acc = json!({"bufferView": view, "componentType": 5126, "count": values.len() / width, "type": kind});
-        if bounds {
-            let (mut lo, mut hi) = (vec![f32::MAX; width], vec![f32::MIN; width]);
-            for e in values.chunks(width) {
-                for k in 0..width {
-                    lo[k] = lo[k].min(e[k]);
-                    hi[k] = hi[k].max(e[k]);
-                }
-            }
-            acc["min"] = json!(lo);
-            acc["max"] = json!(hi);
-        }
-        self.push("accessors", acc)
+    /// FLOAT accessor of `kind` elements in a view of its own.
+    pub(crate) fn floats(&mut self, values: &[f32], kind: ElementType, bounds: bool, target: Option<u32>) -> usize {
+        let view = self.view(&gltf_buffer::f32_bytes(values), target);
+        self.push("accessors", gltf_buffer::float_accessor(view, values, kind, bounds))
     }
 
+    /// UNSIGNED_SHORT index accessor in an ELEMENT_ARRAY_BUFFER view.
     fn indices(&mut self, idx: &[u16]) -> usize {
-        let bytes: Vec<u8> = idx.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let view = self.view(&bytes, Some(34963));
-        self.push("accessors", json!({"bufferView": view, "componentType": 5123, "count": idx.len(), "type": "SCALAR"}))
+        let view = self.view(&gltf_buffer::u16_bytes(idx), Some(ELEMENT_ARRAY_BUFFER));
+        self.push("accessors", gltf_buffer::u16_index_accessor(view, idx.len()))
     }
 
     /// A box mesh centred on the origin, unit edges, flat normals; one per material.
     fn centred_box(&mut self, name: &str, material: usize) -> usize {
         let (pos, nor, idx) = super::gltf::box_geometry(0.0);
         let (pos, nor): (Vec<f32>, Vec<f32>) = (pos.concat(), nor.concat());
-        let p = self.floats(&pos, 3, true, Some(34962));
-        let nn = self.floats(&nor, 3, false, Some(34962));
+        let p = self.floats(&pos, ElementType::Vec3, true, Some(ARRAY_BUFFER));
+        let nn = self.floats(&nor, ElementType::Vec3, false, Some(ARRAY_BUFFER));
         let i = self.indices(&idx);
         self.push("meshes", json!({"name": name, "primitives": [{"attributes": {"POSITION": p, "NORMAL": nn}, "indices": i, "material": material}]}))
     }
@@ -215,7 +191,7 @@ pub fn animated_gltf_document(
             return acc;
         }
         let t: Vec<f32> = (0..n).map(|f| (f as f64 * dt) as f32).collect();
-        let acc = a.floats(&t, 1, true, None);
+        let acc = a.floats(&t, ElementType::Scalar, true, None);
         times.push((n, dt.to_bits(), acc));
         acc
     };
@@ -274,12 +250,12 @@ pub fn animated_gltf_document(
         for (j, joint) in sk.joints().iter().enumerate() {
             if joint.has_translation() {
                 let v: Vec<f32> = poses.iter().flat_map(|p| p.translations[j].to_array().map(|x| x as f32)).collect();
-                let out = a.floats(&v, 3, false, None);
+                let out = a.floats(&v, ElementType::Vec3, false, None);
                 channel(&mut samplers, &mut channels, input, out, first + j, "translation");
             }
             if joint.rotation_order().is_some() {
                 let v = continuous_quats(poses.iter().map(|p| p.rotations[j].as_quat()));
-                let out = a.floats(&v, 4, false, None);
+                let out = a.floats(&v, ElementType::Vec4, false, None);
                 channel(&mut samplers, &mut channels, input, out, first + j, "rotation");
             }
         }
@@ -302,16 +278,16 @@ pub fn animated_gltf_document(
     roots.push(cam_node);
     let input = time_acc(&mut a, n, 1.0 / fps);
     let pos: Vec<f32> = shots.iter().flat_map(|s| s.0).collect();
-    let out = a.floats(&pos, 3, false, None);
+    let out = a.floats(&pos, ElementType::Vec3, false, None);
     channel(&mut samplers, &mut channels, input, out, cam_node, "translation");
     let rot = continuous_quats(shots.iter().map(|s| look_rotation(Vec3::from(s.0), Vec3::from(s.1))));
-    let out = a.floats(&rot, 4, false, None);
+    let out = a.floats(&rot, ElementType::Vec4, false, None);
     channel(&mut samplers, &mut channels, input, out, cam_node, "rotation");
     if shots.iter().any(|s| s.2 != yfov) {
         // Core glTF cannot animate a camera's field of view: KHR_animation_pointer (used, not
         // required; viewers without it keep the frame-0 value) steps it at every change.
         let v: Vec<f32> = shots.iter().map(|s| s.2.to_radians()).collect();
-        let out = a.floats(&v, 1, false, None);
+        let out = a.floats(&v, ElementType::Scalar, false, None);
         samplers.push(json!({"input": input, "output": out, "interpolation": "STEP"}));
         let pointer = format!("/cameras/{cam}/perspective/yfov");
         channels.push(json!({"sampler": samplers.len() - 1, "target": {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": pointer}}}}));
@@ -321,9 +297,7 @@ pub fn animated_gltf_document(
     }
 
     a.push("animations", json!({"name": ANIMATION_NAME, "samplers": samplers, "channels": channels}));
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
+    gltf_buffer::pad_to_4(&mut bin);
     if let Some(s) = doc.pointer_mut("/scenes/0/nodes").and_then(Value::as_array_mut) {
         s.extend(roots.into_iter().map(|r| json!(r)));
     }
@@ -371,7 +345,7 @@ pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate
     }
     let mut a = Appender { doc, bin };
     let t: Vec<f32> = (0..n).map(|f| (f as f64 / anim.fps) as f32).collect();
-    let input = a.floats(&t, 1, true, None);
+    let input = a.floats(&t, ElementType::Scalar, true, None);
     for i in carried {
         let label = anim.scene.objects[i].label.as_str();
         // Object nodes come first in the document (before the characters' joints).
@@ -379,8 +353,8 @@ pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate
         let poses: Vec<(DVec3, DQuat)> = (0..n).map(|f| crate::animate::object_pose(anim, i, f)).collect();
         let pos: Vec<f32> = poses.iter().flat_map(|(p, _)| [p.x as f32, p.y as f32, p.z as f32]).collect();
         let rot = continuous_quats(poses.iter().map(|(_, q)| q.as_quat()));
-        for (values, width, path) in [(pos, 3, "translation"), (rot, 4, "rotation")] {
-            let output = a.floats(&values, width, false, None);
+        for (values, kind, path) in [(pos, ElementType::Vec3, "translation"), (rot, ElementType::Vec4, "rotation")] {
+            let output = a.floats(&values, kind, false, None);
             let samplers = a.doc["animations"][0]["samplers"].as_array_mut().map_or(0, |s| {
                 s.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
                 s.len() - 1
@@ -390,9 +364,7 @@ pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate
             }
         }
     }
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
+    gltf_buffer::pad_to_4(bin);
     doc["buffers"] = json!([{"byteLength": bin.len()}]);
 }
 

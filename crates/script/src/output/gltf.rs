@@ -8,49 +8,16 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
+use inbetween_io::gltf_buffer::{data_uri, pad_to_4, ElementType, GltfBuffer, ARRAY_BUFFER};
 use serde_json::{json, Value};
 
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::scene::Scene;
 
-/// Standard base64 with padding (for the embedded buffer's data URI).
-pub fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for chunk in bytes.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
-        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-        for i in 0..4 {
-            out.push(if i <= chunk.len() { T[(n >> (18 - 6 * i) & 63) as usize] as char } else { '=' });
-        }
-    }
-    out
-}
-
-/// Decodes [`base64`] text (tests and readers of our own files); None on a bad character.
-pub fn base64_decode(text: &str) -> Option<Vec<u8>> {
-    let val = |c: u8| match c {
-        b'A'..=b'Z' => Some(c - b'A'),
-        b'a'..=b'z' => Some(c - b'a' + 26),
-        b'0'..=b'9' => Some(c - b'0' + 52),
-        b'+' => Some(62),
-        b'/' => Some(63),
-        _ => None,
-    };
-    let bytes: Vec<u8> = text.bytes().filter(|&c| c != b'=').collect();
-    let mut out = Vec::with_capacity(bytes.len() * 3 / 4);
-    for chunk in bytes.chunks(4) {
-        let mut n = 0u32;
-        for (k, &c) in chunk.iter().enumerate() {
-            n |= (val(c)? as u32) << (18 - 6 * k);
-        }
-        for k in 0..chunk.len().saturating_sub(1) {
-            out.push((n >> (16 - 8 * k)) as u8);
-        }
-    }
-    Some(out)
-}
+/// The embedded buffer's text encoding, shared with every glTF writer (also used to read data URIs
+/// of models).
+pub use inbetween_io::gltf_buffer::{base64, base64_decode};
 
 /// A parsed GLB: its JSON and its binary chunk.
 #[derive(Debug, Clone)]
@@ -92,9 +59,7 @@ pub fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
         js.push(b' ');
     }
     let mut b = bin.to_vec();
-    while !b.len().is_multiple_of(4) {
-        b.push(0);
-    }
+    pad_to_4(&mut b);
     let total = 12 + 8 + js.len() + if b.is_empty() { 0 } else { 8 + b.len() };
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
@@ -116,12 +81,11 @@ fn srgb_to_linear(c: u8) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
-/// The document under construction: arrays glTF indexes into, plus the one binary buffer.
+/// The document under construction: arrays glTF indexes into, plus the one binary buffer (with
+/// its bufferViews and accessors).
 #[derive(Default)]
 struct Doc {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+    buf: GltfBuffer,
     meshes: Vec<Value>,
     materials: Vec<Value>,
     nodes: Vec<Value>,
@@ -142,44 +106,9 @@ struct Merged {
 }
 
 impl Doc {
-    fn align(&mut self) {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-    }
-
-    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
-        self.align();
-        self.views.push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len(), "target": target}));
-        self.bin.extend_from_slice(bytes);
-        self.views.len() - 1
-    }
-
+    /// Vertex attribute data (ARRAY_BUFFER view); POSITION needs `bounds`.
     fn vec3s(&mut self, values: &[[f32; 3]], bounds: bool) -> usize {
-        let bytes: Vec<u8> = values.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-        let v = self.view(&bytes, 34962);
-        let mut acc = json!({"bufferView": v, "componentType": 5126, "count": values.len(), "type": "VEC3"});
-        if bounds {
-            let mut lo = [f32::MAX; 3];
-            let mut hi = [f32::MIN; 3];
-            for p in values {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
-            }
-            acc["min"] = json!(lo);
-            acc["max"] = json!(hi);
-        }
-        self.accessors.push(acc);
-        self.accessors.len() - 1
-    }
-
-    fn indices(&mut self, idx: &[u16]) -> usize {
-        let bytes: Vec<u8> = idx.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let v = self.view(&bytes, 34963);
-        self.accessors.push(json!({"bufferView": v, "componentType": 5123, "count": idx.len(), "type": "SCALAR"}));
-        self.accessors.len() - 1
+        self.buf.floats(values.as_flattened(), ElementType::Vec3, bounds, Some(ARRAY_BUFFER))
     }
 
     fn material(&mut self, name: &str, color: [u8; 3]) -> usize {
@@ -194,7 +123,7 @@ impl Doc {
     /// Accessors (position, normal, indices) of a box with flat faces: x, z ∈ [-½, ½], y ∈ [0, 1].
     fn unit_box(&mut self) -> (usize, usize, usize) {
         let (pos, nor, idx) = box_geometry(0.5);
-        (self.vec3s(&pos, true), self.vec3s(&nor, false), self.indices(&idx))
+        (self.vec3s(&pos, true), self.vec3s(&nor, false), self.buf.indices(&idx))
     }
 
     /// Appends a GLB's buffers, views, accessors, images, samplers, textures, materials and
@@ -211,11 +140,11 @@ impl Doc {
                 return Err("models with external image files are not supported".into());
             }
         }
-        self.align();
-        let bin_off = self.bin.len();
-        self.bin.extend_from_slice(&glb.bin);
+        self.buf.align();
+        let bin_off = self.buf.bin.len();
+        self.buf.bin.extend_from_slice(&glb.bin);
         let (v0, a0, m0, t0, i0, s0, me0) =
-            (self.views.len(), self.accessors.len(), self.materials.len(), self.textures.len(), self.images.len(), self.samplers.len(), self.meshes.len());
+            (self.buf.views.len(), self.buf.accessors.len(), self.materials.len(), self.textures.len(), self.images.len(), self.samplers.len(), self.meshes.len());
         let add = |v: &mut Value, key: &str, off: usize| {
             if let Some(x) = v.get(key).and_then(Value::as_u64) {
                 v[key] = json!(x as usize + off);
@@ -225,7 +154,7 @@ impl Doc {
             let off = bv.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
             bv["buffer"] = json!(0);
             bv["byteOffset"] = json!(bin_off + off);
-            self.views.push(bv);
+            self.buf.views.push(bv);
         }
         for mut a in arr("accessors") {
             add(&mut a, "bufferView", v0);
@@ -236,7 +165,7 @@ impl Doc {
                     }
                 }
             }
-            self.accessors.push(a);
+            self.buf.accessors.push(a);
         }
         for mut im in arr("images") {
             add(&mut im, "bufferView", v0);
@@ -395,7 +324,7 @@ pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Opt
     let (w, dd) = (scene.room.width, scene.room.depth);
     let fp = d.vec3s(&[[0.0, 0.0, 0.0], [0.0, 0.0, dd], [w, 0.0, dd], [w, 0.0, 0.0]], true);
     let fnrm = d.vec3s(&[[0.0, 1.0, 0.0]; 4], false);
-    let fi = d.indices(&[0, 1, 2, 0, 2, 3]);
+    let fi = d.buf.indices(&[0, 1, 2, 0, 2, 3]);
     let fmat = d.material("floor", [200, 200, 195]);
     d.meshes.push(json!({"name": "floor", "primitives": [{"attributes": {"POSITION": fp, "NORMAL": fnrm}, "indices": fi, "material": fmat}]}));
     d.nodes.push(json!({"name": "floor", "mesh": d.meshes.len() - 1}));
@@ -431,7 +360,7 @@ pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Opt
     }
     d.nodes.push(json!({"name": scene.room.name, "children": children}));
     let root = d.nodes.len() - 1;
-    d.align();
+    d.buf.align();
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": "inbetween script"},
         "scene": 0,
@@ -439,9 +368,9 @@ pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Opt
         "nodes": d.nodes,
         "meshes": d.meshes,
         "materials": d.materials,
-        "accessors": d.accessors,
-        "bufferViews": d.views,
-        "buffers": [{"byteLength": d.bin.len()}],
+        "accessors": d.buf.accessors,
+        "bufferViews": d.buf.views,
+        "buffers": [{"byteLength": d.buf.bin.len()}],
     });
     for (k, v) in [("images", d.images), ("textures", d.textures), ("samplers", d.samplers)] {
         if !v.is_empty() {
@@ -454,7 +383,7 @@ pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Opt
     if !d.extensions_required.is_empty() {
         doc["extensionsRequired"] = json!(d.extensions_required);
     }
-    (doc, d.bin, notes)
+    (doc, d.buf.bin, notes)
 }
 
 /// Writes `scene` as `.glb` (by extension) or `.gltf` with an embedded buffer (atomic): Kenney
@@ -487,7 +416,7 @@ pub(crate) fn write_document(path: &Path, mut doc: Value, bin: Vec<u8>) -> Resul
     let bytes = if glb {
         glb_bytes(&doc, &bin)
     } else {
-        doc["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64(&bin)));
+        doc["buffers"][0]["uri"] = json!(data_uri(&bin));
         doc.to_string().into_bytes()
     };
     inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))

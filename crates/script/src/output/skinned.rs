@@ -30,6 +30,7 @@ use inbetween_core::fk::{forward, GlobalPose};
 use inbetween_core::{Motion, Pose, Skeleton};
 use inbetween_render::canvas::Camera3;
 use inbetween_render::Canvas;
+use inbetween_io::gltf_buffer::{pad_to_4, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT};
 use serde_json::{json, Value};
 
 use super::anim_gltf::{animated_gltf_document, Appender, CameraFn};
@@ -389,32 +390,14 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
     })
 }
 
-/// Typed accessors on top of the animated document's appender.
+/// Accessors of component types the shared builder has no helper for, on the animated
+/// document's appender.
 impl Appender<'_> {
-    /// An accessor over fresh bytes: `kind` is the glTF type, `component` its component type.
-    fn accessor(&mut self, bytes: &[u8], target: Option<u32>, component: u32, count: usize, kind: &str, bounds: Option<(Vec<f32>, Vec<f32>)>) -> usize {
+    /// An accessor over fresh bytes without bounds: `kind` is the glTF type, `component` its
+    /// component type (UNSIGNED_BYTE / UNSIGNED_SHORT / UNSIGNED_INT).
+    fn accessor(&mut self, bytes: &[u8], target: Option<u32>, component: u32, count: usize, kind: &str) -> usize {
         let view = self.view(bytes, target);
-        let mut acc = json!({"bufferView": view, "componentType": component, "count": count, "type": kind});
-        if let Some((lo, hi)) = bounds {
-            acc["min"] = json!(lo);
-            acc["max"] = json!(hi);
-        }
-        self.push("accessors", acc)
-    }
-
-    fn typed_floats(&mut self, values: &[f32], width: usize, kind: &str, target: Option<u32>, bounds: bool) -> usize {
-        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let b = bounds.then(|| {
-            let (mut lo, mut hi) = (vec![f32::MAX; width], vec![f32::MIN; width]);
-            for e in values.chunks(width) {
-                for k in 0..width {
-                    lo[k] = lo[k].min(e[k]);
-                    hi[k] = hi[k].max(e[k]);
-                }
-            }
-            (lo, hi)
-        });
-        self.accessor(&bytes, target, 5126, values.len() / width, kind, b)
+        self.push("accessors", json!({"bufferView": view, "componentType": component, "count": count, "type": kind}))
     }
 }
 
@@ -614,10 +597,10 @@ fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) ->
         out.push("extensionsUsed", json!("KHR_materials_unlit"));
     }
     let flat3 = |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.to_array()).collect() };
-    let pos = out.typed_floats(&flat3(&body.positions), 3, "VEC3", Some(34962), true);
-    let nor = out.typed_floats(&flat3(&body.normals), 3, "VEC3", Some(34962), false);
+    let pos = out.floats(&flat3(&body.positions), ElementType::Vec3, true, Some(ARRAY_BUFFER));
+    let nor = out.floats(&flat3(&body.normals), ElementType::Vec3, false, Some(ARRAY_BUFFER));
     let uv: Vec<f32> = body.uvs.iter().flatten().copied().collect();
-    let uv = out.typed_floats(&uv, 2, "VEC2", Some(34962), false);
+    let uv = out.floats(&uv, ElementType::Vec2, false, Some(ARRAY_BUFFER));
     let count = body.positions.len();
     // JOINTS_0: unsigned byte when the skeleton allows (4-byte elements keep vertex alignment).
     let (jbytes, jtype): (Vec<u8>, u32) = if joints <= 256 {
@@ -625,18 +608,18 @@ fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) ->
     } else {
         (body.joints.iter().flat_map(|&j| [j, 0, 0, 0]).flat_map(u16::to_le_bytes).collect(), 5123)
     };
-    let jacc = out.accessor(&jbytes, Some(34962), jtype, count, "VEC4", None);
+    let jacc = out.accessor(&jbytes, Some(ARRAY_BUFFER), jtype, count, "VEC4");
     let w: Vec<f32> = (0..count).flat_map(|_| [1.0, 0.0, 0.0, 0.0]).collect();
-    let wacc = out.typed_floats(&w, 4, "VEC4", Some(34962), false);
+    let wacc = out.floats(&w, ElementType::Vec4, false, Some(ARRAY_BUFFER));
     let idx = if count <= u16::MAX as usize {
         let b: Vec<u8> = body.indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
-        out.accessor(&b, Some(34963), 5123, body.indices.len(), "SCALAR", None)
+        out.accessor(&b, Some(ELEMENT_ARRAY_BUFFER), UNSIGNED_SHORT, body.indices.len(), "SCALAR")
     } else {
         let b: Vec<u8> = body.indices.iter().flat_map(|&i| i.to_le_bytes()).collect();
-        out.accessor(&b, Some(34963), 5125, body.indices.len(), "SCALAR", None)
+        out.accessor(&b, Some(ELEMENT_ARRAY_BUFFER), 5125, body.indices.len(), "SCALAR")
     };
     let ibm: Vec<f32> = body.inverse_bind().iter().flat_map(|m| m.to_cols_array()).collect();
-    let ibm = out.typed_floats(&ibm, 16, "MAT4", None, false);
+    let ibm = out.floats(&ibm, ElementType::Mat4, false, None);
     let mesh = out.push(
         "meshes",
         json!({"name": format!("{name} body"), "primitives": [{"attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv, "JOINTS_0": jacc, "WEIGHTS_0": wacc}, "indices": idx, "material": material}]}),
@@ -703,9 +686,7 @@ pub fn skinned_gltf_document(
             add_body(&mut out, name, b, shift(first))?;
         }
     }
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
+    pad_to_4(&mut bin);
     doc["buffers"] = json!([{"byteLength": bin.len()}]);
     doc["asset"]["generator"] = json!("inbetween script (animated, skinned Kenney characters)");
     Ok((doc, bin, notes))
