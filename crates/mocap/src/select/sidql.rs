@@ -1,5 +1,6 @@
 //! SIDQL selection (§4): a trained deep Q-network adds, one at a time, the frame with the highest
-//! Q-value until `k` keys are chosen. Training lives in [`crate::dqn`].
+//! Q-value until `k` keys are chosen; beyond the paper, the keys are then checked against uniform
+//! keys and refined ([`crate::dqn::Finish`]). Training lives in [`crate::dqn`].
 
 pub use crate::dqn::SidqlPolicy;
 
