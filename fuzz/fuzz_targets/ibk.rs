@@ -25,8 +25,8 @@ fuzz_target!(|data: &[u8]| {
         }
     }
     if let Ok(f) = v3::File::open(&file) {
-        let time = data.first().map_or(0.0, |&b| b as f64 * f.frame_time * 0.37);
-        let (mut pose, mut scratch) = (inbetween_core::Pose::rest(&f.skeleton), v3::Scratch::default());
+        let time = data.first().map_or(0.0, |&b| b as f64 * f.header.frame_time * 0.37);
+        let (mut pose, mut scratch) = (inbetween_core::Pose::rest(&f.header.skeleton), v3::Scratch::default());
         let _ = f.pose_at(time, &mut pose, &mut scratch);
     }
 });

@@ -390,7 +390,7 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
             }
             let keys = match &d {
                 codec::IbkFile::Keys(k) => k.key_frames.len(),
-                codec::IbkFile::Samples(q) => q.num_frames,
+                codec::IbkFile::Samples(q) => q.header.num_frames,
             };
             (d.motion()?, keys)
         }

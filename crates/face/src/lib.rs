@@ -27,3 +27,32 @@ pub mod visemes;
 pub mod weights;
 
 pub use data::{BlendshapeClip, FaceError};
+
+/// Helpers shared by the readers' robustness tests (`data/robustness.rs`, `visemes/robustness.rs`).
+#[cfg(test)]
+pub(crate) mod test_support {
+    use proptest::test_runner::{Config, TestRunner};
+
+    /// The first `cut` bytes of `text`, moved back to a character boundary.
+    pub fn truncated(text: &str, cut: usize) -> &str {
+        let mut cut = cut.min(text.len());
+        while !text.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        &text[..cut]
+    }
+
+    /// Property test: `check` never panics on arbitrary text of up to 400 characters (256 cases,
+    /// shrunk to the smallest failing text as `proptest!` would, failures kept beside the caller).
+    #[track_caller]
+    pub fn arbitrary_text_never_panics(check: fn(&str)) {
+        let source_file = Some(std::panic::Location::caller().file());
+        let mut runner = TestRunner::new(Config { source_file, ..Config::with_cases(256) });
+        if let Err(e) = runner.run(&"(?s).{0,400}", |text| {
+            check(&text);
+            Ok(())
+        }) {
+            panic!("{e}\n{runner}");
+        }
+    }
+}

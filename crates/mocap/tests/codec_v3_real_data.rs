@@ -26,9 +26,9 @@ fn cmu_takes_at_24_fps_keep_the_bound_in_the_decoded_file_and_seek() {
             assert!(ratio > 5.0, "{name}: ratio {ratio}");
             // One pose at a time from the file equals the whole decode at frame times.
             let file = v3::File::open(&c.bytes).unwrap();
-            let (mut pose, mut sc) = (inbetween_core::Pose::rest(&file.skeleton), v3::Scratch::default());
+            let (mut pose, mut sc) = (inbetween_core::Pose::rest(&file.header.skeleton), v3::Scratch::default());
             for f in [0, 17, t.motion.num_frames() / 2, t.motion.num_frames() - 1] {
-                file.pose_at(f as f64 * file.frame_time, &mut pose, &mut sc).unwrap();
+                file.pose_at(f as f64 * file.header.frame_time, &mut pose, &mut sc).unwrap();
                 let want = c.quantised.pose(f);
                 for j in 0..pose.rotations.len() {
                     assert!(inbetween_core::rotation::angle_between(pose.rotations[j], want.rotations[j]) < 1e-9, "{name} frame {f} joint {j}");

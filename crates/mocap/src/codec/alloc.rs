@@ -16,7 +16,7 @@
 //!
 //! Every check quantises exactly as the decoder dequantises, so the bound holds for the file.
 
-use super::v3::{self, step, Quantised, Track, TrackKind, MAX_Q, STEP_BIAS};
+use super::v3::{self, step, Header, Quantised, Track, TrackKind, MAX_Q, STEP_BIAS};
 use crate::{MocapError, Result};
 use glam::{DMat3, DQuat, DVec3};
 use inbetween_core::rotation::{quat_to_rotvec, rotvec_to_quat};
@@ -96,18 +96,7 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, opts: &Options) -> Result<
         q.extend(c.q);
         codes.extend(c.codes);
     }
-    let quantised = Quantised {
-        skeleton: motion.skeleton.clone(),
-        frame_time: motion.frame_time,
-        num_frames: n,
-        segment_len: opts.segment_len,
-        cm_per_unit: cm,
-        bound_cm: opts.bound_cm,
-        tracks: ctx.tracks.clone(),
-        constants: ctx.constants.clone(),
-        codes,
-        q,
-    };
+    let quantised = Quantised { header: ctx.header(motion, opts.segment_len, cm, opts.bound_cm), codes, q };
     let bytes = v3::encode(&quantised);
     // Measure the file, not the encoder's state.
     let decoded = v3::decode(&bytes)?;
@@ -302,12 +291,26 @@ impl Context {
         (1..4).map(|a| (v[a] - raw[a]).length_squared()).fold(0.0, f64::max)
     }
 
+    /// The file header of `motion` (the clip this context was made from) with these settings.
+    fn header(&self, motion: &Motion, segment_len: usize, cm_per_unit: f64, bound_cm: f64) -> Header {
+        Header {
+            skeleton: self.skeleton.clone(),
+            frame_time: motion.frame_time,
+            num_frames: motion.num_frames(),
+            segment_len,
+            cm_per_unit,
+            bound_cm,
+            tracks: self.tracks.clone(),
+            constants: self.constants.clone(),
+        }
+    }
+
     /// Errors of every joint of every frame of a decoded clip.
     fn errors(&self, qz: &Quantised) -> Vec<f64> {
         let nj = self.skeleton.len();
-        let mut out = Vec::with_capacity(qz.num_frames * nj);
+        let mut out = Vec::with_capacity(qz.header.num_frames * nj);
         let (mut pos, mut rot) = (vec![DVec3::ZERO; nj], vec![DQuat::IDENTITY; nj]);
-        for f in 0..qz.num_frames {
+        for f in 0..qz.header.num_frames {
             let p = qz.pose(f);
             crate::rotations::forward_into(&self.skeleton, &p.rotations, &p.translations, &mut pos, &mut rot);
             out.extend((0..nj).map(|j| self.vertex_error(f, j, pos[j], rot[j])));
@@ -614,18 +617,8 @@ mod tests {
             let ctx = Context::new(&m, SHELL_CM / CM_PER_CMU_UNIT, 0.05 / CM_PER_CMU_UNIT);
             let (n, nt) = (m.num_frames(), ctx.tracks.len());
             let seg = Segment::new(&ctx, 0, n);
-            let qz = Quantised {
-                skeleton: m.skeleton.clone(),
-                frame_time: m.frame_time,
-                num_frames: n,
-                segment_len: n,
-                cm_per_unit: CM_PER_CMU_UNIT,
-                bound_cm: 0.05,
-                tracks: ctx.tracks.clone(),
-                constants: ctx.constants.clone(),
-                codes: ctx.start_codes.clone(),
-                q: seg.q.clone(),
-            };
+            let header = ctx.header(&m, n, CM_PER_CMU_UNIT, 0.05);
+            let qz = Quantised { header, codes: ctx.start_codes.clone(), q: seg.q.clone() };
             assert_eq!(qz.codes.len(), nt);
             let max = ctx.errors(&qz).into_iter().fold(0.0, f64::max) * CM_PER_CMU_UNIT;
             assert!(max <= 0.05, "{max}");
@@ -651,7 +644,7 @@ mod tests {
     fn static_joints_become_constant_tracks_and_bad_options_are_refused() {
         let m = &clips()[0];
         let c = compress(m, &Options::bound(0.05)).unwrap();
-        let constant = c.quantised.constants.iter().filter(|x| x.is_some()).count();
+        let constant = c.quantised.header.constants.iter().filter(|x| x.is_some()).count();
         let static_joints = (0..v3::tracks(&m.skeleton).len())
             .filter(|&t| {
                 let tr = v3::tracks(&m.skeleton)[t];
@@ -699,7 +692,7 @@ mod tests {
                 }
             }
             if let Ok(f) = v3::File::open(&b) {
-                let (mut pose, mut sc) = (inbetween_core::Pose::rest(&f.skeleton), v3::Scratch::default());
+                let (mut pose, mut sc) = (inbetween_core::Pose::rest(&f.header.skeleton), v3::Scratch::default());
                 let _ = f.pose_at(rng.random::<f64>() * 3.0, &mut pose, &mut sc);
             }
         }

@@ -497,14 +497,14 @@ impl IbkFile {
     pub fn skeleton(&self) -> &Skeleton {
         match self {
             IbkFile::Keys(d) => &d.skeleton,
-            IbkFile::Samples(q) => &q.skeleton,
+            IbkFile::Samples(q) => &q.header.skeleton,
         }
     }
 
     pub fn num_frames(&self) -> usize {
         match self {
             IbkFile::Keys(d) => d.num_frames,
-            IbkFile::Samples(q) => q.num_frames,
+            IbkFile::Samples(q) => q.header.num_frames,
         }
     }
 
@@ -514,7 +514,7 @@ impl IbkFile {
             IbkFile::Keys(d) => format!("version 2 or older: {} keys of {} frames", d.key_frames.len(), d.num_frames),
             IbkFile::Samples(q) => format!(
                 "version 3: {} frames in segments of {}, compressed to {} cm (virtual vertices 3 cm from each bone)",
-                q.num_frames, q.segment_len, q.bound_cm
+                q.header.num_frames, q.header.segment_len, q.header.bound_cm
             ),
         }
     }

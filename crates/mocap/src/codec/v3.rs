@@ -83,9 +83,10 @@ pub fn tracks(sk: &Skeleton) -> Vec<Track> {
     rot.chain(trans).collect()
 }
 
-/// Everything a version 3 file holds, quantised: what [`encode`] writes and [`decode`] reads back.
+/// What a version 3 file says before its segments: the header fields, the skeleton, the tracks
+/// and which of them are constant (shared by [`Quantised`] and an opened [`File`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Quantised {
+pub struct Header {
     pub skeleton: Skeleton,
     pub frame_time: f64,
     pub num_frames: usize,
@@ -97,6 +98,12 @@ pub struct Quantised {
     pub tracks: Vec<Track>,
     /// Per track: `Some` value for a constant track, `None` for an animated one.
     pub constants: Vec<Option<[f32; 3]>>,
+}
+
+/// Everything a version 3 file holds, quantised: what [`encode`] writes and [`decode`] reads back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quantised {
+    pub header: Header,
     /// Step codes, `segments × tracks` (ignored for constant tracks).
     pub codes: Vec<u8>,
     /// Quantised values, `frames × tracks` (zero for constant tracks).
@@ -105,16 +112,16 @@ pub struct Quantised {
 
 impl Quantised {
     pub fn num_segments(&self) -> usize {
-        self.num_frames.div_ceil(self.segment_len)
+        self.header.num_frames.div_ceil(self.header.segment_len)
     }
 
     /// Value of track `t` at frame `f` as the decoder computes it.
     pub fn value(&self, f: usize, t: usize) -> DVec3 {
-        match self.constants[t] {
+        match self.header.constants[t] {
             Some(c) => DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64),
             None => {
-                let s = step(self.codes[(f / self.segment_len) * self.tracks.len() + t]);
-                let q = self.q[f * self.tracks.len() + t];
+                let s = step(self.codes[(f / self.header.segment_len) * self.header.tracks.len() + t]);
+                let q = self.q[f * self.header.tracks.len() + t];
                 DVec3::new(q[0] as f64 * s, q[1] as f64 * s, q[2] as f64 * s)
             }
         }
@@ -122,21 +129,21 @@ impl Quantised {
 
     /// The local pose of frame `f`.
     pub fn pose(&self, f: usize) -> Pose {
-        let mut p = Pose::rest(&self.skeleton);
-        for t in 0..self.tracks.len() {
-            set_track(&mut p, self.tracks[t], self.value(f, t));
+        let mut p = Pose::rest(&self.header.skeleton);
+        for t in 0..self.header.tracks.len() {
+            set_track(&mut p, self.header.tracks[t], self.value(f, t));
         }
         p
     }
 
     /// Every frame as local poses.
     pub fn poses(&self) -> Vec<Pose> {
-        (0..self.num_frames).map(|f| self.pose(f)).collect()
+        (0..self.header.num_frames).map(|f| self.pose(f)).collect()
     }
 
     /// The clip as a motion (BVH channels; rotations through each joint's Euler order).
     pub fn motion(&self) -> Result<Motion> {
-        Ok(Motion::from_poses(self.skeleton.clone(), self.frame_time, &self.poses())?)
+        Ok(Motion::from_poses(self.header.skeleton.clone(), self.header.frame_time, &self.poses())?)
     }
 }
 
@@ -198,10 +205,10 @@ fn bit_len(u: u64) -> u32 {
 
 /// Encodes one segment's bit stream.
 fn encode_segment(qz: &Quantised, seg: usize) -> Vec<u8> {
-    let nt = qz.tracks.len();
-    let start = seg * qz.segment_len;
-    let end = (start + qz.segment_len).min(qz.num_frames);
-    let animated: Vec<usize> = (0..nt).filter(|&t| qz.constants[t].is_none()).collect();
+    let nt = qz.header.tracks.len();
+    let start = seg * qz.header.segment_len;
+    let end = (start + qz.header.segment_len).min(qz.header.num_frames);
+    let animated: Vec<usize> = (0..nt).filter(|&t| qz.header.constants[t].is_none()).collect();
     let mut w = BitWriter::new();
     let mut comps: Vec<(Vec<i64>, CompCode)> = Vec::with_capacity(animated.len() * 3);
     for &t in &animated {
@@ -235,13 +242,13 @@ pub fn encode(qz: &Quantised) -> Vec<u8> {
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
     out.extend_from_slice(&0u16.to_le_bytes());
-    out.extend_from_slice(&qz.frame_time.to_le_bytes());
-    out.extend_from_slice(&(qz.num_frames as u32).to_le_bytes());
-    out.extend_from_slice(&(qz.segment_len as u16).to_le_bytes());
-    out.extend_from_slice(&qz.cm_per_unit.to_le_bytes());
-    out.extend_from_slice(&qz.bound_cm.to_le_bytes());
-    write_compact_skeleton(&mut out, &qz.skeleton);
-    for c in &qz.constants {
+    out.extend_from_slice(&qz.header.frame_time.to_le_bytes());
+    out.extend_from_slice(&(qz.header.num_frames as u32).to_le_bytes());
+    out.extend_from_slice(&(qz.header.segment_len as u16).to_le_bytes());
+    out.extend_from_slice(&qz.header.cm_per_unit.to_le_bytes());
+    out.extend_from_slice(&qz.header.bound_cm.to_le_bytes());
+    write_compact_skeleton(&mut out, &qz.header.skeleton);
+    for c in &qz.header.constants {
         match c {
             None => out.push(0),
             Some(v) => {
@@ -271,14 +278,7 @@ pub fn encode(qz: &Quantised) -> Vec<u8> {
 /// Opening checks the checksum and every header field once; [`File::pose_at`] then decodes one
 /// pose from its segment alone.
 pub struct File<'a> {
-    pub skeleton: Skeleton,
-    pub frame_time: f64,
-    pub num_frames: usize,
-    pub segment_len: usize,
-    pub cm_per_unit: f64,
-    pub bound_cm: f64,
-    pub tracks: Vec<Track>,
-    pub constants: Vec<Option<[f32; 3]>>,
+    pub header: Header,
     animated: Vec<usize>,
     offsets: Vec<usize>,
     data: &'a [u8],
@@ -407,7 +407,8 @@ impl<'a> File<'a> {
         let data = &body[data_at..];
         let animated = (0..tracks.len()).filter(|&t| constants[t].is_none()).collect();
         let crc = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("the envelope holds a checksum"));
-        Ok(File { skeleton, frame_time, num_frames, segment_len, cm_per_unit, bound_cm, tracks, constants, animated, offsets, data, data_at, crc })
+        let header = Header { skeleton, frame_time, num_frames, segment_len, cm_per_unit, bound_cm, tracks, constants };
+        Ok(File { header, animated, offsets, data, data_at, crc })
     }
 
     pub fn num_segments(&self) -> usize {
@@ -465,7 +466,7 @@ impl<'a> File<'a> {
     fn values_into(&self, sc: &Scratch, older: bool, out: &mut Vec<DVec3>) {
         out.clear();
         let mut a = 0;
-        for (t, c) in self.constants.iter().enumerate() {
+        for (t, c) in self.header.constants.iter().enumerate() {
             out.push(match c {
                 Some(v) => DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64),
                 None => {
@@ -483,9 +484,9 @@ impl<'a> File<'a> {
     /// Track values of frame `f` (and of frame `f + 1` into `next` when it lies in the same
     /// segment; `next` is left empty otherwise).
     fn frame_values(&self, f: usize, sc: &mut Scratch, want_next: bool) -> Result<(Vec<DVec3>, Vec<DVec3>)> {
-        let seg = f / self.segment_len;
-        let i = f - seg * self.segment_len;
-        let seg_end = ((seg + 1) * self.segment_len).min(self.num_frames);
+        let seg = f / self.header.segment_len;
+        let i = f - seg * self.header.segment_len;
+        let seg_end = ((seg + 1) * self.header.segment_len).min(self.header.num_frames);
         let last = if want_next && f + 1 < seg_end { i + 1 } else { i };
         let key = (self.data.as_ptr() as usize, self.data.len(), self.crc);
         let (a0, b0) = (self.offsets[seg], self.offsets[seg + 1]);
@@ -517,18 +518,18 @@ impl<'a> File<'a> {
     /// clip's length; with the same `sc`, a later time in the same segment only decodes the
     /// frames after the last one decoded (playback forwards: O(joints) per pose).
     pub fn pose_at(&self, time: f64, out: &mut Pose, sc: &mut Scratch) -> Result<()> {
-        let x = if time.is_finite() { (time / self.frame_time).clamp(0.0, (self.num_frames - 1) as f64) } else { 0.0 };
-        let f = (x.floor() as usize).min(self.num_frames - 1);
+        let x = if time.is_finite() { (time / self.header.frame_time).clamp(0.0, (self.header.num_frames - 1) as f64) } else { 0.0 };
+        let f = (x.floor() as usize).min(self.header.num_frames - 1);
         let u = x - f as f64;
-        let interpolate = u > 0.0 && f + 1 < self.num_frames;
+        let interpolate = u > 0.0 && f + 1 < self.header.num_frames;
         let (a, mut b) = self.frame_values(f, sc, interpolate)?;
         if interpolate && b.is_empty() {
             // Frame f + 1 starts the next segment: its values are the segment's first values.
-            let _ = self.segment_header(f / self.segment_len + 1, sc)?;
+            let _ = self.segment_header(f / self.header.segment_len + 1, sc)?;
             self.values_into(sc, false, &mut b);
         }
-        reset_pose(out, &self.skeleton);
-        for (t, &track) in self.tracks.iter().enumerate() {
+        reset_pose(out, &self.header.skeleton);
+        for (t, &track) in self.header.tracks.iter().enumerate() {
             set_track(out, track, a[t]);
             if interpolate {
                 match track.kind {
@@ -550,14 +551,14 @@ impl<'a> File<'a> {
     /// Decodes every segment into the quantised clip, checking that each segment's bits are used
     /// exactly (to its last byte).
     pub fn decode_all(&self) -> Result<Quantised> {
-        let nt = self.tracks.len();
-        let mut q = vec![[0i64; 3]; self.num_frames * nt];
+        let nt = self.header.tracks.len();
+        let mut q = vec![[0i64; 3]; self.header.num_frames * nt];
         let mut codes = vec![0u8; self.num_segments() * nt];
         let mut sc = Scratch::default();
         for seg in 0..self.num_segments() {
             let mut r = self.segment_header(seg, &mut sc)?;
-            let start = seg * self.segment_len;
-            let end = (start + self.segment_len).min(self.num_frames);
+            let start = seg * self.header.segment_len;
+            let end = (start + self.header.segment_len).min(self.header.num_frames);
             for (a, &t) in self.animated.iter().enumerate() {
                 codes[seg * nt + t] = sc.codes[a];
             }
@@ -579,18 +580,7 @@ impl<'a> File<'a> {
                 )));
             }
         }
-        Ok(Quantised {
-            skeleton: self.skeleton.clone(),
-            frame_time: self.frame_time,
-            num_frames: self.num_frames,
-            segment_len: self.segment_len,
-            cm_per_unit: self.cm_per_unit,
-            bound_cm: self.bound_cm,
-            tracks: self.tracks.clone(),
-            constants: self.constants.clone(),
-            codes,
-            q,
-        })
+        Ok(Quantised { header: self.header.clone(), codes, q })
     }
 }
 
@@ -632,7 +622,7 @@ mod tests {
         let segments = n.div_ceil(segment_len);
         // Step codes over the whole range; constant tracks have none (read back as 0).
         let codes = (0..segments * nt).map(|i| if constants[i % nt].is_some() { 0 } else { (i * 37 % 256) as u8 }).collect();
-        Quantised {
+        let header = Header {
             skeleton: m.skeleton,
             frame_time: 1.0 / 24.0,
             num_frames: n,
@@ -641,9 +631,8 @@ mod tests {
             bound_cm: 0.05,
             tracks,
             constants,
-            codes,
-            q,
-        }
+        };
+        Quantised { header, codes, q }
     }
 
     #[test]
@@ -653,7 +642,7 @@ mod tests {
         let d = decode(&bytes).unwrap();
         assert_eq!(d.codes, qz.codes);
         if let Some(i) = (0..qz.q.len()).find(|&i| d.q[i] != qz.q[i]) {
-            panic!("value {i} (frame {}, track {}): {:?} vs {:?}", i / qz.tracks.len(), i % qz.tracks.len(), d.q[i], qz.q[i]);
+            panic!("value {i} (frame {}, track {}): {:?} vs {:?}", i / qz.header.tracks.len(), i % qz.header.tracks.len(), d.q[i], qz.q[i]);
         }
         assert_eq!(d, qz);
         assert_eq!(&bytes[4..6], &3u16.to_le_bytes());
@@ -664,19 +653,19 @@ mod tests {
         let qz = quantised();
         let bytes = encode(&qz);
         let file = File::open(&bytes).unwrap();
-        let (mut pose, mut sc) = (Pose::rest(&qz.skeleton), Scratch::default());
-        for f in 0..qz.num_frames {
-            file.pose_at(f as f64 * qz.frame_time, &mut pose, &mut sc).unwrap();
+        let (mut pose, mut sc) = (Pose::rest(&qz.header.skeleton), Scratch::default());
+        for f in 0..qz.header.num_frames {
+            file.pose_at(f as f64 * qz.header.frame_time, &mut pose, &mut sc).unwrap();
             let want = qz.pose(f);
-            for j in 0..qz.skeleton.len() {
+            for j in 0..qz.header.skeleton.len() {
                 assert!(inbetween_core::rotation::angle_between(pose.rotations[j], want.rotations[j]) < 1e-9, "frame {f}, joint {j}");
                 assert!((pose.translations[j] - want.translations[j]).length() < 1e-9 * (1.0 + want.translations[j].length()));
             }
         }
         // Halfway between frames 7 and 8 (the second starts a segment): the slerp midpoint.
-        file.pose_at(7.5 * qz.frame_time, &mut pose, &mut sc).unwrap();
+        file.pose_at(7.5 * qz.header.frame_time, &mut pose, &mut sc).unwrap();
         let (a, b) = (qz.pose(7), qz.pose(8));
-        for j in 0..qz.skeleton.len() {
+        for j in 0..qz.header.skeleton.len() {
             let (qa, qb) = (a.rotations[j], b.rotations[j]);
             let mid = qa.slerp(if qa.dot(qb) < 0.0 { -qb } else { qb }, 0.5);
             assert!(inbetween_core::rotation::angle_between(pose.rotations[j], mid) < 1e-9);
@@ -687,7 +676,7 @@ mod tests {
         assert_eq!(pose.translations, qz.pose(0).translations);
         file.pose_at(f64::INFINITY, &mut pose, &mut sc).unwrap();
         file.pose_at(1e9, &mut pose, &mut sc).unwrap();
-        assert_eq!(pose.translations, qz.pose(qz.num_frames - 1).translations);
+        assert_eq!(pose.translations, qz.pose(qz.header.num_frames - 1).translations);
     }
 
     /// A scratch that continues from its last frame gives the poses a fresh one gives, for
@@ -698,12 +687,12 @@ mod tests {
         let qz = quantised();
         let bytes = encode(&qz);
         let file = File::open(&bytes).unwrap();
-        let duration = (qz.num_frames - 1) as f64 * qz.frame_time;
+        let duration = (qz.header.num_frames - 1) as f64 * qz.header.frame_time;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let forwards = (0..).map(|k| k as f64 / 60.0).take_while(|&t| t <= duration + 0.05);
         let random: Vec<f64> = (0..200).map(|_| rng.random::<f64>() * duration).collect();
-        let (mut pose, mut sc) = (Pose::rest(&qz.skeleton), Scratch::default());
-        let mut fresh = Pose::rest(&qz.skeleton);
+        let (mut pose, mut sc) = (Pose::rest(&qz.header.skeleton), Scratch::default());
+        let mut fresh = Pose::rest(&qz.header.skeleton);
         for t in forwards.chain(random) {
             file.pose_at(t, &mut pose, &mut sc).unwrap();
             file.pose_at(t, &mut fresh, &mut Scratch::default()).unwrap();
