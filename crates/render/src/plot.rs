@@ -129,16 +129,7 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
     let legend_corner = emptiest_corner(series, &xr, &yr);
     render_png(path, title, |root| {
         let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, TITLE_SIZE).into_font())
-            .margin(px(18))
-            .x_label_area_size(px(52))
-            .y_label_area_size(px(78))
-            .build_cartesian_2d(xr, yr)
-            .map_err(e)?;
-        house_mesh(chart.configure_mesh().x_desc(x_label).y_desc(y_label))
-            .draw()
-            .map_err(e)?;
+        let mut chart = house_axes(root, title, XAxis::Numeric(x_label), xr, y_label, yr)?;
         for (i, s) in series.iter().enumerate() {
             let color = series_color(s, i);
             let anno = match style {
@@ -230,16 +221,7 @@ pub fn grouped_bar_chart(
     let bar_w = 0.8 / series.len() as f64;
     render_png(path, title, |root| {
         let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, TITLE_SIZE).into_font())
-            .margin(px(18))
-            .x_label_area_size(px(40))
-            .y_label_area_size(px(78))
-            .build_cartesian_2d(0.0..n, yr.clone())
-            .map_err(e)?;
-        house_mesh(chart.configure_mesh().disable_x_mesh().x_labels(0).y_desc(y_label))
-            .draw()
-            .map_err(e)?;
+        let mut chart = house_axes(root, title, XAxis::Groups, 0.0..n, y_label, yr.clone())?;
         for (s, (name, values)) in series.iter().enumerate() {
             let color = rgb(DEFAULT_COLORS[s % DEFAULT_COLORS.len()]);
             chart
@@ -334,14 +316,7 @@ pub fn box_plot(
     let box_w = 0.8 / series.len() as f64;
     render_png(path, title, |root| {
         let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, TITLE_SIZE).into_font())
-            .margin(px(18))
-            .x_label_area_size(px(40))
-            .y_label_area_size(px(78))
-            .build_cartesian_2d(0.0..n, yr.clone())
-            .map_err(e)?;
-        house_mesh(chart.configure_mesh().disable_x_mesh().x_labels(0).y_desc(y_label)).draw().map_err(e)?;
+        let mut chart = house_axes(root, title, XAxis::Groups, 0.0..n, y_label, yr.clone())?;
         for (s, (name, _)) in series.iter().enumerate() {
             let color = rgb(DEFAULT_COLORS[s % DEFAULT_COLORS.len()]);
             let stroke = color.stroke_width(px(2) as u32);
@@ -389,6 +364,44 @@ pub(crate) fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage 
     })
 }
 
+
+/// What the x axis of [`house_axes`] shows.
+enum XAxis<'l> {
+    /// Numbers, with this description under them.
+    Numeric(&'l str),
+    /// Side-by-side groups, one unit of x each: no x labels or grid (the caller writes the names).
+    Groups,
+}
+
+/// A chart's axes over `xr` × `yr` with the caption and the house grid drawn.
+fn house_axes<'a>(
+    root: &DrawingArea<BitMapBackend<'a>, Shift>,
+    title: &str,
+    x: XAxis<'_>,
+    xr: std::ops::Range<f64>,
+    y_label: &str,
+    yr: std::ops::Range<f64>,
+) -> Result<ChartContext<'a, BitMapBackend<'a>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>, RenderError> {
+    let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
+    let x_area = match x {
+        XAxis::Numeric(_) => px(52),
+        XAxis::Groups => px(40),
+    };
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FONT, TITLE_SIZE).into_font())
+        .margin(px(18))
+        .x_label_area_size(x_area)
+        .y_label_area_size(px(78))
+        .build_cartesian_2d(xr, yr)
+        .map_err(e)?;
+    let mut mesh = chart.configure_mesh();
+    match x {
+        XAxis::Numeric(label) => mesh.x_desc(label),
+        XAxis::Groups => mesh.disable_x_mesh().x_labels(0),
+    };
+    house_mesh(mesh.y_desc(y_label)).draw().map_err(e)?;
+    Ok(chart)
+}
 
 /// The shared look of every chart's axes and grid: fonts, light grid lines, tick marks.
 fn house_mesh<'m, 'a, 'b, X, Y, DB>(
