@@ -15,7 +15,7 @@ use inbetween_script::motion::kenney::{read_character, KenneyCharacter};
 use inbetween_script::motion::rig::{clip, Rig};
 use inbetween_script::output::gltf::{glb_bytes, parse_glb};
 use inbetween_script::output::skinned::{
-    bind_body, bind_pose, character_file, first_character_dir, joint_matrices, render_skinned_frame, skin_positions, skinned_gltf_document, SkinnedBody,
+    bind_body, bind_pose, character_file, first_character_dir, joint_matrices, render_skinned_frame, skin_positions, skinned_gltf_document, SkinnedBody, SkinnedCast,
     BLOCKY_DIR,
 };
 use inbetween_script::scene::{Room, Scene};
@@ -419,7 +419,7 @@ fn fixture_character_skins_onto_the_rig_and_follows_its_joints() {
     check_bind(&ch, &body, &rig);
     let m = test_motion(&rig);
     let cat = builtin();
-    let (doc, bin, _) = skinned_gltf_document(&room(), &cat, &[("Eve", &m)], &[Some(&body)], &camera, 30.0, &|_| None).unwrap();
+    let (doc, bin, _) = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &cat, characters: &[("Eve", &m)], bodies: &[Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap();
     // Through GLB bytes and back.
     let glb = parse_glb(&glb_bytes(&doc, &bin)).unwrap();
     check_document(&glb.json, &glb.bin, &body, &m);
@@ -430,7 +430,7 @@ fn fixture_character_skins_onto_the_rig_and_follows_its_joints() {
     assert!(shin_low > knee - 0.15, "shin horizontal: lowest {shin_low} vs knee {knee}");
     // A preview frame shows the character's texture colours where the body is.
     let refs = [Some(&body)];
-    let img = render_skinned_frame(&room(), &cat, &[("Eve", &m)], &refs, &camera, 30.0, 0, (160, 120));
+    let img = render_skinned_frame(&SkinnedCast { scene: &room(), cat: &cat, characters: &[("Eve", &m)], bodies: &refs, camera: &camera, fps: 30.0 }, 0, (160, 120));
     let blueish = img.pixels().filter(|p| p.0[2] > 120 && p.0[0] < 200 && p.0[2] > p.0[1].saturating_add(20)).count();
     assert!(blueish > 50, "textured body pixels: {blueish}");
 }
@@ -443,14 +443,14 @@ fn characters_without_a_body_keep_the_stick_figure() {
     let body = bind_body(&ch, &rig.skeleton).unwrap();
     let m = test_motion(&rig);
     let chars = [("Eve", &m), ("Bob", &m)];
-    let (doc, _, _) = skinned_gltf_document(&room(), &builtin(), &chars, &[None, Some(&body)], &camera, 30.0, &|_| None).unwrap();
+    let (doc, _, _) = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &builtin(), characters: &chars, bodies: &[None, Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap();
     let nodes = doc["nodes"].as_array().unwrap();
     let bones = nodes.iter().filter(|n| n["name"].as_str().unwrap_or("").ends_with(" bone")).count();
     assert!(bones > 10, "Eve's bone boxes stay: {bones}");
     assert_eq!(doc["skins"].as_array().unwrap().len(), 1);
     let skinned = nodes.iter().find(|n| n.get("skin").is_some()).unwrap();
     assert_eq!(skinned["name"], "Bob body");
-    let e = skinned_gltf_document(&room(), &builtin(), &chars, &[Some(&body)], &camera, 30.0, &|_| None).unwrap_err().to_string();
+    let e = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &builtin(), characters: &chars, bodies: &[Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap_err().to_string();
     assert!(e.contains("1 bodies for 2 characters"), "{e}");
 }
 
@@ -471,7 +471,7 @@ fn real_kenney_characters_skin_onto_the_rig() {
             assert!((1.3..1.8).contains(&h), "{}: {h} m", file.display());
             println!("{}: {} vertices, {} triangles, {h:.3} m", file.display(), body.positions.len(), body.indices.len() / 3);
             if i == 0 {
-                let (doc, bin, _) = skinned_gltf_document(&room(), &builtin(), &[("Eve", &m)], &[Some(&body)], &camera, 30.0, &|_| None).unwrap();
+                let (doc, bin, _) = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &builtin(), characters: &[("Eve", &m)], bodies: &[Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap();
                 let glb = parse_glb(&glb_bytes(&doc, &bin)).unwrap();
                 check_document(&glb.json, &glb.bin, &body, &m);
             }

@@ -632,19 +632,22 @@ fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) ->
     Ok(())
 }
 
+/// What the skinned outputs show: the furnished scene and its catalogue, the characters with their
+/// motions and bodies (`None`: the character keeps its stick figure), the camera and the frame rate.
+pub struct SkinnedCast<'a> {
+    pub scene: &'a Scene,
+    pub cat: &'a Catalogue,
+    pub characters: &'a [(&'a str, &'a Motion)],
+    pub bodies: &'a [Option<&'a SkinnedBody>],
+    pub camera: &'a CameraFn<'a>,
+    pub fps: f64,
+}
+
 /// The animated document of [`animated_gltf_document`] with every character that has a body
 /// skinned: its bone boxes removed, the body added as a skinned mesh on its joint nodes (which keep
 /// their animation channels). Characters without a body (`None`) keep the stick figure.
-#[allow(clippy::too_many_arguments)]
-pub fn skinned_gltf_document(
-    scene: &Scene,
-    cat: &Catalogue,
-    characters: &[(&str, &Motion)],
-    bodies: &[Option<&SkinnedBody>],
-    camera: &CameraFn,
-    fps: f64,
-    model: &dyn Fn(&str) -> Option<PathBuf>,
-) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
+pub fn skinned_gltf_document(cast: &SkinnedCast, model: &dyn Fn(&str) -> Option<PathBuf>) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
+    let SkinnedCast { scene, cat, characters, bodies, camera, fps } = *cast;
     if bodies.len() != characters.len() {
         return Err(ScriptError::Invalid(format!("{} bodies for {} characters", bodies.len(), characters.len())));
     }
@@ -694,18 +697,9 @@ pub fn skinned_gltf_document(
 
 /// Writes [`skinned_gltf_document`] as `.glb` (by extension) or `.gltf` with the buffer embedded,
 /// atomically; furniture as in [`super::write_animated_gltf`].
-#[allow(clippy::too_many_arguments)]
-pub fn write_skinned_gltf(
-    path: &Path,
-    scene: &Scene,
-    cat: &Catalogue,
-    characters: &[(&str, &Motion)],
-    bodies: &[Option<&SkinnedBody>],
-    camera: &CameraFn,
-    fps: f64,
-) -> Result<(), ScriptError> {
-    let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
-    let (doc, bin, _) = skinned_gltf_document(scene, cat, characters, bodies, camera, fps, &lookup)?;
+pub fn write_skinned_gltf(path: &Path, cast: &SkinnedCast) -> Result<(), ScriptError> {
+    let lookup = |category: &str| cast.cat.model_path(category).filter(|p| p.is_file());
+    let (doc, bin, _) = skinned_gltf_document(cast, &lookup)?;
     write_document(path, doc, bin)
 }
 
@@ -737,17 +731,8 @@ impl Paint {
 /// Story frame `frame` seen through `camera(frame)`: room, boxes and every skinned body (its
 /// triangles coloured from the texture at their centre, Lambert-shaded), everything painted far
 /// to near; characters without a body are left out. A check of the skin, not a renderer.
-#[allow(clippy::too_many_arguments)]
-pub fn render_skinned_frame(
-    scene: &Scene,
-    cat: &Catalogue,
-    characters: &[(&str, &Motion)],
-    bodies: &[Option<&SkinnedBody>],
-    camera: &CameraFn,
-    fps: f64,
-    frame: usize,
-    size: (u32, u32),
-) -> RgbImage {
+pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) -> RgbImage {
+    let SkinnedCast { scene, cat, characters, bodies, camera, fps } = *cast;
     let (eye, target, fov) = camera(frame);
     let cam = Camera3::new(Vec3::from(eye).as_dvec3(), Vec3::from(target).as_dvec3(), DVec3::Y, fov as f64).with_viewport(size.0, size.1);
     let mut cv = Canvas::new(size.0, size.1, [246, 247, 250]);
@@ -854,12 +839,13 @@ pub fn write_skinned_story(dir: &Path, anim: &crate::animate::Animation, cat: &C
     let gltf = dir.join(SKINNED_GLTF);
     // As `write_skinned_gltf`, with the carried props moving as in story.gltf.
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
-    let (mut doc, mut bin, _) = skinned_gltf_document(&anim.scene, cat, &chars, &refs, &cam, anim.fps, &lookup)?;
+    let cast = SkinnedCast { scene: &anim.scene, cat, characters: &chars, bodies: &refs, camera: &cam, fps: anim.fps };
+    let (mut doc, mut bin, _) = skinned_gltf_document(&cast, &lookup)?;
     super::anim_gltf::add_prop_channels(&mut doc, &mut bin, anim, super::anim_gltf::animation_frames(&chars, anim.fps));
     write_document(&gltf, doc, bin)?;
     let png = dir.join(SKINNED_PNG);
     let frames = super::anim_gltf::animation_frames(&chars, anim.fps);
-    let img = render_skinned_frame(&anim.scene, cat, &chars, &refs, &cam, anim.fps, frames / 2, (640, 480));
+    let img = render_skinned_frame(&cast, frames / 2, (640, 480));
     super::write_png(&png, &img)?;
     Ok(SkinnedStory { files: vec![gltf, png], notes })
 }
