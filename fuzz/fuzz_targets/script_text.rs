@@ -26,6 +26,9 @@ fuzz_target!(|data: &[u8]| {
     let parsed = parse_script(&text, cat);
     if data.len() <= 400 {
         let pins = HashMap::new();
-        let _ = compose(&ComposeInput { parsed: &parsed, catalogue: cat, database: db, pins: &pins }, &ComposeConfig::default());
+        let _ = compose(
+            &ComposeInput { parsed: &parsed, catalogue: cat, database: db, pins: &pins },
+            &ComposeConfig::default(),
+        );
     }
 });

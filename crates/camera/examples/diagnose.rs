@@ -39,7 +39,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let kf = last + gap;
             let frames: [Cam; MAP_FRAMES] = std::array::from_fn(|i| x[s0 + i]);
             // Steps 1..=gap after `last`, the key at the end; drop the start.
-            let run = |zz: &[f32]| Rollout::mapped(&model, zz, &frames).through_keys(&c[last..=kf], &[(gap, x[kf])])[1..].to_vec();
+            let run = |zz: &[f32]| {
+                Rollout::mapped(&model, zz, &frames).through_keys(&c[last..=kf], &[(gap, x[kf])])[1..].to_vec()
+            };
             let net = run(&z);
             let alt = run(other);
             let b = s.behaviour.index();
@@ -65,7 +67,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     println!("gap {gap} steps; per-step mean ‖Δx^c‖ (training-loss scale is rec + key)");
-    println!("{:>9} {:>7} {:>7} {:>7} {:>9} {:>8} {:>8}", "behaviour", "net", "lerp", "hold", "z-effect", "key-miss", "gt-step");
+    println!(
+        "{:>9} {:>7} {:>7} {:>7} {:>9} {:>8} {:>8}",
+        "behaviour", "net", "lerp", "hold", "z-effect", "key-miss", "gt-step"
+    );
     let mut tot = [0.0; 6];
     for b in BEHAVIOURS {
         let i = b.index();
@@ -75,7 +80,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         println!("{:>9} {:>7.3} {:>7.3} {:>7.3} {:>9.3} {:>8.3} {:>8.3}", b.name(), m[0], m[1], m[2], m[3], m[4], m[5]);
     }
-    println!("{:>9} {:>7.3} {:>7.3} {:>7.3} {:>9.3} {:>8.3} {:>8.3}", "average", tot[0], tot[1], tot[2], tot[3], tot[4], tot[5]);
+    println!(
+        "{:>9} {:>7.3} {:>7.3} {:>7.3} {:>9.3} {:>8.3} {:>8.3}",
+        "average", tot[0], tot[1], tot[2], tot[3], tot[4], tot[5]
+    );
     let zstd: Vec<f64> = (0..zs[0].len())
         .map(|d| {
             let m = zs.iter().map(|z| z[d] as f64).sum::<f64>() / zs.len() as f64;

@@ -52,7 +52,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         TrainEvent::Iteration { epoch, iter, loss } if iter % 10 == 0 => {
             println!("  epoch {} iter {iter} loss {loss:.4} ({:.1} s)", epoch + 1, t0.elapsed().as_secs_f64())
         }
-        TrainEvent::Epoch { epoch, loss, lr, seconds } => println!("epoch {:>3} loss {loss:.5} lr {lr:.2e} {seconds:.0} s", epoch + 1),
+        TrainEvent::Epoch { epoch, loss, lr, seconds } => {
+            println!("epoch {:>3} loss {loss:.5} lr {lr:.2e} {seconds:.0} s", epoch + 1)
+        }
         _ => {}
     };
     let (model, summary) = train::train(&cfg, Some(&ckpt), &mut report)?;
@@ -60,6 +62,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::create_dir_all(dir)?;
     }
     inbetween_camera::weights::save(&model, &summary, &out, overwrite_committed)?;
-    println!("done: {} epochs, {} iterations, {:.1} min, final loss {:.4}", summary.epochs_done, summary.iterations, summary.seconds / 60.0, summary.final_loss);
+    println!(
+        "done: {} epochs, {} iterations, {:.1} min, final loss {:.4}",
+        summary.epochs_done,
+        summary.iterations,
+        summary.seconds / 60.0,
+        summary.final_loss
+    );
     Ok(())
 }

@@ -22,14 +22,14 @@ use crate::dataset::{Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE};
 use crate::infer::{cam_distance as err, key_vector, Cam, Chr, FastModel, Rollout, Scratch, StepIn};
 use crate::model::{MAP_FRAMES, STYLE_STEPS};
 use crate::toric::Lens;
-use inbetween_core::curve::{Curve, Samples, Track};
-use inbetween_nn::runtime::LstmState;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use crate::CameraError;
+use inbetween_core::curve::{Curve, Samples, Track};
 use inbetween_io::report::{num, Report, Table};
 use inbetween_io::Progress;
+use inbetween_nn::runtime::LstmState;
 use inbetween_render::plot::{grouped_bar_chart, line_plot, scatter_plot, Series};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -59,7 +59,13 @@ impl BenchConfig {
 
     /// Under a minute on 2 cores.
     pub fn quick() -> BenchConfig {
-        BenchConfig { scenes: 3, windows_per_sequence: 1, displacements: vec![0.0, 0.5, 1.0, 2.0], speed_seconds: 0.7, ..BenchConfig::full() }
+        BenchConfig {
+            scenes: 3,
+            windows_per_sequence: 1,
+            displacements: vec![0.0, 0.5, 1.0, 2.0],
+            speed_seconds: 0.7,
+            ..BenchConfig::full()
+        }
     }
 }
 
@@ -155,7 +161,13 @@ fn bend(track: &mut [Cam], keys: &[(usize, Cam)]) {
     }
 }
 
-fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng, progress: &Progress) -> Vec<Table1Row> {
+fn table1(
+    model: &FastModel,
+    seqs: &[EvalSeq],
+    cfg: &BenchConfig,
+    rng: &mut ChaCha8Rng,
+    progress: &Progress,
+) -> Vec<Table1Row> {
     let gap = 40;
     let hd = model.config.hidden;
     let mut sums = vec![[0.0f64; 5]; BEHAVIOURS.len()];
@@ -168,7 +180,8 @@ fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaC
             let chars = &s.chars[base..=base + gap];
             let truth = &s.cams[base..=base + gap];
             let keys = [(gap, truth[gap])];
-            let gaussian = LstmState { h: (0..hd).map(|_| normal(rng)).collect(), c: (0..hd).map(|_| normal(rng)).collect() };
+            let gaussian =
+                LstmState { h: (0..hd).map(|_| normal(rng)).collect(), c: (0..hd).map(|_| normal(rng)).collect() };
             // Warm start: from a zero state the generator reads the context steps (teacher forced).
             let mut warm = Rollout::with_state(model, &z, LstmState::zeros(1, hd), s.cams[s0]);
             let key = key_vector(&truth[gap], &chars[gap]);
@@ -194,7 +207,14 @@ fn table1(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaC
         .map(|b| {
             let i = b.index();
             let n = counts[i].max(1) as f64;
-            Table1Row { behaviour: b.name().into(), zero: sums[i][0] / n, gaussian: sums[i][1] / n, warm_start: sums[i][2] / n, mapped: sums[i][3] / n, lerp: sums[i][4] / n }
+            Table1Row {
+                behaviour: b.name().into(),
+                zero: sums[i][0] / n,
+                gaussian: sums[i][1] / n,
+                warm_start: sums[i][2] / n,
+                mapped: sums[i][3] / n,
+                lerp: sums[i][4] / n,
+            }
         })
         .collect()
 }
@@ -244,7 +264,14 @@ fn lerp_track(a: &Cam, b: &Cam, n: usize) -> Vec<Cam> {
     (0..=n).map(|t| std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t as f32 / n as f32)).collect()
 }
 
-fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, rng: &mut ChaCha8Rng, progress: &Progress) -> Vec<Table2Row> {
+fn table2(
+    model: &FastModel,
+    seqs: &[EvalSeq],
+    cfg: &BenchConfig,
+    lens: &Lens,
+    rng: &mut ChaCha8Rng,
+    progress: &Progress,
+) -> Vec<Table2Row> {
     let len = STYLE_STEPS;
     // One segment per sequence, shared by every δ.
     let segs: Vec<(usize, Vec<f32>)> = seqs
@@ -303,7 +330,13 @@ fn table2(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, lens: &Lens, r
     rows
 }
 
-fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCha8Rng, progress: &Progress) -> Vec<RailsRow> {
+fn rails(
+    model: &FastModel,
+    seqs: &[EvalSeq],
+    cfg: &BenchConfig,
+    rng: &mut ChaCha8Rng,
+    progress: &Progress,
+) -> Vec<RailsRow> {
     let len = STYLE_STEPS;
     let mut acc = vec![(0.0f64, 0.0f64, 0usize, 0usize); BEHAVIOURS.len()];
     for s in seqs {
@@ -349,7 +382,13 @@ fn rails(model: &FastModel, seqs: &[EvalSeq], cfg: &BenchConfig, rng: &mut ChaCh
 
 /// Mean pairwise distance between tracks through the same two keys (60 steps) generated with each
 /// behaviour's mean style code.
-fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool, Vec<f32>)], rng: &mut ChaCha8Rng, progress: &Progress) -> f64 {
+fn style_spread(
+    model: &FastModel,
+    seqs: &[EvalSeq],
+    styles: &[(Behaviour, bool, Vec<f32>)],
+    rng: &mut ChaCha8Rng,
+    progress: &Progress,
+) -> f64 {
     let len = STYLE_STEPS;
     let codes: Vec<Vec<f32>> = BEHAVIOURS
         .iter()
@@ -364,7 +403,8 @@ fn style_spread(model: &FastModel, seqs: &[EvalSeq], styles: &[(Behaviour, bool,
         let base = s0 + MAP_FRAMES - 1;
         let chars = &s.chars[base..=base + len];
         let truth = &s.cams[base..=base + len];
-        let tracks: Vec<Vec<Cam>> = codes.iter().map(|z| roll(model, z, &[truth[0]; MAP_FRAMES], chars, &[(len, truth[len])])).collect();
+        let tracks: Vec<Vec<Cam>> =
+            codes.iter().map(|z| roll(model, z, &[truth[0]; MAP_FRAMES], chars, &[(len, truth[len])])).collect();
         for i in 0..tracks.len() {
             for j in i + 1..tracks.len() {
                 total += mean_err(&tracks[i], &tracks[j]);
@@ -380,7 +420,14 @@ fn speed(model: &FastModel, seconds: f64) -> Speed {
     let scene = crate::dataset::Scene::procedural(42, 900, 30.0);
     let keys = crate::infer::example_keys(&scene, &[0, 299, 599, 899]);
     let style = crate::infer::Style { name: "bench".into(), code: vec![0.0; model.config.style_dim] };
-    let job = crate::infer::GenerateJob { model, scene: &scene, keys: &keys, style: &style, options: Default::default(), origin: std::path::Path::new("bench") };
+    let job = crate::infer::GenerateJob {
+        model,
+        scene: &scene,
+        keys: &keys,
+        style: &style,
+        options: Default::default(),
+        origin: std::path::Path::new("bench"),
+    };
     let t0 = Instant::now();
     let mut frames = 0usize;
     while t0.elapsed().as_secs_f64() < seconds * 0.5 || frames == 0 {
@@ -391,7 +438,13 @@ fn speed(model: &FastModel, seconds: f64) -> Speed {
     let single = frames as f64 / t0.elapsed().as_secs_f64();
     let batch = 16;
     let mut state = LstmState::zeros(batch, model.config.hidden);
-    let input = StepIn { style: &style.code, prev: [-0.3, 0.1, 0.3, 0.1, 1.5, 0.2], character: [0.4, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 1.0], key: [0.1; 14], tta_frames: 100 };
+    let input = StepIn {
+        style: &style.code,
+        prev: [-0.3, 0.1, 0.3, 0.1, 1.5, 0.2],
+        character: [0.4, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 1.0],
+        key: [0.1; 14],
+        tta_frames: 100,
+    };
     let inputs = vec![input; batch];
     let mut scratch = Scratch::for_rows(model, batch);
     let t1 = Instant::now();
@@ -506,19 +559,38 @@ pub const PAPER_TABLE2: [(f64, f64, f64, f64); 10] = [
 
 /// A chart's PNG bytes (see [`inbetween_render::rendered_bytes`]), so that [`Report::write`]
 /// writes it atomically with the rest.
-fn png_bytes(name: &str, draw: impl FnOnce(&Path) -> Result<(), inbetween_render::RenderError>) -> Result<Vec<u8>, CameraError> {
+fn png_bytes(
+    name: &str,
+    draw: impl FnOnce(&Path) -> Result<(), inbetween_render::RenderError>,
+) -> Result<Vec<u8>, CameraError> {
     inbetween_render::rendered_bytes(name, draw).map_err(|e| CameraError::invalid(Path::new(name), e.to_string()))
 }
 
 impl BenchReport {
     /// Table 1 (`table1.csv`): ours by initialisation and the straight line, the paper's beside.
     pub fn table1(&self) -> Table {
-        let headers = ["behaviour", "zero", "gaussian", "warm_start", "mapped", "toric_lerp", "paper_zero", "paper_gaussian", "paper_warm_start", "paper_mapped"];
-        let mut t = Table::new("table1", "Table 1: trajectory error (Toric units) by hidden-state initialisation, 40 generated steps to a keyframe", &headers);
+        let headers = [
+            "behaviour",
+            "zero",
+            "gaussian",
+            "warm_start",
+            "mapped",
+            "toric_lerp",
+            "paper_zero",
+            "paper_gaussian",
+            "paper_warm_start",
+            "paper_mapped",
+        ];
+        let mut t = Table::new(
+            "table1",
+            "Table 1: trajectory error (Toric units) by hidden-state initialisation, 40 generated steps to a keyframe",
+            &headers,
+        );
         let mut avg = [0.0; 5];
         for r in &self.table1 {
             let ours = [r.zero, r.gaussian, r.warm_start, r.mapped, r.lerp];
-            let paper = PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).map_or([f64::NAN; 4], |p| [p.1, p.2, p.3, p.4]);
+            let paper =
+                PAPER_TABLE1.iter().find(|p| p.0 == r.behaviour).map_or([f64::NAN; 4], |p| [p.1, p.2, p.3, p.4]);
             let mut cells = vec![r.behaviour.clone()];
             cells.extend(ours.iter().map(|v| num(*v, 4)));
             cells.extend(paper.iter().map(|v| if v.is_nan() { num(*v, 0) } else { v.to_string() }));
@@ -530,7 +602,11 @@ impl BenchReport {
         let [pz, pg, pw, pm] = PAPER_TABLE1_AVERAGE;
         t.note(format!(
             "average: zero {}, gaussian {}, warm_start {}, mapped {}, toric_lerp {}; paper {pz} / {pg} / {pw} / {pm}",
-            num(avg[0], 3), num(avg[1], 3), num(avg[2], 3), num(avg[3], 3), num(avg[4], 3)
+            num(avg[0], 3),
+            num(avg[1], 3),
+            num(avg[2], 3),
+            num(avg[3], 3),
+            num(avg[4], 3)
         ));
         t.note("toric_lerp: no network, the straight Toric line from the start to the key (the baseline to beat)");
         t.note("warm_start reuses our network (the paper trains one per initialisation); paper_*: the paper's Table 1");
@@ -539,13 +615,32 @@ impl BenchReport {
 
     /// Table 2 (`table2.csv`): SD (Eq. 8), TD and KD against the key displacement δ.
     pub fn table2(&self) -> Table {
-        let headers = ["displacement", "sd_ours", "sd_only_style", "sd_interpolation", "td_ours", "td_only_style", "td_interpolation", "kd_ours"];
+        let headers = [
+            "displacement",
+            "sd_ours",
+            "sd_only_style",
+            "sd_interpolation",
+            "td_ours",
+            "td_only_style",
+            "td_interpolation",
+            "kd_ours",
+        ];
         let mut t = Table::new("table2", "Table 2: keyframe displacement δ (rad on θ): SD (Eq. 8), TD, KD", &headers);
         for r in &self.table2 {
-            let values = [r.sd_ours, r.sd_only_style, r.sd_interpolation, r.td_ours, r.td_only_style, r.td_interpolation, r.kd_ours];
+            let values = [
+                r.sd_ours,
+                r.sd_only_style,
+                r.sd_interpolation,
+                r.td_ours,
+                r.td_only_style,
+                r.td_interpolation,
+                r.kd_ours,
+            ];
             t.row(std::iter::once(r.displacement.to_string()).chain(values.iter().map(|v| num(*v, 4))));
         }
-        let paper = |f: fn(&(f64, f64, f64, f64)) -> f64| PAPER_TABLE2.iter().map(|p| f(p).to_string()).collect::<Vec<_>>().join(" / ");
+        let paper = |f: fn(&(f64, f64, f64, f64)) -> f64| {
+            PAPER_TABLE2.iter().map(|p| f(p).to_string()).collect::<Vec<_>>().join(" / ")
+        };
         let deltas = PAPER_TABLE2.iter().map(|p| p.0.to_string()).collect::<Vec<_>>().join(" / ");
         t.note(format!("paper (its Table 2 \"ours\" rows) at δ = {deltas}:"));
         t.note(format!("paper SD: {}", paper(|p| p.1)));
@@ -557,12 +652,16 @@ impl BenchReport {
 
     /// §6.3 (`rails.csv`): how many spline keys match our 3-key track.
     pub fn rails_table(&self) -> Table {
-        let title = "§6.3: keys a Catmull-Rom spline through the ground truth needs to match our 3-key track (300 frames)";
+        let title =
+            "§6.3: keys a Catmull-Rom spline through the ground truth needs to match our 3-key track (300 frames)";
         let mut t = Table::new("rails", title, &["behaviour", "ours_error", "spline_keys", "capped"]);
         for r in &self.rails {
             t.row([r.behaviour.clone(), num(r.ours_error, 4), num(r.spline_keys, 2), r.capped.to_string()]);
         }
-        t.note(format!("capped: sequences no spline of up to {} keys matched (counted as {})", self.config.max_spline_keys, self.config.max_spline_keys));
+        t.note(format!(
+            "capped: sequences no spline of up to {} keys matched (counted as {})",
+            self.config.max_spline_keys, self.config.max_spline_keys
+        ));
         t.note("paper: up to 20 keys for camera-on-rails");
         t
     }
@@ -571,7 +670,11 @@ impl BenchReport {
     pub fn speed_table(&self) -> Table {
         let mut t = Table::new("speed", "Speed: frames per second, one thread", &["measure", "frames_per_s", "paper"]);
         t.row(["end to end, one 900-frame track", &num(self.speed.single_frames_per_s, 0), "> 2000"]);
-        t.row([&format!("network only, {} trajectories batched", self.speed.batch), &num(self.speed.batched_frames_per_s, 0), ""]);
+        t.row([
+            &format!("network only, {} trajectories batched", self.speed.batch),
+            &num(self.speed.batched_frames_per_s, 0),
+            "",
+        ]);
         t.note("end to end: network every 5th frame, cubic fill, world poses; batched: output frames (5 per step)");
         t
     }
@@ -579,9 +682,16 @@ impl BenchReport {
     /// The whole report: the tables, the style effect, `report.json` and the charts (Table 1,
     /// Table 2's TD and SD, the style PCA of Fig. 4) as PNG files.
     pub fn report(&self) -> Result<Report, CameraError> {
-        let mut r = Report::new("report", &format!("camera bench: {} held-out sequences (seed {})", self.sequences, self.config.seed));
+        let mut r = Report::new(
+            "report",
+            &format!("camera bench: {} held-out sequences (seed {})", self.sequences, self.config.seed),
+        );
         r.table(self.table1()).table(self.table2()).table(self.rails_table());
-        r.text(format!("style effect: tracks through the same keys with the {} behaviour codes differ by {} on average", BEHAVIOURS.len(), num(self.style_spread, 4)));
+        r.text(format!(
+            "style effect: tracks through the same keys with the {} behaviour codes differ by {} on average",
+            BEHAVIOURS.len(),
+            num(self.style_spread, 4)
+        ));
         r.table(self.speed_table());
         r.json("report.json", self).map_err(io_error)?;
         r.file("table1.png", self.table1_png()?);
@@ -608,13 +718,32 @@ impl BenchReport {
             ("Toric lerp".into(), col(|r| r.lerp)),
             ("paper mapped".into(), PAPER_TABLE1.iter().map(|p| p.4).collect()),
         ];
-        png_bytes("table1.png", |p| grouped_bar_chart(p, "Table 1: trajectory error by hidden-state initialisation", "error (Toric units)", &groups, &series))
+        png_bytes("table1.png", |p| {
+            grouped_bar_chart(
+                p,
+                "Table 1: trajectory error by hidden-state initialisation",
+                "error (Toric units)",
+                &groups,
+                &series,
+            )
+        })
     }
 
     fn table2_pngs(&self) -> Result<(Vec<u8>, Vec<u8>), CameraError> {
-        let series = |name: &str, f: fn(&Table2Row) -> f64| Series::new(name, self.table2.iter().map(|r| (r.displacement, f(r))).collect());
-        let td = [series("ours", |r| r.td_ours), series("only style", |r| r.td_only_style), series("Toric lerp", |r| r.td_interpolation), series("KD ours", |r| r.kd_ours)];
-        let sd = [series("ours", |r| r.sd_ours), series("only style", |r| r.sd_only_style), series("Toric lerp", |r| r.sd_interpolation)];
+        let series = |name: &str, f: fn(&Table2Row) -> f64| {
+            Series::new(name, self.table2.iter().map(|r| (r.displacement, f(r))).collect())
+        };
+        let td = [
+            series("ours", |r| r.td_ours),
+            series("only style", |r| r.td_only_style),
+            series("Toric lerp", |r| r.td_interpolation),
+            series("KD ours", |r| r.kd_ours),
+        ];
+        let sd = [
+            series("ours", |r| r.sd_ours),
+            series("only style", |r| r.sd_only_style),
+            series("Toric lerp", |r| r.sd_interpolation),
+        ];
         Ok((
             png_bytes("table2_td.png", |p| line_plot(p, "Table 2: TD vs keyframe displacement", "δ (rad)", "TD", &td))?,
             png_bytes("table2_sd.png", |p| line_plot(p, "Table 2: SD vs keyframe displacement", "δ (rad)", "SD", &sd))?,
@@ -627,10 +756,17 @@ impl BenchReport {
         let mut series = Vec::new();
         for b in BEHAVIOURS {
             for main_is_a in [true, false] {
-                let points = self.styles.iter().zip(&pts).filter(|(s, _)| s.0 == b && s.1 == main_is_a).map(|(_, p)| *p).collect();
+                let points = self
+                    .styles
+                    .iter()
+                    .zip(&pts)
+                    .filter(|(s, _)| s.0 == b && s.1 == main_is_a)
+                    .map(|(_, p)| *p)
+                    .collect();
                 let base = [[31, 119, 180], [44, 160, 44], [255, 127, 14], [214, 39, 40]][b.index()];
                 let color = if main_is_a { base } else { base.map(|c: u8| c / 2 + 100) };
-                let mut s = Series::new(format!("{} ({} main)", b.name(), if main_is_a { "left" } else { "right" }), points);
+                let mut s =
+                    Series::new(format!("{} ({} main)", b.name(), if main_is_a { "left" } else { "right" }), points);
                 s.color = Some(color);
                 series.push(s);
             }
@@ -658,33 +794,64 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let files = r.write(dir.path()).unwrap();
         let names: Vec<String> = files.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-        let expected = ["report.txt", "report.md", "table1.csv", "table2.csv", "rails.csv", "speed.csv", "report.json", "table1.png", "table2_td.png", "table2_sd.png", "style_pca.png"];
+        let expected = [
+            "report.txt",
+            "report.md",
+            "table1.csv",
+            "table2.csv",
+            "rails.csv",
+            "speed.csv",
+            "report.json",
+            "table1.png",
+            "table2_td.png",
+            "table2_sd.png",
+            "style_pca.png",
+        ];
         assert_eq!(names, expected);
         let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
         let t1 = read("table1.csv");
         let t1: Vec<&str> = t1.lines().collect();
         assert_eq!(t1[0], "behaviour,zero,gaussian,warm_start,mapped,toric_lerp,paper_zero,paper_gaussian,paper_warm_start,paper_mapped");
         let direct = &r.table1[0];
-        assert_eq!(t1[1], format!("direct,{:.4},{:.4},{:.4},{:.4},{:.4},0.162,0.146,0.173,0.107", direct.zero, direct.gaussian, direct.warm_start, direct.mapped, direct.lerp));
+        assert_eq!(
+            t1[1],
+            format!(
+                "direct,{:.4},{:.4},{:.4},{:.4},{:.4},0.162,0.146,0.173,0.107",
+                direct.zero, direct.gaussian, direct.warm_start, direct.mapped, direct.lerp
+            )
+        );
         let t2 = read("table2.csv");
-        assert_eq!(t2.lines().next(), Some("displacement,sd_ours,sd_only_style,sd_interpolation,td_ours,td_only_style,td_interpolation,kd_ours"));
+        assert_eq!(
+            t2.lines().next(),
+            Some("displacement,sd_ours,sd_only_style,sd_interpolation,td_ours,td_only_style,td_interpolation,kd_ours")
+        );
         assert!(t2.lines().nth(1).unwrap().starts_with("0,") && t2.lines().nth(2).unwrap().starts_with("1,"), "{t2}");
         assert!(read("rails.csv").starts_with("behaviour,ours_error,spline_keys,capped\ndirect,"));
         let back: BenchReport = serde_json::from_str(&read("report.json")).unwrap();
         // serde_json parses floats to within an ulp, not bit for bit.
-        assert_eq!((back.sequences, back.table2.len(), back.styles.len()), (r.sequences, r.table2.len(), r.styles.len()));
+        assert_eq!(
+            (back.sequences, back.table2.len(), back.styles.len()),
+            (r.sequences, r.table2.len(), r.styles.len())
+        );
         for (a, b) in back.table1.iter().zip(&r.table1) {
-            assert!(a.behaviour == b.behaviour && (a.mapped - b.mapped).abs() < 1e-12 && (a.lerp - b.lerp).abs() < 1e-12, "{a:?} vs {b:?}");
+            assert!(
+                a.behaviour == b.behaviour && (a.mapped - b.mapped).abs() < 1e-12 && (a.lerp - b.lerp).abs() < 1e-12,
+                "{a:?} vs {b:?}"
+            );
         }
         let text = read("report.txt");
-        assert!(text.starts_with("camera bench: 8 held-out sequences (seed 9001)\n") && text.contains("style effect:"), "{text}");
+        assert!(
+            text.starts_with("camera bench: 8 held-out sequences (seed 9001)\n") && text.contains("style effect:"),
+            "{text}"
+        );
         assert!(std::fs::read(dir.path().join("style_pca.png")).unwrap().starts_with(b"\x89PNG"));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), expected.len(), "no temporary files left");
     }
 
     #[test]
     fn pca_finds_the_dominant_axis() {
-        let codes: Vec<Vec<f32>> = (0..20).map(|i| vec![i as f32, 0.5 * i as f32, 0.01 * ((i * 7) % 3) as f32, 0.0]).collect();
+        let codes: Vec<Vec<f32>> =
+            (0..20).map(|i| vec![i as f32, 0.5 * i as f32, 0.01 * ((i * 7) % 3) as f32, 0.0]).collect();
         let p = pca2(&codes);
         let spread1 = p.iter().map(|x| x.0.abs()).fold(0.0, f64::max);
         let spread2 = p.iter().map(|x| x.1.abs()).fold(0.0, f64::max);
@@ -725,7 +892,13 @@ mod tests {
     }
 
     fn tiny_config() -> BenchConfig {
-        BenchConfig { scenes: 1, displacements: vec![0.0, 1.0], max_spline_keys: 6, speed_seconds: 0.05, ..BenchConfig::quick() }
+        BenchConfig {
+            scenes: 1,
+            displacements: vec![0.0, 1.0],
+            max_spline_keys: 6,
+            speed_seconds: 0.05,
+            ..BenchConfig::quick()
+        }
     }
 
     #[test]
@@ -740,7 +913,9 @@ mod tests {
         model.dec2.b.iter_mut().for_each(|b| *b = 0.0);
         let r = run(&model, &tiny_config(), &Progress::hidden());
         for row in &r.table1 {
-            for (name, v) in [("zero", row.zero), ("gaussian", row.gaussian), ("warm", row.warm_start), ("mapped", row.mapped)] {
+            for (name, v) in
+                [("zero", row.zero), ("gaussian", row.gaussian), ("warm", row.warm_start), ("mapped", row.mapped)]
+            {
                 assert!((v - row.lerp).abs() < 1e-5, "{} {name}: {v} vs lerp {}", row.behaviour, row.lerp);
             }
         }

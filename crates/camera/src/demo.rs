@@ -14,7 +14,10 @@ use std::path::Path;
 /// needs to try each style. Returns the files written.
 pub fn write_example_scene(dir: &Path, seed: u64, frames: usize) -> Result<Vec<String>, CameraError> {
     if frames < 2 {
-        return Err(CameraError::Invalid { path: dir.into(), message: format!("a scene needs at least 2 frames, got {frames}") });
+        return Err(CameraError::Invalid {
+            path: dir.into(),
+            message: format!("a scene needs at least 2 frames, got {frames}"),
+        });
     }
     std::fs::create_dir_all(dir).map_err(|source| CameraError::Io { path: dir.into(), source })?;
     let scene = Scene::procedural(seed, frames, 30.0);
@@ -48,7 +51,9 @@ pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>, CameraError> 
     crate::write_json(&keys_path, &keys)?;
     let mut lines = Vec::new();
     for b in BEHAVIOURS {
-        let style = w.style(b).ok_or_else(|| CameraError::Model(format!("the weights card has no style code for `{}`", b.name())))?;
+        let style = w
+            .style(b)
+            .ok_or_else(|| CameraError::Model(format!("the weights card has no style code for `{}`", b.name())))?;
         let track = GenerateJob { origin: &keys_path, ..GenerateJob::new(&w.model, &scene, &keys, &style) }.run()?;
         let worst = track.worst_key_miss();
         crate::write_json(&dir.join(format!("cam-{}.json", b.name())), &track)?;
@@ -57,7 +62,12 @@ pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>, CameraError> 
             crate::gltf::write_gltf(&out.join("cam.gltf"), &track, &scene)?;
             crate::preview::write_preview(&out.join("cam.gif"), &track, &scene, 3)?;
         }
-        lines.push(format!("camera {:<8} {} frames, network key miss {worst:.3} (corrected to {:.0e})", b.name(), track.frames.len(), track.max_corrected_residual));
+        lines.push(format!(
+            "camera {:<8} {} frames, network key miss {worst:.3} (corrected to {:.0e})",
+            b.name(),
+            track.frames.len(),
+            track.max_corrected_residual
+        ));
     }
     progress.inc(1);
     lines.push(format!(

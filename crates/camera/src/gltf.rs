@@ -27,7 +27,8 @@ pub fn camera_gltf(track: &CameraTrack, scene: &Scene) -> serde_json::Value {
         json!({"sampler": 1, "target": {"node": 0, "path": "rotation"}}),
     ];
     for (i, c) in scene.characters.iter().enumerate() {
-        let tgt: Vec<f32> = track.frames.iter().flat_map(|f| c.frame(f.frame).target().to_array().map(|v| v as f32)).collect();
+        let tgt: Vec<f32> =
+            track.frames.iter().flat_map(|f| c.frame(f.frame).target().to_array().map(|v| v as f32)).collect();
         let acc = b.floats(&tgt, ElementType::Vec3, false, None);
         nodes.push(json!({"name": format!("target {}", c.name)}));
         samplers.push(json!({"input": t_acc, "output": acc, "interpolation": "LINEAR"}));
@@ -50,7 +51,8 @@ pub fn camera_gltf(track: &CameraTrack, scene: &Scene) -> serde_json::Value {
 /// Writes the glTF file atomically.
 pub fn write_gltf(path: &std::path::Path, track: &CameraTrack, scene: &Scene) -> Result<(), crate::CameraError> {
     let doc = camera_gltf(track, scene);
-    inbetween_io::write_atomic(path, doc.to_string().as_bytes()).map_err(|source| crate::CameraError::Io { path: path.into(), source })
+    inbetween_io::write_atomic(path, doc.to_string().as_bytes())
+        .map_err(|source| crate::CameraError::Io { path: path.into(), source })
 }
 
 #[cfg(test)]

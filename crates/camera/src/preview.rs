@@ -90,7 +90,8 @@ pub fn render_frames(track: &CameraTrack, scene: &Scene, stride: usize) -> Vec<i
     });
     let map = TopDown::fit(pts);
     let path: Vec<(f32, f32)> = track.frames.iter().map(|f| map.px(f.pose.position)).collect();
-    let keys: Vec<usize> = track.key_residuals.iter().filter_map(|k| track.frames.iter().position(|f| f.frame == k.frame)).collect();
+    let keys: Vec<usize> =
+        track.key_residuals.iter().filter_map(|k| track.frames.iter().position(|f| f.frame == k.frame)).collect();
     let mut out = Vec::new();
     for i in (0..track.frames.len()).step_by(stride.max(1)) {
         let f = &track.frames[i];
@@ -128,9 +129,15 @@ pub fn render_frames(track: &CameraTrack, scene: &Scene, stride: usize) -> Vec<i
 }
 
 /// Writes the preview GIF (every `stride`-th frame, played at the matching rate).
-pub fn write_preview(path: &std::path::Path, track: &CameraTrack, scene: &Scene, stride: usize) -> Result<(), crate::CameraError> {
+pub fn write_preview(
+    path: &std::path::Path,
+    track: &CameraTrack,
+    scene: &Scene,
+    stride: usize,
+) -> Result<(), crate::CameraError> {
     let frames = render_frames(track, scene, stride);
-    inbetween_render::write_gif(path, &frames, track.fps / stride.max(1) as f64).map_err(|e| crate::CameraError::invalid(path, e.to_string()))
+    inbetween_render::write_gif(path, &frames, track.fps / stride.max(1) as f64)
+        .map_err(|e| crate::CameraError::invalid(path, e.to_string()))
 }
 
 #[cfg(test)]

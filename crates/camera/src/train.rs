@@ -145,12 +145,24 @@ pub struct Batch {
 }
 
 /// Extractor input for steps `[start, start + len)` of a sequence: encoded x^v then x^c.
-pub fn style_row<'a>(chars: &'a [[f32; CHAR_ENC]], cams: &'a [[f32; CAM_DIM]], t: usize) -> impl Iterator<Item = f32> + 'a {
+pub fn style_row<'a>(
+    chars: &'a [[f32; CHAR_ENC]],
+    cams: &'a [[f32; CAM_DIM]],
+    t: usize,
+) -> impl Iterator<Item = f32> + 'a {
     chars[t].iter().chain(cams[t].iter()).copied()
 }
 
 /// Draws a batch: `which[b]` picks the sequence of element b.
-pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: usize, static_start: f64, rng: &mut impl Rng, device: &Device) -> Batch {
+pub fn sample_batch(
+    data: &TrainData,
+    cfg: &ModelConfig,
+    which: &[usize],
+    gap: usize,
+    static_start: f64,
+    rng: &mut impl Rng,
+    device: &Device,
+) -> Batch {
     let b = which.len();
     let tta = cfg.tta();
     let mut style: Vec<Vec<f32>> = (0..STYLE_STEPS).map(|_| Vec::with_capacity(b * (CHAR_ENC + CAM_DIM))).collect();
@@ -187,7 +199,8 @@ pub fn sample_batch(data: &TrainData, cfg: &ModelConfig, which: &[usize], gap: u
             tta.embed_batch(&vec![frames; b], device)
         })
         .collect();
-    let arrival = (0..gap).map(|k| rows(vec![cfg.arrival_weight(((gap - 1 - k) * DOWNSAMPLE) as f32); b], 1, device)).collect();
+    let arrival =
+        (0..gap).map(|k| rows(vec![cfg.arrival_weight(((gap - 1 - k) * DOWNSAMPLE) as f32); b], 1, device)).collect();
     Batch {
         arrival,
         style_steps: style.into_iter().map(|v| rows(v, CHAR_ENC + CAM_DIM, device)).collect(),
@@ -224,8 +237,11 @@ pub fn batch_loss(model: &CameraModel, batch: Batch, eps: f32) -> (Tensor<1>, Te
     let gap = batch.targets.len();
     let mut rec = Vec::with_capacity(gap);
     let mut last = None;
-    for (((ch, tta), arrival), target) in batch.characters.into_iter().zip(batch.tta).zip(batch.arrival).zip(batch.targets) {
-        let input = StepInput { style: z.clone(), prev_camera: prev, character: ch, key: batch.key.clone(), tta, arrival };
+    for (((ch, tta), arrival), target) in
+        batch.characters.into_iter().zip(batch.tta).zip(batch.arrival).zip(batch.targets)
+    {
+        let input =
+            StepInput { style: z.clone(), prev_camera: prev, character: ch, key: batch.key.clone(), tta, arrival };
         let (cam, next) = model.generator.step(input, Some(state));
         state = next;
         rec.push(mean_l2(cam.clone(), target.clone(), eps));
@@ -255,7 +271,12 @@ pub fn load_model(config: &ModelConfig, path: &Path, device: &Device) -> Result<
 }
 
 /// [`load_model`] from bytes already in memory (`origin` names them in errors).
-pub fn load_model_bytes(config: &ModelConfig, bytes: Vec<u8>, path: &Path, device: &Device) -> Result<CameraModel, CameraError> {
+pub fn load_model_bytes(
+    config: &ModelConfig,
+    bytes: Vec<u8>,
+    path: &Path,
+    device: &Device,
+) -> Result<CameraModel, CameraError> {
     let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_error(path, e))?;
     config.init(device).try_load_record(record).map_err(|e| record_error(path, e))
 }
@@ -309,7 +330,8 @@ impl inbetween_nn::train::Objective<CameraModel> for CameraObjective<'_, '_> {
         let mut rng = inbetween_core::seed::rng(step.seed);
         let gap = rng.random_range(self.cfg.min_gap..=self.cfg.max_gap);
         let which: Vec<usize> = (0..self.cfg.batch).map(|_| rng.random_range(0..self.data.len())).collect();
-        let batch = sample_batch(self.data, &self.cfg.model, &which, gap, self.cfg.static_start, &mut rng, &self.device);
+        let batch =
+            sample_batch(self.data, &self.cfg.model, &which, gap, self.cfg.static_start, &mut rng, &self.device);
         Some(batch_loss(model, batch, self.cfg.loss_smoothing).0)
     }
 
@@ -327,13 +349,18 @@ impl inbetween_nn::train::Objective<CameraModel> for CameraObjective<'_, '_> {
 /// ([`inbetween_nn::train::fit_with`]) and returns the model on an inference device. A resumed
 /// run is bit-identical to an uninterrupted one; a warm restart sets `lr_decay_from` to the
 /// resumed epoch ([`epochs_done`]).
-pub fn train(cfg: &TrainConfig, checkpoint_dir: Option<&Path>, progress: Progress) -> Result<(CameraModel, TrainSummary), CameraError> {
+pub fn train(
+    cfg: &TrainConfig,
+    checkpoint_dir: Option<&Path>,
+    progress: Progress,
+) -> Result<(CameraModel, TrainSummary), CameraError> {
     let device = inbetween_nn::backend::cpu_autodiff();
     let dataset = Dataset::generate(cfg.seed, cfg.scenes, crate::dataset::SCENE_FRAMES);
     let data = TrainData::from_dataset(&dataset);
     let mut objective = CameraObjective { cfg, data: &data, device: device.clone(), progress };
-    let run = inbetween_nn::train::fit_with(&cfg.loop_config(checkpoint_dir), &device, |d| cfg.model.init(d), &mut objective)
-        .map_err(|e| CameraError::Model(e.to_string()))?;
+    let run =
+        inbetween_nn::train::fit_with(&cfg.loop_config(checkpoint_dir), &device, |d| cfg.model.init(d), &mut objective)
+            .map_err(|e| CameraError::Model(e.to_string()))?;
     let epochs_done = run.loss_history.len();
     let summary = TrainSummary {
         config: cfg.clone(),
@@ -356,7 +383,16 @@ mod tests {
 
     fn tiny(epochs: usize) -> TrainConfig {
         let model = ModelConfig { hidden: 16, tta_dim: 8, ..ModelConfig::default() };
-        TrainConfig { scenes: 1, epochs, iters_per_epoch: 2, batch: 4, min_gap: 3, max_gap: 5, model, ..TrainConfig::default() }
+        TrainConfig {
+            scenes: 1,
+            epochs,
+            iters_per_epoch: 2,
+            batch: 4,
+            min_gap: 3,
+            max_gap: 5,
+            model,
+            ..TrainConfig::default()
+        }
     }
 
     /// Eq. 7 of a fixed batch: equal bits mean equal weights (saved files also hold burn's random

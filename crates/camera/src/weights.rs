@@ -33,12 +33,22 @@ pub fn check_output(out: &Path, overwrite_committed: bool) -> Result<(), CameraE
     if overwrite_committed || !is_in_committed_dir(out) {
         return Ok(());
     }
-    Err(CameraError::invalid(out, format!("refusing to overwrite the committed weights in {} (pass --overwrite-committed to replace them on purpose)", committed_dir().display())))
+    Err(CameraError::invalid(
+        out,
+        format!(
+            "refusing to overwrite the committed weights in {} (pass --overwrite-committed to replace them on purpose)",
+            committed_dir().display()
+        ),
+    ))
 }
 
 fn is_in_committed_dir(out: &Path) -> bool {
     let Ok(committed) = committed_dir().canonicalize() else { return false };
-    let absolute = if out.is_absolute() { out.to_path_buf() } else { std::env::current_dir().map(|d| d.join(out)).unwrap_or_else(|_| out.to_path_buf()) };
+    let absolute = if out.is_absolute() {
+        out.to_path_buf()
+    } else {
+        std::env::current_dir().map(|d| d.join(out)).unwrap_or_else(|_| out.to_path_buf())
+    };
     // The file (or its folders) may not exist yet: compare the nearest folder that does.
     absolute.ancestors().skip(1).find_map(|d| d.canonicalize().ok()).is_some_and(|d| d.starts_with(&committed))
 }
@@ -108,7 +118,12 @@ fn to_json<T: Serialize>(value: &T) -> Result<serde_json::Value, CameraError> {
 
 /// Saves trained weights as `path` (burnpack) + card (`path` with `.json`), refusing the
 /// committed folder unless `overwrite_committed`; returns them ready for inference.
-pub fn save(model: &CameraModel, summary: &TrainSummary, path: &Path, overwrite_committed: bool) -> Result<CameraWeights, CameraError> {
+pub fn save(
+    model: &CameraModel,
+    summary: &TrainSummary,
+    path: &Path,
+    overwrite_committed: bool,
+) -> Result<CameraWeights, CameraError> {
     check_output(path, overwrite_committed)?;
     let fast = FastModel::from_burn(model, summary.config.model);
     let card = card(summary, &fast)?;
@@ -131,7 +146,8 @@ pub fn from_weights(w: &Weights) -> Result<CameraWeights, CameraError> {
 /// load too; their style codes are computed.
 pub fn load(path: &Path) -> Result<CameraWeights, CameraError> {
     let summary_path = path.with_extension("json");
-    let text = std::fs::read_to_string(&summary_path).map_err(|source| CameraError::Io { path: summary_path.clone(), source })?;
+    let text = std::fs::read_to_string(&summary_path)
+        .map_err(|source| CameraError::Io { path: summary_path.clone(), source })?;
     if let Ok(summary) = serde_json::from_str::<TrainSummary>(&text) {
         let device = inbetween_nn::backend::cpu();
         let model = crate::train::load_model(&summary.config.model, path, &device)?;
@@ -200,7 +216,8 @@ mod tests {
         let back = load(&path).unwrap();
         assert_eq!(back.styles, saved.styles);
         assert_eq!(back.model.dec2, saved.model.dec2);
-        let card: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path.with_extension("json")).unwrap()).unwrap();
+        let card: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(path.with_extension("json")).unwrap()).unwrap();
         assert_eq!((card["kind"].as_str(), card["metrics"]["final_loss"].as_f64()), (Some(KIND), Some(0.3)));
         // Another model's card is refused, naming the file.
         let mut other = card.clone();

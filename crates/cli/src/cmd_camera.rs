@@ -160,17 +160,23 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
     let keys = Keys::load(&a.keys)?;
     let options = GenerateOptions { exact_keys: !a.no_exact_keys, causal: a.causal, ..GenerateOptions::default() };
     let runs: Vec<(Style, PathBuf)> = if a.all_styles {
-        BEHAVIOURS.iter().map(|b| Ok((behaviour_style(&w, *b)?, with_suffix(&a.out, b.name())))).collect::<anyhow::Result<_>>()?
+        BEHAVIOURS
+            .iter()
+            .map(|b| Ok((behaviour_style(&w, *b)?, with_suffix(&a.out, b.name()))))
+            .collect::<anyhow::Result<_>>()?
     } else if let Some(r) = &a.reference {
         vec![(reference_style(&w, r)?, a.out.clone())]
     } else {
         let name = a.style.clone().unwrap_or_else(|| "relative".into());
-        let b = Behaviour::parse(&name).with_context(|| format!("unknown style `{name}` (direct, relative, side, orbit)"))?;
+        let b = Behaviour::parse(&name)
+            .with_context(|| format!("unknown style `{name}` (direct, relative, side, orbit)"))?;
         vec![(behaviour_style(&w, b)?, a.out.clone())]
     };
     for (style, out) in runs {
         let name = style.name.clone();
-        let track = GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin: &a.keys }.run()?;
+        let track =
+            GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin: &a.keys }
+                .run()?;
         inbetween_camera::write_json(&out, &track)?;
         let gltf = match &a.gltf {
             Some(g) if a.all_styles => with_suffix(g, &name),

@@ -13,7 +13,7 @@ use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::{read_keys, EditJob, Guide, Inpainter, Method};
 use inbetween_face::preview::{span_flags, write_edit_gif, write_edit_png, CurvePreview};
 use inbetween_face::train::{save_face_weights, train_face, FaceTrainConfig};
-use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, phoneme_viseme, PhonemeSpan};
+use inbetween_face::visemes::{phoneme_viseme, read_viseme_source, text_to_phonemes, PhonemeSpan};
 use inbetween_face::{corpus, procedural, weights};
 use inbetween_io::Progress;
 
@@ -212,7 +212,8 @@ fn viseme_runs(spans: &[PhonemeSpan]) -> anyhow::Result<Vec<(f64, f64, inbetween
     spans
         .iter()
         .map(|s| {
-            let v = phoneme_viseme(&s.phoneme).with_context(|| format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))?;
+            let v = phoneme_viseme(&s.phoneme)
+                .with_context(|| format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))?;
             Ok((s.start_s, s.end_s, v))
         })
         .collect()
@@ -248,7 +249,8 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let net = match a.method {
         MethodArg::Network => Some(match &a.weights {
             Some(w) => weights::load(w).with_context(|| format!("loading face weights {}", w.display()))?,
-            None => weights::committed(guide.kind()).with_context(|| format!("loading the committed {} network", guide.kind().name()))?,
+            None => weights::committed(guide.kind())
+                .with_context(|| format!("loading the committed {} network", guide.kind().name()))?,
         }),
         _ => None,
     };
@@ -262,20 +264,39 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let t = std::time::Instant::now();
     let out = job.run()?;
     let ms = t.elapsed().as_secs_f64() * 1000.0;
-    let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) && is_live_link(&a.input);
+    let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+        && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        && is_live_link(&a.input);
     write_clip(&a.out, &out.clip, live_link)?;
     let segs = out.mask.segments();
     let png = a.png.clone().unwrap_or_else(|| a.out.with_extension("png"));
     let title = format!("{} · {} · {}", a.input.display(), method.name(), job.guide.kind().name());
-    let preview = CurvePreview { title: &title, fps: MODEL_FPS, before: &out.before, after: &out.after, spans: &segs, keys: &out.keys, extra: None, n_curves: 6 };
+    let preview = CurvePreview {
+        title: &title,
+        fps: MODEL_FPS,
+        before: &out.before,
+        after: &out.after,
+        spans: &segs,
+        keys: &out.keys,
+        extra: None,
+        n_curves: 6,
+    };
     write_edit_png(&png, &preview).with_context(|| format!("writing {}", png.display()))?;
     if let Some(gif) = &a.gif {
         let first = segs.iter().map(|s| s.start).min().unwrap_or(0).saturating_sub(25);
         let last = (segs.iter().map(|s| s.end).max().unwrap_or(0) + 25).min(out.before.len());
-        let local: Vec<_> = segs.iter().map(|s| inbetween_face::edit::Segment { start: s.start - first, end: s.end - first }).collect();
+        let local: Vec<_> =
+            segs.iter().map(|s| inbetween_face::edit::Segment { start: s.start - first, end: s.end - first }).collect();
         let progress = Progress::new((last - first) as u64, "face gif");
-        write_edit_gif(gif, MODEL_FPS, &[("original", &out.before[first..last]), ("edited", &out.after[first..last])], None, &span_flags(last - first, &local), &progress)
-            .with_context(|| format!("writing {}", gif.display()))?;
+        write_edit_gif(
+            gif,
+            MODEL_FPS,
+            &[("original", &out.before[first..last]), ("edited", &out.after[first..last])],
+            None,
+            &span_flags(last - first, &local),
+            &progress,
+        )
+        .with_context(|| format!("writing {}", gif.display()))?;
         progress.finish();
         println!("  preview {}", gif.display());
     }
@@ -293,7 +314,9 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
 }
 
 fn is_live_link(path: &Path) -> bool {
-    std::fs::read_to_string(path).map(|t| t.trim_start_matches('\u{feff}').trim_start().to_ascii_lowercase().starts_with("timecode")).unwrap_or(false)
+    std::fs::read_to_string(path)
+        .map(|t| t.trim_start_matches('\u{feff}').trim_start().to_ascii_lowercase().starts_with("timecode"))
+        .unwrap_or(false)
 }
 
 fn kinds(arg: &str) -> anyhow::Result<Vec<ConstraintKind>> {
@@ -301,7 +324,10 @@ fn kinds(arg: &str) -> anyhow::Result<Vec<ConstraintKind>> {
         return Ok(ConstraintKind::ALL.to_vec());
     }
     arg.split(',')
-        .map(|k| ConstraintKind::from_name(k.trim()).with_context(|| format!("unknown network kind '{k}' (unguided, keyframes, noisy, visemes or all)")))
+        .map(|k| {
+            ConstraintKind::from_name(k.trim())
+                .with_context(|| format!("unknown network kind '{k}' (unguided, keyframes, noisy, visemes or all)"))
+        })
         .collect()
 }
 
@@ -370,9 +396,15 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
 fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
     let p = procedural::generate(&procedural::ProceduralConfig { duration_s: a.seconds, ..Default::default() }, a.seed);
     write_clip(&a.out, &p.clip, a.live_link)?;
-    let spans: Vec<PhonemeSpan> = p.phonemes.iter().map(|(s, e, ph)| PhonemeSpan { start_s: *s, end_s: *e, phoneme: ph.to_string() }).collect();
+    let spans: Vec<PhonemeSpan> =
+        p.phonemes.iter().map(|(s, e, ph)| PhonemeSpan { start_s: *s, end_s: *e, phoneme: ph.to_string() }).collect();
     let timing = a.out.with_extension("phonemes.csv");
     inbetween_face::visemes::write_phoneme_timing(&timing, &spans)?;
-    println!("wrote {} ({} frames at {MODEL_FPS} fps) and its phoneme timing {}", a.out.display(), p.clip.num_frames(), timing.display());
+    println!(
+        "wrote {} ({} frames at {MODEL_FPS} fps) and its phoneme timing {}",
+        a.out.display(),
+        p.clip.num_frames(),
+        timing.display()
+    );
     Ok(())
 }

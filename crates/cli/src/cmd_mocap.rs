@@ -291,7 +291,9 @@ fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let v3 = match (a.format.as_deref(), a.budget.k) {
         (None, None) | (Some("v3"), None) => true,
         (None, Some(_)) | (Some("v2"), _) => false,
-        (Some("v3"), Some(_)) => bail!("-k picks keyframes, which version 3 does not store; use --format v2 or --max-error"),
+        (Some("v3"), Some(_)) => {
+            bail!("-k picks keyframes, which version 3 does not store; use --format v2 or --max-error")
+        }
         (Some(other), _) => bail!("unknown format '{other}'; expected v2 or v3"),
     };
     let t = Instant::now();
@@ -468,8 +470,6 @@ fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
     }
     Ok(())
 }
-
-
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
     let data_choice = match (a.procedural, a.all_takes) {

@@ -73,7 +73,8 @@ pub fn run(a: PreviewArgs) -> anyhow::Result<()> {
         fps: a.fps,
         max_frames: a.max_frames,
         grid: !a.no_grid,
-        title: Some(a.title.clone().unwrap_or_else(|| file_label(&a.file))).filter(|_| other.is_none() || a.title.is_some()),
+        title: Some(a.title.clone().unwrap_or_else(|| file_label(&a.file)))
+            .filter(|_| other.is_none() || a.title.is_some()),
         // With a comparison, the legend names both files; alone, the title does.
         labels: if other.is_some() { labels } else { Vec::new() },
         ..StickOptions::default()
@@ -97,7 +98,14 @@ pub fn run(a: PreviewArgs) -> anyhow::Result<()> {
         let frame = a.frame.unwrap_or(0);
         stick::render_motion_png(&a.output, &motions, frame, &opts)
             .with_context(|| format!("rendering frame {frame} of {}", a.file.display()))?;
-        println!("wrote {}: frame {frame} of {} ({} frames), {}×{}", a.output.display(), a.file.display(), main.num_frames(), a.width, a.height);
+        println!(
+            "wrote {}: frame {frame} of {} ({} frames), {}×{}",
+            a.output.display(),
+            a.file.display(),
+            main.num_frames(),
+            a.width,
+            a.height
+        );
     }
     Ok(())
 }

@@ -159,7 +159,12 @@ fn scene_job(a: &SceneArgs) -> SceneJob {
 }
 
 fn run_job(a: &RunArgs) -> RunJob {
-    RunJob { scene: scene_job(&a.scene), optimize: !a.no_optimize, shared_motions: a.shared_motions, gif_width: a.gif_width }
+    RunJob {
+        scene: scene_job(&a.scene),
+        optimize: !a.no_optimize,
+        shared_motions: a.shared_motions,
+        gif_width: a.gif_width,
+    }
 }
 
 fn print_run(source: &Path, r: &inbetween_script::job::RunReport) {
@@ -199,7 +204,8 @@ fn print_run(source: &Path, r: &inbetween_script::job::RunReport) {
 
 fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let (text, source) = load(&a.scene.script)?;
-    let report = inbetween_script::job::run_story(&text, &source, &run_job(&a)).with_context(|| format!("animating {}", source.display()))?;
+    let report = inbetween_script::job::run_story(&text, &source, &run_job(&a))
+        .with_context(|| format!("animating {}", source.display()))?;
     print_run(&source, &report);
     if a.skinned {
         skinned(&a, &report)?;
@@ -212,7 +218,8 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
 fn skinned(a: &RunArgs, r: &inbetween_script::job::RunReport) -> anyhow::Result<()> {
     let models = a.scene.models.as_deref();
     let cat = inbetween_script::job::catalogue(models)?;
-    let s = inbetween_script::output::skinned::write_skinned_story(&a.scene.out, &r.animation, &cat, models).context("writing the skinned characters")?;
+    let s = inbetween_script::output::skinned::write_skinned_story(&a.scene.out, &r.animation, &cat, models)
+        .context("writing the skinned characters")?;
     for n in &s.notes {
         println!("  {n}");
     }
@@ -283,7 +290,8 @@ fn list_stories(a: StoriesArgs) -> anyhow::Result<()> {
     let all = stories::all();
     match a.name {
         Some(name) => {
-            let (_, text) = all.iter().find(|(n, _)| *n == name).with_context(|| format!("no built-in script '{name}'"))?;
+            let (_, text) =
+                all.iter().find(|(n, _)| *n == name).with_context(|| format!("no built-in script '{name}'"))?;
             println!("{text}");
         }
         None => {
@@ -304,7 +312,8 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
         BenchConfig { seed: a.seed, ..BenchConfig::default() }
     };
     let progress = Progress::new(1, "script bench");
-    let files = run(&a.out, &cfg, &progress).with_context(|| format!("writing the script bench to {}", a.out.display()))?;
+    let files =
+        run(&a.out, &cfg, &progress).with_context(|| format!("writing the script bench to {}", a.out.display()))?;
     progress.finish();
     let txt = files.iter().find(|f| f.extension().is_some_and(|e| e == "txt"));
     if let Some(txt) = txt {

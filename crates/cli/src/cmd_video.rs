@@ -215,7 +215,12 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
     let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     anyhow::ensure!(ext == "mp4" || ext == "gif", "{}: the output must end in .mp4 or .gif", a.out.display());
     let clip = read_input(&a)?;
-    anyhow::ensure!(a.start < clip.len(), "--start {} is outside the clip (frames 0..{})", a.start, clip.len().saturating_sub(1));
+    anyhow::ensure!(
+        a.start < clip.len(),
+        "--start {} is outside the clip (frames 0..{})",
+        a.start,
+        clip.len().saturating_sub(1)
+    );
     let mut cfg = ResequenceConfig {
         metric: match a.metric {
             MetricArg::Rsfnet => MetricChoice::RsfNet,
@@ -250,14 +255,23 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         let out = numbered(&a.out, i, a.count);
         write_clip(&out, &reorder(&clip, &path.frames)).with_context(|| format!("writing {}", out.display()))?;
         let sheet = a.sheet.as_ref().map(|s| numbered(s, i, a.count)).unwrap_or_else(|| sheet_path(&out));
-        let title = format!("{} from frame {} (seed {}): {} frames", a.input.display(), a.start, path.seed, path.frames.len());
+        let title =
+            format!("{} from frame {} (seed {}): {} frames", a.input.display(), a.start, path.seed, path.frames.len());
         write_contact_sheet(&sheet, &clip.frames, &path.frames, &SheetOptions { title, ..SheetOptions::default() })?;
         println!(
             "{}: {} frames ({:?}{}), M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
             out.display(),
             path.frames.len(),
             path.stop,
-            if a.loop_close { if path.closes_loop { ", loop closes" } else { ", no loop found" } } else { "" },
+            if a.loop_close {
+                if path.closes_loop {
+                    ", loop closes"
+                } else {
+                    ", no loop found"
+                }
+            } else {
+                ""
+            },
             stability_md(&clip.frames, &path.frames),
             md_source,
             overlap_delta_o(&path.frames, clip.len()),
@@ -284,10 +298,16 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
     let cfg = if a.quick {
         VideoBenchConfig::quick(cache.clone())
     } else {
-        let dir = a.clips.clone().or_else(|| Some(inbetween_io::shared_data_dir().unwrap_or_else(|missing| missing).join("video")));
+        let dir = a
+            .clips
+            .clone()
+            .or_else(|| Some(inbetween_io::shared_data_dir().unwrap_or_else(|missing| missing).join("video")));
         match &dir {
             Some(d) if d.exists() => println!("real clips from {}", d.display()),
-            _ => println!("skipped real clips: no data at {}", dir.as_ref().map(|d| d.display().to_string()).unwrap_or_else(|| "../shared/data/video".into())),
+            _ => println!(
+                "skipped real clips: no data at {}",
+                dir.as_ref().map(|d| d.display().to_string()).unwrap_or_else(|| "../shared/data/video".into())
+            ),
         }
         VideoBenchConfig::full(dir.as_deref().filter(|d| d.exists()), cache.clone())
     };

@@ -15,7 +15,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "inbetween", version, about = "AI-assisted keyframe animation: in-betweening, keyframe extraction, previews")]
+#[command(
+    name = "inbetween",
+    version,
+    about = "AI-assisted keyframe animation: in-betweening, keyframe extraction, previews"
+)]
 struct Cli {
     /// On an error, also print its backtrace (same as INBETWEEN_DEBUG=1).
     #[arg(long, global = true)]

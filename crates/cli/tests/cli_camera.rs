@@ -19,7 +19,20 @@ fn scene_then_generate_writes_track_gltf_and_preview() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let cam = d.join("cam.json");
     let gif = d.join("cam.gif");
-    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--style", "side", "-o", s(&cam), "--gif", s(&gif)]);
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--scene",
+        s(&d.join("scene.json")),
+        "--keys",
+        s(&d.join("keys.json")),
+        "--style",
+        "side",
+        "-o",
+        s(&cam),
+        "--gif",
+        s(&gif),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let track: serde_json::Value = serde_json::from_slice(&std::fs::read(&cam).unwrap()).unwrap();
     assert_eq!(track["frames"].as_array().unwrap().len(), 120);
@@ -29,7 +42,17 @@ fn scene_then_generate_writes_track_gltf_and_preview() {
     assert_eq!(gltf["asset"]["version"], "2.0");
     assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
 
-    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--all-styles", "-o", s(&cam)]);
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--scene",
+        s(&d.join("scene.json")),
+        "--keys",
+        s(&d.join("keys.json")),
+        "--all-styles",
+        "-o",
+        s(&cam),
+    ]);
     assert!(out.status.success());
     for b in ["direct", "relative", "side", "orbit"] {
         assert!(d.join(format!("cam-{b}.json")).exists(), "{b}");
@@ -42,10 +65,30 @@ fn bad_inputs_are_clear_errors() {
     let d = dir.path();
     assert!(inbetween(&["camera", "scene", "-o", s(d), "--frames", "60"]).status.success());
     std::fs::write(d.join("bad.json"), "{\"keys\": [ {\"frame\": 0,\n \"camera\": 7} ]}").unwrap();
-    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("bad.json")), "-o", s(&d.join("c.json"))]);
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--scene",
+        s(&d.join("scene.json")),
+        "--keys",
+        s(&d.join("bad.json")),
+        "-o",
+        s(&d.join("c.json")),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("bad.json:2"), "{err}");
-    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--style", "dolly", "-o", s(&d.join("c.json"))]);
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--scene",
+        s(&d.join("scene.json")),
+        "--keys",
+        s(&d.join("keys.json")),
+        "--style",
+        "dolly",
+        "-o",
+        s(&d.join("c.json")),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("unknown style `dolly`"), "{err}");
 }
@@ -77,7 +120,18 @@ fn train_resumes_from_its_checkpoint_and_can_restart_the_learning_rate() {
     // The trained weights load back for generation.
     let d = dir.path();
     assert!(inbetween(&["camera", "scene", "-o", s(d), "--frames", "60"]).status.success());
-    let out = inbetween(&["camera", "generate", "--scene", s(&d.join("scene.json")), "--keys", s(&d.join("keys.json")), "--weights", s(&weights), "-o", s(&d.join("c.json"))]);
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--scene",
+        s(&d.join("scene.json")),
+        "--keys",
+        s(&d.join("keys.json")),
+        "--weights",
+        s(&weights),
+        "-o",
+        s(&d.join("c.json")),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
@@ -85,7 +139,22 @@ fn train_resumes_from_its_checkpoint_and_can_restart_the_learning_rate() {
 fn train_refuses_to_overwrite_the_committed_weights() {
     let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../camera/weights/camera.bpk");
     let before = std::fs::read(&committed).unwrap();
-    let out = inbetween(&["camera", "train", "-o", s(&committed), "--epochs", "1", "--iters-per-epoch", "1", "--batch", "2", "--scenes", "1", "--hidden", "8"]);
+    let out = inbetween(&[
+        "camera",
+        "train",
+        "-o",
+        s(&committed),
+        "--epochs",
+        "1",
+        "--iters-per-epoch",
+        "1",
+        "--batch",
+        "2",
+        "--scenes",
+        "1",
+        "--hidden",
+        "8",
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("--overwrite-committed"), "{err}");
     assert_eq!(std::fs::read(&committed).unwrap(), before, "the committed weights are untouched");

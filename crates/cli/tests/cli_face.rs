@@ -12,7 +12,12 @@ fn s(p: &Path) -> &str {
 }
 
 fn ok(out: &std::process::Output) {
-    assert!(out.status.success(), "stdout {}\nstderr {}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "stdout {}\nstderr {}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -72,7 +77,11 @@ fn bad_face_inputs_are_clear_errors_and_write_nothing() {
     let input = d.join("take.json");
     ok(&inbetween(&["face", "synth", "-o", s(&input), "--seconds", "3"]));
     let out = inbetween(&["face", "edit", s(&input), "--mask", "5s..6s", "-o", s(&out_path)]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("outside the clip"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("outside the clip"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = inbetween(&["face", "edit", s(&input), "--mask", "1s..2s", "--groups", "nose", "-o", s(&out_path)]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("'nose'"));
     assert!(!out_path.exists());

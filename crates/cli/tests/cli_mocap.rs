@@ -92,7 +92,17 @@ fn compress_infers_the_unit_of_any_rig_and_accepts_an_override() {
         let bvh = dir.path().join(format!("{name}.bvh"));
         inbetween_io::write_bvh(&bvh, &scaled).unwrap();
         let ibk = dir.path().join(format!("{name}.ibk")).to_string_lossy().into_owned();
-        let o = inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "--format", "v2", "-o", &ibk]);
+        let o = inbetween(&[
+            "mocap",
+            "compress",
+            bvh.to_str().unwrap(),
+            "--max-error",
+            "0.5cm",
+            "--format",
+            "v2",
+            "-o",
+            &ibk,
+        ]);
         assert!(o.status.success(), "{}", text(&o));
         assert!(text(&o).contains(&format!("length unit: {unit} (rest-pose height")), "{}", text(&o));
         reports.push(text(&o));
@@ -104,8 +114,19 @@ fn compress_infers_the_unit_of_any_rig_and_accepts_an_override() {
     // Told the CMU clip is in cm, the bound is 5.6 times looser: fewer keys.
     let bvh = dir.path().join("cmu.bvh");
     let out = dir.path().join("o.ibk").to_string_lossy().into_owned();
-    let o =
-        inbetween(&["mocap", "compress", bvh.to_str().unwrap(), "--max-error", "0.5cm", "--unit", "cm", "--format", "v2", "-o", &out]);
+    let o = inbetween(&[
+        "mocap",
+        "compress",
+        bvh.to_str().unwrap(),
+        "--max-error",
+        "0.5cm",
+        "--unit",
+        "cm",
+        "--format",
+        "v2",
+        "-o",
+        &out,
+    ]);
     assert!(o.status.success() && text(&o).contains("length unit: cm (given with --unit)"), "{}", text(&o));
     assert!(keys(&text(&o)) < keys(&reports[0]), "{}", text(&o));
     let o =

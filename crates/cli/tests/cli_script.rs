@@ -18,7 +18,8 @@ fn scene_writes_json_gltf_and_previews() {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let scene: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("scene.json")).unwrap()).unwrap();
-    let cats: Vec<&str> = scene["objects"].as_array().unwrap().iter().map(|o| o["category"].as_str().unwrap()).collect();
+    let cats: Vec<&str> =
+        scene["objects"].as_array().unwrap().iter().map(|o| o["category"].as_str().unwrap()).collect();
     for c in ["desk", "bed", "lamp"] {
         assert!(cats.contains(&c), "{c} not in {cats:?}");
     }
@@ -76,16 +77,33 @@ fn the_quick_bench_writes_its_tables_and_box_plot() {
 fn run_writes_the_animated_story_and_watch_reruns_on_save() {
     let dir = tempfile::tempdir().unwrap();
     let script = dir.path().join("story.txt");
-    std::fs::write(&script, "A chair is near a desk$.\ncamera left\nEve walks to the desk and sits on the chair.\n").unwrap();
+    std::fs::write(&script, "A chair is near a desk$.\ncamera left\nEve walks to the desk and sits on the chair.\n")
+        .unwrap();
     let out = dir.path().join("out");
-    let o = inbetween().args(["script", "run"]).arg(&script).arg("-o").arg(&out).arg("--no-optimize").arg("--gif-width").arg("160").output().unwrap();
+    let o = inbetween()
+        .args(["script", "run"])
+        .arg(&script)
+        .arg("-o")
+        .arg(&out)
+        .arg("--no-optimize")
+        .arg("--gif-width")
+        .arg("160")
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for f in ["story.gltf", "Eve.bvh", "Eve.bvh.json", "story.gif", "routes.png", "scene.json"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains("1 characters") && stdout.contains("frames"), "{stdout}");
-    let o = inbetween().args(["script", "watch"]).arg(&script).arg("-o").arg(dir.path().join("w")).args(["--no-optimize", "--gif-width", "160", "--max-runs", "1"]).output().unwrap();
+    let o = inbetween()
+        .args(["script", "watch"])
+        .arg(&script)
+        .arg("-o")
+        .arg(dir.path().join("w"))
+        .args(["--no-optimize", "--gif-width", "160", "--max-runs", "1"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(dir.path().join("w").join("story.gltf").is_file());
 }

@@ -11,18 +11,28 @@ fn inbetween() -> Command {
 }
 
 fn run_skinned(out: &Path, data: &Path) -> std::process::Output {
-    inbetween().args(["script", "run", "builtin:demo", "-o"]).arg(out).args(["--skinned", "--gif-width", "160"]).env("INBETWEEN_DATA", data).output().unwrap()
+    inbetween()
+        .args(["script", "run", "builtin:demo", "-o"])
+        .arg(out)
+        .args(["--skinned", "--gif-width", "160"])
+        .env("INBETWEEN_DATA", data)
+        .output()
+        .unwrap()
 }
 
 fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap_or_else(|e| panic!("{}: not JSON: {e}", path.display()))
+    serde_json::from_slice(&std::fs::read(path).unwrap())
+        .unwrap_or_else(|e| panic!("{}: not JSON: {e}", path.display()))
 }
 
 #[test]
 fn run_skinned_writes_kenney_characters_from_the_shared_data() {
     let Some(data) = inbetween_io::data::with_shared_data("script run --skinned", |p| p) else { return };
     if !data.join("assets/kenney_blocky_characters/character-a.glb").is_file() {
-        println!("skipped: no data at {} (assets/kenney_blocky_characters)", data.join("assets/kenney_blocky_characters").display());
+        println!(
+            "skipped: no data at {} (assets/kenney_blocky_characters)",
+            data.join("assets/kenney_blocky_characters").display()
+        );
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -53,7 +63,12 @@ fn run_skinned_without_the_kenney_files_names_where_it_looked() {
     let o = run_skinned(&out, Path::new("/tmp/no-such-data-xyz"));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
-    assert!(stderr.contains("error:") && stderr.contains("/tmp/no-such-data-xyz") && stderr.contains("kenney_blocky_characters"), "{stderr}");
+    assert!(
+        stderr.contains("error:")
+            && stderr.contains("/tmp/no-such-data-xyz")
+            && stderr.contains("kenney_blocky_characters"),
+        "{stderr}"
+    );
     assert!(!stderr.contains("panicked"), "{stderr}");
     // The usual outputs come first and stay; the skinned ones are not written.
     assert_eq!(json(&out.join("story.gltf"))["asset"]["version"], "2.0");

@@ -12,7 +12,12 @@ fn s(p: &Path) -> &str {
 }
 
 fn ok(out: &std::process::Output) -> String {
-    assert!(out.status.success(), "stdout {}\nstderr {}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "stdout {}\nstderr {}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
@@ -28,10 +33,38 @@ fn synth_then_resequence_writes_clips_sheets_and_explains() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let clip = d.join("clip.gif");
-    ok(&inbetween(&["video", "synth", "-o", s(&clip), "--kind", "pendulum", "--frames", "24", "--width", "96", "--height", "64"]));
+    ok(&inbetween(&[
+        "video",
+        "synth",
+        "-o",
+        s(&clip),
+        "--kind",
+        "pendulum",
+        "--frames",
+        "24",
+        "--width",
+        "96",
+        "--height",
+        "64",
+    ]));
     let out = d.join("new.gif");
     let cache = d.join("cache");
-    let args = ["video", "resequence", s(&clip), "--start", "3", "--count", "2", "--steps", "10", "--explain", "--cache-dir", s(&cache), "-o", s(&out)];
+    let args = [
+        "video",
+        "resequence",
+        s(&clip),
+        "--start",
+        "3",
+        "--count",
+        "2",
+        "--steps",
+        "10",
+        "--explain",
+        "--cache-dir",
+        s(&cache),
+        "-o",
+        s(&out),
+    ];
     let text = ok(&inbetween(&args));
     assert!(text.contains("S1 (content, Eq. 8)"), "{text}");
     assert!(text.contains("SDPF walks"), "{text}");
@@ -54,7 +87,10 @@ fn bad_inputs_name_the_problem() {
     let clip = d.join("clip.gif");
     ok(&inbetween(&["video", "synth", "-o", s(&clip), "--frames", "6", "--width", "32", "--height", "32"]));
     fails_with(&inbetween(&["video", "resequence", s(&clip), "-o", s(&d.join("o.avi"))]), ".mp4 or .gif");
-    fails_with(&inbetween(&["video", "resequence", s(&clip), "--start", "99", "-o", s(&d.join("o.gif"))]), "--start 99");
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--start", "99", "-o", s(&d.join("o.gif"))]),
+        "--start 99",
+    );
     let junk = d.join("junk.gif");
     std::fs::write(&junk, b"GIF89a not really").unwrap();
     fails_with(&inbetween(&["video", "resequence", s(&junk), "-o", s(&d.join("o.gif"))]), "junk.gif");

@@ -157,7 +157,10 @@ impl<T: Animatable> Samples<T> {
     /// Fails on no values or a rate that is not finite and positive.
     pub fn new(start: f64, rate: f64, values: Vec<T>) -> Result<Self, CoreError> {
         if values.is_empty() || !(rate.is_finite() && rate > 0.0) || !start.is_finite() {
-            return Err(CoreError::InvalidCurve(format!("samples need values and a positive rate (got {} values at rate {rate})", values.len())));
+            return Err(CoreError::InvalidCurve(format!(
+                "samples need values and a positive rate (got {} values at rate {rate})",
+                values.len()
+            )));
         }
         Ok(Samples { start, rate, values })
     }

@@ -44,10 +44,7 @@ pub fn forward(skeleton: &Skeleton, pose: &Pose) -> GlobalPose {
 
 /// Global transforms of every frame of a clip, in parallel over frames.
 pub fn forward_clip(motion: &Motion) -> Vec<GlobalPose> {
-    (0..motion.num_frames())
-        .into_par_iter()
-        .map(|f| forward(&motion.skeleton, &motion.pose(f)))
-        .collect()
+    (0..motion.num_frames()).into_par_iter().map(|f| forward(&motion.skeleton, &motion.pose(f))).collect()
 }
 
 /// Global positions only, frame-major `[frame][joint]`.

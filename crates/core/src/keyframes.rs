@@ -16,7 +16,9 @@ impl KeyframeSet {
             return Err(CoreError::InvalidKeyframes(format!("a clip of {num_frames} frames has no segments")));
         }
         if let Some(&bad) = frames.iter().find(|&&f| f >= num_frames) {
-            return Err(CoreError::InvalidKeyframes(format!("keyframe {bad} is outside the clip's {num_frames} frames")));
+            return Err(CoreError::InvalidKeyframes(format!(
+                "keyframe {bad} is outside the clip's {num_frames} frames"
+            )));
         }
         frames.push(0);
         frames.push(num_frames - 1);

@@ -218,10 +218,7 @@ pub fn read_pose(skeleton: &Skeleton, frame: &[f64]) -> Pose {
 pub fn write_pose(skeleton: &Skeleton, pose: &Pose, frame: &mut [f64]) {
     for (j, joint) in skeleton.joints().iter().enumerate() {
         let start = skeleton.channel_start(j);
-        let angles = joint
-            .rotation_order()
-            .map(|o: EulerOrder| o.from_quat(pose.rotations[j]))
-            .unwrap_or([0.0; 3]);
+        let angles = joint.rotation_order().map(|o: EulerOrder| o.from_quat(pose.rotations[j])).unwrap_or([0.0; 3]);
         let mut k = 0;
         for (c, ch) in joint.channels.iter().enumerate() {
             frame[start + c] = if ch.is_rotation() {
@@ -241,7 +238,8 @@ pub fn pose_is_representable(skeleton: &Skeleton, pose: &Pose) -> bool {
         joint.rotation_order().is_some() || crate::rotation::angle_between(pose.rotations[j], DQuat::IDENTITY) < 1e-9
     }) && skeleton.joints().iter().enumerate().all(|(j, joint)| {
         Channel::POSITION_XYZ.iter().all(|c| {
-            joint.channels.contains(c) || (pose.translations[j][c.axis().index()] - joint.offset[c.axis().index()]).abs() < 1e-9
+            joint.channels.contains(c)
+                || (pose.translations[j][c.axis().index()] - joint.offset[c.axis().index()]).abs() < 1e-9
         })
     })
 }

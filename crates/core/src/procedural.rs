@@ -38,7 +38,13 @@ pub fn standard_skeleton() -> Skeleton {
         add(&format!("{side}UpLeg"), Some(&format!("{short}HipJoint")), [1.7 * s, -1.0, 0.0], None, &mut joints);
         add(&format!("{side}Leg"), Some(&format!("{side}UpLeg")), [0.0, -7.4, 0.0], None, &mut joints);
         add(&format!("{side}Foot"), Some(&format!("{side}Leg")), [0.0, -7.3, 0.0], None, &mut joints);
-        add(&format!("{side}ToeBase"), Some(&format!("{side}Foot")), [0.0, -0.9, 2.0], Some([0.0, 0.0, 1.0]), &mut joints);
+        add(
+            &format!("{side}ToeBase"),
+            Some(&format!("{side}Foot")),
+            [0.0, -0.9, 2.0],
+            Some([0.0, 0.0, 1.0]),
+            &mut joints,
+        );
     }
     add("LowerBack", Some("Hips"), [0.0, 0.3, 0.0], None, &mut joints);
     add("Spine", Some("LowerBack"), [0.0, 2.0, 0.0], None, &mut joints);
@@ -52,8 +58,20 @@ pub fn standard_skeleton() -> Skeleton {
         add(&format!("{side}ForeArm"), Some(&format!("{side}Arm")), [0.0, -5.2, 0.0], None, &mut joints);
         add(&format!("{side}Hand"), Some(&format!("{side}ForeArm")), [0.0, -4.6, 0.0], None, &mut joints);
         add(&format!("{side}FingerBase"), Some(&format!("{side}Hand")), [0.0, -0.7, 0.0], None, &mut joints);
-        add(&format!("{side}HandIndex1"), Some(&format!("{side}FingerBase")), [0.0, -0.6, 0.0], Some([0.0, -0.4, 0.0]), &mut joints);
-        add(&format!("{short}Thumb"), Some(&format!("{side}Hand")), [0.3 * s, -0.4, 0.3], Some([0.0, -0.5, 0.3]), &mut joints);
+        add(
+            &format!("{side}HandIndex1"),
+            Some(&format!("{side}FingerBase")),
+            [0.0, -0.6, 0.0],
+            Some([0.0, -0.4, 0.0]),
+            &mut joints,
+        );
+        add(
+            &format!("{short}Thumb"),
+            Some(&format!("{side}Hand")),
+            [0.3 * s, -0.4, 0.3],
+            Some([0.0, -0.5, 0.3]),
+            &mut joints,
+        );
     }
     Skeleton::new(joints).expect("the standard skeleton is valid")
 }
@@ -168,7 +186,8 @@ pub fn gait(params: &GaitParams) -> Motion {
             let yaw = DQuat::from_rotation_y(heading);
             root.y = standard_hip_height() - params.bob * 0.5 + params.bob * 0.5 * (2.0 * phase).cos();
             pose.translations[hips] = root + yaw * DVec3::new(0.15 * phase.sin(), 0.0, 0.0);
-            pose.rotations[hips] = yaw * DQuat::from_rotation_y(0.12 * phase.sin()) * DQuat::from_rotation_z(0.04 * phase.cos());
+            pose.rotations[hips] =
+                yaw * DQuat::from_rotation_y(0.12 * phase.sin()) * DQuat::from_rotation_z(0.04 * phase.cos());
             for &(up, knee, foot, offset) in &legs {
                 let p = phase + offset;
                 // Negative X rotation swings a leg forward (+Z).
@@ -184,7 +203,8 @@ pub fn gait(params: &GaitParams) -> Motion {
             }
             pose.rotations[lowback] = DQuat::from_rotation_x(params.lean);
             pose.rotations[spine1] = DQuat::from_rotation_y(-0.15 * phase.sin());
-            pose.rotations[neck] = DQuat::from_rotation_x(-0.5 * params.lean) * DQuat::from_rotation_y(0.08 * phase.sin());
+            pose.rotations[neck] =
+                DQuat::from_rotation_x(-0.5 * params.lean) * DQuat::from_rotation_y(0.08 * phase.sin());
             heading += params.turn_rate * dt;
             root += DQuat::from_rotation_y(heading) * DVec3::new(0.0, 0.0, params.speed * dt);
             pose

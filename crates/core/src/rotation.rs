@@ -52,14 +52,8 @@ pub enum EulerOrder {
 }
 
 impl EulerOrder {
-    pub const ALL: [EulerOrder; 6] = [
-        EulerOrder::Xyz,
-        EulerOrder::Xzy,
-        EulerOrder::Yxz,
-        EulerOrder::Yzx,
-        EulerOrder::Zxy,
-        EulerOrder::Zyx,
-    ];
+    pub const ALL: [EulerOrder; 6] =
+        [EulerOrder::Xyz, EulerOrder::Xzy, EulerOrder::Yxz, EulerOrder::Yzx, EulerOrder::Zxy, EulerOrder::Zyx];
 
     /// The axes in channel order.
     pub fn axes(self) -> [Axis; 3] {

@@ -123,12 +123,7 @@ impl Skeleton {
                             j.name
                         )))
                     }
-                    None => {
-                        return Err(CoreError::InvalidSkeleton(format!(
-                            "joint {i} '{}' is a second root",
-                            j.name
-                        )))
-                    }
+                    None => return Err(CoreError::InvalidSkeleton(format!("joint {i} '{}' is a second root", j.name))),
                 }
             }
             if !names.insert(j.name.as_str()) {
@@ -229,7 +224,13 @@ mod tests {
     use super::*;
 
     fn joint(name: &str, parent: Option<usize>, offset: DVec3) -> Joint {
-        Joint { name: name.into(), parent, offset, channels: Channel::rotations(EulerOrder::Zyx).to_vec(), end_site: None }
+        Joint {
+            name: name.into(),
+            parent,
+            offset,
+            channels: Channel::rotations(EulerOrder::Zyx).to_vec(),
+            end_site: None,
+        }
     }
 
     #[test]

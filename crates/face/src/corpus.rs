@@ -12,8 +12,12 @@ use crate::train::data::{ClipPool, TrainClip};
 /// `clips` procedural clips of `seconds` each, seeded.
 pub fn procedural_pool(clips: usize, seconds: f64, seed: u64) -> Result<ClipPool, FaceError> {
     let corpus = procedural::generate_corpus(clips, seconds, seed);
-    let clips = corpus.iter().map(|p| TrainClip::from_clip(&p.clip, Some(p.visemes.clone()))).collect::<Result<Vec<_>, _>>()?;
-    Ok(ClipPool::new(clips, format!("procedural face generator (crate::procedural): {} clips x {seconds} s, seed {seed}", corpus.len())))
+    let clips =
+        corpus.iter().map(|p| TrainClip::from_clip(&p.clip, Some(p.visemes.clone()))).collect::<Result<Vec<_>, _>>()?;
+    Ok(ClipPool::new(
+        clips,
+        format!("procedural face generator (crate::procedural): {} clips x {seconds} s, seed {seed}", corpus.len()),
+    ))
 }
 
 /// The training split of the Live Link captures under `captures` (`…/face/neurosync`).

@@ -39,12 +39,20 @@ fn mse(truth: &[Frame], out: &[Frame], seg: Segment) -> f64 {
 pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<FaceDemo, FaceError> {
     let clip = generate(&ProceduralConfig { duration_s: 10.0, ..ProceduralConfig::default() }, seed).clip;
     let net = crate::weights::committed(ConstraintKind::None)?;
-    let methods: [(&str, Method); 3] = [("linear", Method::Linear), ("cubic", Method::Cubic), ("ours", Method::Network(&net as &dyn Inpainter))];
+    let methods: [(&str, Method); 3] =
+        [("linear", Method::Linear), ("cubic", Method::Cubic), ("ours", Method::Network(&net as &dyn Inpainter))];
     let mut outs = Vec::new();
     let mut truth = Vec::new();
     let mut seg = Segment { start: 0, end: 0 };
     for (name, method) in methods {
-        let job = EditJob { clip: &clip, spans: vec![OCCLUSION_S], channels: [true; NUM_ARKIT], guide: Guide::None, method, seed };
+        let job = EditJob {
+            clip: &clip,
+            spans: vec![OCCLUSION_S],
+            channels: [true; NUM_ARKIT],
+            guide: Guide::None,
+            method,
+            seed,
+        };
         let out = job.run()?;
         truth = out.before.clone();
         seg = out.mask.segments()[0];
@@ -55,11 +63,25 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<FaceDemo, FaceE
     let input = dir.join("face-demo-input.csv");
     crate::data::write_curves(&input, &clip_of(&truth))?;
     let png = dir.join("face-demo.png");
-    let title = format!("3 s occlusion ({:.1}-{:.1} s) filled by our unguided network; dashed: cubic", OCCLUSION_S.0, OCCLUSION_S.1);
-    let preview = CurvePreview { title: &title, fps: MODEL_FPS, before: &truth, after: &outs[2].1, spans: &[seg], keys: &[], extra: Some(("cubic", &outs[1].1)), n_curves: 6 };
-    write_edit_png(&png, &preview).map_err(|e| FaceError::File { file: png.display().to_string(), message: e.to_string() })?;
+    let title = format!(
+        "3 s occlusion ({:.1}-{:.1} s) filled by our unguided network; dashed: cubic",
+        OCCLUSION_S.0, OCCLUSION_S.1
+    );
+    let preview = CurvePreview {
+        title: &title,
+        fps: MODEL_FPS,
+        before: &truth,
+        after: &outs[2].1,
+        spans: &[seg],
+        keys: &[],
+        extra: Some(("cubic", &outs[1].1)),
+        n_curves: 6,
+    };
+    write_edit_png(&png, &preview)
+        .map_err(|e| FaceError::File { file: png.display().to_string(), message: e.to_string() })?;
     let gif = dir.join("face-demo.gif");
-    let columns: Vec<(&str, &[Frame])> = std::iter::once(("captured", truth.as_slice())).chain(outs.iter().map(|(n, o)| (*n, o.as_slice()))).collect();
+    let columns: Vec<(&str, &[Frame])> =
+        std::iter::once(("captured", truth.as_slice())).chain(outs.iter().map(|(n, o)| (*n, o.as_slice()))).collect();
     let window = seg.start.saturating_sub(25)..(seg.end + 25).min(truth.len());
     let cropped: Vec<(&str, &[Frame])> = columns.iter().map(|(n, f)| (*n, &f[window.clone()])).collect();
     let flags = span_flags(window.len(), &[Segment { start: seg.start - window.start, end: seg.end - window.start }]);

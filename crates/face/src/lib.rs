@@ -47,7 +47,11 @@ pub(crate) mod test_support {
     #[track_caller]
     pub fn arbitrary_text_never_panics(check: fn(&str)) {
         let source_file = Some(std::panic::Location::caller().file());
-        let mut runner = TestRunner::new(Config { source_file, rng_seed: proptest::test_runner::RngSeed::Fixed(inbetween_core::seed::PROPTEST_SEED), ..Config::with_cases(256) });
+        let mut runner = TestRunner::new(Config {
+            source_file,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(inbetween_core::seed::PROPTEST_SEED),
+            ..Config::with_cases(256)
+        });
         if let Err(e) = runner.run(&"(?s).{0,400}", |text| {
             check(&text);
             Ok(())

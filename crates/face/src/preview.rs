@@ -200,7 +200,8 @@ pub fn write_edit_gif(
     let poses: Vec<(String, Vec<FacePose>)> = columns
         .iter()
         .map(|(name, frames)| {
-            let poses = frames.iter().enumerate().map(|(f, w)| pose_from_arkit(w, head_eye.map(|h| &h[f][..]))).collect();
+            let poses =
+                frames.iter().enumerate().map(|(f, w)| pose_from_arkit(w, head_eye.map(|h| &h[f][..]))).collect();
             (name.to_string(), poses)
         })
         .collect();
@@ -236,7 +237,17 @@ pub const CHANGED_THRESHOLD: f32 = 0.02;
 /// biggest first; when fewer changed, JawOpen and then EyeBlinkLeft fill up the list.
 pub fn changed_channels(before: &[Frame], after: &[Frame], n: usize) -> Vec<usize> {
     let mut score: Vec<(usize, f32)> = (0..NUM_ARKIT)
-        .map(|c| (c, before.iter().zip(after).map(|(b, a)| (a[c] - b[c]).abs()).filter(|d| d.is_finite()).fold(0.0, f32::max)))
+        .map(|c| {
+            (
+                c,
+                before
+                    .iter()
+                    .zip(after)
+                    .map(|(b, a)| (a[c] - b[c]).abs())
+                    .filter(|d| d.is_finite())
+                    .fold(0.0, f32::max),
+            )
+        })
         .filter(|&(_, s)| s >= CHANGED_THRESHOLD)
         .collect();
     score.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
@@ -253,13 +264,20 @@ pub fn changed_channels(before: &[Frame], after: &[Frame], n: usize) -> Vec<usiz
 pub fn edit_plot(p: &CurvePreview<'_>) -> Result<EditPlot, RenderError> {
     let n = p.before.len();
     if n == 0 || p.after.len() != n {
-        return Err(invalid(format!("curve preview needs equal, non-empty before ({n}) and after ({}) frames", p.after.len())));
+        return Err(invalid(format!(
+            "curve preview needs equal, non-empty before ({n}) and after ({}) frames",
+            p.after.len()
+        )));
     }
     if !(p.fps.is_finite() && p.fps > 0.0) {
         return Err(invalid(format!("curve preview frame rate {} must be a positive number", p.fps)));
     }
     if p.n_curves == 0 || p.n_curves > inbetween_render::curves::MAX_EDIT_CURVES {
-        return Err(invalid(format!("{} curves requested; 1 to {} fit", p.n_curves, inbetween_render::curves::MAX_EDIT_CURVES)));
+        return Err(invalid(format!(
+            "{} curves requested; 1 to {} fit",
+            p.n_curves,
+            inbetween_render::curves::MAX_EDIT_CURVES
+        )));
     }
     if let Some((name, extra)) = p.extra {
         if extra.len() != n {
@@ -282,7 +300,12 @@ pub fn edit_plot(p: &CurvePreview<'_>) -> Result<EditPlot, RenderError> {
         plot.markers.extend(p.keys.iter().map(|(f, w)| (ARKIT_NAMES[c].to_string(), *f as f64 / p.fps, w[c])));
     }
     // Shade half a frame either side of the erased frames, so that one erased frame shows too.
-    plot.spans = p.spans.iter().filter(|s| !s.is_empty()).map(|s| ((s.start as f64 - 0.5) / p.fps, (s.end as f64 - 0.5) / p.fps)).collect();
+    plot.spans = p
+        .spans
+        .iter()
+        .filter(|s| !s.is_empty())
+        .map(|s| ((s.start as f64 - 0.5) / p.fps, (s.end as f64 - 0.5) / p.fps))
+        .collect();
     Ok(plot)
 }
 
@@ -309,7 +332,10 @@ mod tests {
 
     #[test]
     fn arkit_shapes_map_to_their_pose_fields() {
-        let p = pose_from_arkit(&frame(&[("JawOpen", 0.7), ("EyeBlinkLeft", 1.0), ("MouthSmileRight", 0.5), ("EyeWideRight", 1.0)]), None);
+        let p = pose_from_arkit(
+            &frame(&[("JawOpen", 0.7), ("EyeBlinkLeft", 1.0), ("MouthSmileRight", 0.5), ("EyeWideRight", 1.0)]),
+            None,
+        );
         assert_eq!(p.jaw_open, 0.7);
         assert_eq!(p.eyelid_open_left, 0.0);
         assert!((p.eyelid_open_right - 1.4).abs() < 1e-6);
@@ -351,7 +377,11 @@ mod tests {
         (0..n)
             .map(|i| {
                 let t = i as f32 * speed;
-                frame(&[("JawOpen", 0.4 + 0.4 * t.sin()), ("EyeBlinkLeft", if i % 40 < 4 { 1.0 } else { 0.0 }), ("MouthSmileLeft", 0.3)])
+                frame(&[
+                    ("JawOpen", 0.4 + 0.4 * t.sin()),
+                    ("EyeBlinkLeft", if i % 40 < 4 { 1.0 } else { 0.0 }),
+                    ("MouthSmileLeft", 0.3),
+                ])
             })
             .collect()
     }
@@ -367,11 +397,23 @@ mod tests {
         let spans = [Segment { start: 40, end: 60 }];
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("curves.png");
-        let preview = CurvePreview { title: "test edit", fps: 25.0, before: &before, after: &after, spans: &spans, keys: &keys, extra: Some(("linear", &before)), n_curves: 3 };
+        let preview = CurvePreview {
+            title: "test edit",
+            fps: 25.0,
+            before: &before,
+            after: &after,
+            spans: &spans,
+            keys: &keys,
+            extra: Some(("linear", &before)),
+            n_curves: 3,
+        };
         let chosen = write_edit_png(&path, &preview).unwrap();
         assert_eq!(chosen, vec![JAW_OPEN, EYE_BLINK_L]);
         let img = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(img.dimensions(), (inbetween_render::curves::EDIT_PLOT_WIDTH, inbetween_render::curves::edit_plot_height(2)));
+        assert_eq!(
+            img.dimensions(),
+            (inbetween_render::curves::EDIT_PLOT_WIDTH, inbetween_render::curves::edit_plot_height(2))
+        );
         assert!(img.pixels().any(|p| p.0 == inbetween_render::curves::SPAN_COLOR));
         let plot = edit_plot(&preview).unwrap();
         assert_eq!(plot.markers.len(), 2, "one key on each of the two curves");
@@ -395,7 +437,8 @@ mod tests {
         assert_eq!(flags.iter().filter(|&&f| f).count(), 4);
         let progress = Progress::hidden();
         let he = vec![[0.0f32; NUM_HEAD_EYE]; 12];
-        write_edit_gif(&path, 25.0, &[("original", &before), ("edited", &after)], Some(&he), &flags, &progress).unwrap();
+        write_edit_gif(&path, 25.0, &[("original", &before), ("edited", &after)], Some(&he), &flags, &progress)
+            .unwrap();
         assert_eq!(progress.position(), 12);
         let file = std::io::BufReader::new(std::fs::File::open(&path).unwrap());
         let frames = image::codecs::gif::GifDecoder::new(file).unwrap().into_frames().collect_frames().unwrap();

@@ -59,7 +59,9 @@ pub fn committed_file(kind: ConstraintKind) -> String {
 pub fn committed(kind: ConstraintKind) -> Result<Network, FaceError> {
     let (bpk, card): (&'static [u8], &'static str) = match kind {
         ConstraintKind::None => (include_bytes!("../weights/unguided.bpk"), include_str!("../weights/unguided.json")),
-        ConstraintKind::Keyframes => (include_bytes!("../weights/keyframes.bpk"), include_str!("../weights/keyframes.json")),
+        ConstraintKind::Keyframes => {
+            (include_bytes!("../weights/keyframes.bpk"), include_str!("../weights/keyframes.json"))
+        }
         ConstraintKind::Noisy => (include_bytes!("../weights/noisy.bpk"), include_str!("../weights/noisy.json")),
         ConstraintKind::Visemes => (include_bytes!("../weights/visemes.bpk"), include_str!("../weights/visemes.json")),
     };
@@ -69,7 +71,10 @@ pub fn committed(kind: ConstraintKind) -> Result<Network, FaceError> {
 
 /// All four committed networks.
 pub fn committed_set() -> Result<NetworkSet, FaceError> {
-    let nets = ConstraintKind::ALL.iter().map(|k| committed(*k).map(|n| Box::new(n) as Box<dyn Inpainter>)).collect::<Result<_, _>>()?;
+    let nets = ConstraintKind::ALL
+        .iter()
+        .map(|k| committed(*k).map(|n| Box::new(n) as Box<dyn Inpainter>))
+        .collect::<Result<_, _>>()?;
     Ok(NetworkSet { label: "procedural".into(), nets })
 }
 
@@ -83,7 +88,10 @@ pub fn set_from_dir(dir: &Path, label: &str) -> Result<NetworkSet, FaceError> {
         }
     }
     if nets.is_empty() {
-        return Err(FaceError::Invalid(format!("{} holds no face weights (expected unguided.bpk, keyframes.bpk, noisy.bpk or visemes.bpk)", dir.display())));
+        return Err(FaceError::Invalid(format!(
+            "{} holds no face weights (expected unguided.bpk, keyframes.bpk, noisy.bpk or visemes.bpk)",
+            dir.display()
+        )));
     }
     Ok(NetworkSet { label: label.into(), nets })
 }
@@ -91,7 +99,8 @@ pub fn set_from_dir(dir: &Path, label: &str) -> Result<NetworkSet, FaceError> {
 /// Refuse to write weights into the committed folder unless asked to.
 pub fn check_output(out: &Path, overwrite_committed: bool) -> Result<(), FaceError> {
     let committed = committed_dir();
-    let parent = out.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p }).unwrap_or(Path::new("."));
+    let parent =
+        out.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p }).unwrap_or(Path::new("."));
     let same = match (parent.canonicalize(), committed.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,

@@ -39,7 +39,11 @@ fn every_face_csv_parses_and_round_trips() {
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let header = std::fs::read_to_string(path).unwrap();
             let header = header.lines().next().unwrap();
-            assert!(header.contains(&ARKIT_NAMES.join(",")), "{}: ARKit columns in the canonical order", path.display());
+            assert!(
+                header.contains(&ARKIT_NAMES.join(",")),
+                "{}: ARKit columns in the canonical order",
+                path.display()
+            );
 
             let n = clip.num_frames();
             let ark = range((0..n).flat_map(|f| clip.arkit(f).to_vec()));
@@ -91,11 +95,15 @@ fn every_face_csv_parses_and_round_trips() {
             let expect = (clip.duration() * MODEL_FPS).floor() as usize + 1;
             assert_eq!(low.num_frames(), expect);
             let again = low.resample_at(clip.times(), clip.fps()).unwrap();
-            let diffs: Vec<f32> =
-                (0..n).flat_map(|f| clip.arkit(f).iter().zip(again.arkit(f)).map(|(a, b)| (a - b).abs()).collect::<Vec<_>>()).collect();
+            let diffs: Vec<f32> = (0..n)
+                .flat_map(|f| clip.arkit(f).iter().zip(again.arkit(f)).map(|(a, b)| (a - b).abs()).collect::<Vec<_>>())
+                .collect();
             let err = diffs.iter().fold(0.0f32, |m, &d| m.max(d));
             let mean = diffs.iter().map(|&d| d as f64).sum::<f64>() / diffs.len() as f64;
-            println!("  60 → 25 → 60 fps: {} frames at 25 fps, ARKit max |error| {err:.4}, mean {mean:.5}", low.num_frames());
+            println!(
+                "  60 → 25 → 60 fps: {} frames at 25 fps, ARKit max |error| {err:.4}, mean {mean:.5}",
+                low.num_frames()
+            );
             assert!(mean < 0.01, "mean round-trip error {mean}");
         }
     });

@@ -373,7 +373,10 @@ fn parse_asf(text: &str, file: &str) -> Result<Asf, IoError> {
                         asf.bones.push(b);
                     }
                     "name" => {
-                        b.name = words.next().ok_or_else(|| syntax(file, line, "a bone name", "end of line".into()))?.to_string()
+                        b.name = words
+                            .next()
+                            .ok_or_else(|| syntax(file, line, "a bone name", "end of line".into()))?
+                            .to_string()
                     }
                     "direction" => b.direction = DVec3::from(lp.vec3(&mut words, "direction")?),
                     "length" => b.length = lp.number(words.next(), "a bone length")?,
@@ -385,8 +388,17 @@ fn parse_asf(text: &str, file: &str) -> Result<Asf, IoError> {
                         for w in words {
                             match parse_dof(w) {
                                 Some(Dof::Rotate(a)) if !b.dofs.contains(&a) => b.dofs.push(a),
-                                Some(Dof::Rotate(_)) => return Err(invalid(file, line, format!("dof {w} appears twice"))),
-                                _ => return Err(syntax(file, line, "bone dof rx, ry or rz (translation and length dof are not supported)", crate::lexer::quote(w))),
+                                Some(Dof::Rotate(_)) => {
+                                    return Err(invalid(file, line, format!("dof {w} appears twice")))
+                                }
+                                _ => {
+                                    return Err(syntax(
+                                        file,
+                                        line,
+                                        "bone dof rx, ry or rz (translation and length dof are not supported)",
+                                        crate::lexer::quote(w),
+                                    ))
+                                }
                             }
                         }
                     }
@@ -429,7 +441,11 @@ fn parse_asf(text: &str, file: &str) -> Result<Asf, IoError> {
     Ok(asf)
 }
 
-fn parse_limits<'w>(lp: &LineParser, words: impl Iterator<Item = &'w str>, out: &mut Vec<(f64, f64)>) -> Result<(), IoError> {
+fn parse_limits<'w>(
+    lp: &LineParser,
+    words: impl Iterator<Item = &'w str>,
+    out: &mut Vec<(f64, f64)>,
+) -> Result<(), IoError> {
     let mut pending: Option<f64> = None;
     for w in words {
         let w = w.trim_matches(|c| c == '(' || c == ')');
@@ -483,7 +499,10 @@ fn build_hierarchy(asf: &mut Asf, lines: &[(usize, Vec<&str>)], file: &str) -> R
     let mut has_parent = vec![false; n];
     for (line, words) in lines {
         let lookup = |w: &str| {
-            node_of.get(w).copied().ok_or_else(|| syntax(file, *line, "a bone named in :bonedata", crate::lexer::quote(w)))
+            node_of
+                .get(w)
+                .copied()
+                .ok_or_else(|| syntax(file, *line, "a bone named in :bonedata", crate::lexer::quote(w)))
         };
         let parent = lookup(words[0])?;
         for &w in &words[1..] {
@@ -539,7 +558,11 @@ fn parse_amc(asf: &Asf, text: &str, file: &str) -> Result<Vec<f64>, IoError> {
     let nc = next;
     for (node, &channel_start) in channel.iter().enumerate() {
         let frame = asf.axis_frame(node);
-        let dofs = if node == 0 { asf.root_order.clone() } else { asf.bones[node - 1].dofs.iter().map(|&a| Dof::Rotate(a)).collect() };
+        let dofs = if node == 0 {
+            asf.root_order.clone()
+        } else {
+            asf.bones[node - 1].dofs.iter().map(|&a| Dof::Rotate(a)).collect()
+        };
         layouts.push(NodeLayout { dofs, frame, frame_inv: frame.inverse(), channel_start });
     }
     let mut node_of: HashMap<&str, usize> = HashMap::with_capacity(n);
@@ -571,11 +594,17 @@ fn parse_amc(asf: &Asf, text: &str, file: &str) -> Result<Vec<f64>, IoError> {
             if let Some(extra) = words.next() {
                 return Err(syntax(file, line, "only a frame number on the line", crate::lexer::quote(extra)));
             }
-            let number: u64 = first.parse().map_err(|_| syntax(file, line, "a frame number", crate::lexer::quote(first)))?;
+            let number: u64 =
+                first.parse().map_err(|_| syntax(file, line, "a frame number", crate::lexer::quote(first)))?;
             if let Some(prev) = frame.number {
                 frame.finish(asf, &layouts, nc, angle_to_rad, &mut data, file)?;
                 if Some(number) != prev.checked_add(1) {
-                    return Err(syntax(file, line, format!("frame number {}", prev.saturating_add(1)), format!("{number}")));
+                    return Err(syntax(
+                        file,
+                        line,
+                        format!("frame number {}", prev.saturating_add(1)),
+                        format!("{number}"),
+                    ));
                 }
             }
             frame.start(number, line);
@@ -584,9 +613,15 @@ fn parse_amc(asf: &Asf, text: &str, file: &str) -> Result<Vec<f64>, IoError> {
         let Some(_) = frame.number else {
             return Err(syntax(file, line, "a frame number before bone values", crate::lexer::quote(first)));
         };
-        let node = *node_of.get(first).ok_or_else(|| syntax(file, line, "a bone named in the ASF file", crate::lexer::quote(first)))?;
+        let node = *node_of
+            .get(first)
+            .ok_or_else(|| syntax(file, line, "a bone named in the ASF file", crate::lexer::quote(first)))?;
         if frame.seen[node] {
-            return Err(invalid(file, line, format!("bone '{first}' appears twice in frame {}", frame.number.unwrap_or(0))));
+            return Err(invalid(
+                file,
+                line,
+                format!("bone '{first}' appears twice in frame {}", frame.number.unwrap_or(0)),
+            ));
         }
         frame.seen[node] = true;
         let k = layouts[node].dofs.len();
@@ -626,7 +661,15 @@ impl FrameBuilder {
     }
 
     /// Converts the finished frame to channel values: `L = C · M · C⁻¹` per node, as ZYX degrees.
-    fn finish(&self, asf: &Asf, layouts: &[NodeLayout], nc: usize, angle_to_rad: f64, data: &mut Vec<f64>, file: &str) -> Result<(), IoError> {
+    fn finish(
+        &self,
+        asf: &Asf,
+        layouts: &[NodeLayout],
+        nc: usize,
+        angle_to_rad: f64,
+        data: &mut Vec<f64>,
+        file: &str,
+    ) -> Result<(), IoError> {
         let start = data.len();
         data.resize(start + nc, 0.0);
         let out = &mut data[start..];

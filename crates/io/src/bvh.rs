@@ -104,10 +104,8 @@ impl<'a> Parser<'a> {
             match top {
                 Block::Joint { index, has_offset, has_channels } => {
                     let index = *index;
-                    let expected = format!(
-                        "OFFSET, CHANNELS, JOINT, End Site or '}}' inside joint '{}'",
-                        joints[index].name
-                    );
+                    let expected =
+                        format!("OFFSET, CHANNELS, JOINT, End Site or '}}' inside joint '{}'", joints[index].name);
                     let t = self.token(&expected)?;
                     match t.text.to_ascii_uppercase().as_str() {
                         "OFFSET" if !*has_offset => {
@@ -122,7 +120,8 @@ impl<'a> Parser<'a> {
                         "END" => {
                             self.keyword("Site")?;
                             if joints[index].end_site.is_some() {
-                                return Err(self.invalid(t.line, format!("joint '{}' has a second End Site", joints[index].name)));
+                                return Err(self
+                                    .invalid(t.line, format!("joint '{}' has a second End Site", joints[index].name)));
                             }
                             self.keyword("{")?;
                             joints[index].end_site = Some(DVec3::ZERO);
@@ -169,7 +168,13 @@ impl<'a> Parser<'a> {
             self.keyword("{")?;
         }
         stack.push(Block::Joint { index: joints.len(), has_offset: false, has_channels: false });
-        joints.push(Joint { name: name.to_string(), parent, offset: DVec3::ZERO, channels: Vec::new(), end_site: None });
+        joints.push(Joint {
+            name: name.to_string(),
+            parent,
+            offset: DVec3::ZERO,
+            channels: Vec::new(),
+            end_site: None,
+        });
         Ok(())
     }
 
@@ -192,7 +197,9 @@ impl<'a> Parser<'a> {
         }
         let rotations = channels.iter().filter(|c| c.is_rotation()).count();
         if rotations != 0 && rotations != 3 {
-            return Err(self.invalid(line, format!("{rotations} rotation channels; expected none or all three of X, Y, Z")));
+            return Err(
+                self.invalid(line, format!("{rotations} rotation channels; expected none or all three of X, Y, Z"))
+            );
         }
         Ok(channels)
     }
@@ -200,12 +207,14 @@ impl<'a> Parser<'a> {
     fn motion(mut self, skeleton: Skeleton, text_len: usize) -> Result<Motion, IoError> {
         let t = self.token("'MOTION'")?;
         if !t.text.eq_ignore_ascii_case("MOTION") {
-            let hint = if t.text.eq_ignore_ascii_case("ROOT") { "'MOTION' (only one ROOT is supported)" } else { "'MOTION'" };
+            let hint =
+                if t.text.eq_ignore_ascii_case("ROOT") { "'MOTION' (only one ROOT is supported)" } else { "'MOTION'" };
             return Err(self.syntax(t.line, hint, quote(t.text)));
         }
         let frames_tok = self.keyword("Frames:")?;
         let t = self.token("a frame count")?;
-        let frames: u64 = t.text.parse().map_err(|_| self.syntax(t.line, "a frame count (a whole number)", quote(t.text)))?;
+        let frames: u64 =
+            t.text.parse().map_err(|_| self.syntax(t.line, "a frame count (a whole number)", quote(t.text)))?;
         self.keyword("Frame")?;
         self.keyword("Time:")?;
         let t = self.token("a frame time in seconds")?;
@@ -251,13 +260,21 @@ impl<'a> Parser<'a> {
                     ));
                 }
                 let v = parse_finite(word).ok_or_else(|| {
-                    self.syntax(line, format!("a finite number for frame {read}, channel {c} ({})", channel_label(&skeleton, c)), quote(word))
+                    self.syntax(
+                        line,
+                        format!("a finite number for frame {read}, channel {c} ({})", channel_label(&skeleton, c)),
+                        quote(word),
+                    )
                 })?;
                 data.push(v);
             }
             let got = data.len() - before;
             if got != nc {
-                return Err(self.syntax(line, format!("{nc} values in frame {read} (one per channel)"), format!("{got}")));
+                return Err(self.syntax(
+                    line,
+                    format!("{nc} values in frame {read} (one per channel)"),
+                    format!("{got}"),
+                ));
             }
             read += 1;
         }

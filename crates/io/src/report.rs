@@ -79,15 +79,20 @@ impl Table {
 
     /// Whether every body cell of column `c` reads as a number (or is empty or "—").
     fn numeric(&self, c: usize) -> bool {
-        self.rows.iter().map(|r| Self::cell(r, c).trim_end_matches(['%', '×', 'x'])).all(|t| t.is_empty() || t == "—" || t.parse::<f64>().is_ok())
+        self.rows
+            .iter()
+            .map(|r| Self::cell(r, c).trim_end_matches(['%', '×', 'x']))
+            .all(|t| t.is_empty() || t == "—" || t.parse::<f64>().is_ok())
     }
 
     /// Aligned plain text: the title, the header, the rows (numeric columns right-aligned, text
     /// columns and the first column left-aligned), then the notes.
     pub fn to_text(&self) -> String {
         let n = self.columns();
-        let all: Vec<&[String]> = std::iter::once(self.headers.as_slice()).chain(self.rows.iter().map(Vec::as_slice)).collect();
-        let widths: Vec<usize> = (0..n).map(|c| all.iter().map(|r| Self::cell(r, c).chars().count()).max().unwrap_or(0)).collect();
+        let all: Vec<&[String]> =
+            std::iter::once(self.headers.as_slice()).chain(self.rows.iter().map(Vec::as_slice)).collect();
+        let widths: Vec<usize> =
+            (0..n).map(|c| all.iter().map(|r| Self::cell(r, c).chars().count()).max().unwrap_or(0)).collect();
         let right: Vec<bool> = (0..n).map(|c| c > 0 && self.numeric(c)).collect();
         let mut out = format!("{}\n", self.title);
         for row in &all {
@@ -95,7 +100,11 @@ impl Table {
                 .map(|c| {
                     let (text, w) = (Self::cell(row, c), widths[c]);
                     let pad = " ".repeat(w.saturating_sub(text.chars().count()));
-                    if right[c] { format!("{pad}{text}") } else { format!("{text}{pad}") }
+                    if right[c] {
+                        format!("{pad}{text}")
+                    } else {
+                        format!("{text}{pad}")
+                    }
                 })
                 .collect();
             out += cells.join("  ").trim_end();
@@ -117,7 +126,9 @@ impl Table {
     /// A GitHub Markdown table under a bold title, notes as a list: what a README pastes.
     pub fn to_markdown(&self) -> String {
         let n = self.columns();
-        let line = |row: &[String]| format!("| {} |\n", (0..n).map(|c| Self::cell(row, c).replace('|', "\\|")).collect::<Vec<_>>().join(" | "));
+        let line = |row: &[String]| {
+            format!("| {} |\n", (0..n).map(|c| Self::cell(row, c).replace('|', "\\|")).collect::<Vec<_>>().join(" | "))
+        };
         let mut out = format!("**{}**\n\n", self.title);
         out += &line(&self.headers);
         out += &format!("|{}\n", "---|".repeat(n));
@@ -176,10 +187,8 @@ impl Report {
 
     /// Adds `value` as pretty JSON in `file` (e.g. "report.json").
     pub fn json<T: serde::Serialize>(&mut self, file: &str, value: &T) -> Result<&mut Report, IoError> {
-        let text = serde_json::to_string_pretty(value).map_err(|e| IoError::Io {
-            path: PathBuf::from(file),
-            source: std::io::Error::other(e),
-        })?;
+        let text = serde_json::to_string_pretty(value)
+            .map_err(|e| IoError::Io { path: PathBuf::from(file), source: std::io::Error::other(e) })?;
         Ok(self.file(file, (text + "\n").into_bytes()))
     }
 
@@ -287,7 +296,16 @@ mod tests {
         let mut t = sample();
         t.row(["say \"hi\"", "a|b", "x"]);
         let csv = t.to_csv();
-        assert_eq!(csv.lines().collect::<Vec<_>>(), ["method,ours,paper", "uniform,0.500,0.480", "\"greedy, fast\",0.25,", "random,1.5,—", "\"say \"\"hi\"\"\",a|b,x"]);
+        assert_eq!(
+            csv.lines().collect::<Vec<_>>(),
+            [
+                "method,ours,paper",
+                "uniform,0.500,0.480",
+                "\"greedy, fast\",0.25,",
+                "random,1.5,—",
+                "\"say \"\"hi\"\"\",a|b,x"
+            ]
+        );
         let md = t.to_markdown();
         assert!(md.contains("| method | ours | paper |\n|---|---|---|\n"), "{md}");
         assert!(md.contains("| say \"hi\" | a\\|b | x |"), "{md}");

@@ -46,7 +46,10 @@ fn crlf_radians_and_root_order_are_honoured() {
     let base = parse_asf_amc(ASF, AMC, "t.asf", "t.amc").unwrap();
     let crlf = parse_asf_amc(&ASF.replace('\n', "\r\n"), &AMC.replace('\n', "\r\n"), "t.asf", "t.amc").unwrap();
     assert_eq!(crlf, base);
-    let rad_amc = AMC.replace(":DEGREES", ":RADIANS").replace("a 90", &format!("a {}", std::f64::consts::FRAC_PI_2)).replace("b 0 0 90", &format!("b 0 0 {}", std::f64::consts::FRAC_PI_2));
+    let rad_amc = AMC
+        .replace(":DEGREES", ":RADIANS")
+        .replace("a 90", &format!("a {}", std::f64::consts::FRAC_PI_2))
+        .replace("b 0 0 90", &format!("b 0 0 {}", std::f64::consts::FRAC_PI_2));
     let rad = parse_asf_amc(ASF, &rad_amc, "t.asf", "t.amc").unwrap();
     let worst = rad.data().iter().zip(base.data()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     assert!(worst < 1e-9, "{worst}");

@@ -6,9 +6,8 @@ use inbetween_io::load_motion;
 use std::path::PathBuf;
 
 fn bvh_files(dir: PathBuf) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir(dir).map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
     files.retain(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")));
     files.sort();
     files
@@ -104,7 +103,11 @@ fn asf_amc_matches_cgspeed_bvh_of_the_same_take() {
             println!("{name:<16} mean {mean:9.5} cm  max {max:9.5} cm");
         }
         let (mean, max) = summary(&raw);
-        println!("as converted: mean {mean:.4} cm, max {max:.4} cm ({} joints x {} frames)", raw.len(), amc.num_frames());
+        println!(
+            "as converted: mean {mean:.4} cm, max {max:.4} cm ({} joints x {} frames)",
+            raw.len(),
+            amc.num_frames()
+        );
 
         let with_cgspeed_offsets: Vec<Joint> = amc
             .skeleton
@@ -115,7 +118,8 @@ fn asf_amc_matches_cgspeed_bvh_of_the_same_take() {
                 Joint { offset: bvh.skeleton.joint(b).offset, ..j.clone() }
             })
             .collect();
-        let aligned = Motion::new(Skeleton::new(with_cgspeed_offsets).unwrap(), amc.frame_time, amc.data().to_vec()).unwrap();
+        let aligned =
+            Motion::new(Skeleton::new(with_cgspeed_offsets).unwrap(), amc.frame_time, amc.data().to_vec()).unwrap();
         let same = joint_differences_cm(&aligned, &bvh);
         let (mean_a, max_a) = summary(&same);
         println!("with cgspeed offsets: mean {mean_a:.5} cm, max {max_a:.5} cm");
@@ -141,11 +145,8 @@ fn converted_amc_survives_bvh_round_trip() {
         let back = parse_bvh(&to_bvh_string(&amc), "11_01.bvh").unwrap();
         assert_eq!(back.skeleton.len(), amc.skeleton.len());
         let (pa, pb) = (positions_clip(&amc), positions_clip(&back));
-        let worst = pa
-            .iter()
-            .zip(&pb)
-            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (*x - *y).length()))
-            .fold(0.0, f64::max);
+        let worst =
+            pa.iter().zip(&pb).flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (*x - *y).length())).fold(0.0, f64::max);
         println!("11_01 AMC -> BVH -> read: worst joint position difference {worst:.2e} CMU units");
         assert!(worst < 1e-4, "{worst}");
     });

@@ -41,7 +41,8 @@ fn mutate(text: &str, edits: &[(usize, u8, u8)]) -> Vec<u8> {
 /// A random skeleton in depth-first order (each joint's parent is the previous joint or one of its
 /// ancestors) with every channel layout BVH allows.
 fn skeleton_strategy() -> impl Strategy<Value = Skeleton> {
-    let joint = (any::<prop::sample::Index>(), 0usize..7, 0usize..6, prop::array::uniform3(-50.0f64..50.0), any::<bool>());
+    let joint =
+        (any::<prop::sample::Index>(), 0usize..7, 0usize..6, prop::array::uniform3(-50.0f64..50.0), any::<bool>());
     prop::collection::vec(joint, 1..8).prop_map(|specs| {
         let mut joints: Vec<Joint> = Vec::new();
         let mut path: Vec<usize> = Vec::new(); // the chain from the root to the previous joint
@@ -138,7 +139,13 @@ fn non_depth_first_skeletons_are_reordered_but_move_the_same() {
         end_site: None,
     };
     // Breadth-first: root, a, b, a_child.
-    let s = Skeleton::new(vec![j("root", None, 0.0), j("a", Some(0), 1.0), j("b", Some(0), -1.0), j("a_child", Some(1), 2.0)]).unwrap();
+    let s = Skeleton::new(vec![
+        j("root", None, 0.0),
+        j("a", Some(0), 1.0),
+        j("b", Some(0), -1.0),
+        j("a_child", Some(1), 2.0),
+    ])
+    .unwrap();
     let data: Vec<f64> = (0..24).map(|i| i as f64 * 7.0 - 60.0).collect();
     let m = Motion::new(s, 0.04, data).unwrap();
     let back = parse_bvh(&to_bvh_string(&m), "w.bvh").unwrap();

@@ -369,4 +369,3 @@ mod tests {
         assert!(training_windows(&clips, &[], &p, 10).unwrap().is_empty());
     }
 }
-

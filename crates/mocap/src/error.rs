@@ -218,7 +218,9 @@ impl SegmentTable {
     /// selector needs to know about them.
     pub fn bounded(model: &dyn SegmentModel, max_gap: usize, max_cm: f64) -> SegmentTable {
         let infeasible = SegmentCost { angle_sum: f64::INFINITY, cm_sum: f64::INFINITY, cm_max: f64::INFINITY };
-        Self::fill(model, max_gap, |a, b, scratch| model.segment_cost_within(a, b, max_cm, scratch).unwrap_or(infeasible))
+        Self::fill(model, max_gap, |a, b, scratch| {
+            model.segment_cost_within(a, b, max_cm, scratch).unwrap_or(infeasible)
+        })
     }
 
     /// Rows of segment costs `(a, a + 1 ..= a + max_gap)`, computed in parallel over rows with one

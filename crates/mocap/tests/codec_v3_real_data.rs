@@ -31,7 +31,10 @@ fn cmu_takes_at_24_fps_keep_the_bound_in_the_decoded_file_and_seek() {
                 file.pose_at(f as f64 * file.header.frame_time, &mut pose, &mut sc).unwrap();
                 let want = c.quantised.pose(f);
                 for j in 0..pose.rotations.len() {
-                    assert!(inbetween_core::rotation::angle_between(pose.rotations[j], want.rotations[j]) < 1e-9, "{name} frame {f} joint {j}");
+                    assert!(
+                        inbetween_core::rotation::angle_between(pose.rotations[j], want.rotations[j]) < 1e-9,
+                        "{name} frame {f} joint {j}"
+                    );
                 }
             }
         }

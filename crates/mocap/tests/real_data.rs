@@ -36,8 +36,8 @@ fn every_cmu_take_filters_to_the_major_joints_and_optimal_never_loses() {
 /// programme over the full segment table, with the same total to the bit.
 #[test]
 fn fast_optimum_equals_the_full_table_programme_on_every_cmu_window() {
-    use inbetween_mocap::select::optimal::optimal_spherical_with_total;
     use inbetween_mocap::select::optimal;
+    use inbetween_mocap::select::optimal::optimal_spherical_with_total;
     use inbetween_mocap::{Objective, SegmentTable};
     with_shared_data("mocap fast-optimum real-data test", |dir| {
         let corpus = inbetween_mocap::corpus::load(&dir, None).unwrap();

@@ -52,9 +52,7 @@ static SEED_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
 /// initialisation is only reproducible when no other thread uses random tensors meanwhile
 /// (parallel tests do). Random draws outside any `seeded` section are not excluded.
 pub fn seeded<T>(device: &Device, seed: u64, f: impl FnOnce() -> T) -> T {
-    let _guard = SEED_LOCK
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    let _guard = SEED_LOCK.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     device.seed(seed);
     f()
 }
@@ -80,11 +78,7 @@ impl burn::module::ModuleVisitor for InitializeParams {
 /// burn initialises parameters lazily, on first use: a model built inside `seeded` but first
 /// used outside it would draw its weights later, from whatever state the shared generator is in
 /// then. This forces the draws to happen under the seed.
-pub fn seeded_module<M: burn::module::Module>(
-    device: &Device,
-    seed: u64,
-    build: impl FnOnce(&Device) -> M,
-) -> M {
+pub fn seeded_module<M: burn::module::Module>(device: &Device, seed: u64, build: impl FnOnce(&Device) -> M) -> M {
     seeded(device, seed, || {
         let module = build(device);
         module.visit(&mut InitializeParams);
@@ -106,14 +100,7 @@ pub fn cuda_autodiff(index: usize) -> Device {
 
 /// Human-readable name of the backend a device uses, for logs and bench tables.
 pub fn describe(device: &Device) -> String {
-    format!(
-        "{device:?}{}",
-        if device.is_autodiff() {
-            " (autodiff)"
-        } else {
-            ""
-        }
-    )
+    format!("{device:?}{}", if device.is_autodiff() { " (autodiff)" } else { "" })
 }
 
 #[cfg(test)]

@@ -4,14 +4,13 @@
 //! one trajectory and a batch of trajectories (inference, no autodiff), and a stacked
 //! [`BiLstm`](crate::lstm::BiLstm) forward + backward + Adam step (training). [`table`] lays the rows out.
 
-
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Distribution, Tensor};
 
 use crate::backend;
-use inbetween_io::report::{num, Table};
 use crate::lstm::{BiLstmConfig, FusedLstmConfig, LstmState};
+use inbetween_io::report::{num, Table};
 
 /// One measured quantity.
 #[derive(Debug, Clone, PartialEq)]
@@ -85,20 +84,14 @@ impl LstmBenchOptions {
 }
 
 fn random_frames(frames: usize, batch: usize, features: usize, device: &Device) -> Vec<Tensor<2>> {
-    (0..frames)
-        .map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device))
-        .collect()
+    (0..frames).map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device)).collect()
 }
 
 /// Frames per second of a `hidden`-unit FusedLstm stepping `batch` trajectories of `frames`
 /// frames (inference device, inputs generated up front).
 fn lstm_inference_fps(opts: &LstmBenchOptions, batch: usize, device: &Device) -> f64 {
-    let lstm = backend::seeded_module(device, 0, |d| {
-        FusedLstmConfig::new(opts.d_input, opts.hidden).init(d)
-    });
-    let xs = backend::seeded(device, 1, || {
-        random_frames(opts.frames, batch, opts.d_input, device)
-    });
+    let lstm = backend::seeded_module(device, 0, |d| FusedLstmConfig::new(opts.d_input, opts.hidden).init(d));
+    let xs = backend::seeded(device, 1, || random_frames(opts.frames, batch, opts.d_input, device));
     let secs = seconds_per_call(1, opts.repeats, || {
         let mut state: Option<LstmState> = None;
         for x in &xs {
@@ -115,9 +108,7 @@ fn lstm_inference_fps(opts: &LstmBenchOptions, batch: usize, device: &Device) ->
 fn bilstm_train_step_seconds(opts: &LstmBenchOptions, device: &Device) -> f64 {
     let config = BiLstmConfig::new(opts.d_input, opts.bi_hidden).with_num_layers(opts.bi_layers);
     let model = backend::seeded_module(device, 0, |d| config.init(d));
-    let xs = backend::seeded(device, 1, || {
-        random_frames(opts.bi_frames, opts.bi_batch, opts.d_input, device)
-    });
+    let xs = backend::seeded(device, 1, || random_frames(opts.bi_frames, opts.bi_batch, opts.d_input, device));
     let mut model = Some(model);
     let mut optim = AdamConfig::new().init();
     seconds_per_call(1, opts.repeats, || {
@@ -127,13 +118,7 @@ fn bilstm_train_step_seconds(opts: &LstmBenchOptions, device: &Device) -> f64 {
         let grads = GradientsParams::from_grads(loss.backward(), &current);
         let updated = optim.step(1e-3, current, grads);
         // Read one parameter back so the update has run.
-        let _ = updated.layers[0]
-            .forward
-            .gates
-            .weight
-            .val()
-            .sum()
-            .into_scalar::<f32>();
+        let _ = updated.layers[0].forward.gates.weight.val().sum().into_scalar::<f32>();
         model = Some(updated);
     })
 }
@@ -151,18 +136,10 @@ pub fn lstm_throughput(opts: &LstmBenchOptions) -> Vec<BenchRow> {
             name: format!("FusedLstm {} units, 1 trajectory", opts.hidden),
             value: single,
             unit: "frames/s".into(),
-            detail: format!(
-                "{} frames, input {}, {} params",
-                opts.frames,
-                opts.d_input,
-                model.num_params()
-            ),
+            detail: format!("{} frames, input {}, {} params", opts.frames, opts.d_input, model.num_params()),
         },
         BenchRow {
-            name: format!(
-                "FusedLstm {} units, {} trajectories",
-                opts.hidden, opts.batch
-            ),
+            name: format!("FusedLstm {} units, {} trajectories", opts.hidden, opts.batch),
             value: batched,
             unit: "frames/s".into(),
             detail: format!("{} frames each, counted over all trajectories", opts.frames),
@@ -171,10 +148,7 @@ pub fn lstm_throughput(opts: &LstmBenchOptions) -> Vec<BenchRow> {
             name: format!("BiLstm {}×{} fwd+bwd+Adam", opts.bi_layers, opts.bi_hidden),
             value: bi,
             unit: "s/step".into(),
-            detail: format!(
-                "batch {} × {} frames, input {}",
-                opts.bi_batch, opts.bi_frames, opts.d_input
-            ),
+            detail: format!("batch {} × {} frames, input {}", opts.bi_batch, opts.bi_frames, opts.d_input),
         },
     ]
 }

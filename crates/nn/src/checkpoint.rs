@@ -26,17 +26,11 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), NnError> {
 }
 
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, NnError> {
-    std::fs::read(path).map_err(|source| NnError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    std::fs::read(path).map_err(|source| NnError::Io { path: path.to_path_buf(), source })
 }
 
 fn record_err(path: &Path, err: impl std::fmt::Display) -> NnError {
-    NnError::Record {
-        path: path.to_path_buf(),
-        message: err.to_string(),
-    }
+    NnError::Record { path: path.to_path_buf(), message: err.to_string() }
 }
 
 /// A module's parameters as burnpack bytes (`origin` names them in errors), e.g. to keep a copy
@@ -60,11 +54,8 @@ pub fn load_module<M: Module>(module: M, path: &Path) -> Result<M, NnError> {
 /// Like [`load_module`], from bytes already in memory (weights compiled into a binary); `origin`
 /// names them in errors.
 pub fn load_module_bytes<M: Module>(module: M, bytes: Vec<u8>, origin: &Path) -> Result<M, NnError> {
-    let record =
-        ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(origin, e))?;
-    module
-        .try_load_record(record)
-        .map_err(|e| record_err(origin, e))
+    let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(origin, e))?;
+    module.try_load_record(record).map_err(|e| record_err(origin, e))
 }
 
 /// Save an optimizer's state (Adam moments and step counts, keyed by parameter id).
@@ -79,9 +70,7 @@ pub fn save_optimizer(optim: &ModuleOptimizer, path: &Path) -> Result<(), NnErro
 /// so load the model from the same checkpoint.
 pub fn load_optimizer(optim: ModuleOptimizer, path: &Path) -> Result<ModuleOptimizer, NnError> {
     let bytes = read_file(path)?;
-    optim
-        .from_bytes(Bytes::from_bytes_vec(bytes))
-        .map_err(|e| record_err(path, e))
+    optim.from_bytes(Bytes::from_bytes_vec(bytes)).map_err(|e| record_err(path, e))
 }
 
 /// The JSON sidecar of a checkpoint.
@@ -119,10 +108,7 @@ fn nan_as_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Er
 impl CheckpointMeta {
     /// Write the sidecar as pretty JSON, atomically.
     pub fn save(&self, path: &Path) -> Result<(), NnError> {
-        let exact = Self {
-            loss_history_bits: self.loss_history.iter().map(|l| l.to_bits()).collect(),
-            ..self.clone()
-        };
+        let exact = Self { loss_history_bits: self.loss_history.iter().map(|l| l.to_bits()).collect(), ..self.clone() };
         let json = serde_json::to_vec_pretty(&exact).map_err(|e| NnError::Metadata {
             path: path.to_path_buf(),
             line: 0,
@@ -142,11 +128,7 @@ impl CheckpointMeta {
             message: format!("invalid checkpoint metadata: {e}"),
         })?;
         if meta.loss_history_bits.len() == meta.loss_history.len() {
-            meta.loss_history = meta
-                .loss_history_bits
-                .iter()
-                .map(|&b| f64::from_bits(b))
-                .collect();
+            meta.loss_history = meta.loss_history_bits.iter().map(|&b| f64::from_bits(b)).collect();
         }
         Ok(meta)
     }
@@ -206,19 +188,11 @@ pub fn latest_checkpoint(dir: &Path) -> Result<Option<CheckpointFiles>, NnError>
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(source) => {
-            return Err(NnError::Io {
-                path: dir.to_path_buf(),
-                source,
-            })
-        }
+        Err(source) => return Err(NnError::Io { path: dir.to_path_buf(), source }),
     };
     let mut best: Option<usize> = None;
     for entry in entries {
-        let entry = entry.map_err(|source| NnError::Io {
-            path: dir.to_path_buf(),
-            source,
-        })?;
+        let entry = entry.map_err(|source| NnError::Io { path: dir.to_path_buf(), source })?;
         let name = entry.file_name();
         let epoch = name
             .to_str()

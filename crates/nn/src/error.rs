@@ -15,12 +15,7 @@ pub enum NnError {
     Record { path: PathBuf, message: String },
     /// A checkpoint's JSON sidecar is malformed.
     #[error("{}: line {line}, column {column}: {message}", path.display())]
-    Metadata {
-        path: PathBuf,
-        line: usize,
-        column: usize,
-        message: String,
-    },
+    Metadata { path: PathBuf, line: usize, column: usize, message: String },
     /// A weights file for another model, architecture version or configuration.
     #[error("{}: {message}", path.display())]
     Mismatch { path: PathBuf, message: String },

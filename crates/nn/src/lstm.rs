@@ -39,10 +39,7 @@ impl LstmState {
 
     /// The state cut from the autodiff graph (truncated backpropagation through time).
     pub fn detach(self) -> Self {
-        Self {
-            h: self.h.detach(),
-            c: self.c.detach(),
-        }
+        Self { h: self.h.detach(), c: self.c.detach() }
     }
 }
 
@@ -81,25 +78,14 @@ impl FusedLstmConfig {
         if self.forget_bias != 0.0 {
             if let Some(bias) = gates.bias.take() {
                 // Built from plain data so the bias stays a leaf parameter under autodiff.
-                let mut values = bias
-                    .val()
-                    .into_data()
-                    .try_to_vec::<f32>()
-                    .unwrap_or_default();
+                let mut values = bias.val().into_data().try_to_vec::<f32>().unwrap_or_default();
                 for v in &mut values[hidden..2 * hidden] {
                     *v += self.forget_bias as f32;
                 }
-                gates.bias = Some(Param::from_data(
-                    TensorData::new(values, [4 * hidden]),
-                    device,
-                ));
+                gates.bias = Some(Param::from_data(TensorData::new(values, [4 * hidden]), device));
             }
         }
-        FusedLstm {
-            gates,
-            d_input: self.d_input,
-            d_hidden: hidden,
-        }
+        FusedLstm { gates, d_input: self.d_input, d_hidden: hidden }
     }
 }
 
@@ -126,11 +112,7 @@ impl FusedLstm {
     }
 
     /// Run the cell over a sequence; returns every step's `h` and the final state.
-    pub fn forward_seq(
-        &self,
-        xs: &[Tensor<2>],
-        state: Option<LstmState>,
-    ) -> (Vec<Tensor<2>>, LstmState) {
+    pub fn forward_seq(&self, xs: &[Tensor<2>], state: Option<LstmState>) -> (Vec<Tensor<2>>, LstmState) {
         let mut outputs = Vec::with_capacity(xs.len());
         let mut state = state;
         for x in xs {
@@ -182,23 +164,12 @@ pub struct BiLstm {
 impl BiLstmConfig {
     /// Build the stack on `device`.
     pub fn init(&self, device: &Device) -> BiLstm {
-        assert!(
-            self.num_layers >= 1,
-            "BiLstmConfig: num_layers must be at least 1"
-        );
+        assert!(self.num_layers >= 1, "BiLstmConfig: num_layers must be at least 1");
         let layers = (0..self.num_layers)
             .map(|k| {
-                let d_in = if k == 0 {
-                    self.d_input
-                } else {
-                    2 * self.d_hidden
-                };
-                let cell =
-                    FusedLstmConfig::new(d_in, self.d_hidden).with_forget_bias(self.forget_bias);
-                BiLstmLayer {
-                    forward: cell.init(device),
-                    backward: cell.init(device),
-                }
+                let d_in = if k == 0 { self.d_input } else { 2 * self.d_hidden };
+                let cell = FusedLstmConfig::new(d_in, self.d_hidden).with_forget_bias(self.forget_bias);
+                BiLstmLayer { forward: cell.init(device), backward: cell.init(device) }
             })
             .collect();
         BiLstm { layers }
@@ -212,10 +183,7 @@ impl BiLstmLayer {
         let reversed: Vec<Tensor<2>> = xs.iter().rev().cloned().collect();
         let (mut bwd, _) = self.backward.forward_seq(&reversed, None);
         bwd.reverse();
-        fwd.into_iter()
-            .zip(bwd)
-            .map(|(f, b)| Tensor::cat(vec![f, b], 1))
-            .collect()
+        fwd.into_iter().zip(bwd).map(|(f, b)| Tensor::cat(vec![f, b], 1)).collect()
     }
 }
 
@@ -239,9 +207,7 @@ impl BiLstm {
 /// Split `[batch, time, features]` into `time` tensors of `[batch, features]`.
 pub fn unstack_time(seq: Tensor<3>) -> Vec<Tensor<2>> {
     let [batch, time, features] = seq.dims();
-    (0..time)
-        .map(|t| seq.clone().narrow(1, t, 1).reshape([batch, features]))
-        .collect()
+    (0..time).map(|t| seq.clone().narrow(1, t, 1).reshape([batch, features])).collect()
 }
 
 /// Stack per-step `[batch, features]` tensors into `[batch, time, features]`.
@@ -261,9 +227,7 @@ mod tests {
 
     fn random_seq(steps: usize, batch: usize, features: usize, device: &Device) -> Vec<Tensor<2>> {
         backend::seeded(device, steps as u64, || {
-            (0..steps)
-                .map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device))
-                .collect()
+            (0..steps).map(|_| Tensor::random([batch, features], Distribution::Normal(0.0, 1.0), device)).collect()
         })
     }
 
@@ -290,22 +254,8 @@ mod tests {
         // One step of a 1-input, 1-unit cell checked against the scalar equations in f64.
         let device = backend::cpu();
         let lstm = backend::seeded_module(&device, 2, |d| FusedLstmConfig::new(1, 1).init(d));
-        let w: Vec<f32> = lstm
-            .gates
-            .weight
-            .val()
-            .into_data()
-            .try_to_vec::<f32>()
-            .unwrap();
-        let b: Vec<f32> = lstm
-            .gates
-            .bias
-            .as_ref()
-            .unwrap()
-            .val()
-            .into_data()
-            .try_to_vec::<f32>()
-            .unwrap();
+        let w: Vec<f32> = lstm.gates.weight.val().into_data().try_to_vec::<f32>().unwrap();
+        let b: Vec<f32> = lstm.gates.bias.as_ref().unwrap().val().into_data().try_to_vec::<f32>().unwrap();
         let (x, h0, c0) = (0.7_f64, -0.3_f64, 0.5_f64);
         // weight is [d_input + d_hidden, 4·hidden] = [2, 4]: row 0 multiplies x, row 1 multiplies h.
         let z = |k: usize| x * w[k] as f64 + h0 * w[4 + k] as f64 + b[k] as f64;
@@ -328,9 +278,7 @@ mod tests {
     #[test]
     fn bilstm_shape_and_backward_half_sees_the_future() {
         let device = backend::cpu();
-        let bilstm = backend::seeded_module(&device, 3, |d| {
-            BiLstmConfig::new(5, 6).with_num_layers(2).init(d)
-        });
+        let bilstm = backend::seeded_module(&device, 3, |d| BiLstmConfig::new(5, 6).with_num_layers(2).init(d));
         let mut xs = random_seq(10, 2, 5, &device);
         let out = bilstm.forward_seq(&xs);
         assert_eq!(out.len(), 10);

@@ -174,7 +174,8 @@ impl Lstm {
         for r in 0..rows {
             let zr = &z[r * 4 * hd..(r + 1) * 4 * hd];
             for k in 0..hd {
-                let (i, f, o, g) = (sigmoid(zr[k]), sigmoid(zr[hd + k]), sigmoid(zr[2 * hd + k]), zr[3 * hd + k].tanh());
+                let (i, f, o, g) =
+                    (sigmoid(zr[k]), sigmoid(zr[hd + k]), sigmoid(zr[2 * hd + k]), zr[3 * hd + k].tanh());
                 let c = f * state.c[r * hd + k] + i * g;
                 state.c[r * hd + k] = c;
                 state.h[r * hd + k] = o * c.tanh();
@@ -188,7 +189,8 @@ impl Lstm {
 /// shape); the row for a `bench` table. Weights come from a seeded burn cell.
 pub fn lstm_runtime_throughput(hidden: usize, d_input: usize, batch: usize, frames: usize, repeats: usize) -> BenchRow {
     let device = crate::backend::cpu();
-    let fused = crate::backend::seeded_module(&device, 0, |d| crate::lstm::FusedLstmConfig::new(d_input, hidden).init(d));
+    let fused =
+        crate::backend::seeded_module(&device, 0, |d| crate::lstm::FusedLstmConfig::new(d_input, hidden).init(d));
     let dense = crate::backend::seeded_module(&device, 1, |d| burn::nn::LinearConfig::new(hidden, hidden).init(d));
     let (lstm, dense) = (Lstm::from_fused(&fused), Dense::from_linear(&dense));
     let x: Vec<f32> = (0..batch * d_input).map(|i| ((i as f32) * 0.37).sin()).collect();
@@ -264,7 +266,15 @@ fn row_times_matrix<const FMA: bool>(x: &[f32], w: &[f32], n_out: usize, y: &mut
 /// `y[r] = b + x[r] · W` for `rows` rows, `W` `n_in × n_out` row-major (a block of a [`Dense`]'s
 /// rows: the fused LSTM gates split into their `x` and `h` parts).
 #[inline(always)]
-fn affine_rows<const FMA: bool>(w: &[f32], b: &[f32], n_out: usize, x: &[f32], n_in: usize, y: &mut [f32], rows: usize) {
+fn affine_rows<const FMA: bool>(
+    w: &[f32],
+    b: &[f32],
+    n_out: usize,
+    x: &[f32],
+    n_in: usize,
+    y: &mut [f32],
+    rows: usize,
+) {
     for r in 0..rows {
         let yr = &mut y[r * n_out..(r + 1) * n_out];
         yr.copy_from_slice(b);
@@ -386,7 +396,13 @@ impl Lstm {
     }
 
     #[inline(always)]
-    fn run_sequence_with<const FMA: bool>(&self, input: &[f32], frames: usize, reverse: bool, s: &mut DirectionScratch) {
+    fn run_sequence_with<const FMA: bool>(
+        &self,
+        input: &[f32],
+        frames: usize,
+        reverse: bool,
+        s: &mut DirectionScratch,
+    ) {
         let (hd, d_in) = (self.hidden, self.d_input());
         let n4 = 4 * hd;
         grow(&mut s.xz, frames * n4);
@@ -592,7 +608,7 @@ mod tests {
         let frames = 9;
         let mut x = input(frames, 5, 0.4);
         x[7] = 0.0; // the skipped-zero path
-        // burn: one [1, 5] tensor per frame.
+                    // burn: one [1, 5] tensor per frame.
         let steps: Vec<Tensor<2>> = (0..frames).map(|t| rows_tensor(&x[t * 5..(t + 1) * 5], 5, &device)).collect();
         let expected: Vec<f32> = stack_time(&burn_lstm.forward_seq(&steps)).into_data().try_into_vec::<f32>().unwrap();
         let mut scratch = BiLstmScratch::default();
@@ -602,7 +618,8 @@ mod tests {
         let parallel = lstm.forward_parallel(&x, frames, &mut scratch).to_vec();
         assert_eq!(parallel, got, "two threads give the same bits");
         // A shorter sequence afterwards reuses the buffers and equals a fresh run.
-        let ptrs = |s: &BiLstmScratch| (s.seq[0].as_ptr(), s.seq[1].as_ptr(), s.dirs[0].xz.as_ptr(), s.dirs[1].out.as_ptr());
+        let ptrs =
+            |s: &BiLstmScratch| (s.seq[0].as_ptr(), s.seq[1].as_ptr(), s.dirs[0].xz.as_ptr(), s.dirs[1].out.as_ptr());
         let before = ptrs(&scratch);
         let short = lstm.forward(&x[..4 * 5], 4, &mut scratch).to_vec();
         assert_eq!(ptrs(&scratch), before, "no buffer was reallocated");

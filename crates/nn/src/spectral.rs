@@ -25,11 +25,7 @@ fn normalize(x: Tensor<1>) -> Tensor<1> {
 }
 
 fn random_unit_vector(len: usize, device: &Device) -> Tensor<1> {
-    normalize(Tensor::random(
-        [len],
-        Distribution::Normal(0.0, 1.0),
-        device,
-    ))
+    normalize(Tensor::random([len], Distribution::Normal(0.0, 1.0), device))
 }
 
 /// `n` power iterations on the detached matrix `m` (`[rows, cols]`) from `u` (`[rows]`).
@@ -39,17 +35,8 @@ fn power_iteration(m: Tensor<2>, u: Tensor<1>, n: usize) -> (Tensor<1>, Tensor<1
     let mut u = u;
     let mut v = Tensor::zeros([cols], &m.device());
     for _ in 0..n.max(1) {
-        v = normalize(
-            m.clone()
-                .transpose()
-                .matmul(u.reshape([rows, 1]))
-                .reshape([cols]),
-        );
-        u = normalize(
-            m.clone()
-                .matmul(v.clone().reshape([cols, 1]))
-                .reshape([rows]),
-        );
+        v = normalize(m.clone().transpose().matmul(u.reshape([rows, 1])).reshape([cols]));
+        u = normalize(m.clone().matmul(v.clone().reshape([cols, 1])).reshape([rows]));
     }
     (u, v)
 }
@@ -57,10 +44,7 @@ fn power_iteration(m: Tensor<2>, u: Tensor<1>, n: usize) -> (Tensor<1>, Tensor<1
 /// σ(W) ≈ uᵀ W v as a `[1]` tensor, differentiable through `m`.
 fn sigma_estimate(m: Tensor<2>, u: Tensor<1>, v: Tensor<1>) -> Tensor<1> {
     let [rows, cols] = m.dims();
-    u.reshape([1, rows])
-        .matmul(m)
-        .matmul(v.reshape([cols, 1]))
-        .reshape([1])
+    u.reshape([1, rows]).matmul(m).matmul(v.reshape([cols, 1])).reshape([1])
 }
 
 /// Shared state of a spectrally normalised layer: the persistent left singular vector `u`.
@@ -74,10 +58,7 @@ pub struct SpectralState {
 
 impl SpectralState {
     fn new(rows: usize, n_power_iterations: usize, device: &Device) -> Self {
-        Self {
-            u: RunningState::new(random_unit_vector(rows, device)),
-            n_power_iterations: n_power_iterations.max(1),
-        }
+        Self { u: RunningState::new(random_unit_vector(rows, device)), n_power_iterations: n_power_iterations.max(1) }
     }
 
     /// Advance the power iteration on `m` (`[out, in]`), store `u`, and return `m / σ` and σ.
@@ -90,10 +71,7 @@ impl SpectralState {
         let _ = self.u.value_sync();
         let sigma = sigma_estimate(m.clone(), u, v);
         let [rows, cols] = m.dims();
-        (
-            m / sigma.clone().reshape([1, 1]).expand([rows, cols]),
-            sigma,
-        )
+        (m / sigma.clone().reshape([1, 1]).expand([rows, cols]), sigma)
     }
 }
 
@@ -125,9 +103,7 @@ impl SpectralLinearConfig {
     /// Build the layer on `device`.
     pub fn init(&self, device: &Device) -> SpectralLinear {
         SpectralLinear {
-            linear: LinearConfig::new(self.d_input, self.d_output)
-                .with_bias(self.bias)
-                .init(device),
+            linear: LinearConfig::new(self.d_input, self.d_output).with_bias(self.bias).init(device),
             spectral: SpectralState::new(self.d_output, self.n_power_iterations, device),
         }
     }
@@ -137,17 +113,13 @@ impl SpectralLinear {
     /// The normalised weight `W / σ(W)` (`[d_input, d_output]`); advances the power iteration.
     pub fn normalized_weight(&self) -> Tensor<2> {
         // burn stores W as [in, out]; the power iteration works on [out, in].
-        let (m, _) = self
-            .spectral
-            .normalize_matrix(self.linear.weight.val().transpose());
+        let (m, _) = self.spectral.normalize_matrix(self.linear.weight.val().transpose());
         m.transpose()
     }
 
     /// Current estimate of σ(W) of the raw weight; advances the power iteration.
     pub fn sigma(&self) -> f32 {
-        let (_, sigma) = self
-            .spectral
-            .normalize_matrix(self.linear.weight.val().transpose());
+        let (_, sigma) = self.spectral.normalize_matrix(self.linear.weight.val().transpose());
         sigma.into_scalar()
     }
 
@@ -207,15 +179,10 @@ impl SpectralConv1dConfig {
     /// Build the layer on `device` (uniform ±1/√(in·k) initialisation, like burn's Conv1d).
     pub fn init(&self, device: &Device) -> SpectralConv1d {
         let fan_in = self.channels_in * self.kernel_size;
-        let init = Initializer::KaimingUniform {
-            gain: 1.0 / 3f64.sqrt(),
-            fan_out_only: false,
-        };
+        let init = Initializer::KaimingUniform { gain: 1.0 / 3f64.sqrt(), fan_out_only: false };
         let shape = [self.channels_out, self.channels_in, self.kernel_size];
         let weight = init.init_with(shape, Some(fan_in), None, device);
-        let bias = self
-            .bias
-            .then(|| init.init_with([self.channels_out], Some(fan_in), None, device));
+        let bias = self.bias.then(|| init.init_with([self.channels_out], Some(fan_in), None, device));
         SpectralConv1d {
             weight,
             bias,
@@ -239,12 +206,7 @@ impl SpectralConv1d {
     /// `[batch, channels_in, length]` → `[batch, channels_out, length_out]`.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
         let options = ConvOptions::new([self.stride], [self.padding], [self.dilation], 1);
-        conv1d(
-            x,
-            self.normalized_weight(),
-            self.bias.as_ref().map(Param::val),
-            options,
-        )
+        conv1d(x, self.normalized_weight(), self.bias.as_ref().map(Param::val), options)
     }
 }
 
@@ -293,19 +255,11 @@ mod tests {
                 }
             }
         }
-        (0..cols)
-            .map(|i| a[i * cols + i])
-            .fold(0.0, f64::max)
-            .sqrt()
+        (0..cols).map(|i| a[i * cols + i]).fold(0.0, f64::max).sqrt()
     }
 
     fn to_f64(t: Tensor<2>) -> Vec<f64> {
-        t.into_data()
-            .try_to_vec::<f32>()
-            .unwrap()
-            .into_iter()
-            .map(f64::from)
-            .collect()
+        t.into_data().try_to_vec::<f32>().unwrap().into_iter().map(f64::from).collect()
     }
 
     #[test]
@@ -319,8 +273,7 @@ mod tests {
     #[test]
     fn spectral_linear_brings_largest_singular_value_to_one() {
         let device = backend::cpu();
-        let layer =
-            backend::seeded_module(&device, 11, |d| SpectralLinearConfig::new(6, 4).init(d));
+        let layer = backend::seeded_module(&device, 11, |d| SpectralLinearConfig::new(6, 4).init(d));
         let raw = to_f64(layer.linear.weight.val());
         let sigma_ref = largest_singular_value(&raw, 6, 4);
         // The persistent u converges over successive forward passes.
@@ -328,60 +281,35 @@ mod tests {
             let _ = layer.forward(Tensor::<2>::ones([2, 6], &device));
         }
         let sigma = layer.sigma() as f64;
-        assert!(
-            (sigma - sigma_ref).abs() < 1e-4 * sigma_ref,
-            "σ {sigma} vs reference {sigma_ref}"
-        );
+        assert!((sigma - sigma_ref).abs() < 1e-4 * sigma_ref, "σ {sigma} vs reference {sigma_ref}");
         let normalized = to_f64(layer.normalized_weight());
         let top = largest_singular_value(&normalized, 6, 4);
-        assert!(
-            (top - 1.0).abs() < 1e-4,
-            "largest singular value after normalisation: {top}"
-        );
-        assert!(
-            sigma_ref > 0.3,
-            "raw weight should not already be normalised: {sigma_ref}"
-        );
+        assert!((top - 1.0).abs() < 1e-4, "largest singular value after normalisation: {top}");
+        assert!(sigma_ref > 0.3, "raw weight should not already be normalised: {sigma_ref}");
     }
 
     #[test]
     fn spectral_conv1d_normalises_the_reshaped_kernel() {
         let device = backend::cpu();
         let conv = backend::seeded_module(&device, 12, |d| {
-            SpectralConv1dConfig::new(3, 5, 3)
-                .with_padding(1)
-                .with_n_power_iterations(20)
-                .init(d)
+            SpectralConv1dConfig::new(3, 5, 3).with_padding(1).with_n_power_iterations(20).init(d)
         });
-        let x = backend::seeded(&device, 14, || {
-            Tensor::<3>::random([2, 3, 9], Distribution::Normal(0.0, 1.0), &device)
-        });
+        let x =
+            backend::seeded(&device, 14, || Tensor::<3>::random([2, 3, 9], Distribution::Normal(0.0, 1.0), &device));
         let y = conv.forward(x);
         assert_eq!(y.dims(), [2, 5, 9]);
         let normalized = to_f64(conv.normalized_weight().reshape([5, 9]));
         let top = largest_singular_value(&normalized, 5, 9);
-        assert!(
-            (top - 1.0).abs() < 1e-3,
-            "largest singular value after normalisation: {top}"
-        );
+        assert!((top - 1.0).abs() < 1e-3, "largest singular value after normalisation: {top}");
     }
 
     #[test]
     fn gradient_flows_to_the_raw_weight() {
         let device = backend::cpu_autodiff();
-        let layer =
-            backend::seeded_module(&device, 13, |d| SpectralLinearConfig::new(3, 2).init(d));
-        let loss = layer
-            .forward(Tensor::<2>::ones([4, 3], &device))
-            .square()
-            .sum();
+        let layer = backend::seeded_module(&device, 13, |d| SpectralLinearConfig::new(3, 2).init(d));
+        let loss = layer.forward(Tensor::<2>::ones([4, 3], &device)).square().sum();
         let grads = loss.backward();
-        let g = layer
-            .linear
-            .weight
-            .val()
-            .grad(&grads)
-            .expect("weight gradient");
+        let g = layer.linear.weight.val().grad(&grads).expect("weight gradient");
         let g = g.abs().sum().into_scalar::<f32>();
         assert!(g.is_finite() && g > 0.0, "gradient magnitude {g}");
     }

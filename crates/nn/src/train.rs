@@ -264,7 +264,12 @@ where
 /// The tensor kernels run on rayon's pool: every core by default (`RAYON_NUM_THREADS=1`, or a
 /// caller's `ThreadPool::install`, for fewer); flex gives bit-identical results on any number of
 /// threads (tested), so two single-threaded runs side by side are a fair use of two cores.
-pub fn fit_with<M, B, O>(config: &TrainConfig, device: &Device, build: B, objective: &mut O) -> Result<TrainReport<M>, NnError>
+pub fn fit_with<M, B, O>(
+    config: &TrainConfig,
+    device: &Device,
+    build: B,
+    objective: &mut O,
+) -> Result<TrainReport<M>, NnError>
 where
     M: Module,
     B: FnOnce(&Device) -> M,
@@ -296,16 +301,25 @@ where
 {
     let model = crate::backend::seeded_module(device, config.seed, build);
     let optim = new_optimizer(config);
-    let fresh = RunState { model, optim, loss_history: Vec::new(), optimizer_steps: 0, start_epoch: 0, seconds_before: 0.0, resumed_from: None };
+    let fresh = RunState {
+        model,
+        optim,
+        loss_history: Vec::new(),
+        optimizer_steps: 0,
+        start_epoch: 0,
+        seconds_before: 0.0,
+        resumed_from: None,
+    };
     let Some(dir) = &config.checkpoint_dir else { return Ok(fresh) };
     let Some(files) = checkpoint::latest_checkpoint(dir)? else { return Ok(fresh) };
     let (model, optim, meta) = checkpoint::load_checkpoint(&files, fresh.model, fresh.optim)?;
     check_resumable(config, &meta, &files.meta)?;
     if files.state.exists() {
         let bytes = std::fs::read(&files.state).map_err(|source| NnError::Io { path: files.state.clone(), source })?;
-        objective
-            .restore(&bytes)
-            .map_err(|message| NnError::Record { path: files.state.clone(), message: format!("objective state: {message}") })?;
+        objective.restore(&bytes).map_err(|message| NnError::Record {
+            path: files.state.clone(),
+            message: format!("objective state: {message}"),
+        })?;
     }
     Ok(RunState {
         model,
@@ -324,8 +338,15 @@ where
     B: FnOnce(&Device) -> M,
     O: Objective<M>,
 {
-    let RunState { mut model, mut optim, mut loss_history, mut optimizer_steps, start_epoch, seconds_before, resumed_from } =
-        start(config, device, build, objective)?;
+    let RunState {
+        mut model,
+        mut optim,
+        mut loss_history,
+        mut optimizer_steps,
+        start_epoch,
+        seconds_before,
+        resumed_from,
+    } = start(config, device, build, objective)?;
     let total = (config.epochs * config.steps_per_epoch) as u64;
     let bar = if config.progress { Progress::new(total, "training") } else { Progress::hidden() };
     bar.set_position((start_epoch * config.steps_per_epoch) as u64);
@@ -385,7 +406,10 @@ where
                 seconds,
                 config: serde_json::to_value(config).unwrap_or(serde_json::Value::Null),
             };
-            let state = objective.state().map_err(|message| NnError::Record { path: dir.clone(), message: format!("objective state: {message}") })?;
+            let state = objective.state().map_err(|message| NnError::Record {
+                path: dir.clone(),
+                message: format!("objective state: {message}"),
+            })?;
             let files = checkpoint::save_checkpoint(dir, &model, &optim, &state, &meta)?;
             last_checkpoint = Some(files.model);
         }
@@ -422,8 +446,12 @@ fn check_resumable(config: &TrainConfig, meta: &CheckpointMeta, path: &std::path
              this run has seed {}, steps_per_epoch {}, grad_clip_norm {:?} \
              (use another checkpoint_dir to start afresh)",
             path.display(),
-            saved.seed, saved.steps_per_epoch, saved.grad_clip_norm,
-            config.seed, config.steps_per_epoch, config.grad_clip_norm,
+            saved.seed,
+            saved.steps_per_epoch,
+            saved.grad_clip_norm,
+            config.seed,
+            config.steps_per_epoch,
+            config.grad_clip_norm,
         )));
     }
     if saved.schedule_key() != config.schedule_key() && config.lr_decay_from < meta.epoch {
@@ -433,8 +461,12 @@ fn check_resumable(config: &TrainConfig, meta: &CheckpointMeta, path: &std::path
              (set lr_decay_from to {} for a warm restart)",
             path.display(),
             meta.epoch,
-            saved.lr, saved.lr_decay, saved.lr_decay_from,
-            config.lr, config.lr_decay, config.lr_decay_from,
+            saved.lr,
+            saved.lr_decay,
+            saved.lr_decay_from,
+            config.lr,
+            config.lr_decay,
+            config.lr_decay_from,
             meta.epoch,
         )));
     }
@@ -457,10 +489,7 @@ mod tests {
     }
 
     fn build(device: &Device) -> SinePredictor {
-        SinePredictor {
-            lstm: FusedLstmConfig::new(1, 16).init(device),
-            head: LinearConfig::new(16, 1).init(device),
-        }
+        SinePredictor { lstm: FusedLstmConfig::new(1, 16).init(device), head: LinearConfig::new(16, 1).init(device) }
     }
 
     const BATCH: usize = 16;
@@ -474,9 +503,8 @@ mod tests {
             state = inbetween_core::seed::mix(state);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        let waves: Vec<(f64, f64)> = (0..BATCH)
-            .map(|_| (uniform() * std::f64::consts::TAU, 0.25 + 0.3 * uniform()))
-            .collect();
+        let waves: Vec<(f64, f64)> =
+            (0..BATCH).map(|_| (uniform() * std::f64::consts::TAU, 0.25 + 0.3 * uniform())).collect();
         let sample = |b: usize, t: usize| {
             let (phase, omega) = waves[b];
             (phase + omega * t as f64).sin() as f32
@@ -487,14 +515,9 @@ mod tests {
                 Tensor::from_data(TensorData::new(column, [BATCH, 1]), device)
             })
             .collect();
-        let targets: Vec<f32> = (0..BATCH)
-            .flat_map(|b| (1..=STEPS).map(move |t| (b, t)))
-            .map(|(b, t)| sample(b, t))
-            .collect();
-        (
-            inputs,
-            Tensor::from_data(TensorData::new(targets, [BATCH, STEPS]), device),
-        )
+        let targets: Vec<f32> =
+            (0..BATCH).flat_map(|b| (1..=STEPS).map(move |t| (b, t))).map(|(b, t)| sample(b, t)).collect();
+        (inputs, Tensor::from_data(TensorData::new(targets, [BATCH, STEPS]), device))
     }
 
     fn predict(model: &SinePredictor, inputs: &[Tensor<2>]) -> Tensor<2> {
@@ -522,23 +545,8 @@ mod tests {
     }
 
     fn weights(model: &SinePredictor) -> Vec<f32> {
-        let mut all = model
-            .lstm
-            .gates
-            .weight
-            .val()
-            .into_data()
-            .try_to_vec::<f32>()
-            .unwrap();
-        all.extend(
-            model
-                .head
-                .weight
-                .val()
-                .into_data()
-                .try_to_vec::<f32>()
-                .unwrap(),
-        );
+        let mut all = model.lstm.gates.weight.val().into_data().try_to_vec::<f32>().unwrap();
+        all.extend(model.head.weight.val().into_data().try_to_vec::<f32>().unwrap());
         all
     }
 
@@ -548,16 +556,10 @@ mod tests {
         let report = fit(&config(30), &device, build, sine_loss(&device)).unwrap();
         let first = report.loss_history[0];
         let last = *report.loss_history.last().unwrap();
-        println!(
-            "sine smoke: first-epoch loss {first:.5}, last-epoch loss {last:.5}, ratio {:.4}",
-            last / first
-        );
+        println!("sine smoke: first-epoch loss {first:.5}, last-epoch loss {last:.5}, ratio {:.4}", last / first);
         assert_eq!(report.loss_history.len(), 30);
         assert_eq!(report.optimizer_steps, 150);
-        assert!(
-            last < 0.2 * first,
-            "loss did not fall enough: {first} -> {last}"
-        );
+        assert!(last < 0.2 * first, "loss did not fall enough: {first} -> {last}");
     }
 
     #[test]
@@ -567,10 +569,7 @@ mod tests {
         let b = fit(&config(2), &device, build, sine_loss(&device)).unwrap();
         assert_eq!(a.loss_history, b.loss_history);
         assert_eq!(weights(&a.model), weights(&b.model));
-        let other = TrainConfig {
-            seed: 43,
-            ..config(2)
-        };
+        let other = TrainConfig { seed: 43, ..config(2) };
         let c = fit(&other, &device, build, sine_loss(&device)).unwrap();
         assert_ne!(weights(&a.model), weights(&c.model));
     }
@@ -585,29 +584,11 @@ mod tests {
             checkpoint_dir: Some(dir.to_path_buf()),
             ..config(epochs)
         };
-        let straight = fit(
-            &with_dir(4, straight_dir.path()),
-            &device,
-            build,
-            sine_loss(&device),
-        )
-        .unwrap();
+        let straight = fit(&with_dir(4, straight_dir.path()), &device, build, sine_loss(&device)).unwrap();
         // Interrupted after 2 epochs, then restarted with the full epoch count.
-        let first = fit(
-            &with_dir(2, split_dir.path()),
-            &device,
-            build,
-            sine_loss(&device),
-        )
-        .unwrap();
+        let first = fit(&with_dir(2, split_dir.path()), &device, build, sine_loss(&device)).unwrap();
         assert_eq!(first.loss_history.len(), 2);
-        let resumed = fit(
-            &with_dir(4, split_dir.path()),
-            &device,
-            build,
-            sine_loss(&device),
-        )
-        .unwrap();
+        let resumed = fit(&with_dir(4, split_dir.path()), &device, build, sine_loss(&device)).unwrap();
         assert_eq!(resumed.start_epoch, 2);
         assert!(resumed.resumed_from.is_some());
         assert_eq!(resumed.optimizer_steps, straight.optimizer_steps);
@@ -615,13 +596,8 @@ mod tests {
         assert_eq!(weights(&resumed.model), weights(&straight.model));
 
         // A checkpoint from another seed is refused with a message naming both.
-        let mismatched = TrainConfig {
-            seed: 7,
-            ..with_dir(6, split_dir.path())
-        };
-        let err = fit(&mismatched, &device, build, sine_loss(&device))
-            .unwrap_err()
-            .to_string();
+        let mismatched = TrainConfig { seed: 7, ..with_dir(6, split_dir.path()) };
+        let err = fit(&mismatched, &device, build, sine_loss(&device)).unwrap_err().to_string();
         assert!(err.contains("seed 42") && err.contains("seed 7"), "{err}");
     }
 
@@ -658,7 +634,11 @@ mod tests {
         }
         fn after_epoch(&mut self, _: &SinePredictor, end: &EpochEnd) -> Control {
             self.epochs.push(*end);
-            if self.stop_after == Some(end.epoch + 1) { Control::Stop } else { Control::Continue }
+            if self.stop_after == Some(end.epoch + 1) {
+                Control::Stop
+            } else {
+                Control::Continue
+            }
         }
         fn state(&self) -> Result<Vec<u8>, String> {
             Ok(self.seen.to_le_bytes().to_vec())
@@ -673,7 +653,8 @@ mod tests {
     fn hooks_see_every_step_and_objective_state_resumes_bit_identically() {
         let device = backend::cpu_autodiff();
         let (straight_dir, split_dir) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-        let with_dir = |epochs, dir: &std::path::Path| TrainConfig { checkpoint_dir: Some(dir.to_path_buf()), ..config(epochs) };
+        let with_dir =
+            |epochs, dir: &std::path::Path| TrainConfig { checkpoint_dir: Some(dir.to_path_buf()), ..config(epochs) };
         let mut whole = Counting::new(&device);
         let straight = fit_with(&with_dir(4, straight_dir.path()), &device, build, &mut whole).unwrap();
         assert_eq!(whole.steps.len(), 20);
@@ -699,7 +680,8 @@ mod tests {
     fn a_time_limit_stops_after_a_checkpointed_epoch_that_resumes() {
         let device = backend::cpu_autodiff();
         let dir = tempfile::tempdir().unwrap();
-        let limited = TrainConfig { time_limit_s: Some(1e-9), checkpoint_dir: Some(dir.path().to_path_buf()), ..config(3) };
+        let limited =
+            TrainConfig { time_limit_s: Some(1e-9), checkpoint_dir: Some(dir.path().to_path_buf()), ..config(3) };
         let report = fit(&limited, &device, build, sine_loss(&device)).unwrap();
         assert_eq!(report.finish, Finish::TimeLimit { epochs_done: 1 });
         assert!(report.last_checkpoint.is_some());
@@ -725,7 +707,9 @@ mod tests {
         let with_dir = |c: TrainConfig| TrainConfig { checkpoint_dir: Some(dir.path().to_path_buf()), ..c };
         fit(&with_dir(config(2)), &device, build, sine_loss(&device)).unwrap();
         // A new lr that claims to count from epoch 0 would rewrite history: refused.
-        let err = fit(&with_dir(TrainConfig { lr: 0.01, ..config(3) }), &device, build, sine_loss(&device)).unwrap_err().to_string();
+        let err = fit(&with_dir(TrainConfig { lr: 0.01, ..config(3) }), &device, build, sine_loss(&device))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("lr_decay_from") && err.contains("epoch 2"), "{err}");
         let warm = with_dir(TrainConfig { lr: 0.01, lr_decay_from: 2, ..config(3) });
         let report = fit(&warm, &device, build, sine_loss(&device)).unwrap();
@@ -757,52 +741,32 @@ mod tests {
         let fresh = backend::seeded_module(&device, 999, build);
         let loaded = checkpoint::load_module(fresh, &path).unwrap();
         let (inputs, _) = sine_batch(5, &device);
-        let expected = predict(&report.model, &inputs)
-            .into_data()
-            .try_to_vec::<f32>()
-            .unwrap();
-        let got = predict(&loaded, &inputs)
-            .into_data()
-            .try_to_vec::<f32>()
-            .unwrap();
+        let expected = predict(&report.model, &inputs).into_data().try_to_vec::<f32>().unwrap();
+        let got = predict(&loaded, &inputs).into_data().try_to_vec::<f32>().unwrap();
         assert_eq!(expected, got);
     }
 
     #[test]
     fn bad_config_and_files_give_clear_errors() {
         let device = backend::cpu_autodiff();
-        let bad = TrainConfig {
-            lr_decay: 1.5,
-            ..config(1)
-        };
-        let err = fit(&bad, &device, build, sine_loss(&device))
-            .unwrap_err()
-            .to_string();
+        let bad = TrainConfig { lr_decay: 1.5, ..config(1) };
+        let err = fit(&bad, &device, build, sine_loss(&device)).unwrap_err().to_string();
         assert!(err.contains("lr_decay"), "{err}");
         let plain = backend::cpu();
-        let err = fit(&config(1), &plain, build, sine_loss(&plain))
-            .unwrap_err()
-            .to_string();
+        let err = fit(&config(1), &plain, build, sine_loss(&plain)).unwrap_err().to_string();
         assert!(err.contains("autodiff"), "{err}");
 
         let dir = tempfile::tempdir().unwrap();
         let garbage = dir.path().join("garbage.bpk");
         std::fs::write(&garbage, b"not a burnpack").unwrap();
-        let err = checkpoint::load_module(build(&device), &garbage)
-            .unwrap_err()
-            .to_string();
+        let err = checkpoint::load_module(build(&device), &garbage).unwrap_err().to_string();
         assert!(err.contains("garbage.bpk"), "{err}");
         let meta = dir.path().join("epoch-000001.json");
         std::fs::write(&meta, "{\n  \"epoch\": 1,\n  oops\n}").unwrap();
         let err = CheckpointMeta::load(&meta).unwrap_err().to_string();
-        assert!(
-            err.contains("epoch-000001.json") && err.contains("line 3"),
-            "{err}"
-        );
+        assert!(err.contains("epoch-000001.json") && err.contains("line 3"), "{err}");
         let missing = dir.path().join("missing.bpk");
-        let err = checkpoint::load_module(build(&device), &missing)
-            .unwrap_err()
-            .to_string();
+        let err = checkpoint::load_module(build(&device), &missing).unwrap_err().to_string();
         assert!(err.contains("missing.bpk"), "{err}");
     }
 }

@@ -30,15 +30,8 @@ impl TtaEmbedding {
     /// # Panics
     /// If `dim` is odd or zero: sin/cos pairs need an even size.
     pub fn new(dim: usize, max_tta: f32) -> Self {
-        assert!(
-            dim > 0 && dim.is_multiple_of(2),
-            "TtaEmbedding: dim must be even and > 0, got {dim}"
-        );
-        Self {
-            dim,
-            basis: 10_000.0,
-            max_tta,
-        }
+        assert!(dim > 0 && dim.is_multiple_of(2), "TtaEmbedding: dim must be even and > 0, got {dim}");
+        Self { dim, basis: 10_000.0, max_tta }
     }
 
     /// Like [`new`](Self::new) but returns an error instead of panicking on a bad `dim` or cap
@@ -50,9 +43,7 @@ impl TtaEmbedding {
             )));
         }
         if !(max_tta >= 0.0 && max_tta.is_finite()) {
-            return Err(crate::NnError::Config(format!(
-                "TTA cap must be finite and >= 0, got {max_tta}"
-            )));
+            return Err(crate::NnError::Config(format!("TTA cap must be finite and >= 0, got {max_tta}")));
         }
         Ok(Self::new(dim, max_tta))
     }
@@ -108,11 +99,7 @@ mod tests {
         for i in 0..4 {
             let angle = 5.0_f64 / 10_000f64.powf(2.0 * i as f64 / 8.0);
             assert!((z[2 * i] as f64 - angle.sin()).abs() < 1e-7, "z[{}]", 2 * i);
-            assert!(
-                (z[2 * i + 1] as f64 - angle.cos()).abs() < 1e-7,
-                "z[{}]",
-                2 * i + 1
-            );
+            assert!((z[2 * i + 1] as f64 - angle.cos()).abs() < 1e-7, "z[{}]", 2 * i + 1);
         }
         // Hand-checked first pair: sin(5), cos(5).
         assert!((z[0] - (-0.958_924_3)).abs() < 1e-6 && (z[1] - 0.283_662_2).abs() < 1e-6);
@@ -153,9 +140,6 @@ mod tests {
         let err = TtaEmbedding::try_new(7, 30.0).unwrap_err().to_string();
         assert!(err.contains("even") && err.contains('7'), "{err}");
         assert!(TtaEmbedding::try_new(8, f32::NAN).is_err());
-        assert_eq!(
-            TtaEmbedding::try_new(8, 30.0).unwrap(),
-            TtaEmbedding::new(8, 30.0)
-        );
+        assert_eq!(TtaEmbedding::try_new(8, 30.0).unwrap(), TtaEmbedding::new(8, 30.0));
     }
 }

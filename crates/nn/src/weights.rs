@@ -90,7 +90,8 @@ pub fn card_path(weights: &Path) -> PathBuf {
 /// weights file whose card exists is complete).
 pub fn save<M: Module>(model: &M, card: &WeightsCard, path: &Path) -> Result<(), NnError> {
     save_module(model, path)?;
-    let json = serde_json::to_string_pretty(card).map_err(|e| NnError::Record { path: card_path(path), message: e.to_string() })?;
+    let json = serde_json::to_string_pretty(card)
+        .map_err(|e| NnError::Record { path: card_path(path), message: e.to_string() })?;
     write_atomic(&card_path(path), (json + "\n").as_bytes())
 }
 
@@ -107,7 +108,8 @@ impl Weights {
     pub fn from_path(path: &Path) -> Result<Weights, NnError> {
         let bytes = std::fs::read(path).map_err(|source| NnError::Io { path: path.to_path_buf(), source })?;
         let card_file = card_path(path);
-        let text = std::fs::read_to_string(&card_file).map_err(|source| NnError::Io { path: card_file.clone(), source })?;
+        let text =
+            std::fs::read_to_string(&card_file).map_err(|source| NnError::Io { path: card_file.clone(), source })?;
         let card = WeightsCard::parse(&text, &card_file)?;
         Ok(Weights { origin: path.to_path_buf(), bytes: Cow::Owned(bytes), card })
     }
@@ -215,7 +217,12 @@ mod tests {
         save(&model, &card(), &path).unwrap();
         let w = Weights::from_path(&path).unwrap();
         let err = w.expect_kind("camera", 1).unwrap_err().to_string();
-        assert!(err.contains("w.bpk") && err.contains("holds test-lstm weights (format 2)") && err.contains("expected camera"), "{err}");
+        assert!(
+            err.contains("w.bpk")
+                && err.contains("holds test-lstm weights (format 2)")
+                && err.contains("expected camera"),
+            "{err}"
+        );
         let err = w.expect_kind("test-lstm", 3).unwrap_err().to_string();
         assert!(err.contains("format 3"), "{err}");
         // Another shape: burn names the parameter.

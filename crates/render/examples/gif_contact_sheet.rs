@@ -22,7 +22,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let rgb = image::DynamicImage::ImageRgba8(frames[i].buffer().clone()).to_rgb8();
         let small = image::imageops::resize(&rgb, tw, th, image::imageops::FilterType::Triangle);
         sheet.blit(&small, (k as u32 % cols * tw) as i64, (k as u32 / cols * th) as i64);
-        sheet.text(((k as u32 % cols * tw) as f32 + 4.0, (k as u32 / cols * th) as f32 + 2.0), &format!("#{i}"), 12.0, [200, 0, 0]);
+        sheet.text(
+            ((k as u32 % cols * tw) as f32 + 4.0, (k as u32 / cols * th) as f32 + 2.0),
+            &format!("#{i}"),
+            12.0,
+            [200, 0, 0],
+        );
     }
     inbetween_render::write_png(std::path::Path::new(&args[2]), &sheet.into_image())?;
     println!("{} frames in {}, sheet of {:?}", frames.len(), args[1], picks);

@@ -11,7 +11,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let frame: usize = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(0);
     let motion = inbetween_io::load_motion(Path::new(&args[1]))?;
-    let opts = StickOptions { title: Some(args[1].rsplit('/').next().unwrap_or("").to_string()), ..StickOptions::default() };
+    let opts =
+        StickOptions { title: Some(args[1].rsplit('/').next().unwrap_or("").to_string()), ..StickOptions::default() };
     render_motion_png(Path::new(&args[2]), &[&motion], frame, &opts)?;
     println!("wrote {} (frame {frame} of {})", args[2], motion.num_frames());
     Ok(())

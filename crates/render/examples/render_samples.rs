@@ -13,7 +13,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let walk = gait(&GaitParams::walk());
     let run = gait(&GaitParams { turn_rate: 0.5, ..GaitParams::run() });
     let other = gait(&GaitParams::walk().jittered(7, 0.3));
-    let timed = |name: &str, f: &mut dyn FnMut() -> Result<(), inbetween_render::RenderError>| -> Result<(), inbetween_render::RenderError> {
+    let timed = |name: &str,
+                 f: &mut dyn FnMut() -> Result<(), inbetween_render::RenderError>|
+     -> Result<(), inbetween_render::RenderError> {
         let t = Instant::now();
         f()?;
         let kib = std::fs::metadata(dir.join(name)).map(|m| m.len() as f64 / 1024.0).unwrap_or(0.0);
@@ -24,7 +26,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     timed("walk_frame.png", &mut || render_motion_png(&dir.join("walk_frame.png"), &[&walk], 40, &titled))?;
     timed("walk.gif", &mut || render_motion_gif(&dir.join("walk.gif"), &[&walk], &titled))?;
     let compare = StickOptions { labels: vec!["walk".into(), "jittered walk".into()], ..StickOptions::default() };
-    timed("compare_frame.png", &mut || render_motion_png(&dir.join("compare_frame.png"), &[&walk, &other], 60, &compare))?;
+    timed("compare_frame.png", &mut || {
+        render_motion_png(&dir.join("compare_frame.png"), &[&walk, &other], 60, &compare)
+    })?;
     timed("compare.gif", &mut || render_motion_gif(&dir.join("compare.gif"), &[&walk, &other], &compare))?;
     let long_title = StickOptions {
         labels: vec!["original".into(), "from 12 keys".into()],
@@ -32,13 +36,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..StickOptions::default()
     };
     timed("long_title.png", &mut || render_motion_png(&dir.join("long_title.png"), &[&walk, &other], 0, &long_title))?;
-    timed("run_turning.png", &mut || render_motion_png(&dir.join("run_turning.png"), &[&run], 100, &StickOptions::default()))?;
+    timed("run_turning.png", &mut || {
+        render_motion_png(&dir.join("run_turning.png"), &[&run], 100, &StickOptions::default())
+    })?;
     let curve = |f: fn(f64) -> f64| (0..200).map(|i| (i as f64 / 30.0, f(i as f64 / 30.0))).collect::<Vec<_>>();
     timed("line.png", &mut || {
-        line_plot(&dir.join("line.png"), "Position error per frame", "time (s)", "error (cm)", &[
-            Series::new("uniform keys", curve(|t| 2.0 + (t * 3.0).sin().abs() * 3.0)),
-            Series::new("SIDQL keys", curve(|t| 1.0 + (t * 3.0).sin().abs())),
-        ])
+        line_plot(
+            &dir.join("line.png"),
+            "Position error per frame",
+            "time (s)",
+            "error (cm)",
+            &[
+                Series::new("uniform keys", curve(|t| 2.0 + (t * 3.0).sin().abs() * 3.0)),
+                Series::new("SIDQL keys", curve(|t| 1.0 + (t * 3.0).sin().abs())),
+            ],
+        )
     })?;
     timed("scatter.png", &mut || {
         let pts = (0..80).map(|i| (i as f64, ((i * 37) % 23) as f64 * 0.3 + i as f64 * 0.05)).collect();
@@ -47,11 +59,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     timed("bars.png", &mut || {
         // Illustrative values to show the chart layout; they are not measurements.
         let groups: Vec<String> = ["group 1", "group 2", "group 3", "group 4"].iter().map(|s| s.to_string()).collect();
-        grouped_bar_chart(&dir.join("bars.png"), "Sample bar chart (illustrative values)", "value", &groups, &[
-            ("series a".into(), vec![3.1, 5.2, 4.4, 6.0]),
-            ("series b".into(), vec![2.0, 3.1, 2.9, 3.8]),
-            ("series c".into(), vec![1.4, 2.2, 2.0, 2.9]),
-        ])
+        grouped_bar_chart(
+            &dir.join("bars.png"),
+            "Sample bar chart (illustrative values)",
+            "value",
+            &groups,
+            &[
+                ("series a".into(), vec![3.1, 5.2, 4.4, 6.0]),
+                ("series b".into(), vec![2.0, 3.1, 2.9, 3.8]),
+                ("series c".into(), vec![1.4, 2.2, 2.0, 2.9]),
+            ],
+        )
     })?;
     Ok(())
 }

@@ -30,10 +30,26 @@ pub fn render_bench(dir: &Path, repeats: usize) -> Result<Vec<BenchRow>, RenderE
     let bars = vec![("a".to_string(), vec![1.0; 6]), ("b".to_string(), vec![2.0; 6]), ("c".to_string(), vec![1.5; 6])];
     let tasks: Vec<(&str, &str, Task)> = vec![
         ("GIF, 1 figure, 120 frames, 480x360", "walk.gif", Box::new(|p| render_motion_gif(p, &[&walk], &opts))),
-        ("GIF, 2 figures, 120 frames, 480x360", "compare.gif", Box::new(|p| render_motion_gif(p, &[&walk, &other], &opts))),
-        ("PNG, 2 figures, 1 frame, 480x360", "compare.png", Box::new(|p| render_motion_png(p, &[&walk, &other], 60, &opts))),
-        ("line plot, 1000 points, 900x560", "line.png", Box::new(|p| line_plot(p, "bench", "t", "y", &[Series::new("sin", curve.clone())]))),
-        ("bar chart, 6 groups x 3, 900x560", "bars.png", Box::new(|p| grouped_bar_chart(p, "bench", "y", &groups, &bars))),
+        (
+            "GIF, 2 figures, 120 frames, 480x360",
+            "compare.gif",
+            Box::new(|p| render_motion_gif(p, &[&walk, &other], &opts)),
+        ),
+        (
+            "PNG, 2 figures, 1 frame, 480x360",
+            "compare.png",
+            Box::new(|p| render_motion_png(p, &[&walk, &other], 60, &opts)),
+        ),
+        (
+            "line plot, 1000 points, 900x560",
+            "line.png",
+            Box::new(|p| line_plot(p, "bench", "t", "y", &[Series::new("sin", curve.clone())])),
+        ),
+        (
+            "bar chart, 6 groups x 3, 900x560",
+            "bars.png",
+            Box::new(|p| grouped_bar_chart(p, "bench", "y", &groups, &bars)),
+        ),
     ];
     let mut rows = Vec::new();
     for (task, file, run) in tasks {

@@ -400,7 +400,10 @@ mod tests {
         assert_eq!(cv.pixel(65, 45), [255, 255, 255]);
         let w = cv.text((30.0, 20.0), "Hello", 20.0, [0, 0, 0]);
         assert!((w - text_width("Hello", 20.0)).abs() < 1e-3 && w > 30.0);
-        let dark = (30..30 + w as u32).flat_map(|x| (20..40).map(move |y| (x, y))).filter(|&(x, y)| cv.pixel(x, y)[0] < 100).count();
+        let dark = (30..30 + w as u32)
+            .flat_map(|x| (20..40).map(move |y| (x, y)))
+            .filter(|&(x, y)| cv.pixel(x, y)[0] < 100)
+            .count();
         assert!(dark > 40, "text left {dark} dark pixels");
     }
 }

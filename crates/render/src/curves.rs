@@ -93,7 +93,6 @@ fn err(plot: &EditPlot, message: impl std::fmt::Display) -> RenderError {
     RenderError::Plot { title: plot.title.clone(), message: message.to_string() }
 }
 
-
 /// Rejects plots that cannot be drawn: no curves or times, length mismatches, non-finite values,
 /// decreasing times, bad spans, markers on unknown curves.
 fn check(plot: &EditPlot) -> Result<(), RenderError> {
@@ -108,7 +107,10 @@ fn check(plot: &EditPlot) -> Result<(), RenderError> {
         return Err(err(plot, format!("time of frame {i} is not finite")));
     }
     if let Some(i) = plot.times_s.windows(2).position(|w| w[1] < w[0]) {
-        return Err(err(plot, format!("times decrease at frame {}: {} after {}", i + 1, plot.times_s[i + 1], plot.times_s[i])));
+        return Err(err(
+            plot,
+            format!("times decrease at frame {}: {} after {}", i + 1, plot.times_s[i + 1], plot.times_s[i]),
+        ));
     }
     for c in &plot.curves {
         let mut series = vec![("before", &c.before), ("after", &c.after)];
@@ -228,7 +230,12 @@ fn draw_legend(root: &DrawingArea<BitMapBackend<'_>, Shift>, plot: &EditPlot) ->
 }
 
 /// One curve's panel: shaded spans, before, extra, after, markers.
-fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, plot: &EditPlot, c: &EditCurve, last: bool) -> Result<(), RenderError> {
+fn draw_panel(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    plot: &EditPlot,
+    c: &EditCurve,
+    last: bool,
+) -> Result<(), RenderError> {
     let e = |x| err(plot, x);
     let (xr, yr) = (time_range(&plot.times_s), value_range(plot, c));
     let mut chart = ChartBuilder::on(area)
@@ -256,7 +263,9 @@ fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, plot: &EditPlot, c: 
     }
     mesh.draw().map_err(e)?;
     let spans = plot.spans.iter().map(|&(a, b)| (a.max(xr.start), b.min(xr.end))).filter(|(a, b)| a < b);
-    chart.draw_series(spans.map(|(a, b)| Rectangle::new([(a, yr.start), (b, yr.end)], rgb(SPAN_COLOR).filled()))).map_err(e)?;
+    chart
+        .draw_series(spans.map(|(a, b)| Rectangle::new([(a, yr.start), (b, yr.end)], rgb(SPAN_COLOR).filled())))
+        .map_err(e)?;
     let points = |v: &[f32]| -> Vec<(f64, f64)> { plot.times_s.iter().zip(v).map(|(&t, &y)| (t, y as f64)).collect() };
     // The original is drawn wider, so it shows beside the edited curve where both agree.
     chart.draw_series(LineSeries::new(points(&c.before), rgb(BEFORE_COLOR).stroke_width(px(4) as u32))).map_err(e)?;
@@ -285,7 +294,12 @@ mod tests {
         let times: Vec<f64> = (0..n).map(|i| i as f64 * 0.04).collect();
         let wave = |f: f32| -> Vec<f32> { (0..n).map(|i| 0.5 + 0.4 * (i as f32 * f).sin()).collect() };
         let mut plot = EditPlot::new("edit of two curves", times);
-        plot.curves.push(EditCurve { name: "JawOpen".into(), before: wave(0.2), after: wave(0.3), extra: Some(("linear".into(), wave(0.1))) });
+        plot.curves.push(EditCurve {
+            name: "JawOpen".into(),
+            before: wave(0.2),
+            after: wave(0.3),
+            extra: Some(("linear".into(), wave(0.1))),
+        });
         plot.curves.push(EditCurve { name: "EyeBlinkLeft".into(), before: wave(0.5), after: wave(0.5), extra: None });
         // The middle fifth of the time axis is edited.
         plot.spans.push((1.6, 2.4));

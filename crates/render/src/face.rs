@@ -604,7 +604,8 @@ fn mouth_shape(p: &FacePose) -> MouthShape {
     };
     let (w_r, w_l) = (side_w(-1.0), side_w(1.0));
     let (cy_r, cy_l) = (corner_y(-1.0), corner_y(1.0));
-    let open_up = |side: f32| 0.05 * FacePose::sided(side, p.upper_lip_raise_left, p.upper_lip_raise_right) + 0.02 * p.funnel;
+    let open_up =
+        |side: f32| 0.05 * FacePose::sided(side, p.upper_lip_raise_left, p.upper_lip_raise_right) + 0.02 * p.funnel;
     let open_lo = |side: f32| {
         let drop = FacePose::sided(side, p.lower_lip_drop_left, p.lower_lip_drop_right);
         (jaw_lips + 0.06 * drop + 0.03 * p.funnel - 0.04 * p.chin_raise).max(0.0)
@@ -645,7 +646,9 @@ fn draw_mouth(cv: &mut Canvas, v: &View, p: &FacePose) {
     let m = mouth_shape(p);
     let px = |pts: &[(f32, f32)]| -> Vec<(f32, f32)> { pts.iter().map(|&(x, y)| v.at(x, y, DEPTH_MOUTH)).collect() };
     let offset = |pts: &[(f32, f32)], dy: f32| -> Vec<(f32, f32)> { pts.iter().map(|&(x, y)| (x, y + dy)).collect() };
-    let join = |a: Vec<(f32, f32)>, b: Vec<(f32, f32)>| -> Vec<(f32, f32)> { a.into_iter().chain(b.into_iter().rev()).collect() };
+    let join = |a: Vec<(f32, f32)>, b: Vec<(f32, f32)>| -> Vec<(f32, f32)> {
+        a.into_iter().chain(b.into_iter().rev()).collect()
+    };
     let cavity = join(px(&m.upper_inner), px(&m.lower_inner));
     fill(cv, &[&cavity], MOUTH_CAVITY, 1.0);
     let upper_teeth = join(px(&offset(&m.upper_inner, -0.01)), px(&offset(&m.upper_inner, 0.032)));
@@ -724,7 +727,15 @@ fn header(labels: &[&str], title: Option<&str>, panel_size: u32, footer: u32) ->
         centred_text(&mut cv, 0.0, width as f32, size * 0.3, t, size, TEXT);
     }
     for (i, l) in labels.iter().enumerate() {
-        centred_text(&mut cv, (i as u32 * panel_size) as f32, panel_size as f32, title_h as f32 + size * 0.3, l, size, TEXT);
+        centred_text(
+            &mut cv,
+            (i as u32 * panel_size) as f32,
+            panel_size as f32,
+            title_h as f32 + size * 0.3,
+            l,
+            size,
+            TEXT,
+        );
     }
     cv
 }
@@ -852,7 +863,10 @@ mod tests {
     /// Pixels in the region (pixel rectangle) that satisfy `pred`.
     fn count(cv: &Canvas, region: (u32, u32, u32, u32), pred: impl Fn([u8; 3]) -> bool) -> Vec<(u32, u32)> {
         let (x0, y0, x1, y1) = region;
-        (y0..y1.min(cv.height())).flat_map(|y| (x0..x1.min(cv.width())).map(move |x| (x, y))).filter(|&(x, y)| pred(cv.pixel(x, y))).collect()
+        (y0..y1.min(cv.height()))
+            .flat_map(|y| (x0..x1.min(cv.width())).map(move |x| (x, y)))
+            .filter(|&(x, y)| pred(cv.pixel(x, y)))
+            .collect()
     }
 
     fn whole() -> (u32, u32, u32, u32) {
@@ -901,7 +915,10 @@ mod tests {
         // One lid only: the iris remains on the other side of the image.
         let wink = FacePose { eyelid_open_left: 0.0, ..FacePose::default() };
         let wink = count(&face(&wink), whole(), is_iris);
-        assert!(!wink.is_empty() && wink.iter().all(|p| p.0 < SIZE / 2), "the subject's left eye is on the image right");
+        assert!(
+            !wink.is_empty() && wink.iter().all(|p| p.0 < SIZE / 2),
+            "the subject's left eye is on the image right"
+        );
     }
 
     #[test]
@@ -910,7 +927,13 @@ mod tests {
         let right = FacePose { gaze_left_x: 1.0, gaze_right_x: 1.0, ..FacePose::default() };
         let right = centroid_x(&count(&face(&right), whole(), is_iris));
         assert!(right > ahead + 4.0, "looking right moves the iris right: {ahead} -> {right}");
-        let up = FacePose { gaze_left_y: -1.0, gaze_right_y: -1.0, eyelid_open_left: 1.4, eyelid_open_right: 1.4, ..FacePose::default() };
+        let up = FacePose {
+            gaze_left_y: -1.0,
+            gaze_right_y: -1.0,
+            eyelid_open_left: 1.4,
+            eyelid_open_right: 1.4,
+            ..FacePose::default()
+        };
         let wide = FacePose { eyelid_open_left: 1.4, eyelid_open_right: 1.4, ..FacePose::default() };
         let cy = |pose: &FacePose| {
             let pts = count(&face(pose), whole(), is_iris);
@@ -948,7 +971,12 @@ mod tests {
             let pts = count(cv, (0, 0, SIZE, SIZE / 2), |c| c == BROW);
             pts.iter().map(|p| p.1 as f32).sum::<f32>() / pts.len() as f32
         };
-        let raised = face(&FacePose { brow_inner_up: 1.0, brow_outer_up_left: 1.0, brow_outer_up_right: 1.0, ..FacePose::default() });
+        let raised = face(&FacePose {
+            brow_inner_up: 1.0,
+            brow_outer_up_left: 1.0,
+            brow_outer_up_right: 1.0,
+            ..FacePose::default()
+        });
         assert!(brow_y(&raised) < brow_y(&neutral) - 3.0);
         // Yaw shifts the features (iris) more than nothing.
         let turned = face(&FacePose { head_yaw: 0.5, ..FacePose::default() });
@@ -958,7 +986,13 @@ mod tests {
 
     #[test]
     fn bad_values_draw_without_panicking() {
-        let wild = FacePose { jaw_open: f32::NAN, head_yaw: f32::INFINITY, eyelid_open_left: -5.0, smile_left: 1e9, ..FacePose::default() };
+        let wild = FacePose {
+            jaw_open: f32::NAN,
+            head_yaw: f32::INFINITY,
+            eyelid_open_left: -5.0,
+            smile_left: 1e9,
+            ..FacePose::default()
+        };
         assert_eq!(wild.sanitized().jaw_open, 0.0);
         assert_eq!(wild.sanitized().eyelid_open_left, 0.0);
         let cv = face(&wild);
@@ -993,7 +1027,8 @@ mod tests {
     fn gif_has_one_frame_per_pose_and_highlights_flagged_frames() {
         use image::AnimationDecoder;
         let n = 6;
-        let talk: Vec<FacePose> = (0..n).map(|i| FacePose { jaw_open: i as f32 / n as f32, ..FacePose::default() }).collect();
+        let talk: Vec<FacePose> =
+            (0..n).map(|i| FacePose { jaw_open: i as f32 / n as f32, ..FacePose::default() }).collect();
         let still = vec![FacePose::default(); n];
         let columns = vec![("original".to_string(), still), ("edited".to_string(), talk)];
         let highlight: Vec<bool> = (0..n).map(|i| (2..4).contains(&i)).collect();
@@ -1013,7 +1048,8 @@ mod tests {
         assert_eq!(decoded[0].buffer().dimensions(), frames[0].dimensions());
         assert_eq!(frames[0].width(), 2 * 96);
         // Mismatched inputs are errors and write nothing.
-        let bad = vec![("a".to_string(), vec![FacePose::default(); 3]), ("b".to_string(), vec![FacePose::default(); 2])];
+        let bad =
+            vec![("a".to_string(), vec![FacePose::default(); 3]), ("b".to_string(), vec![FacePose::default(); 2])];
         let bad_path = dir.path().join("bad.gif");
         let err = write_face_gif(&bad_path, &bad, &[], &opts, &mut |_, _| {}).unwrap_err().to_string();
         assert!(err.contains("'b' has 2 frames"), "{err}");

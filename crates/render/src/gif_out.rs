@@ -179,7 +179,11 @@ pub(crate) fn delays_cs(count: usize, fps: f64) -> Vec<u16> {
 }
 
 /// Encodes the frames into GIF bytes, calling `progress(done, total)` after each frame.
-pub(crate) fn encode(frames: &[RgbImage], fps: f64, progress: &mut dyn FnMut(usize, usize)) -> Result<Vec<u8>, RenderError> {
+pub(crate) fn encode(
+    frames: &[RgbImage],
+    fps: f64,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<u8>, RenderError> {
     let first = frames.first().ok_or_else(|| RenderError::InvalidInput("a GIF needs at least one frame".into()))?;
     let (w, h) = first.dimensions();
     if w == 0 || h == 0 || w > u16::MAX as u32 || h > u16::MAX as u32 {
@@ -244,7 +248,9 @@ fn delta_frame(prev: Option<&[u8]>, cur: &[u8], w: usize, h: usize, transparent:
         let row = y * w + x0..y * w + x1;
         match prev {
             None => sub.extend_from_slice(&cur[row]),
-            Some(p) => sub.extend(cur[row.clone()].iter().zip(&p[row]).map(|(&c, &o)| if c == o { transparent } else { c })),
+            Some(p) => {
+                sub.extend(cur[row.clone()].iter().zip(&p[row]).map(|(&c, &o)| if c == o { transparent } else { c }))
+            }
         }
     }
     gif::Frame {

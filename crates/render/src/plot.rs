@@ -124,7 +124,14 @@ enum Style {
     Points,
 }
 
-fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series], style: Style) -> Result<(), RenderError> {
+fn xy_chart(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    style: Style,
+) -> Result<(), RenderError> {
     let (xr, yr) = data_ranges(title, series)?;
     let legend_corner = emptiest_corner(series, &xr, &yr);
     render_png(path, title, |root| {
@@ -133,7 +140,9 @@ fn xy_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Se
         for (i, s) in series.iter().enumerate() {
             let color = series_color(s, i);
             let anno = match style {
-                Style::Lines => chart.draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(px(2) as u32))),
+                Style::Lines => {
+                    chart.draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(px(2) as u32)))
+                }
                 Style::Points => chart.draw_series(s.points.iter().map(|&p| Circle::new(p, px(3), color.filled()))),
             }
             .map_err(e)?;
@@ -188,7 +197,13 @@ pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series:
 }
 
 /// Scatter chart of one or more point sets.
-pub fn scatter_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<(), RenderError> {
+pub fn scatter_plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+) -> Result<(), RenderError> {
     xy_chart(path, title, x_label, y_label, series, Style::Points)
 }
 
@@ -206,7 +221,10 @@ pub fn grouped_bar_chart(
     }
     for (name, values) in series {
         if values.len() != groups.len() {
-            return Err(plot_err(title, format!("series '{name}' has {} values for {} groups", values.len(), groups.len())));
+            return Err(plot_err(
+                title,
+                format!("series '{name}' has {} values for {} groups", values.len(), groups.len()),
+            ));
         }
         if let Some(g) = values.iter().position(|v| !v.is_finite()) {
             return Err(plot_err(title, format!("series '{name}', group '{}': value is not finite", groups[g])));
@@ -231,7 +249,9 @@ pub fn grouped_bar_chart(
                 }))
                 .map_err(e)?
                 .label(name.as_str())
-                .legend(move |(x, y)| Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled()));
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled())
+                });
         }
         legend_and_groups(&mut chart, root, groups, yr.start, SeriesLabelPosition::UpperRight, title)
     })
@@ -240,7 +260,11 @@ pub fn grouped_bar_chart(
 /// The legend box and, under the x axis, each group's name centred on its unit-wide slot (the
 /// grouped charts: bars and box plots).
 fn legend_and_groups<'a>(
-    chart: &mut ChartContext<'a, BitMapBackend<'a>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>,
+    chart: &mut ChartContext<
+        'a,
+        BitMapBackend<'a>,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
     root: &DrawingArea<BitMapBackend<'a>, Shift>,
     groups: &[String],
     y_floor: f64,
@@ -298,7 +322,10 @@ pub fn box_plot(
     let mut summaries = Vec::new();
     for (name, per_group) in series {
         if per_group.len() != groups.len() {
-            return Err(plot_err(title, format!("series '{name}' has {} sample sets for {} groups", per_group.len(), groups.len())));
+            return Err(plot_err(
+                title,
+                format!("series '{name}' has {} sample sets for {} groups", per_group.len(), groups.len()),
+            ));
         }
         let mut row = Vec::new();
         for (g, samples) in per_group.iter().enumerate() {
@@ -308,7 +335,8 @@ pub fn box_plot(
         }
         summaries.push(row);
     }
-    let (lo, hi) = summaries.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f[0]), b.max(f[4])));
+    let (lo, hi) =
+        summaries.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| (a.min(f[0]), b.max(f[4])));
     let span = (hi - lo).max(1e-9);
     // Room below the data for the legend.
     let yr = (lo - span * 0.3)..(hi + span * 0.12);
@@ -333,13 +361,12 @@ pub fn box_plot(
                 let cap = box_w * 0.2;
                 elements.push(PathElement::new(vec![(xm - cap, f[0]), (xm + cap, f[0])], stroke));
                 elements.push(PathElement::new(vec![(xm - cap, f[4]), (xm + cap, f[4])], stroke));
-                elements.push(PathElement::new(vec![(x0, f[1]), (x1, f[1]), (x1, f[3]), (x0, f[3]), (x0, f[1])], stroke));
+                elements
+                    .push(PathElement::new(vec![(x0, f[1]), (x1, f[1]), (x1, f[3]), (x0, f[3]), (x0, f[1])], stroke));
             }
-            chart
-                .draw_series(boxes)
-                .map_err(e)?
-                .label(name.as_str())
-                .legend(move |(x, y)| Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled()));
+            chart.draw_series(boxes).map_err(e)?.label(name.as_str()).legend(move |(x, y)| {
+                Rectangle::new([(x + px(4), y - px(5)), (x + px(14), y + px(5))], color.filled())
+            });
             chart.draw_series(elements).map_err(e)?;
         }
         legend_and_groups(&mut chart, root, groups, yr.start, SeriesLabelPosition::LowerLeft, title)
@@ -364,7 +391,6 @@ pub(crate) fn downsample(big: &image::RgbImage, factor: u32) -> image::RgbImage 
     })
 }
 
-
 /// What the x axis of [`house_axes`] shows.
 enum XAxis<'l> {
     /// Numbers, with this description under them.
@@ -381,7 +407,14 @@ fn house_axes<'a>(
     xr: std::ops::Range<f64>,
     y_label: &str,
     yr: std::ops::Range<f64>,
-) -> Result<ChartContext<'a, BitMapBackend<'a>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>, RenderError> {
+) -> Result<
+    ChartContext<
+        'a,
+        BitMapBackend<'a>,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    RenderError,
+> {
     let e = |e: DrawingAreaErrorKind<_>| plot_err(title, e);
     let x_area = match x {
         XAxis::Numeric(_) => px(52),
@@ -452,7 +485,8 @@ mod tests {
 
     #[test]
     fn the_legend_goes_to_the_corner_without_data() {
-        let crowded_upper_right = Series { name: "a".into(), points: vec![(0.0, 0.0), (0.9, 0.9), (1.0, 1.0), (0.95, 0.8)], color: None };
+        let crowded_upper_right =
+            Series { name: "a".into(), points: vec![(0.0, 0.0), (0.9, 0.9), (1.0, 1.0), (0.95, 0.8)], color: None };
         let (xr, yr) = (0.0..1.0, 0.0..1.0);
         let corner = emptiest_corner(std::slice::from_ref(&crowded_upper_right), &xr, &yr);
         assert!(matches!(corner, SeriesLabelPosition::UpperLeft), "upper right holds 3 points, upper left none");
@@ -462,7 +496,10 @@ mod tests {
 
     fn dark_pixels(img: &image::RgbImage, region: (u32, u32, u32, u32)) -> usize {
         let (x0, y0, x1, y1) = region;
-        (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&v| v < 120)).count()
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&v| v < 120))
+            .count()
     }
 
     #[test]
@@ -471,7 +508,14 @@ mod tests {
         let path = dir.path().join("line.png");
         let sine: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 * 0.1, (i as f64 * 0.1).sin())).collect();
         let cosine: Vec<(f64, f64)> = (0..100).map(|i| (i as f64 * 0.1, (i as f64 * 0.1).cos())).collect();
-        line_plot(&path, "Error over time", "time (s)", "error (cm)", &[Series::new("sin", sine), Series::new("cos", cosine)]).unwrap();
+        line_plot(
+            &path,
+            "Error over time",
+            "time (s)",
+            "error (cm)",
+            &[Series::new("sin", sine), Series::new("cos", cosine)],
+        )
+        .unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (PLOT_WIDTH, PLOT_HEIGHT));
         // Title band across the top centre: text pixels, not an empty strip.
@@ -508,10 +552,13 @@ mod tests {
     fn bad_plot_input_is_a_clear_error() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("x.png");
-        let err = line_plot(&p, "t", "x", "y", &[Series::new("a", vec![(0.0, 1.0), (1.0, f64::NAN)])]).unwrap_err().to_string();
+        let err = line_plot(&p, "t", "x", "y", &[Series::new("a", vec![(0.0, 1.0), (1.0, f64::NAN)])])
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("series 'a', point 1"), "{err}");
         assert!(line_plot(&p, "t", "x", "y", &[]).is_err());
-        let err = grouped_bar_chart(&p, "t", "y", &["a".into()], &[("s".into(), vec![1.0, 2.0])]).unwrap_err().to_string();
+        let err =
+            grouped_bar_chart(&p, "t", "y", &["a".into()], &[("s".into(), vec![1.0, 2.0])]).unwrap_err().to_string();
         assert!(err.contains("2 values for 1 groups"), "{err}");
         assert!(!p.exists());
     }

@@ -118,8 +118,13 @@ fn figures_from_positions(
     if !(fps.is_finite() && fps > 0.0) {
         return Err(RenderError::InvalidInput(format!("positions_fps {fps} must be a positive number")));
     }
-    if let Some((j, p)) = parents.iter().enumerate().find_map(|(j, p)| p.filter(|&p| p >= parents.len()).map(|p| (j, p))) {
-        return Err(RenderError::InvalidInput(format!("joint {j} has parent {p}, but there are only {} joints", parents.len())));
+    if let Some((j, p)) =
+        parents.iter().enumerate().find_map(|(j, p)| p.filter(|&p| p >= parents.len()).map(|p| (j, p)))
+    {
+        return Err(RenderError::InvalidInput(format!(
+            "joint {j} has parent {p}, but there are only {} joints",
+            parents.len()
+        )));
     }
     for (fi, fig) in figures.iter().enumerate() {
         if fig.is_empty() {
@@ -134,14 +139,13 @@ fn figures_from_positions(
                 )));
             }
             if let Some(j) = pts.iter().position(|p| !p.is_finite()) {
-                return Err(RenderError::InvalidInput(format!("figure {fi}, frame {f}, joint {j}: position is not finite")));
+                return Err(RenderError::InvalidInput(format!(
+                    "figure {fi}, frame {f}, joint {j}: position is not finite"
+                )));
             }
         }
     }
-    Ok(figures
-        .iter()
-        .map(|fr| Figure { parents: parents.to_vec(), frames: fr.clone(), fps, heading: None })
-        .collect())
+    Ok(figures.iter().map(|fr| Figure { parents: parents.to_vec(), frames: fr.clone(), fps, heading: None }).collect())
 }
 
 fn figures_from_motions(motions: &[&Motion]) -> Result<Vec<Figure>, RenderError> {
@@ -178,7 +182,9 @@ fn sample_points(figs: &[Figure]) -> Vec<DVec3> {
 }
 
 fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
-    points.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    points
+        .iter()
+        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)))
 }
 
 /// Height of the tallest single pose (not the whole path), the scale for grid spacing.
@@ -262,7 +268,15 @@ pub fn auto_camera(points: &[DVec3], heading: DVec3, width: u32, height: u32, to
 fn nice_step(approx: f64) -> f64 {
     let mag = 10f64.powf(approx.log10().floor());
     let r = approx / mag;
-    mag * if r < 1.5 { 1.0 } else if r < 3.5 { 2.0 } else if r < 7.5 { 5.0 } else { 10.0 }
+    mag * if r < 1.5 {
+        1.0
+    } else if r < 3.5 {
+        2.0
+    } else if r < 7.5 {
+        5.0
+    } else {
+        10.0
+    }
 }
 
 const GRID_COLOR: [u8; 3] = [196, 200, 206];
@@ -327,7 +341,12 @@ fn header(opts: &StickOptions, figure_count: usize) -> Header {
     let box_h = labels.len() as f32 * size * 1.35 + pad;
     let side_by_side = title_w + box_w + 2.0 * pad <= opts.width as f32;
     let y = if side_by_side { pad } else { title_h };
-    Header { size, pad, legend: Some((opts.width as f32 - box_w - pad, y, box_w, box_h)), height: title_h.max(y + box_h + pad) }
+    Header {
+        size,
+        pad,
+        legend: Some((opts.width as f32 - box_w - pad, y, box_w, box_h)),
+        height: title_h.max(y + box_h + pad),
+    }
 }
 
 /// Pixel heights of the bands at the top (title, legend) and bottom (caption) that figures keep clear of.
@@ -374,7 +393,13 @@ fn build_scene(figs: &[Figure], opts: &StickOptions) -> Result<Scene, RenderErro
     }
     draw_title_and_legend(&mut canvas, opts, figs.len());
     let ref_depth = (cam.target - cam.eye).length() as f32;
-    Ok(Scene { cam, ground_y, base: canvas.into_image(), line_width: (opts.height as f32 / 110.0).clamp(1.5, 8.0), ref_depth })
+    Ok(Scene {
+        cam,
+        ground_y,
+        base: canvas.into_image(),
+        line_width: (opts.height as f32 / 110.0).clamp(1.5, 8.0),
+        ref_depth,
+    })
 }
 
 /// Colour `c` mixed toward black by `amount` (0…1).
@@ -392,7 +417,13 @@ enum Prim {
     Dot { at: (f32, f32), radius: f32, color: [u8; 3] },
 }
 
-fn draw_frame(scene: &Scene, figs: &[Figure], frames: &[usize], opts: &StickOptions, caption: Option<&str>) -> RgbImage {
+fn draw_frame(
+    scene: &Scene,
+    figs: &[Figure],
+    frames: &[usize],
+    opts: &StickOptions,
+    caption: Option<&str>,
+) -> RgbImage {
     let mut canvas = Canvas::from_image(scene.base.clone());
     let cam = &scene.cam;
     let persp = |depth: f32| (scene.ref_depth / depth.max(1e-6)).clamp(0.6, 1.7);
@@ -418,13 +449,17 @@ fn draw_frame(scene: &Scene, figs: &[Figure], frames: &[usize], opts: &StickOpti
         for (j, parent) in fig.parents.iter().enumerate() {
             if let Some((a, b)) = parent.and_then(|p| cam.project_segment(pts[p], pts[j])) {
                 let depth = (a.2 + b.2) * 0.5;
-                prims.push((depth - layer_bias, Prim::Bone { a: (a.0, a.1), b: (b.0, b.1), width: scene.line_width * persp(depth), color }));
+                prims.push((
+                    depth - layer_bias,
+                    Prim::Bone { a: (a.0, a.1), b: (b.0, b.1), width: scene.line_width * persp(depth), color },
+                ));
             }
             if let Some((x, y, depth)) = cam.project(pts[j]) {
                 let full = scene.line_width * 0.95 * persp(depth);
                 // Joints at the end of short bones (fingers, toes) get small dots, so hands stay
                 // hands instead of blobs.
-                let bone_px = parent.and_then(|p| cam.project(pts[p])).map(|q| ((q.0 - x).powi(2) + (q.1 - y).powi(2)).sqrt());
+                let bone_px =
+                    parent.and_then(|p| cam.project(pts[p])).map(|q| ((q.0 - x).powi(2) + (q.1 - y).powi(2)).sqrt());
                 let radius = bone_px.map_or(full, |l| full * (l / (4.0 * full)).clamp(0.3, 1.0));
                 // Dots sit just in front of the bones that meet at them.
                 prims.push((depth * 0.999 - layer_bias, Prim::Dot { at: (x, y), radius, color: darken(color, 0.35) }));
@@ -483,7 +518,12 @@ fn caption(opts: &StickOptions, figs: &[Figure], frame: usize) -> Option<String>
     })
 }
 
-fn render_gif(path: &Path, figs: &[Figure], opts: &StickOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<(), RenderError> {
+fn render_gif(
+    path: &Path,
+    figs: &[Figure],
+    opts: &StickOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(), RenderError> {
     let scene = build_scene(figs, opts)?;
     let (frames, gif_fps) = timeline(figs, opts)?;
     let images: Vec<RgbImage> = frames
@@ -502,7 +542,11 @@ pub fn render_motion_frame(motions: &[&Motion], frame: usize, opts: &StickOption
 }
 
 /// Like [`render_motion_frame`], but reports bad input (no motions, frame out of range, bad size).
-pub fn try_render_motion_frame(motions: &[&Motion], frame: usize, opts: &StickOptions) -> Result<RgbImage, RenderError> {
+pub fn try_render_motion_frame(
+    motions: &[&Motion],
+    frame: usize,
+    opts: &StickOptions,
+) -> Result<RgbImage, RenderError> {
     let figs = figures_from_motions(motions)?;
     render_figures_frame(&figs, frame, opts)
 }
@@ -510,7 +554,10 @@ pub fn try_render_motion_frame(motions: &[&Motion], frame: usize, opts: &StickOp
 fn render_figures_frame(figs: &[Figure], frame: usize, opts: &StickOptions) -> Result<RgbImage, RenderError> {
     let n = figs[0].frames.len();
     if frame >= n {
-        return Err(RenderError::InvalidInput(format!("frame {frame} is out of range: the clip has {n} frames (0…{})", n - 1)));
+        return Err(RenderError::InvalidInput(format!(
+            "frame {frame} is out of range: the clip has {n} frames (0…{})",
+            n - 1
+        )));
     }
     let scene = build_scene(figs, opts)?;
     let t = frame as f64 / figs[0].fps;
@@ -519,7 +566,12 @@ fn render_figures_frame(figs: &[Figure], frame: usize, opts: &StickOptions) -> R
 }
 
 /// Writes frame `frame` as a PNG.
-pub fn render_motion_png(path: &Path, motions: &[&Motion], frame: usize, opts: &StickOptions) -> Result<(), RenderError> {
+pub fn render_motion_png(
+    path: &Path,
+    motions: &[&Motion],
+    frame: usize,
+    opts: &StickOptions,
+) -> Result<(), RenderError> {
     crate::write_png(path, &try_render_motion_frame(motions, frame, opts)?)
 }
 
@@ -584,7 +636,11 @@ mod tests {
         let (x0, y0, x1, y1) = region;
         img.enumerate_pixels()
             .filter(|(x, y, p)| {
-                *x >= x0 && *x < x1 && *y >= y0 && *y < y1 && p.0.iter().zip(color).all(|(&a, b)| (a as i32 - b as i32).abs() <= tol)
+                *x >= x0
+                    && *x < x1
+                    && *y >= y0
+                    && *y < y1
+                    && p.0.iter().zip(color).all(|(&a, b)| (a as i32 - b as i32).abs() <= tol)
             })
             .count()
     }
@@ -658,8 +714,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("pos.gif");
         let parents = vec![None, Some(0), Some(1)];
-        let frames: Vec<Vec<DVec3>> =
-            (0..10).map(|f| vec![DVec3::ZERO, DVec3::new(0.0, 1.0, 0.0), DVec3::new(f as f64 * 0.1, 2.0, 0.0)]).collect();
+        let frames: Vec<Vec<DVec3>> = (0..10)
+            .map(|f| vec![DVec3::ZERO, DVec3::new(0.0, 1.0, 0.0), DVec3::new(f as f64 * 0.1, 2.0, 0.0)])
+            .collect();
         let opts = StickOptions { width: 100, height: 80, ..StickOptions::default() };
         render_positions_gif(&path, &parents, &[frames.clone(), frames.clone()], &opts).unwrap();
         assert!(path.exists());
@@ -677,7 +734,11 @@ mod tests {
         let short = StickOptions { title: Some("walk".into()), labels: labels.clone(), ..StickOptions::default() };
         let (_, y, _, _) = header(&short, 2).legend.unwrap();
         assert!(y < 10.0, "short title: legend on the first row");
-        let long = StickOptions { title: Some("a title long enough to run across most of the image, and then some more".into()), labels, ..short };
+        let long = StickOptions {
+            title: Some("a title long enough to run across most of the image, and then some more".into()),
+            labels,
+            ..short
+        };
         let h = header(&long, 2);
         let (_, y, _, bh) = h.legend.unwrap();
         assert!(y >= text_size(&long) * 1.5, "legend below the title, got y = {y}");
@@ -694,7 +755,8 @@ mod tests {
         // All joints at one place, and a huge unit scale.
         let same = vec![vec![DVec3::splat(3.0); 3]; 4];
         render_positions_frame(&[None, Some(0), Some(1)], &[same], 2, &opts).unwrap();
-        let far: Vec<Vec<DVec3>> = (0..3).map(|f| vec![DVec3::new(1e6, 0.0, f as f64 * 1e5), DVec3::new(1e6, 2e5, 0.0)]).collect();
+        let far: Vec<Vec<DVec3>> =
+            (0..3).map(|f| vec![DVec3::new(1e6, 0.0, f as f64 * 1e5), DVec3::new(1e6, 2e5, 0.0)]).collect();
         render_positions_frame(&[None, Some(0)], &[far], 1, &opts).unwrap();
     }
 

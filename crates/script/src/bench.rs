@@ -115,7 +115,14 @@ pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<Pat
     let mut fig8 = Table::new(
         "fig8",
         "SSG matching score (Fig. 8): relation-first (ours, Algorithm 1) vs object-first (LDS)",
-        &["query SSGs", "relation-first median", "relation-first mean", "object-first median", "object-first mean", "relation-first better in"],
+        &[
+            "query SSGs",
+            "relation-first median",
+            "relation-first mean",
+            "object-first median",
+            "object-first mean",
+            "relation-first better in",
+        ],
     );
     let mut groups = Vec::new();
     let (mut ours, mut lds) = (Vec::new(), Vec::new());
@@ -204,8 +211,21 @@ fn story_table(
         "stories",
         "Part 2: animation and joint optimisation per text (Fig. 11 analogue)",
         &[
-            "script", "characters", "frames", "animation s", "seconds", "C before", "C after", "collided boxes before", "after",
-            "contact m before", "after", "C after, T as printed", "foot skate cm/s", "closest characters m", "paper s / text",
+            "script",
+            "characters",
+            "frames",
+            "animation s",
+            "seconds",
+            "C before",
+            "C after",
+            "collided boxes before",
+            "after",
+            "contact m before",
+            "after",
+            "C after, T as printed",
+            "foot skate cm/s",
+            "closest characters m",
+            "paper s / text",
         ],
     );
     let pins = HashMap::new();
@@ -251,7 +271,8 @@ fn story_table(
 }
 
 /// The demo's second character's sentence, and the edit the bench makes to it.
-pub const DEMO_CHARACTER_EDIT: (&str, &str) = ("Tom walks slowly to the sofa and sits on it.", "Tom walks to the table and sits on the sofa.");
+pub const DEMO_CHARACTER_EDIT: (&str, &str) =
+    ("Tom walks slowly to the sofa and sits on it.", "Tom walks to the table and sits on the sofa.");
 
 /// Times an edit of one character's sentence in a [`StorySession`](crate::animate::incremental::StorySession)
 /// (the demo, [`DEMO_CHARACTER_EDIT`]) against the full run, and says what was re-solved.
@@ -264,7 +285,8 @@ fn story_edit_note(
     ocfg: &crate::optimize::OptimizeConfig,
 ) -> String {
     use crate::animate::incremental::StorySession;
-    let mut session = StorySession::new(cat.clone(), db.clone(), compose_cfg.clone(), lib.clone(), acfg.clone(), Some(ocfg.clone()));
+    let mut session =
+        StorySession::new(cat.clone(), db.clone(), compose_cfg.clone(), lib.clone(), acfg.clone(), Some(ocfg.clone()));
     let full = session.update(stories::DEMO);
     let edited = stories::DEMO.replace(DEMO_CHARACTER_EDIT.0, DEMO_CHARACTER_EDIT.1);
     let edit = session.update(&edited);

@@ -151,7 +151,11 @@ fn is_definite(sentence: &str, word: &str) -> bool {
     let word = word.to_lowercase();
     let head = word.split_whitespace().last().unwrap_or("");
     words.iter().enumerate().filter(|(_, w)| **w == head).any(|(i, _)| {
-        words[i.saturating_sub(4)..i].iter().rev().take_while(|w| !matches!(**w, "a" | "an")).any(|w| matches!(*w, "the" | "this" | "that" | "its" | "his" | "her" | "their"))
+        words[i.saturating_sub(4)..i]
+            .iter()
+            .rev()
+            .take_while(|w| !matches!(**w, "a" | "an"))
+            .any(|w| matches!(*w, "the" | "this" | "that" | "its" | "his" | "her" | "their"))
     })
 }
 
@@ -345,7 +349,12 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
     }
     for ((sentence, category), labels, why) in groups {
         let Some(s) = input.parsed.sentences.iter().find(|s| s.raw.at.sentence == sentence + 1) else { continue };
-        let asked = items.iter().filter(|i| i.category == category && matches!(i.origin, Origin::Script { sentence: t, .. } if t == sentence)).count();
+        let asked = items
+            .iter()
+            .filter(|i| {
+                i.category == category && matches!(i.origin, Origin::Script { sentence: t, .. } if t == sentence)
+            })
+            .count();
         let message = if labels.len() == 1 {
             format!("'{}' left out: {why}", labels[0])
         } else {
@@ -401,7 +410,13 @@ struct Solved {
 /// them with the script's poses pinned. Furnishing is optional: a furnishing object that does not
 /// fit, or takes part in a violation, is left out quietly, so the user's objects never give way to
 /// objects they did not ask for.
-fn solve_layout(room: &Room, items: &[LayoutItem], constraints: &[LayoutConstraint], n_script: usize, seed: u64) -> Solved {
+fn solve_layout(
+    room: &Room,
+    items: &[LayoutItem],
+    constraints: &[LayoutConstraint],
+    n_script: usize,
+    seed: u64,
+) -> Solved {
     let sub = |keep: &[usize], pins: &HashMap<usize, ([f32; 3], f32)>| {
         let index: HashMap<usize, usize> = keep.iter().enumerate().map(|(k, &i)| (i, k)).collect();
         let items: Vec<LayoutItem> = keep
@@ -416,7 +431,9 @@ fn solve_layout(room: &Room, items: &[LayoutItem], constraints: &[LayoutConstrai
             .collect();
         let relations = constraints
             .iter()
-            .filter_map(|c| Some(LayoutConstraint { active: *index.get(&c.active)?, anchor: *index.get(&c.anchor)?, ..*c }))
+            .filter_map(|c| {
+                Some(LayoutConstraint { active: *index.get(&c.active)?, anchor: *index.get(&c.anchor)?, ..*c })
+            })
             .collect();
         LayoutProblem { room: room.clone(), items, relations }
     };
@@ -430,7 +447,8 @@ fn solve_layout(room: &Room, items: &[LayoutItem], constraints: &[LayoutConstrai
             pins.insert(script[k], (o.position, o.yaw));
         }
     }
-    let mut keep: Vec<usize> = script.iter().copied().filter(|i| pins.contains_key(i)).chain(n_script..items.len()).collect();
+    let mut keep: Vec<usize> =
+        script.iter().copied().filter(|i| pins.contains_key(i)).chain(n_script..items.len()).collect();
     let mut best = (keep.clone(), first);
     for round in 0..4 {
         if keep.len() == pins.len() && round > 0 {

@@ -12,7 +12,14 @@ use crate::ScriptError;
 /// Runs the demo into `<dir>/script`; returns the lines the CLI prints.
 pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
     let out = dir.join("script");
-    let job = SceneJob { out_dir: out.clone(), seed, view: None, models: None, config: ComposeConfig { seed, ..ComposeConfig::default() }, semantic: None };
+    let job = SceneJob {
+        out_dir: out.clone(),
+        seed,
+        view: None,
+        models: None,
+        config: ComposeConfig { seed, ..ComposeConfig::default() },
+        semantic: None,
+    };
     let report = run_scene(stories::DEMO, &PathBuf::from("builtin:demo"), &job)?;
     let c = &report.composition;
     let mut lines = vec![format!(
@@ -30,7 +37,12 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         lines.push(format!("script: note: {d}"));
     }
     // Part 2: the characters act in the scene, after the joint optimisation (§4.3).
-    let run = crate::job::RunJob { scene: SceneJob { out_dir: out.join("story"), ..job.clone() }, optimize: true, shared_motions: false, gif_width: 320 };
+    let run = crate::job::RunJob {
+        scene: SceneJob { out_dir: out.join("story"), ..job.clone() },
+        optimize: true,
+        shared_motions: false,
+        gif_width: 320,
+    };
     let story = crate::job::run_story(stories::DEMO, &PathBuf::from("builtin:demo"), &run)?;
     lines.push(format!(
         "script: {} characters animated, {} frames ({:.1} s); joint optimisation C {:.3} -> {:.3}, mean contact distance {:.3} m -> {:.3} m -> {}",

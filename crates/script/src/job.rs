@@ -3,13 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::animate::incremental::StorySession;
 use crate::catalogue::{builtin::builtin, kenney, Catalogue};
 use crate::compose::{ComposeConfig, Composition};
 use crate::database::SceneDatabase;
 use crate::error::Diagnostic;
 use crate::output;
 use crate::session::Session;
-use crate::animate::incremental::StorySession;
 use crate::ScriptError;
 
 /// Variations per hand-authored room in the default database.
@@ -53,11 +53,13 @@ pub fn catalogue(models: Option<&Path>) -> Result<Catalogue, ScriptError> {
 /// Reads a script file: UTF-8 text with at least one sentence.
 pub fn read_script(path: &Path) -> Result<String, ScriptError> {
     let bytes = std::fs::read(path).map_err(|e| ScriptError::io(path, e))?;
-    let text = String::from_utf8(bytes).map_err(|e| ScriptError::Invalid(format!(
-        "{}: not UTF-8 text (byte {} is invalid); save the script as plain UTF-8",
-        path.display(),
-        e.utf8_error().valid_up_to()
-    )))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        ScriptError::Invalid(format!(
+            "{}: not UTF-8 text (byte {} is invalid); save the script as plain UTF-8",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
     if crate::script::split(&text).is_empty() {
         return Err(ScriptError::Empty { path: path.to_path_buf() });
     }
@@ -89,11 +91,8 @@ fn write_scene(composition: &Composition, cat: &Catalogue, job: &SceneJob) -> Re
     let gltf = dir.join("scene.gltf");
     output::write_gltf(&gltf, &composition.scene, cat)?;
     files.push(gltf);
-    let view = job
-        .view
-        .clone()
-        .or_else(|| composition.scene.camera.last().cloned())
-        .unwrap_or_else(|| "front".to_string());
+    let view =
+        job.view.clone().or_else(|| composition.scene.camera.last().cloned()).unwrap_or_else(|| "front".to_string());
     files.extend(output::write_previews(dir, &composition.scene, cat, &view)?);
     Ok(files)
 }
@@ -155,7 +154,8 @@ pub fn story_session(text: &str, job: &RunJob) -> Result<(StorySession, Vec<Diag
     use crate::optimize::OptimizeConfig;
     let (cat, notes) = script_catalogue(text, &job.scene)?;
     let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, job.scene.seed);
-    let lib = if job.shared_motions { MotionLibrary::from_shared(64) } else { MotionLibrary::procedural(job.scene.seed) };
+    let lib =
+        if job.shared_motions { MotionLibrary::from_shared(64) } else { MotionLibrary::procedural(job.scene.seed) };
     let ocfg = job.optimize.then(|| OptimizeConfig { seed: job.scene.seed, ..OptimizeConfig::default() });
     let compose = ComposeConfig { seed: job.scene.seed, ..job.scene.config.clone() };
     Ok((StorySession::new(cat, db, compose, lib, AnimateConfig::default(), ocfg), notes))
@@ -174,7 +174,13 @@ pub fn run_story(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, S
 
 /// [`run_story`] in a session: only the first version of a story is solved in full; a later one
 /// re-solves only the characters and objects its edit touches.
-pub fn run_story_in(session: &mut StorySession, notes: Vec<Diagnostic>, text: &str, source: &Path, job: &RunJob) -> Result<RunReport, ScriptError> {
+pub fn run_story_in(
+    session: &mut StorySession,
+    notes: Vec<Diagnostic>,
+    text: &str,
+    source: &Path,
+    job: &RunJob,
+) -> Result<RunReport, ScriptError> {
     use crate::animate::camera_pose;
     use crate::optimize::plot_costs;
     let start = std::time::Instant::now();
@@ -192,7 +198,8 @@ pub fn run_story_in(session: &mut StorySession, notes: Vec<Diagnostic>, text: &s
         files.push(plot);
     }
     let animation = u.animation;
-    let chars: Vec<(&str, &inbetween_core::Motion)> = animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &inbetween_core::Motion)> =
+        animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let cam = |f: usize| camera_pose(&animation, f);
     let gltf = dir.join("story.gltf");
     output::write_story_gltf(&gltf, &animation, cat, &cam)?;
@@ -245,7 +252,12 @@ pub fn run_story_in(session: &mut StorySession, notes: Vec<Diagnostic>, text: &s
 /// `--semantic` the catalogue depends on the text, and every run starts afresh). `on_run` sees
 /// each outcome; an error in one version (an empty file while saving) is reported and the loop
 /// goes on.
-pub fn watch(path: &Path, job: &RunJob, max_runs: Option<usize>, mut on_run: impl FnMut(Result<RunReport, ScriptError>)) -> Result<(), ScriptError> {
+pub fn watch(
+    path: &Path,
+    job: &RunJob,
+    max_runs: Option<usize>,
+    mut on_run: impl FnMut(Result<RunReport, ScriptError>),
+) -> Result<(), ScriptError> {
     let mut last: Option<(std::time::SystemTime, u64)> = None;
     let mut runs = 0;
     let mut session: Option<StorySession> = None;

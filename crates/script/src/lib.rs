@@ -25,6 +25,8 @@ pub mod catalogue;
 pub mod compose;
 pub mod database;
 pub mod demo;
+#[cfg(feature = "embeddings")]
+pub mod embed;
 pub mod error;
 pub mod job;
 pub mod layout;
@@ -39,7 +41,5 @@ pub mod semantic;
 pub mod session;
 pub mod ssg;
 pub mod stories;
-#[cfg(feature = "embeddings")]
-pub mod embed;
 
 pub use error::ScriptError;

@@ -74,13 +74,7 @@ impl MatchMap {
 /// How well a database object fits a query object: category similarity (1 or 0.5, 0 = no match)
 /// plus small tie-breakers: 0.1 × the share of the query's attributes it has, 0.05 when the scene's
 /// room is the room the query names.
-pub fn object_score(
-    cat: &Catalogue,
-    q: &Ssg,
-    node: &ObjectNode,
-    scene: &DbScene,
-    db_node: NodeId,
-) -> f64 {
+pub fn object_score(cat: &Catalogue, q: &Ssg, node: &ObjectNode, scene: &DbScene, db_node: NodeId) -> f64 {
     let d = &scene.ssg.objects[db_node];
     let sim = cat.similarity(&node.category, &d.category);
     if sim == 0.0 {
@@ -89,22 +83,15 @@ pub fn object_score(
     let attr = if node.attributes.is_empty() {
         0.0
     } else {
-        node.attributes
-            .iter()
-            .filter(|a| d.attributes.contains(a))
-            .count() as f64
-            / node.attributes.len() as f64
+        node.attributes.iter().filter(|a| d.attributes.contains(a)).count() as f64 / node.attributes.len() as f64
     };
     sim + 0.1 * attr + 0.05 * f64::from(room_matches(cat, q, scene))
 }
 
 fn room_matches(cat: &Catalogue, q: &Ssg, scene: &DbScene) -> bool {
-    q.room.as_deref().is_some_and(|r| {
-        r == scene.room.name
-            || cat
-                .resolve_room(r)
-                .is_some_and(|k| k.name == scene.room.name)
-    })
+    q.room
+        .as_deref()
+        .is_some_and(|r| r == scene.room.name || cat.resolve_room(r).is_some_and(|k| k.name == scene.room.name))
 }
 
 /// Query relations worth matching: valid, distinct ends.
@@ -151,8 +138,7 @@ impl Search<'_> {
 
     fn go(&mut self, k: usize, count: usize, decided: usize) {
         self.steps += 1;
-        if ((count + self.rels.len() - decided) as f64) < self.best.0 - 1e-9 || self.steps > BUDGET
-        {
+        if ((count + self.rels.len() - decided) as f64) < self.best.0 - 1e-9 || self.steps > BUDGET {
             return;
         }
         if k == self.domains.len() {
@@ -171,27 +157,18 @@ impl Search<'_> {
             let loss: f64 = (0..self.domains.len())
                 .filter(|&v| touched[v])
                 .map(|v| {
-                    self.domains[v]
-                        .iter()
-                        .find(|c| Some(c.0) == self.current[v])
-                        .map_or(0.0, |c| c.1)
-                        - self.alone[v]
+                    self.domains[v].iter().find(|c| Some(c.0) == self.current[v]).map_or(0.0, |c| c.1) - self.alone[v]
                 })
                 .sum();
             let value = count as f64 + loss;
-            if count > 0
-                && (value > self.best.0 + 1e-9
-                    || ((value - self.best.0).abs() <= 1e-9 && count > self.best.1))
+            if count > 0 && (value > self.best.0 + 1e-9 || ((value - self.best.0).abs() <= 1e-9 && count > self.best.1))
             {
                 self.best = (value, count, self.current.clone());
             }
             return;
         }
-        let options: Vec<Option<NodeId>> = self.domains[k]
-            .iter()
-            .map(|c| Some(c.0))
-            .chain(std::iter::once(None))
-            .collect();
+        let options: Vec<Option<NodeId>> =
+            self.domains[k].iter().map(|c| Some(c.0)).chain(std::iter::once(None)).collect();
         for opt in options {
             if let Some(d) = opt {
                 if self.current[..k].contains(&Some(d)) {
@@ -228,11 +205,7 @@ fn components(q: &Ssg, rels: &[usize]) -> Vec<Vec<usize>> {
     for i in 0..rels.len() {
         for j in i + 1..rels.len() {
             let (a, b) = (&q.relations[rels[i]], &q.relations[rels[j]]);
-            if a.active == b.active
-                || a.active == b.anchor
-                || a.anchor == b.active
-                || a.anchor == b.anchor
-            {
+            if a.active == b.active || a.active == b.anchor || a.anchor == b.active || a.anchor == b.anchor {
                 let (ri, rj) = (root(&mut comp, i), root(&mut comp, j));
                 comp[ri] = rj;
             }
@@ -269,20 +242,14 @@ fn match_in_scene(
     group: &[usize],
     state: &State,
 ) -> Option<Joint> {
-    let State {
-        assign,
-        used,
-        alone,
-    } = *state;
+    let State { assign, used, alone } = *state;
     // Relations usable here: each end unassigned or already assigned to this scene.
     let rels: Vec<usize> = group
         .iter()
         .copied()
         .filter(|&ri| {
             let r = &q.relations[ri];
-            [r.active, r.anchor]
-                .iter()
-                .all(|&n| assign[n].is_none_or(|a| a.0 == scene_index))
+            [r.active, r.anchor].iter().all(|&n| assign[n].is_none_or(|a| a.0 == scene_index))
         })
         .collect();
     if rels.is_empty() {
@@ -313,32 +280,20 @@ fn match_in_scene(
     let mut order: Vec<usize> = (0..vars.len()).collect();
     order.sort_by_key(|&k| (domains[k].len(), vars[k]));
     vars = order.iter().map(|&k| vars[k]).collect();
-    domains = order
-        .iter()
-        .map(|&k| std::mem::take(&mut domains[k]))
-        .collect();
+    domains = order.iter().map(|&k| std::mem::take(&mut domains[k])).collect();
     let end = |n: NodeId| match vars.iter().position(|&v| v == n) {
         Some(k) => End::Var(k),
         None => End::Fixed(assign[n].expect("fixed end").1),
     };
     let srels: Vec<(Relation, End, End)> = rels
         .iter()
-        .map(|&ri| {
-            (
-                q.relations[ri].relation,
-                end(q.relations[ri].active),
-                end(q.relations[ri].anchor),
-            )
-        })
+        .map(|&ri| (q.relations[ri].relation, end(q.relations[ri].active), end(q.relations[ri].anchor)))
         .collect();
     let mut ready_at = vec![Vec::new(); vars.len().max(1)];
     let mut pre = 0;
     let mut pre_count = 0;
     for (i, &(rel, a, b)) in srels.iter().enumerate() {
-        let last = [a, b]
-            .iter()
-            .filter_map(|e| if let End::Var(k) = e { Some(*k) } else { None })
-            .max();
+        let last = [a, b].iter().filter_map(|e| if let End::Var(k) = e { Some(*k) } else { None }).max();
         match last {
             Some(k) => ready_at[k].push(i),
             None => {
@@ -402,8 +357,7 @@ fn ranked(cat: &Catalogue, q: &Ssg, db: &SceneDatabase, node: NodeId) -> Vec<(us
         .iter()
         .enumerate()
         .flat_map(|(s, scene)| {
-            (0..scene.ssg.objects.len())
-                .map(move |d| (s, d, object_score(cat, q, &q.objects[node], scene, d)))
+            (0..scene.ssg.objects.len()).map(move |d| (s, d, object_score(cat, q, &q.objects[node], scene, d)))
         })
         .filter(|c| c.2 > 0.0)
         .collect();
@@ -422,27 +376,17 @@ pub fn relation_first(q: &Ssg, db: &SceneDatabase, cat: &Catalogue) -> MatchMap 
     let n = q.objects.len();
     let mut assign: Vec<Option<(usize, NodeId, bool)>> = vec![None; n];
     let mut used: Vec<(usize, NodeId)> = Vec::new();
-    let mut open: Vec<usize> = (0..q.relations.len())
-        .filter(|&i| usable(q, &q.relations[i]))
-        .collect();
-    let alone: Vec<f64> = (0..n)
-        .map(|i| ranked(cat, q, db, i).first().map_or(0.0, |c| c.2))
-        .collect();
+    let mut open: Vec<usize> = (0..q.relations.len()).filter(|&i| usable(q, &q.relations[i])).collect();
+    let alone: Vec<f64> = (0..n).map(|i| ranked(cat, q, db, i).first().map_or(0.0, |c| c.2)).collect();
     loop {
         let mut best: Option<(usize, Joint)> = None;
         for group in components(q, &open) {
             for (s, scene) in db.scenes.iter().enumerate() {
-                let state = State {
-                    assign: &assign,
-                    used: &used,
-                    alone: &alone,
-                };
+                let state = State { assign: &assign, used: &used, alone: &alone };
                 if let Some(j) = match_in_scene(cat, q, (s, scene), &group, &state) {
                     let better = match &best {
                         None => true,
-                        Some((_, b)) => {
-                            j.0 > b.0 + 1e-9 || ((j.0 - b.0).abs() <= 1e-9 && j.1 > b.1)
-                        }
+                        Some((_, b)) => j.0 > b.0 + 1e-9 || ((j.0 - b.0).abs() <= 1e-9 && j.1 > b.1),
                     };
                     if better {
                         best = Some((s, j));
@@ -501,18 +445,10 @@ pub fn object_first(q: &Ssg, db: &SceneDatabase, cat: &Catalogue) -> MatchMap {
     let ranks: Vec<Vec<(usize, NodeId, f64)>> = (0..n).map(|i| ranked(cat, q, db, i)).collect();
     let mut assign: Vec<Option<(usize, NodeId, bool)>> = vec![None; n];
     for i in 0..n {
-        let pick = ranks[i]
-            .iter()
-            .find(|c| !assign.iter().flatten().any(|a| a.0 == c.0 && a.1 == c.1));
+        let pick = ranks[i].iter().find(|c| !assign.iter().flatten().any(|a| a.0 == c.0 && a.1 == c.1));
         assign[i] = pick.map(|c| (c.0, c.1, false));
     }
-    let top = |i: usize| {
-        ranks[i]
-            .iter()
-            .take(LDS_TOP)
-            .map(|c| (c.0, c.1))
-            .collect::<Vec<_>>()
-    };
+    let top = |i: usize| ranks[i].iter().take(LDS_TOP).map(|c| (c.0, c.1)).collect::<Vec<_>>();
     let mut locked = vec![false; n];
     for r in q.relations.iter().filter(|r| usable(q, r)) {
         let (u, v) = (r.active, r.anchor);
@@ -520,29 +456,21 @@ pub fn object_first(q: &Ssg, db: &SceneDatabase, cat: &Catalogue) -> MatchMap {
             (Some(a), Some(b)) => a.0 == b.0 && db.scenes[a.0].relation_holds(r.relation, a.1, b.1),
             _ => false,
         };
-        let free = |cand: (usize, NodeId),
-                    assign: &[Option<(usize, NodeId, bool)>],
-                    me: usize,
-                    other: usize| {
-            !assign.iter().enumerate().any(|(k, a)| {
-                k != me && k != other && a.is_some_and(|a| a.0 == cand.0 && a.1 == cand.1)
-            })
+        let free = |cand: (usize, NodeId), assign: &[Option<(usize, NodeId, bool)>], me: usize, other: usize| {
+            !assign
+                .iter()
+                .enumerate()
+                .any(|(k, a)| k != me && k != other && a.is_some_and(|a| a.0 == cand.0 && a.1 == cand.1))
         };
         if holds_now {
             locked[u] = true;
             locked[v] = true;
             continue;
         }
-        let cu: Vec<(usize, NodeId)> = if locked[u] {
-            assign[u].map(|a| vec![(a.0, a.1)]).unwrap_or_default()
-        } else {
-            top(u)
-        };
-        let cv: Vec<(usize, NodeId)> = if locked[v] {
-            assign[v].map(|a| vec![(a.0, a.1)]).unwrap_or_default()
-        } else {
-            top(v)
-        };
+        let cu: Vec<(usize, NodeId)> =
+            if locked[u] { assign[u].map(|a| vec![(a.0, a.1)]).unwrap_or_default() } else { top(u) };
+        let cv: Vec<(usize, NodeId)> =
+            if locked[v] { assign[v].map(|a| vec![(a.0, a.1)]).unwrap_or_default() } else { top(v) };
         'pairs: for &a in &cu {
             for &b in &cv {
                 if a.0 == b.0
@@ -579,9 +507,7 @@ pub fn score(q: &Ssg, db: &SceneDatabase, map: &MatchMap) -> f64 {
         .iter()
         .filter(|e| e.query_node < q.objects.len())
         .map(|e| {
-            if q.objects[e.query_node].category
-                == db.scenes[e.scene].ssg.objects[e.db_node].category
-            {
+            if q.objects[e.query_node].category == db.scenes[e.scene].ssg.objects[e.db_node].category {
                 1.0
             } else {
                 0.5
@@ -592,8 +518,7 @@ pub fn score(q: &Ssg, db: &SceneDatabase, map: &MatchMap) -> f64 {
         .iter()
         .filter(|r| match (map.get(r.active), map.get(r.anchor)) {
             (Some(a), Some(b)) => {
-                a.scene == b.scene
-                    && db.scenes[a.scene].relation_holds(r.relation, a.db_node, b.db_node)
+                a.scene == b.scene && db.scenes[a.scene].relation_holds(r.relation, a.db_node, b.db_node)
             }
             _ => false,
         })
@@ -604,39 +529,20 @@ pub fn score(q: &Ssg, db: &SceneDatabase, map: &MatchMap) -> f64 {
 // ---------------------------------------------------------------------------------------------
 // The Fig. 8 experiment.
 
-fn query(
-    cat: &Catalogue,
-    room: Option<&str>,
-    objects: &[(&str, &[&str])],
-    rels: &[(usize, Relation, usize)],
-) -> Ssg {
+fn query(cat: &Catalogue, room: Option<&str>, objects: &[(&str, &[&str])], rels: &[(usize, Relation, usize)]) -> Ssg {
     let objects = objects
         .iter()
         .map(|&(w, attrs)| ObjectNode {
-            category: cat
-                .resolve(w)
-                .map_or_else(|| w.to_string(), |c| c.name.clone()),
+            category: cat.resolve(w).map_or_else(|| w.to_string(), |c| c.name.clone()),
             attributes: attrs.iter().map(|s| s.to_string()).collect(),
             count: 1,
             word: w.to_string(),
             sentence: 0,
         })
         .collect();
-    let relations = rels
-        .iter()
-        .map(|&(active, relation, anchor)| RelationNode {
-            relation,
-            active,
-            anchor,
-            sentence: 0,
-        })
-        .collect();
-    Ssg {
-        room: room.map(str::to_string),
-        objects,
-        relations,
-        ..Ssg::default()
-    }
+    let relations =
+        rels.iter().map(|&(active, relation, anchor)| RelationNode { relation, active, anchor, sentence: 0 }).collect();
+    Ssg { room: room.map(str::to_string), objects, relations, ..Ssg::default() }
 }
 
 /// Ten hand-written query SSGs: the paper's scene sentences (Fig. 1, 4, 5, 7 and §6's "Put a vase
@@ -644,89 +550,44 @@ fn query(
 pub fn handwritten_queries(cat: &Catalogue) -> Vec<Ssg> {
     use Relation::*;
     vec![
-        query(
-            cat,
-            Some("room"),
-            &[("desk", &["organized", "office"]), ("bed", &[])],
-            &[(0, Near, 1)],
-        ),
+        query(cat, Some("room"), &[("desk", &["organized", "office"]), ("bed", &[])], &[(0, Near, 1)]),
         query(
             cat,
             Some("gallery"),
-            &[
-                ("horsesculpture", &[]),
-                ("oilpainting", &[]),
-                ("sculpture", &[]),
-                ("picture", &[]),
-                ("bench", &[]),
-            ],
+            &[("horsesculpture", &[]), ("oilpainting", &[]), ("sculpture", &[]), ("picture", &[]), ("bench", &[])],
             &[(4, InFrontOf, 1), (2, Behind, 0)],
         ),
         query(
             cat,
             Some("meetingroom"),
-            &[
-                ("blackboard", &[]),
-                ("table", &["arranged"]),
-                ("chair", &[]),
-                ("chair", &[]),
-                ("clock", &[]),
-            ],
+            &[("blackboard", &[]), ("table", &["arranged"]), ("chair", &[]), ("chair", &[]), ("clock", &[])],
             &[(2, InFrontOf, 1), (3, Behind, 1), (4, Above, 0)],
         ),
         query(
             cat,
             Some("workshop"),
-            &[
-                ("table", &[]),
-                ("hammer", &[]),
-                ("wood", &[]),
-                ("shelf", &[]),
-                ("sofa", &[]),
-            ],
+            &[("table", &[]), ("hammer", &[]), ("wood", &[]), ("shelf", &[]), ("sofa", &[])],
             &[(1, On, 0), (2, On, 0), (3, InFrontOf, 0), (4, InFrontOf, 0)],
         ),
         query(
             cat,
             Some("musicroom"),
-            &[
-                ("desk", &[]),
-                ("computer", &[]),
-                ("recorder", &[]),
-                ("piano", &[]),
-                ("chair", &[]),
-            ],
+            &[("desk", &[]), ("computer", &[]), ("recorder", &[]), ("piano", &[]), ("chair", &[])],
             &[(1, On, 0), (2, On, 0), (4, InFrontOf, 0)],
         ),
         query(
             cat,
             Some("boxinggym"),
-            &[
-                ("boxingring", &[]),
-                ("boxingbag", &[]),
-                ("stool", &[]),
-                ("desk", &[]),
-                ("bottle", &[]),
-            ],
+            &[("boxingring", &[]), ("boxingbag", &[]), ("stool", &[]), ("desk", &[]), ("bottle", &[])],
             &[(1, Above, 0), (2, NextTo, 0), (4, On, 3)],
         ),
         query(
             cat,
             None,
-            &[
-                ("table", &[]),
-                ("desklamp", &[]),
-                ("chair", &[]),
-                ("chair", &[]),
-            ],
+            &[("table", &[]), ("desklamp", &[]), ("chair", &[]), ("chair", &[])],
             &[(1, On, 0), (2, InFrontOf, 0), (3, Behind, 0)],
         ),
-        query(
-            cat,
-            None,
-            &[("table", &[]), ("vase", &[]), ("teapot", &[])],
-            &[(1, On, 0), (2, On, 0)],
-        ),
+        query(cat, None, &[("table", &[]), ("vase", &[]), ("teapot", &[])], &[(1, On, 0), (2, On, 0)]),
         query(
             cat,
             Some("office"),
@@ -738,24 +599,12 @@ pub fn handwritten_queries(cat: &Catalogue) -> Vec<Ssg> {
                 ("picture", &[]),
                 ("trashcan", &[]),
             ],
-            &[
-                (1, On, 0),
-                (2, On, 0),
-                (3, InFrontOf, 0),
-                (4, Above, 0),
-                (5, NextTo, 0),
-            ],
+            &[(1, On, 0), (2, On, 0), (3, InFrontOf, 0), (4, Above, 0), (5, NextTo, 0)],
         ),
         query(
             cat,
             Some("bedroom"),
-            &[
-                ("bed", &[]),
-                ("nightstand", &[]),
-                ("lamp", &[]),
-                ("rug", &[]),
-                ("picture", &[]),
-            ],
+            &[("bed", &[]), ("nightstand", &[]), ("lamp", &[]), ("rug", &[]), ("picture", &[])],
             &[(1, NextTo, 0), (2, On, 1), (3, InFrontOf, 0), (4, Above, 0)],
         ),
     ]
@@ -767,35 +616,20 @@ pub fn handwritten_queries(cat: &Catalogue) -> Vec<Ssg> {
 fn sampled_query(db: &SceneDatabase, cat: &Catalogue, rng: &mut impl Rng) -> Ssg {
     let scene = &db.scenes[rng.random_range(0..db.scenes.len())];
     let rels = &scene.ssg.relations;
-    let specific: Vec<usize> = (0..rels.len())
-        .filter(|&i| rels[i].relation != Relation::Near)
-        .collect();
-    let pool = if specific.is_empty() {
-        (0..rels.len()).collect()
-    } else {
-        specific
-    };
-    let mut out = Ssg {
-        room: rng.random_bool(0.5).then(|| scene.room.name.clone()),
-        ..Ssg::default()
-    };
+    let specific: Vec<usize> = (0..rels.len()).filter(|&i| rels[i].relation != Relation::Near).collect();
+    let pool = if specific.is_empty() { (0..rels.len()).collect() } else { specific };
+    let mut out = Ssg { room: rng.random_bool(0.5).then(|| scene.room.name.clone()), ..Ssg::default() };
     if pool.is_empty() {
         return out;
     }
     let mut chosen = vec![pool[rng.random_range(0..pool.len())]];
     let want = rng.random_range(2..=4);
     while chosen.len() < want {
-        let nodes: Vec<NodeId> = chosen
-            .iter()
-            .flat_map(|&i| [rels[i].active, rels[i].anchor])
-            .collect();
+        let nodes: Vec<NodeId> = chosen.iter().flat_map(|&i| [rels[i].active, rels[i].anchor]).collect();
         let next: Vec<usize> = pool
             .iter()
             .copied()
-            .filter(|i| {
-                !chosen.contains(i)
-                    && (nodes.contains(&rels[*i].active) || nodes.contains(&rels[*i].anchor))
-            })
+            .filter(|i| !chosen.contains(i) && (nodes.contains(&rels[*i].active) || nodes.contains(&rels[*i].anchor)))
             .collect();
         if next.is_empty() {
             break;
@@ -822,30 +656,14 @@ fn sampled_query(db: &SceneDatabase, cat: &Catalogue, rng: &mut impl Rng) -> Ssg
                     category = mates[rng.random_range(0..mates.len())].to_string();
                 }
             }
-            let attributes = o
-                .attributes
-                .iter()
-                .filter(|_| rng.random_bool(0.5))
-                .cloned()
-                .collect();
-            out.objects.push(ObjectNode {
-                word: category.clone(),
-                category,
-                attributes,
-                count: 1,
-                sentence: 0,
-            });
+            let attributes = o.attributes.iter().filter(|_| rng.random_bool(0.5)).cloned().collect();
+            out.objects.push(ObjectNode { word: category.clone(), category, attributes, count: 1, sentence: 0 });
             map.push((d, out.objects.len() - 1));
             out.objects.len() - 1
         };
         let active = id(r.active, &mut out, rng);
         let anchor = id(r.anchor, &mut out, rng);
-        out.relations.push(RelationNode {
-            relation: r.relation,
-            active,
-            anchor,
-            sentence: 0,
-        });
+        out.relations.push(RelationNode { relation: r.relation, active, anchor, sentence: 0 });
     }
     out
 }
@@ -894,32 +712,16 @@ pub struct Fig8Set {
 
 /// The Fig. 8 experiment: for each size in `sizes` (the paper: 5, 10, 15), draw that many queries
 /// from `pool` (seeded) and score both matchers on each.
-pub fn fig8(
-    db: &SceneDatabase,
-    cat: &Catalogue,
-    pool: &[Ssg],
-    sizes: &[usize],
-    seed: u64,
-) -> Vec<Fig8Set> {
+pub fn fig8(db: &SceneDatabase, cat: &Catalogue, pool: &[Ssg], sizes: &[usize], seed: u64) -> Vec<Fig8Set> {
     sizes
         .iter()
         .enumerate()
         .map(|(k, &n)| {
             let queries = query_sets(pool.len(), n, inbetween_core::seed::derive(seed, k as u64));
-            let relation_first = queries
-                .iter()
-                .map(|&i| score(&pool[i], db, &relation_first(&pool[i], db, cat)))
-                .collect();
-            let object_first = queries
-                .iter()
-                .map(|&i| score(&pool[i], db, &object_first(&pool[i], db, cat)))
-                .collect();
-            Fig8Set {
-                n,
-                queries,
-                relation_first,
-                object_first,
-            }
+            let relation_first =
+                queries.iter().map(|&i| score(&pool[i], db, &relation_first(&pool[i], db, cat))).collect();
+            let object_first = queries.iter().map(|&i| score(&pool[i], db, &object_first(&pool[i], db, cat))).collect();
+            Fig8Set { n, queries, relation_first, object_first }
         })
         .collect()
 }

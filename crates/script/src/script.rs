@@ -71,14 +71,8 @@ pub fn split(text: &str) -> Vec<RawSentence> {
             match c {
                 '$' => push_seg(&mut segs, &mut cur, true),
                 '.' | '!' | '?' => {
-                    let prev = chars[..k]
-                        .iter()
-                        .rev()
-                        .find(|c| !c.is_whitespace())
-                        .copied();
-                    if c == '.'
-                        && (is_decimal_point(&chars, k) || ends_with_abbreviation(&cur.text))
-                    {
+                    let prev = chars[..k].iter().rev().find(|c| !c.is_whitespace()).copied();
+                    if c == '.' && (is_decimal_point(&chars, k) || ends_with_abbreviation(&cur.text)) {
                         cur.text.push(c);
                     } else if c == '.' && prev == Some('"') && chars[..k].last() == Some(&'"') {
                         // `".` stands for `$".` in the captions (Fig. 5, boxing gym).
@@ -143,14 +137,7 @@ pub fn split(text: &str) -> Vec<RawSentence> {
             } else {
                 SentenceKind::Direction
             };
-            RawSentence {
-                at: SentenceRef {
-                    line,
-                    sentence: i + 1,
-                    text,
-                },
-                kind,
-            }
+            RawSentence { at: SentenceRef { line, sentence: i + 1, text }, kind }
         })
         .collect()
 }
@@ -176,9 +163,7 @@ pub fn command_parts(text: &str) -> Option<(String, String)> {
 
 fn push_seg(segs: &mut Vec<(String, usize, bool)>, cur: &mut Pending, scene: bool) {
     let text = cur.text.split_whitespace().collect::<Vec<_>>().join(" ");
-    let text = text
-        .trim_matches(|c: char| c == ',' || c == ';' || c == ':' || c.is_whitespace())
-        .to_string();
+    let text = text.trim_matches(|c: char| c == ',' || c == ';' || c == ':' || c.is_whitespace()).to_string();
     if !text.is_empty() && text.chars().any(char::is_alphanumeric) {
         segs.push((text, cur.line.max(1), scene));
     }
@@ -199,10 +184,7 @@ fn is_decimal_point(chars: &[char], k: usize) -> bool {
 }
 
 fn ends_with_abbreviation(text: &str) -> bool {
-    let last = text
-        .rsplit(|c: char| !c.is_alphanumeric())
-        .next()
-        .unwrap_or("");
+    let last = text.rsplit(|c: char| !c.is_alphanumeric()).next().unwrap_or("");
     !last.is_empty() && ABBREVIATIONS.contains(&last.to_lowercase().as_str())
 }
 

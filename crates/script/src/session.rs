@@ -62,12 +62,8 @@ impl Session {
             .filter(|s| !self.sentences.contains(&s.raw.at.text))
             .map(|s| s.raw.at.sentence)
             .collect();
-        let input = ComposeInput {
-            parsed: &parsed,
-            catalogue: &self.catalogue,
-            database: &self.database,
-            pins: &self.pins,
-        };
+        let input =
+            ComposeInput { parsed: &parsed, catalogue: &self.catalogue, database: &self.database, pins: &self.pins };
         let composition = compose(&input, &self.config);
         let mut pins = HashMap::new();
         let (mut kept, mut placed) = (0, 0);

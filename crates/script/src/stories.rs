@@ -14,7 +14,8 @@ pub const FIG1: &str = "'Eve walks to the house
 ";
 
 /// Fig. 5: iterative creation with customised text (gallery and meeting room).
-pub const FIG5: &str = "\"In a gallery there is a horsesculpture and a oilpainting\\$. There is also a sculpture and a picture\\$.\"
+pub const FIG5: &str =
+    "\"In a gallery there is a horsesculpture and a oilpainting\\$. There is also a sculpture and a picture\\$.\"
 \"There is a blackboard in a meetingroom\\$. There is an arranged table in the meetingroom\\$......\"
 \"Susan walks to the oilpainting. Susan stands in the front of oilpainting and is looking at it.\"
 \"Susan walks to the picture and plays with the phone.\"
@@ -28,7 +29,8 @@ pub const FIG6: &str = "\"The man walks unbelievably to the road.\"
 ";
 
 /// Fig. 7: actions in different scenes (boxing gym, workshop, music room).
-pub const FIG7: &str = "\"There is a boxing ring above which a boxingbag hangs\". There is a stool and a desk.\". There is a bottle\"
+pub const FIG7: &str =
+    "\"There is a boxing ring above which a boxingbag hangs\". There is a stool and a desk.\". There is a bottle\"
 \"There is an organized working shop\\$. A hammer and a wood is on the table\\$. A shelf and a sofa are in the front\"
 \"There is a music room\\$. A computer and a recorder are on a desk\\$. There is a piano and a chair in front\"
 \"Worker is serving the wood
@@ -46,20 +48,23 @@ and pushes the record button.\"
 
 /// The Fig. 5 and Fig. 7 texts hold several scenes each; composed as one they would crowd a single
 /// room. These are the same lines, one scene per text, with the characters that act in it.
-pub const FIG5_GALLERY: &str = "\"In a gallery there is a horsesculpture and a oilpainting\\$. There is also a sculpture and a picture\\$.\"
+pub const FIG5_GALLERY: &str =
+    "\"In a gallery there is a horsesculpture and a oilpainting\\$. There is also a sculpture and a picture\\$.\"
 \"Susan walks to the oilpainting. Susan stands in the front of oilpainting and is looking at it.\"
 \"Susan walks to the picture and plays with the phone.\"
 \"Susan walks to the horsesculpture. Susan is thinking before the horsesculpture.\"
 ";
 
 /// Fig. 5, the meeting-room scene.
-pub const FIG5_MEETING_ROOM: &str = "\"There is a blackboard in a meetingroom\\$. There is an arranged table in the meetingroom\\$......\"
+pub const FIG5_MEETING_ROOM: &str =
+    "\"There is a blackboard in a meetingroom\\$. There is an arranged table in the meetingroom\\$......\"
 \"Tom sits on a modernchair. Tom sits and calls with phone. Tom sits madly. Tom stands.\"
 \"Tom turns right. Tom stands and writes on the blackboard.\"
 ";
 
 /// Fig. 7, the boxing gym.
-pub const FIG7_BOXING: &str = "\"There is a boxing ring above which a boxingbag hangs\". There is a stool and a desk.\". There is a bottle\"
+pub const FIG7_BOXING: &str =
+    "\"There is a boxing ring above which a boxingbag hangs\". There is a stool and a desk.\". There is a bottle\"
 \"Mary is punching boxingbag.\"
 \"Mary is drinking soda.\"
 ";
@@ -73,7 +78,8 @@ pub const FIG7_WORKSHOP: &str = "\"There is an organized working shop\\$. A hamm
 ";
 
 /// Fig. 7, the music room.
-pub const FIG7_MUSIC_ROOM: &str = "\"There is a music room\\$. A computer and a recorder are on a desk\\$. There is a piano and a chair in front\"
+pub const FIG7_MUSIC_ROOM: &str =
+    "\"There is a music room\\$. A computer and a recorder are on a desk\\$. There is a piano and a chair in front\"
 \"Anny walks to the recorder
 
 and pushes the record button.\"

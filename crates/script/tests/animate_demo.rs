@@ -19,7 +19,10 @@ fn demo() -> (Composition, Animation) {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let parsed = parse_script(stories::DEMO, &cat);
-    let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
+    let comp = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig::default(),
+    );
     let lib = MotionLibrary::procedural(0);
     let anim = animate(&comp, &cat, &lib, &AnimateConfig::default());
     (comp, anim)
@@ -48,7 +51,9 @@ fn demo_characters_move_continuously_and_reach_their_targets() {
             let o = &anim.scene.objects[s.object.unwrap()];
             let r = poses[s.end - 1].translations[rig.hips];
             let [hx, hz] = o.half_extents_xz();
-            let gap = ((r.x as f32 - o.position[0]).abs() - hx).max(0.0).hypot(((r.z as f32 - o.position[2]).abs() - hz).max(0.0));
+            let gap = ((r.x as f32 - o.position[0]).abs() - hx)
+                .max(0.0)
+                .hypot(((r.z as f32 - o.position[2]).abs() - hz).max(0.0));
             let limit = if o.support.is_some() { 1.2 } else { 0.8 };
             assert!(gap < limit, "{} {} ends {gap:.2} m from {}", c.name, s.verb, o.label);
         }
@@ -69,7 +74,12 @@ fn sitting_puts_the_pelvis_on_the_seat() {
                 let seat_y = jc.point[1] as f64 - PELVIS_ABOVE_SEAT;
                 let obj = &anim.scene.objects[s.object.unwrap()];
                 eprintln!("{}: pelvis {:.3} seat {:.3} on {}", c.name, pelvis.y - PELVIS_ABOVE_SEAT, seat_y, obj.label);
-                assert!((pelvis.y - PELVIS_ABOVE_SEAT - seat_y).abs() < 0.05, "{}: pelvis {:.3} over seat {seat_y:.3}", c.name, pelvis.y);
+                assert!(
+                    (pelvis.y - PELVIS_ABOVE_SEAT - seat_y).abs() < 0.05,
+                    "{}: pelvis {:.3} over seat {seat_y:.3}",
+                    c.name,
+                    pelvis.y
+                );
                 let h = ((pelvis.x - jc.point[0] as f64).powi(2) + (pelvis.z - jc.point[2] as f64).powi(2)).sqrt();
                 assert!(h < 0.1, "{}: pelvis {h:.2} m off the seat", c.name);
                 sat += 1;
@@ -91,7 +101,11 @@ fn walking_roots_stay_out_of_floor_objects() {
                     if o.support.is_some() || !blocks_walking(o) || s.touching.contains(&i) {
                         continue;
                     }
-                    let l = inbetween_script::layout::geom::to_local([o.position[0], o.position[2]], o.yaw, [r.x as f32, r.z as f32]);
+                    let l = inbetween_script::layout::geom::to_local(
+                        [o.position[0], o.position[2]],
+                        o.yaw,
+                        [r.x as f32, r.z as f32],
+                    );
                     let inside = l[0].abs() < o.size[0] / 2.0 && l[1].abs() < o.size[2] / 2.0;
                     assert!(!inside, "{} walks through {} at frame {f}", c.name, o.label);
                 }
@@ -109,7 +123,9 @@ fn front_camera_frames_the_characters_from_inside_the_room() {
     let room = &anim.scene.room;
     for f in (0..anim.frames()).step_by(17) {
         let (eye, target, fov) = camera_pose(&anim, f);
-        assert!(eye[0] >= 0.0 && eye[0] <= room.width && eye[2] >= 0.0 && eye[2] <= room.depth && eye[1] <= room.height);
+        assert!(
+            eye[0] >= 0.0 && eye[0] <= room.width && eye[2] >= 0.0 && eye[2] <= room.depth && eye[1] <= room.height
+        );
         // The first character's chest, or on the axis of a two-shot, which frames both heads in
         // the upper third (so it aims below them).
         assert!(target[1] > 0.3 && target[1] < 1.7, "target height {}", target[1]);
@@ -124,12 +140,16 @@ fn camera_commands_cut_at_the_next_action() {
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let text = "In the office, a desk is near a bookshelf$\nA chair is next to the desk$\ncamera left\nEve walks to the desk.\ncamera top\nEve sits on the chair.\n";
     let parsed = parse_script(text, &cat);
-    let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
+    let comp = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig::default(),
+    );
     let anim = animate(&comp, &cat, &MotionLibrary::procedural(0), &AnimateConfig::default());
     let views: Vec<&str> = anim.camera.iter().map(|s| s.view.as_str()).collect();
     assert_eq!(views, ["left", "top"], "{:?}", anim.camera);
     let eve = &anim.characters[0];
-    let sit_start = eve.segments.iter().find(|s| s.target.as_deref() == Some("chair")).expect("walk to the chair").start;
+    let sit_start =
+        eve.segments.iter().find(|s| s.target.as_deref() == Some("chair")).expect("walk to the chair").start;
     assert_eq!(anim.camera[1].start, sit_start);
     assert_eq!(anim.camera[0].end, sit_start);
     let (eye, target, _) = camera_pose(&anim, 0);
@@ -145,9 +165,18 @@ fn every_builtin_story_animates() {
     let lib = MotionLibrary::procedural(0);
     for (name, text) in stories::all() {
         let parsed = parse_script(text, &cat);
-        let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
+        let comp = compose(
+            &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+            &ComposeConfig::default(),
+        );
         let anim = animate(&comp, &cat, &lib, &AnimateConfig::default());
-        eprintln!("{name}: {} characters, {} frames, camera {:?}, notes {:?}", anim.characters.len(), anim.frames(), anim.camera.iter().map(|s| &s.view).collect::<Vec<_>>(), anim.notes);
+        eprintln!(
+            "{name}: {} characters, {} frames, camera {:?}, notes {:?}",
+            anim.characters.len(),
+            anim.frames(),
+            anim.camera.iter().map(|s| &s.view).collect::<Vec<_>>(),
+            anim.notes
+        );
         assert!(!anim.camera.is_empty());
         for c in &anim.characters {
             let rig = Rig::of(c.motion.skeleton.clone());

@@ -6,7 +6,9 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 use inbetween_core::fk::forward;
-use inbetween_script::animate::{animate, carried_from, contacts_of, object_pose, AnimateConfig, Animation, ContactJoint};
+use inbetween_script::animate::{
+    animate, carried_from, contacts_of, object_pose, AnimateConfig, Animation, ContactJoint,
+};
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::catalogue::ContactKind;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput};
@@ -20,7 +22,10 @@ fn animated(text: &str) -> Animation {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let parsed = parse_script(text, &cat);
-    let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
+    let comp = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig::default(),
+    );
     animate(&comp, &cat, &MotionLibrary::procedural(0), &AnimateConfig::default())
 }
 
@@ -98,8 +103,15 @@ fn the_story_gltf_moves_a_carried_prop() {
     let cam = |f: usize| inbetween_script::animate::camera_pose(&anim, f);
     inbetween_script::output::write_story_gltf(&path, &anim, &cat, &cam).unwrap();
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-    let node = doc["nodes"].as_array().unwrap().iter().position(|n| n["name"] == "microphone").expect("the microphone's node");
-    let paths: Vec<&str> = doc["animations"][0]["channels"].as_array().unwrap().iter().filter(|c| c["target"]["node"] == node).map(|c| c["target"]["path"].as_str().unwrap()).collect();
+    let node =
+        doc["nodes"].as_array().unwrap().iter().position(|n| n["name"] == "microphone").expect("the microphone's node");
+    let paths: Vec<&str> = doc["animations"][0]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["target"]["node"] == node)
+        .map(|c| c["target"]["path"].as_str().unwrap())
+        .collect();
     assert_eq!(paths, ["translation", "rotation"]);
 }
 
@@ -110,14 +122,22 @@ fn the_preview_draws_a_moving_object_where_it_is() {
     let cat = builtin();
     let anim = animated("A microphone is on a table$.\nEve waves.\n");
     let table = anim.scene.objects.iter().position(|o| o.category == "table").unwrap();
-    let chars: Vec<(&str, &inbetween_core::Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &inbetween_core::Motion)> =
+        anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let cam = |f: usize| inbetween_script::animate::camera_pose(&anim, f);
-    let base = inbetween_script::output::AnimPreviewOptions { width: 160, max_frames: 2, labels: false, ..Default::default() };
+    let base =
+        inbetween_script::output::AnimPreviewOptions { width: 160, max_frames: 2, labels: false, ..Default::default() };
     let o = &anim.scene.objects[table];
     let up = ([o.position[0], o.position[1] + 1.5, o.position[2]], o.yaw);
     let moved = inbetween_script::output::AnimPreviewOptions { moving: vec![(table, vec![up])], ..base.clone() };
-    let still = inbetween_script::output::anim_preview::preview_frames(&anim.scene, &cat, &chars, &cam, anim.fps, &base).unwrap().0;
-    let carried = inbetween_script::output::anim_preview::preview_frames(&anim.scene, &cat, &chars, &cam, anim.fps, &moved).unwrap().0;
+    let still =
+        inbetween_script::output::anim_preview::preview_frames(&anim.scene, &cat, &chars, &cam, anim.fps, &base)
+            .unwrap()
+            .0;
+    let carried =
+        inbetween_script::output::anim_preview::preview_frames(&anim.scene, &cat, &chars, &cam, anim.fps, &moved)
+            .unwrap()
+            .0;
     assert_eq!(still.len(), carried.len());
     assert!(still.iter().zip(&carried).all(|(a, b)| a != b), "the moved table is drawn elsewhere");
 }

@@ -13,20 +13,10 @@ fn every_scene_is_sound() {
         assert!(problems.is_empty(), "seed {seed}:\n{}", problems.join("\n"));
         for s in &db.scenes {
             assert_eq!(s.ssg.objects.len(), s.placements.len());
-            assert!(
-                s.ssg.objects.len() >= 6,
-                "{} has {} objects",
-                s.name,
-                s.ssg.objects.len()
-            );
+            assert!(s.ssg.objects.len() >= 6, "{} has {} objects", s.name, s.ssg.objects.len());
             assert!(s.ssg.objects.iter().all(|o| cat.get(&o.category).is_some()));
             // The stored relation nodes are exactly what the placements imply.
-            assert_eq!(
-                s.ssg.relations,
-                derive_relations(&s.placements),
-                "{}",
-                s.name
-            );
+            assert_eq!(s.ssg.relations, derive_relations(&s.placements), "{}", s.name);
         }
     }
 }
@@ -38,16 +28,7 @@ fn authored_rooms_have_their_intended_relations() {
     let names: Vec<&str> = db.scenes.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(
         names,
-        [
-            "office",
-            "bedroom",
-            "livingroom",
-            "gallery",
-            "musicroom",
-            "meetingroom",
-            "workshop",
-            "boxinggym"
-        ]
+        ["office", "bedroom", "livingroom", "gallery", "musicroom", "meetingroom", "workshop", "boxinggym"]
     );
     let intended = authored_relations(&cat);
     assert!(intended.len() >= 40);
@@ -63,18 +44,9 @@ fn authored_rooms_have_their_intended_relations() {
         );
         kinds.insert(rel);
     }
-    assert_eq!(
-        kinds.len(),
-        8,
-        "every relation kind is authored somewhere: {kinds:?}"
-    );
+    assert_eq!(kinds.len(), 8, "every relation kind is authored somewhere: {kinds:?}");
     for s in &db.scenes {
-        assert!(
-            (8..=16).contains(&s.ssg.objects.len()),
-            "{}: {}",
-            s.name,
-            s.ssg.objects.len()
-        );
+        assert!((8..=16).contains(&s.ssg.objects.len()), "{}: {}", s.name, s.ssg.objects.len());
     }
 }
 
@@ -86,13 +58,9 @@ fn same_seed_same_database_and_variations_vary() {
     assert_eq!(a.scenes, b.scenes);
     let c = SceneDatabase::builtin(&cat, 4, 10);
     assert_ne!(a.scenes, c.scenes);
-    let differing = a
-        .scenes
-        .iter()
-        .filter(|s| s.name.contains("-v"))
-        .filter(|s| {
-            let base = a.find(s.name.split("-v").next().unwrap()).unwrap();
-            base.placements != s.placements || base.ssg.objects != s.ssg.objects
-        });
+    let differing = a.scenes.iter().filter(|s| s.name.contains("-v")).filter(|s| {
+        let base = a.find(s.name.split("-v").next().unwrap()).unwrap();
+        base.placements != s.placements || base.ssg.objects != s.ssg.objects
+    });
     assert_eq!(differing.count(), 8 * 4);
 }

@@ -30,10 +30,7 @@ fn tiny_glb() -> Vec<u8> {
 
 #[test]
 fn a_tiny_glb_sets_size_and_model() {
-    assert_eq!(
-        glb_bounds(&tiny_glb()).unwrap(),
-        ([1.0, 0.0, -2.0], [3.0, 2.0, 0.0])
-    );
+    assert_eq!(glb_bounds(&tiny_glb()).unwrap(), ([1.0, 0.0, -2.0], [3.0, 2.0, 0.0]));
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("desk.glb"), tiny_glb()).unwrap();
     let cat = with_models(builtin(), dir.path()).unwrap();
@@ -58,10 +55,7 @@ fn a_broken_glb_is_an_error_naming_the_file() {
     let err = with_models(builtin(), dir.path()).unwrap_err();
     assert!(matches!(err, ScriptError::Asset { .. }));
     let msg = err.to_string();
-    assert!(
-        msg.contains("bedSingle.glb") && msg.contains("past the file end"),
-        "{msg}"
-    );
+    assert!(msg.contains("bedSingle.glb") && msg.contains("past the file end"), "{msg}");
     assert!(with_models(builtin(), &dir.path().join("missing")).is_err());
 }
 
@@ -92,12 +86,7 @@ fn kenney_furniture_from_shared_data() {
                 // Measured footprints stay plausible next to the box guesses (a vintage TV is deep).
                 for k in [0, 2] {
                     let ratio = c.size[k] / b.size[k];
-                    assert!(
-                        ratio > 0.25 && ratio < 5.0,
-                        "{name} ({stem}): {:?} vs {:?}",
-                        c.size,
-                        b.size
-                    );
+                    assert!(ratio > 0.25 && ratio < 5.0, "{name} ({stem}): {:?} vs {:?}", c.size, b.size);
                 }
                 println!(
                     "{name:12} {stem:20} ×{:.2} {:?} (box {:?})",
@@ -111,9 +100,6 @@ fn kenney_furniture_from_shared_data() {
         assert!(measured >= 20, "{measured}");
         // The scene database does not depend on the installed models.
         use inbetween_script::database::SceneDatabase;
-        assert_eq!(
-            SceneDatabase::builtin(&cat, 2, 3).scenes,
-            SceneDatabase::builtin(&base, 2, 3).scenes
-        );
+        assert_eq!(SceneDatabase::builtin(&cat, 2, 3).scenes, SceneDatabase::builtin(&base, 2, 3).scenes);
     });
 }

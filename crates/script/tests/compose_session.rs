@@ -22,7 +22,10 @@ fn every_builtin_story_composes_without_layout_violations() {
     let db = SceneDatabase::builtin(&cat, 2, 7);
     for (name, text) in stories::all() {
         let parsed = parse_script(text, &cat);
-        let c = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
+        let c = compose(
+            &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+            &ComposeConfig::default(),
+        );
         assert!(!c.scene.objects.is_empty(), "{name}: no object");
         assert_eq!(c.violations.total(), 0, "{name}: {:?}", c.violations);
         for o in &c.scene.objects {
@@ -108,7 +111,11 @@ fn changing_a_relation_moves_the_objects_it_names() {
 fn an_unknown_word_is_reported_and_the_rest_still_runs() {
     let mut s = session();
     let u = s.update("A desk is near a bed$. A flumpstick is on the desk$. Tom sits on a chair.");
-    assert!(u.composition.diagnostics.iter().any(|d| d.word.as_deref() == Some("flumpstick")), "{:?}", u.composition.diagnostics);
+    assert!(
+        u.composition.diagnostics.iter().any(|d| d.word.as_deref() == Some("flumpstick")),
+        "{:?}",
+        u.composition.diagnostics
+    );
     let d = u.composition.diagnostics.iter().find(|d| d.word.as_deref() == Some("flumpstick")).unwrap();
     assert_eq!(d.at.sentence, 2);
     assert!(u.composition.scene.objects.iter().any(|o| o.category == "desk"));
@@ -136,7 +143,8 @@ fn relation_first_matching_scores_at_least_object_first_on_the_captions() {
         let parsed = parse_script(text, &cat);
         let score = |m| {
             let cfg = ComposeConfig { matcher: m, ..ComposeConfig::default() };
-            compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &cfg).match_score
+            compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &cfg)
+                .match_score
         };
         if score(Matcher::RelationFirst) >= score(Matcher::ObjectFirst) - 1e-9 {
             better_or_equal += 1;
@@ -168,7 +176,12 @@ fn the_bench_edit_changes_exactly_one_sentence_of_the_demo() {
     s.update(stories::DEMO);
     let u = s.update(&inbetween_script::bench::edit_one_sentence(stories::DEMO));
     assert_eq!(u.changed_sentences.len(), 1);
-    assert!(u.composition.scene.objects.iter().any(|o| o.category == "plant" && matches!(o.origin, inbetween_script::scene::Origin::Script { .. })));
+    assert!(u
+        .composition
+        .scene
+        .objects
+        .iter()
+        .any(|o| o.category == "plant" && matches!(o.origin, inbetween_script::scene::Origin::Script { .. })));
 }
 
 mod word_soup {
@@ -176,9 +189,46 @@ mod word_soup {
     use proptest::prelude::*;
 
     const WORDS: &[&str] = &[
-        "a", "the", "two", "is", "are", "on", "near", "in", "front", "of", "next", "to", "under", "above", "behind",
-        "desk", "chair", "bed", "lamp", "sofa", "table", "piano", "tv", "room", "office", "Tom", "walks", "sits",
-        "camera", "left", "and", "it", "there", "$", ".", ",", "\n", "flumpstick", "which", "hangs",
+        "a",
+        "the",
+        "two",
+        "is",
+        "are",
+        "on",
+        "near",
+        "in",
+        "front",
+        "of",
+        "next",
+        "to",
+        "under",
+        "above",
+        "behind",
+        "desk",
+        "chair",
+        "bed",
+        "lamp",
+        "sofa",
+        "table",
+        "piano",
+        "tv",
+        "room",
+        "office",
+        "Tom",
+        "walks",
+        "sits",
+        "camera",
+        "left",
+        "and",
+        "it",
+        "there",
+        "$",
+        ".",
+        ",",
+        "\n",
+        "flumpstick",
+        "which",
+        "hangs",
     ];
 
     proptest! {

@@ -20,7 +20,14 @@ fn session() -> StorySession {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let ocfg = OptimizeConfig { iterations: ITERATIONS, ..OptimizeConfig::default() };
-    StorySession::new(cat, db, ComposeConfig::default(), MotionLibrary::procedural(0), AnimateConfig::default(), Some(ocfg))
+    StorySession::new(
+        cat,
+        db,
+        ComposeConfig::default(),
+        MotionLibrary::procedural(0),
+        AnimateConfig::default(),
+        Some(ocfg),
+    )
 }
 
 /// The demo with Tom's sentence changed: he walks to the table first, then sits on the sofa.
@@ -40,8 +47,17 @@ fn the_first_version_is_the_full_run() {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let parsed = parse_script(DEMO, &cat);
-    let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
-    let o = optimize(&comp, &cat, &MotionLibrary::procedural(0), &AnimateConfig::default(), &OptimizeConfig { iterations: ITERATIONS, ..OptimizeConfig::default() });
+    let comp = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig::default(),
+    );
+    let o = optimize(
+        &comp,
+        &cat,
+        &MotionLibrary::procedural(0),
+        &AnimateConfig::default(),
+        &OptimizeConfig { iterations: ITERATIONS, ..OptimizeConfig::default() },
+    );
     assert!(o.animation == first.animation, "the session's first run differs from optimize");
     assert_eq!(o.after, first.after);
 }
@@ -53,7 +69,13 @@ fn editing_one_characters_sentence_re_solves_only_that_character_and_its_objects
     let second = s.update(&edited());
     eprintln!(
         "re-solved {:?}, kept {:?}, objects {:?}, builds {:?}, {:.3} s (full {:.3} s); notes {:?}",
-        second.resolved_characters, second.kept_characters, second.resolved_objects, second.character_builds, second.seconds, first.seconds, second.animation.notes
+        second.resolved_characters,
+        second.kept_characters,
+        second.resolved_objects,
+        second.character_builds,
+        second.seconds,
+        first.seconds,
+        second.animation.notes
     );
     assert!(!second.full);
     assert_eq!(second.scene.changed_sentences.len(), 1);
@@ -63,7 +85,9 @@ fn editing_one_characters_sentence_re_solves_only_that_character_and_its_objects
     let builds: HashMap<&str, usize> = second.character_builds.iter().map(|(n, b)| (n.as_str(), *b)).collect();
     assert_eq!(builds["Eve"], 0);
     assert!(builds["Tom"] >= 1);
-    let eve = |u: &inbetween_script::animate::incremental::StoryUpdate| u.animation.characters.iter().find(|c| c.name == "Eve").unwrap().clone();
+    let eve = |u: &inbetween_script::animate::incremental::StoryUpdate| {
+        u.animation.characters.iter().find(|c| c.name == "Eve").unwrap().clone()
+    };
     assert!(eve(&first).motion == eve(&second).motion, "Eve's motion changed");
     // Tom now walks to the table first.
     let tom = second.animation.characters.iter().find(|c| c.name == "Tom").unwrap();
@@ -99,14 +123,32 @@ fn an_unchanged_text_re_solves_nothing() {
     for (a, b) in again.animation.characters.iter().zip(&first.animation.characters) {
         assert!(a.motion == b.motion, "{}'s motion changed", a.name);
     }
-    let moved: Vec<&str> = again.animation.scene.objects.iter().filter(|o| first.animation.scene.find(&o.label).is_none_or(|p| (p.position, p.size, p.yaw) != (o.position, o.size, o.yaw))).map(|o| o.label.as_str()).collect();
+    let moved: Vec<&str> = again
+        .animation
+        .scene
+        .objects
+        .iter()
+        .filter(|o| {
+            first
+                .animation
+                .scene
+                .find(&o.label)
+                .is_none_or(|p| (p.position, p.size, p.yaw) != (o.position, o.size, o.yaw))
+        })
+        .map(|o| o.label.as_str())
+        .collect();
     assert!(moved.is_empty(), "objects not at their previous pose: {moved:?}");
     // The whole value: scene (supports included), tracks, segments, camera, notes.
     assert!(again.animation == first.animation, "an unchanged re-run gives another Animation");
     // Also after an edit: the edited version, saved again, stays as it was.
     let second = s.update(&edited());
     let third = s.update(&edited());
-    assert!(third.resolved_characters.is_empty() && third.resolved_objects.is_empty(), "{:?} {:?}", third.resolved_characters, third.resolved_objects);
+    assert!(
+        third.resolved_characters.is_empty() && third.resolved_objects.is_empty(),
+        "{:?} {:?}",
+        third.resolved_characters,
+        third.resolved_objects
+    );
     assert!(third.scene.changed_sentences.is_empty());
     for (a, b) in third.animation.characters.iter().zip(&second.animation.characters) {
         assert!(a.motion == b.motion, "{}'s motion changed", a.name);

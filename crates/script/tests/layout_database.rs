@@ -34,7 +34,12 @@ fn database_scenes_lay_out_cleanly_from_their_hints() {
                 }
             })
             .collect();
-        let relations = s.ssg.relations.iter().map(|r| LayoutConstraint { relation: r.relation, active: r.active, anchor: r.anchor }).collect();
+        let relations = s
+            .ssg
+            .relations
+            .iter()
+            .map(|r| LayoutConstraint { relation: r.relation, active: r.active, anchor: r.anchor })
+            .collect();
         let p = LayoutProblem { room: s.room.clone(), items, relations };
         let t = std::time::Instant::now();
         let out = solve(&p, 1);

@@ -3,7 +3,9 @@
 
 use inbetween_script::catalogue::Support;
 use inbetween_script::database::Placement;
-use inbetween_script::layout::{check, relation_holds, solve, strictly_holds, LayoutConstraint, LayoutItem, LayoutProblem};
+use inbetween_script::layout::{
+    check, relation_holds, solve, strictly_holds, LayoutConstraint, LayoutItem, LayoutProblem,
+};
 use inbetween_script::scene::{Origin, PlacedObject, Room};
 use inbetween_script::ssg::Relation;
 use proptest::prelude::*;
@@ -61,7 +63,10 @@ fn problem(items: Vec<LayoutItem>, rels: &[(Relation, usize, usize)]) -> LayoutP
     LayoutProblem {
         room: room(5.0, 4.0),
         items,
-        relations: rels.iter().map(|&(relation, active, anchor)| LayoutConstraint { relation, active, anchor }).collect(),
+        relations: rels
+            .iter()
+            .map(|&(relation, active, anchor)| LayoutConstraint { relation, active, anchor })
+            .collect(),
     }
 }
 
@@ -93,9 +98,19 @@ fn every_relation_is_placed_and_holds() {
         for seed in 0..5 {
             let p = problem(vec![anchor.clone(), active.clone()], &[(rel, 1, 0)]);
             let out = solve(&p, seed);
-            assert!(out.dropped.is_empty() && out.violations.total() == 0, "{rel:?} seed {seed}: {:?} {:?}\n{:#?}", out.dropped, out.violations, out.objects);
+            assert!(
+                out.dropped.is_empty() && out.violations.total() == 0,
+                "{rel:?} seed {seed}: {:?} {:?}\n{:#?}",
+                out.dropped,
+                out.violations,
+                out.objects
+            );
             let out = assert_clean(&p, seed);
-            assert!(strictly_holds(rel, &out.objects[1], &out.objects[0]), "{rel:?} seed {seed}: not tidy\n{:#?}", out.objects);
+            assert!(
+                strictly_holds(rel, &out.objects[1], &out.objects[0]),
+                "{rel:?} seed {seed}: not tidy\n{:#?}",
+                out.objects
+            );
             if rel == Relation::On {
                 assert_eq!(out.objects[1].support, Some(0));
             }
@@ -115,7 +130,10 @@ fn facing_and_heights_follow_the_conventions() {
     let pt = &out.objects[2];
     assert!((pt.position[1] + pt.size[1] / 2.0 - 1.5).abs() < 1e-3, "painting centred at 1.5 m");
     let [hx, hz] = pt.half_extents_xz();
-    let touches = pt.position[0] - hx < 0.01 || pt.position[2] - hz < 0.01 || pt.position[0] + hx > 4.99 || pt.position[2] + hz > 3.99;
+    let touches = pt.position[0] - hx < 0.01
+        || pt.position[2] - hz < 0.01
+        || pt.position[0] + hx > 4.99
+        || pt.position[2] + hz > 3.99;
     assert!(touches, "painting on a wall: {:?}", pt.position);
     let bag = &out.objects[3];
     assert!((bag.top() - 2.8).abs() < 1e-3, "hangs from the ceiling");
@@ -169,8 +187,17 @@ fn an_overfull_room_drops_items_with_reasons() {
     assert!(!out.dropped.is_empty());
     assert_eq!(out.objects.len() + out.dropped.len(), 12);
     let (k, why) = &out.dropped[0];
-    assert!(why.contains(&format!("'piano {k}'")) && why.contains("5.0 × 4.0 m room") && why.contains("no free floor space"), "{why}");
-    assert!(out.violations.overlaps.is_empty() && out.violations.outside.is_empty() && out.violations.unreachable.is_empty());
+    assert!(
+        why.contains(&format!("'piano {k}'"))
+            && why.contains("5.0 × 4.0 m room")
+            && why.contains("no free floor space"),
+        "{why}"
+    );
+    assert!(
+        out.violations.overlaps.is_empty()
+            && out.violations.outside.is_empty()
+            && out.violations.unreachable.is_empty()
+    );
     // An object bigger than the room.
     let out = solve(&problem(vec![item("stage", [6.0, 1.0, 6.0], Support::Floor, false)], &[]), 0);
     assert_eq!(out.dropped.len(), 1);

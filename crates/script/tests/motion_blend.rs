@@ -4,7 +4,9 @@ use glam::DVec3;
 use inbetween_core::fk::forward;
 use inbetween_core::rotation::angle_between;
 use inbetween_script::motion::locomotion::place_clip;
-use inbetween_script::motion::{blend_upper, reach_contacts, walk_route, BlendParams, Contact, Limb, MotionLibrary, Rig, WalkParams};
+use inbetween_script::motion::{
+    blend_upper, reach_contacts, walk_route, BlendParams, Contact, Limb, MotionLibrary, Rig, WalkParams,
+};
 
 #[test]
 fn blend_keeps_lower_body_from_locomotion_and_upper_body_from_action() {
@@ -32,7 +34,10 @@ fn blend_keeps_lower_body_from_locomotion_and_upper_body_from_action() {
             let a = action.pose(params.action_frame(f, action.num_frames()));
             for (j, &upper) in mask.iter().enumerate() {
                 if upper && j != rig.lower_back {
-                    assert!(angle_between(o.rotations[j], a.rotations[j]) < 1e-6, "frame {f} joint {j} not from the action");
+                    assert!(
+                        angle_between(o.rotations[j], a.rotations[j]) < 1e-6,
+                        "frame {f} joint {j} not from the action"
+                    );
                 }
             }
         }
@@ -80,6 +85,9 @@ fn seated_typing_meets_the_keyboard() {
         assert!((g.positions[rig.arms[0][3]] - keys[1]).length() < 1e-6);
         assert!((g.positions[rig.arms[1][3]] - keys[0]).length() < 1e-6);
         // The seated lower body is untouched.
-        assert!((g.positions[rig.legs[0][2]] - forward(&sit.skeleton, &sit.pose(f)).positions[rig.legs[0][2]]).length() < 1e-9);
+        assert!(
+            (g.positions[rig.legs[0][2]] - forward(&sit.skeleton, &sit.pose(f)).positions[rig.legs[0][2]]).length()
+                < 1e-9
+        );
     }
 }

@@ -16,13 +16,18 @@ fn reachable_targets_are_met_exactly() {
             let mut pose = rig.standing();
             let g = forward(&rig.skeleton, &pose);
             let (l1, l2) = ((g.positions[b] - g.positions[a]).length(), (g.positions[c] - g.positions[b]).length());
-            let dir = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize();
+            let dir = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
+                .normalize();
             let dist = rng.random_range((l1 - l2).abs() + 0.02..l1 + l2 - 0.01);
             let target = g.positions[a] + dir * dist;
             let err = solve_limb(&rig, &mut pose, limb, target, None);
             let h = forward(&rig.skeleton, &pose);
             assert!(err < 1e-9, "{limb:?}: {err}");
-            assert!((h.positions[c] - target).length() < 1e-9, "{limb:?}: FK misses by {}", (h.positions[c] - target).length());
+            assert!(
+                (h.positions[c] - target).length() < 1e-9,
+                "{limb:?}: FK misses by {}",
+                (h.positions[c] - target).length()
+            );
             // The root of the chain did not move, bone lengths are kept, the end kept its orientation.
             assert!((h.positions[a] - g.positions[a]).length() < 1e-12);
             assert!(((h.positions[b] - h.positions[a]).length() - l1).abs() < 1e-9);
@@ -63,7 +68,8 @@ fn pole_vector_chooses_the_bend_side() {
         assert!(((s.end - s.mid).length() - 0.4).abs() < 1e-12);
     }
     // Too close: clamped to the inner shell.
-    let s = two_bone(root, DVec3::new(0.0, -0.5, 0.0), DVec3::new(0.0, -0.8, 0.0), DVec3::new(0.0, -0.1, 0.0), DVec3::Z);
+    let s =
+        two_bone(root, DVec3::new(0.0, -0.5, 0.0), DVec3::new(0.0, -0.8, 0.0), DVec3::new(0.0, -0.1, 0.0), DVec3::Z);
     assert!(s.clamped);
     assert!((s.end.length() - 0.2).abs() < 1e-12);
 }
@@ -71,7 +77,9 @@ fn pole_vector_chooses_the_bend_side() {
 #[test]
 fn hips_meet_the_seat_and_feet_stay_on_the_floor() {
     let rig = Rig::standard();
-    for (seat, heading) in [(DVec3::new(2.0, 0.45, 1.0), 0.0), (DVec3::new(-1.0, 0.5, 3.0), 1.3), (DVec3::new(0.0, 0.40, 0.0), -2.0)] {
+    for (seat, heading) in
+        [(DVec3::new(2.0, 0.45, 1.0), 0.0), (DVec3::new(-1.0, 0.5, 3.0), 1.3), (DVec3::new(0.0, 0.40, 0.0), -2.0)]
+    {
         let pose = seated_pose(&rig, seat, heading);
         let g = forward(&rig.skeleton, &pose);
         let pelvis = (g.positions[rig.legs[0][0]] + g.positions[rig.legs[1][0]]) * 0.5;

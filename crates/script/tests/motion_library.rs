@@ -23,7 +23,10 @@ fn procedural_library_needs_no_files_and_stands_on_the_floor() {
         let head = g[0].positions[rig.head].y;
         assert!(head > 0.9 && head < 1.8, "{}: head at {head}", c.name);
     }
-    for needed in ["walk", "run", "stand", "sit", "sit_down", "stand_up", "reach", "wave", "punch", "type", "call", "look", "think", "write"] {
+    for needed in [
+        "walk", "run", "stand", "sit", "sit_down", "stand_up", "reach", "wave", "punch", "type", "call", "look",
+        "think", "write",
+    ] {
         assert!(lib.clips.iter().any(|c| c.has_tag(needed)), "no clip tagged {needed}");
     }
 }
@@ -97,7 +100,8 @@ fn cmu_index_is_tagged_and_cgspeed_clips_load() {
             let g = forward_clip(&c.motion);
             // Grounded: the 5th percentile of the lowest toe is at the floor (uneven-terrain and
             // climbing trials go below and above it elsewhere).
-            let mut toes: Vec<f64> = g.iter().map(|p| p.positions[rig.legs[0][3]].y.min(p.positions[rig.legs[1][3]].y)).collect();
+            let mut toes: Vec<f64> =
+                g.iter().map(|p| p.positions[rig.legs[0][3]].y.min(p.positions[rig.legs[1][3]].y)).collect();
             toes.sort_by(f64::total_cmp);
             let toe = toes[toes.len() / 20];
             assert!(toe.abs() < 0.03, "{}: 5th-percentile toe {toe}", c.name);
@@ -153,7 +157,11 @@ fn kenney_characters_add_clips_when_present() {
         }
         let mut lib = MotionLibrary::procedural(0);
         let added = lib.add_kenney(&dir).expect("glb files read");
-        println!("Kenney: {added} clips in {:.3} s: {:?}", lib.load_seconds, lib.clips.iter().filter(|c| c.has_tag("kenney")).map(|c| &c.name).collect::<Vec<_>>());
+        println!(
+            "Kenney: {added} clips in {:.3} s: {:?}",
+            lib.load_seconds,
+            lib.clips.iter().filter(|c| c.has_tag("kenney")).map(|c| &c.name).collect::<Vec<_>>()
+        );
         assert!(added >= 5);
         // The procedural library has no kick: the Kenney one fills the gap; procedural clips
         // still win where both exist.
@@ -194,7 +202,10 @@ fn captured_walks_give_locomotion_its_cycle() {
         let route = [[0.0, 0.0], [0.0, 3.0], [2.5, 3.0]];
         let (_, captured) = walk_route_stats(&route, &lib, &WalkParams::default());
         let (_, procedural) = walk_route_stats(&route, &MotionLibrary::procedural(0), &WalkParams::default());
-        println!("{}: {seconds:.2} s; skate {:.1} → {:.1} cm/s (procedural cycle {:.1} → {:.1})", cycle.name, captured.skate_before, captured.skate_after, procedural.skate_before, procedural.skate_after);
+        println!(
+            "{}: {seconds:.2} s; skate {:.1} → {:.1} cm/s (procedural cycle {:.1} → {:.1})",
+            cycle.name, captured.skate_before, captured.skate_after, procedural.skate_before, procedural.skate_after
+        );
         assert!(captured.skate_after < 10.0, "{captured:?}");
         assert!(captured.max_route_error < 0.3, "{captured:?}");
     });

@@ -3,7 +3,9 @@
 
 use inbetween_core::fk::forward_clip;
 use inbetween_script::motion::locomotion::{heading_at, place_clip};
-use inbetween_script::motion::{foot_skate, lock_feet, walk_route, walk_route_stats, LockParams, MotionLibrary, Rig, WalkParams};
+use inbetween_script::motion::{
+    foot_skate, lock_feet, walk_route, walk_route_stats, LockParams, MotionLibrary, Rig, WalkParams,
+};
 
 fn arc_route() -> Vec<[f32; 2]> {
     (0..=40)
@@ -133,7 +135,10 @@ fn walking_is_deterministic_and_run_is_faster() {
     let placed = place_clip(sit, [2.0, 3.0], 1.0).unwrap();
     let r = placed.pose(0).translations[0];
     let r0 = sit.pose(0).translations[0];
-    assert!((glam::DVec3::new(r.x - 2.0, 0.0, r.z - 3.0).length() - glam::DVec3::new(r0.x, 0.0, r0.z).length()).abs() < 1e-9);
+    assert!(
+        (glam::DVec3::new(r.x - 2.0, 0.0, r.z - 3.0).length() - glam::DVec3::new(r0.x, 0.0, r0.z).length()).abs()
+            < 1e-9
+    );
     assert!((r.y - r0.y).abs() < 1e-12);
 }
 
@@ -145,7 +150,14 @@ fn walks_an_astar_route_around_an_obstacle() {
     let route = grid.astar([0.6, 0.6], [4.4, 4.4]).expect("a route around the table");
     let lib = MotionLibrary::procedural(0);
     let (m, st) = walk_route_stats(&route, &lib, &WalkParams::default());
-    println!("A* route: {} points, {:.2} m, {} frames, skate {:.2} -> {:.2} cm/s", route.len(), st.length, st.frames, st.skate_before, st.skate_after);
+    println!(
+        "A* route: {} points, {:.2} m, {} frames, skate {:.2} -> {:.2} cm/s",
+        route.len(),
+        st.length,
+        st.frames,
+        st.skate_before,
+        st.skate_after
+    );
     for f in 0..m.num_frames() {
         let [x, z] = root_xz(&m, f);
         assert!(grid.is_free_at([x as f32, z as f32]), "frame {f}: root at ({x:.2}, {z:.2}) is inside the obstacle");
@@ -168,7 +180,8 @@ fn a_foreign_skeleton_gives_an_error_naming_the_missing_joint_not_a_panic() {
     let mut pose = Pose::rest(&sk);
     pose.translations[0].y = 0.9;
     let m = Motion::from_poses(sk.clone(), 1.0 / 30.0, &[pose.clone(), pose]).unwrap();
-    let contact = Contact { limb: Limb::RightArm, target: glam::DVec3::new(0.3, 1.0, 0.3), window: BlendParams::default() };
+    let contact =
+        Contact { limb: Limb::RightArm, target: glam::DVec3::new(0.3, 1.0, 0.3), window: BlendParams::default() };
     let errors = [
         ("foot_skate", foot_skate(&m).err()),
         ("lock_feet", lock_feet(&m, &LockParams::default()).err()),

@@ -36,7 +36,12 @@ fn animate_in(objects: Vec<PlacedObject>, text: &str) -> Animation {
     let cat = builtin();
     let parsed = parse_script(text, &cat);
     let query = query_graph(&parsed);
-    let scene = Scene { room: Room { name: "room".into(), width: 6.0, depth: 5.0, height: 2.8 }, objects, camera: Vec::new(), weather: None };
+    let scene = Scene {
+        room: Room { name: "room".into(), width: 6.0, depth: 5.0, height: 2.8 },
+        objects,
+        camera: Vec::new(),
+        weather: None,
+    };
     animate_scene(&scene, &query, &cat, &MotionLibrary::procedural(0), &AnimateConfig::default())
 }
 
@@ -64,14 +69,25 @@ fn closest(anim: &Animation) -> f32 {
 fn three_characters_crossing_the_room_keep_their_distance_at_every_frame() {
     // Tom starts left of the door and goes to the desk on the right wall, Anny starts right of it
     // and goes to the bookshelf on the left wall: their routes cross in front of Eve's table.
-    let objects = vec![object("bookshelf", "bookshelf", 0.4, 1.5, std::f32::consts::FRAC_PI_2), object("desk", "desk", 5.5, 1.5, -std::f32::consts::FRAC_PI_2), object("table", "table", 3.0, 0.8, 0.0)];
+    let objects = vec![
+        object("bookshelf", "bookshelf", 0.4, 1.5, std::f32::consts::FRAC_PI_2),
+        object("desk", "desk", 5.5, 1.5, -std::f32::consts::FRAC_PI_2),
+        object("table", "table", 3.0, 0.8, 0.0),
+    ];
     let anim = animate_in(objects, "Eve walks to the table.\nTom walks to the desk.\nAnny walks to the bookshelf.\n");
     eprintln!("notes: {:?}", anim.notes);
     let names: Vec<&str> = anim.characters.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["Eve", "Tom", "Anny"]);
     let c = min_clearance(&anim).expect("three characters");
     eprintln!("closest: {:.3} m at frame {} ({} and {})", c.metres, c.frame, names[c.a], names[c.b]);
-    assert!(c.metres >= PASSING_DISTANCE, "{} and {} come {:.3} m close at frame {}", names[c.a], names[c.b], c.metres, c.frame);
+    assert!(
+        c.metres >= PASSING_DISTANCE,
+        "{} and {} come {:.3} m close at frame {}",
+        names[c.a],
+        names[c.b],
+        c.metres,
+        c.frame
+    );
     assert!((closest(&anim) - c.metres).abs() < 1e-6, "min_clearance is the smallest distance over all frames");
     assert!(anim.notes.iter().all(|n| !n.contains("close")), "{:?}", anim.notes);
     // Everyone still gets where they were sent.
@@ -88,7 +104,8 @@ fn a_character_standing_still_is_not_walked_through() {
     // Tom (second, started left of the door) only waves and stands there for good; Eve (first,
     // started at the door) walks to the bookshelf by the door wall on Tom's side: her shortest
     // route passes within 0.2 m of Tom.
-    let objects = vec![object("bookshelf", "bookshelf", 0.8, 4.6, std::f32::consts::PI), object("table", "table", 4.5, 1.5, 0.0)];
+    let objects =
+        vec![object("bookshelf", "bookshelf", 0.8, 4.6, std::f32::consts::PI), object("table", "table", 4.5, 1.5, 0.0)];
     let anim = animate_in(objects, "Eve walks to the bookshelf.\nTom waves.\n");
     eprintln!("notes: {:?}", anim.notes);
     let eve = root_track(&anim.characters[0].motion).unwrap();
@@ -98,9 +115,16 @@ fn a_character_standing_still_is_not_walked_through() {
     assert!(tom.iter().all(|p| dist(*p, tom_spot) < 0.1), "Tom stays where he started");
     // Eve's straight line would pass him closely.
     let (a, b) = (eve[0], *eve.last().unwrap());
-    let t = (((tom_spot[0] - a[0]) * (b[0] - a[0]) + (tom_spot[1] - a[1]) * (b[1] - a[1])) / ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2))).clamp(0.0, 1.0);
+    let t = (((tom_spot[0] - a[0]) * (b[0] - a[0]) + (tom_spot[1] - a[1]) * (b[1] - a[1]))
+        / ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)))
+    .clamp(0.0, 1.0);
     let on_line = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
-    eprintln!("Tom at ({:.2}, {:.2}), {:.2} m from Eve's straight line", tom_spot[0], tom_spot[1], dist(on_line, tom_spot));
+    eprintln!(
+        "Tom at ({:.2}, {:.2}), {:.2} m from Eve's straight line",
+        tom_spot[0],
+        tom_spot[1],
+        dist(on_line, tom_spot)
+    );
     assert!(dist(on_line, tom_spot) < PASSING_DISTANCE, "the test needs Tom in Eve's way");
     let frames = eve.len().max(tom.len());
     for f in 0..frames {
@@ -122,12 +146,22 @@ fn every_builtin_story_keeps_its_characters_apart() {
     let mut pairs = 0;
     for (name, text) in stories::all() {
         let parsed = parse_script(text, &cat);
-        let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default());
+        let comp = compose(
+            &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+            &ComposeConfig::default(),
+        );
         let anim = animate(&comp, &cat, &lib, &AnimateConfig::default());
         let Some(c) = min_clearance(&anim) else { continue };
         pairs += 1;
         eprintln!("{name}: closest {:.3} m at frame {}; notes {:?}", c.metres, c.frame, anim.notes);
-        assert!(c.metres >= PASSING_DISTANCE, "{name}: {} and {} come {:.3} m close at frame {}", anim.characters[c.a].name, anim.characters[c.b].name, c.metres, c.frame);
+        assert!(
+            c.metres >= PASSING_DISTANCE,
+            "{name}: {} and {} come {:.3} m close at frame {}",
+            anim.characters[c.a].name,
+            anim.characters[c.b].name,
+            c.metres,
+            c.frame
+        );
         assert!((closest(&anim) - c.metres).abs() < 1e-6);
         assert!(anim.notes.iter().all(|n| !n.contains(" m close")), "{name}: {:?}", anim.notes);
     }
@@ -140,9 +174,21 @@ fn night_of_the_living_dead_keeps_its_characters_apart_after_the_optimisation() 
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, inbetween_script::job::DEFAULT_VARIATIONS, 1);
     let parsed = parse_script(stories::NIGHT_OF_THE_LIVING_DEAD, &cat);
-    let comp = compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig { seed: 1, ..ComposeConfig::default() });
-    let o = optimize(&comp, &cat, &MotionLibrary::procedural(1), &AnimateConfig::default(), &OptimizeConfig { iterations: 30, ..OptimizeConfig::default() });
+    let comp = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig { seed: 1, ..ComposeConfig::default() },
+    );
+    let o = optimize(
+        &comp,
+        &cat,
+        &MotionLibrary::procedural(1),
+        &AnimateConfig::default(),
+        &OptimizeConfig { iterations: 30, ..OptimizeConfig::default() },
+    );
     let c = min_clearance(&o.animation).expect("two characters");
-    eprintln!("closest {:.3} m at frame {}; C {:.3} -> {:.3}; notes {:?}", c.metres, c.frame, o.before.total, o.after.total, o.animation.notes);
+    eprintln!(
+        "closest {:.3} m at frame {}; C {:.3} -> {:.3}; notes {:?}",
+        c.metres, c.frame, o.before.total, o.after.total, o.animation.notes
+    );
     assert!(c.metres >= PASSING_DISTANCE, "{:.3} m at frame {}", c.metres, c.frame);
 }

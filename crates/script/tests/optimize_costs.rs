@@ -18,7 +18,10 @@ fn demo() -> Composition {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let parsed = parse_script(stories::DEMO, &cat);
-    compose(&ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() }, &ComposeConfig::default())
+    compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig::default(),
+    )
 }
 
 #[test]
@@ -55,8 +58,24 @@ fn demo_optimisation_never_increases_the_cost_and_is_deterministic() {
     assert!(std::fs::metadata(&png).unwrap().len() > 1000);
 }
 
-fn object(label: &str, category: &str, size: [f32; 3], position: [f32; 3], support: Option<usize>, node: usize) -> PlacedObject {
-    PlacedObject { label: label.into(), category: category.into(), attributes: vec![], position, yaw: 0.0, size, support, origin: Origin::Script { sentence: 0, node } }
+fn object(
+    label: &str,
+    category: &str,
+    size: [f32; 3],
+    position: [f32; 3],
+    support: Option<usize>,
+    node: usize,
+) -> PlacedObject {
+    PlacedObject {
+        label: label.into(),
+        category: category.into(),
+        attributes: vec![],
+        position,
+        yaw: 0.0,
+        size,
+        support,
+        origin: Origin::Script { sentence: 0, node },
+    }
 }
 
 /// A desk facing the door with a keyboard at its back edge: out of reach from the front.
@@ -71,12 +90,21 @@ fn keyboard_case() -> (Scene, Ssg, Vec<(Relation, usize, usize)>) {
         weather: None,
     };
     let node = |c: &str| ObjectNode { category: c.into(), attributes: vec![], count: 1, word: c.into(), sentence: 0 };
-    let act = |verb: &str, target: usize| Action { verb: verb.into(), preposition: None, target: Some(target), manner: vec![] };
+    let act = |verb: &str, target: usize| Action {
+        verb: verb.into(),
+        preposition: None,
+        target: Some(target),
+        manner: vec![],
+    };
     let query = Ssg {
         room: None,
         objects: vec![node("desk"), node("keyboard")],
         relations: vec![],
-        characters: vec![CharacterNode { name: "Ann".into(), actions: vec![act("walk", 0), act("type", 1)], sentence: 1 }],
+        characters: vec![CharacterNode {
+            name: "Ann".into(),
+            actions: vec![act("walk", 0), act("type", 1)],
+            sentence: 1,
+        }],
         commands: vec![],
     };
     (scene, query, vec![(Relation::On, 1, 0)])

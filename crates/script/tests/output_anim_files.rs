@@ -12,14 +12,15 @@ use image::AnimationDecoder;
 use inbetween_core::fk::forward;
 use inbetween_core::Motion;
 use inbetween_script::catalogue::builtin::builtin;
+use inbetween_script::motion::{walk_route, MotionLibrary, WalkParams};
 use inbetween_script::output::anim_gltf::{animation_frames, ANIMATION_NAME, CHARACTER_COLORS};
 use inbetween_script::output::anim_preview::{plan_pixel, preview_frame_indices, preview_frames, root_route};
 use inbetween_script::output::bvh_out::bvh_sidecar_path;
 use inbetween_script::output::gltf::{base64_decode, parse_glb};
 use inbetween_script::output::{
-    animated_gltf_document, render_preview_gif, render_top_down_trails, write_animated_gltf, write_character_bvh, AnimPreviewOptions,
+    animated_gltf_document, render_preview_gif, render_top_down_trails, write_animated_gltf, write_character_bvh,
+    AnimPreviewOptions,
 };
-use inbetween_script::motion::{walk_route, MotionLibrary, WalkParams};
 use inbetween_script::scene::{Room, Scene};
 use serde_json::Value;
 
@@ -65,7 +66,8 @@ fn check_animation(doc: &Value, bin: &[u8], name: &str, m: &Motion, fps: f64) {
     check_buffers(doc, bin);
     let nodes = doc["nodes"].as_array().unwrap();
     let parent = parents_by_node(doc);
-    let scene_roots: Vec<usize> = doc["scenes"][0]["nodes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
+    let scene_roots: Vec<usize> =
+        doc["scenes"][0]["nodes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect();
     // The static scene is still there.
     assert!(nodes.iter().any(|n| n["name"] == "desk"));
     // Character: a scene root named `name` whose one child is the skeleton's root joint.
@@ -143,7 +145,12 @@ fn check_animation(doc: &Value, bin: &[u8], name: &str, m: &Motion, fps: f64) {
     // One key per frame on every joint's rotation and on the root's translation.
     let n = m.num_frames();
     for j in 0..sk.len() {
-        assert_eq!(keyed[&(joint_node[j], "rotation".to_string())].len(), 4 * n, "rotation keys of {}", sk.joint(j).name);
+        assert_eq!(
+            keyed[&(joint_node[j], "rotation".to_string())].len(),
+            4 * n,
+            "rotation keys of {}",
+            sk.joint(j).name
+        );
     }
     assert_eq!(keyed[&(hips, "translation".to_string())].len(), 3 * n);
     // FK through the keyed node transforms equals core FK (a foot, a hand, the head).
@@ -211,7 +218,15 @@ fn animated_glb_round_trips_with_two_characters() {
     let glb = parse_glb(&std::fs::read(&p).unwrap()).unwrap();
     check_animation(&glb.json, &glb.bin, "ann", &a, 30.0);
     check_animation(&glb.json, &glb.bin, "bob", &b, 30.0);
-    assert_eq!(glb.json["materials"].as_array().unwrap().iter().filter(|m| m["name"].as_str().unwrap().ends_with(" body")).count(), 2);
+    assert_eq!(
+        glb.json["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["name"].as_str().unwrap().ends_with(" body"))
+            .count(),
+        2
+    );
 }
 
 #[test]
@@ -308,7 +323,8 @@ fn preview_gif_decodes_with_expected_frames_and_motion() {
     let count = |f: &image::RgbaImage| f.pixels().filter(|p| near(&p.0, body, 6)).count();
     let mid = frames.len() / 2;
     assert!(count(&frames[0]) > 30 && count(&frames[mid]) > 30, "{} {}", count(&frames[0]), count(&frames[mid]));
-    let changed = frames[0].pixels().zip(frames[mid].pixels()).filter(|(a, b)| !near(&a.0, [b.0[0], b.0[1], b.0[2]], 10)).count();
+    let changed =
+        frames[0].pixels().zip(frames[mid].pixels()).filter(|(a, b)| !near(&a.0, [b.0[0], b.0[1], b.0[2]], 10)).count();
     assert!(changed > 500, "{changed} pixels changed");
     // Where the figure was at frame 0 it is gone half-way (the title aside).
     let left: usize = frames[0].enumerate_pixels().filter(|(_, y, p)| *y > 30 && near(&p.0, body, 6)).count();
@@ -322,7 +338,13 @@ fn preview_gif_decodes_with_expected_frames_and_motion() {
 #[test]
 fn preview_frames_respect_size_and_rate_caps() {
     let m = walk();
-    let opts = AnimPreviewOptions { width: 2000, max_fps: 60.0, max_frames: 7, labels: false, ..AnimPreviewOptions::default() };
+    let opts = AnimPreviewOptions {
+        width: 2000,
+        max_fps: 60.0,
+        max_frames: 7,
+        labels: false,
+        ..AnimPreviewOptions::default()
+    };
     let (frames, fps) = preview_frames(&scene(), &builtin(), &[("walker", &m)], &camera, 30.0, &opts).unwrap();
     assert!(frames.len() <= 7 && !frames.is_empty());
     assert!(fps <= 10.0);

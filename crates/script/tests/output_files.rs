@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::output::gltf::{base64, base64_decode, gltf_document, parse_glb};
-use inbetween_script::output::{perspective, read_json, top_down, write_gltf, write_gltf_with_models, write_json, write_previews, VIEWS};
+use inbetween_script::output::{
+    perspective, read_json, top_down, write_gltf, write_gltf_with_models, write_json, write_previews, VIEWS,
+};
 use inbetween_script::scene::{Room, Scene};
 use serde_json::Value;
 
@@ -115,7 +117,9 @@ fn kenney_models_are_merged_and_fitted_when_present() {
         return;
     };
     let path = dir.join("desk.glb");
-    let model = |c: &str| (c == "desk" || c == "bed").then(|| if c == "desk" { path.clone() } else { dir.join("bedSingle.glb") });
+    let model = |c: &str| {
+        (c == "desk" || c == "bed").then(|| if c == "desk" { path.clone() } else { dir.join("bedSingle.glb") })
+    };
     let (doc, bin, notes) = gltf_document(&scene(), &builtin(), &model);
     assert!(notes.is_empty(), "{notes:?}");
     validate(&doc, &bin);

@@ -7,11 +7,7 @@ use inbetween_script::ssg::{Relation, Ssg};
 use inbetween_script::stories;
 
 fn find<'a>(p: &'a inbetween_script::parse::ParsedScript, text: &str) -> &'a Ssg {
-    &p.sentences
-        .iter()
-        .find(|s| s.raw.at.text == text)
-        .unwrap_or_else(|| panic!("{text}"))
-        .ssg
+    &p.sentences.iter().find(|s| s.raw.at.text == text).unwrap_or_else(|| panic!("{text}")).ssg
 }
 
 #[test]
@@ -37,43 +33,20 @@ fn figure_scenes_with_builtin_catalogue() {
     let p = parse_script(stories::FIG5, &cat);
     let g = find(&p, "Tom sits on a modernchair");
     let target = g.characters[0].actions[0].target.unwrap();
-    assert_eq!(
-        g.objects[target].category,
-        cat.resolve("modernchair").unwrap().name
-    );
-    assert_eq!(
-        find(
-            &p,
-            "In a gallery there is a horsesculpture and a oilpainting"
-        )
-        .room
-        .as_deref(),
-        Some("gallery")
-    );
+    assert_eq!(g.objects[target].category, cat.resolve("modernchair").unwrap().name);
+    assert_eq!(find(&p, "In a gallery there is a horsesculpture and a oilpainting").room.as_deref(), Some("gallery"));
 
     let p = parse_script(stories::FIG7, &cat);
     let g = find(&p, "There is a boxing ring above which a boxingbag hangs");
     assert_eq!(g.relations.len(), 1);
     assert_eq!(g.relations[0].relation, Relation::Above);
-    assert_eq!(
-        g.objects[g.relations[0].anchor].category,
-        cat.resolve("boxingring").unwrap().name
-    );
+    assert_eq!(g.objects[g.relations[0].anchor].category, cat.resolve("boxingring").unwrap().name);
     assert!(g.objects[g.relations[0].anchor].attributes.is_empty());
     let room = |t: &str| find(&p, t).room.clone();
-    assert_eq!(
-        room("There is an organized working shop"),
-        cat.resolve_room("workingshop").map(|r| r.name.clone())
-    );
-    assert_eq!(
-        room("There is a music room"),
-        cat.resolve_room("musicroom").map(|r| r.name.clone())
-    );
+    assert_eq!(room("There is an organized working shop"), cat.resolve_room("workingshop").map(|r| r.name.clone()));
+    assert_eq!(room("There is a music room"), cat.resolve_room("musicroom").map(|r| r.name.clone()));
     assert!(room("There is a music room").is_some());
-    for text in [
-        "A hammer and a wood is on the table",
-        "A computer and a recorder are on a desk",
-    ] {
+    for text in ["A hammer and a wood is on the table", "A computer and a recorder are on a desk"] {
         let g = find(&p, text);
         assert_eq!(g.relations.len(), 2, "{text}");
         assert!(g.relations.iter().all(|r| r.relation == Relation::On));

@@ -12,21 +12,15 @@ fn empty_and_comment_only_scripts_have_no_sentences() {
 
 #[test]
 fn crlf_and_lf_line_numbers() {
-    let text = "# comment\r\nIn the room, a desk is near a bed$\r\n\r\ncamera left\r\nEve walks to the desk. Eve sits.\r\n";
+    let text =
+        "# comment\r\nIn the room, a desk is near a bed$\r\n\r\ncamera left\r\nEve walks to the desk. Eve sits.\r\n";
     let s = split(text);
-    let got: Vec<(usize, usize, &str, SentenceKind)> = s
-        .iter()
-        .map(|r| (r.at.line, r.at.sentence, r.at.text.as_str(), r.kind))
-        .collect();
+    let got: Vec<(usize, usize, &str, SentenceKind)> =
+        s.iter().map(|r| (r.at.line, r.at.sentence, r.at.text.as_str(), r.kind)).collect();
     assert_eq!(
         got,
         [
-            (
-                2,
-                1,
-                "In the room, a desk is near a bed",
-                SentenceKind::Scene
-            ),
+            (2, 1, "In the room, a desk is near a bed", SentenceKind::Scene),
             (4, 2, "camera left", SentenceKind::Command),
             (5, 3, "Eve walks to the desk", SentenceKind::Direction),
             (5, 4, "Eve sits", SentenceKind::Direction),
@@ -48,12 +42,9 @@ fn a_sentence_starts_on_the_line_of_its_first_word() {
 
 #[test]
 fn scene_markers_as_in_the_captions() {
-    for text in [
-        "A desk is near a bed$",
-        "A desk is near a bed\\$",
-        "A desk is near a bed$.",
-        "\"A desk is near a bed\\$.\"",
-    ] {
+    for text in
+        ["A desk is near a bed$", "A desk is near a bed\\$", "A desk is near a bed$.", "\"A desk is near a bed\\$.\""]
+    {
         let s = split(text);
         assert_eq!(s.len(), 1, "{text}");
         assert_eq!(s[0].kind, SentenceKind::Scene, "{text}");
@@ -62,14 +53,7 @@ fn scene_markers_as_in_the_captions() {
     // `".` after a sentence, and after `.` (Fig. 7 boxing caption).
     let s = split("\"There is a ring above which a bag hangs\". There is a stool and a desk.\". There is a bottle\"");
     let kinds: Vec<SentenceKind> = s.iter().map(|r| r.kind).collect();
-    assert_eq!(
-        kinds,
-        [
-            SentenceKind::Scene,
-            SentenceKind::Scene,
-            SentenceKind::Direction
-        ]
-    );
+    assert_eq!(kinds, [SentenceKind::Scene, SentenceKind::Scene, SentenceKind::Direction]);
     assert_eq!(s[2].at.text, "There is a bottle");
 }
 
@@ -77,19 +61,8 @@ fn scene_markers_as_in_the_captions() {
 fn terminators_and_quotes() {
     let s = split("Eve walks! Does Tom sit? 'Tom sits.' Eve's desk is near a bed$");
     let texts: Vec<&str> = s.iter().map(|r| r.at.text.as_str()).collect();
-    assert_eq!(
-        texts,
-        [
-            "Eve walks",
-            "Does Tom sit",
-            "Tom sits",
-            "Eve's desk is near a bed"
-        ]
-    );
-    assert_eq!(
-        s.iter().map(|r| r.at.sentence).collect::<Vec<_>>(),
-        [1, 2, 3, 4]
-    );
+    assert_eq!(texts, ["Eve walks", "Does Tom sit", "Tom sits", "Eve's desk is near a bed"]);
+    assert_eq!(s.iter().map(|r| r.at.sentence).collect::<Vec<_>>(), [1, 2, 3, 4]);
 }
 
 #[test]
@@ -101,20 +74,13 @@ fn commands() {
         ("time night", "time", "night"),
         ("camera: top", "camera", "top"),
     ] {
-        assert_eq!(
-            command_parts(text),
-            Some((what.to_string(), value.to_string())),
-            "{text}"
-        );
+        assert_eq!(command_parts(text), Some((what.to_string(), value.to_string())), "{text}");
         assert_eq!(split(text)[0].kind, SentenceKind::Command, "{text}");
     }
     // "time" only with a time of day; three words are no command.
     assert_eq!(command_parts("time flies"), None);
     assert_eq!(command_parts("camera moves left"), None);
-    assert_eq!(
-        split("the camera watches").first().map(|r| r.kind),
-        Some(SentenceKind::Direction)
-    );
+    assert_eq!(split("the camera watches").first().map(|r| r.kind), Some(SentenceKind::Direction));
     assert_eq!(split("camera left$")[0].kind, SentenceKind::Command);
 }
 
@@ -175,10 +141,6 @@ fn cat() -> inbetween_script::catalogue::Catalogue {
     };
     Catalogue::new(
         vec![c("chair"), c("desk")],
-        vec![RoomKind {
-            name: "room".into(),
-            synonyms: vec![],
-            size: [5.0, 2.8, 4.0],
-        }],
+        vec![RoomKind { name: "room".into(), synonyms: vec![], size: [5.0, 2.8, 4.0] }],
     )
 }

@@ -3,18 +3,15 @@
 mod parse_common;
 
 use inbetween_script::parse::{
-    lemmatize, lemmatize_noun, lemmatize_verb, number_value, parse_script, parse_sentence,
-    suggestions, tag, tokenize, Tag,
+    lemmatize, lemmatize_noun, lemmatize_verb, number_value, parse_script, parse_sentence, suggestions, tag, tokenize,
+    Tag,
 };
 use inbetween_script::script::split;
 use inbetween_script::ssg::Relation;
 use parse_common::paper_catalogue;
 
 fn tags(s: &str) -> Vec<&'static str> {
-    tag(&tokenize(s), &paper_catalogue())
-        .into_iter()
-        .map(|t| t.tag.name())
-        .collect()
+    tag(&tokenize(s), &paper_catalogue()).into_iter().map(|t| t.tag.name()).collect()
 }
 
 #[test]
@@ -23,10 +20,7 @@ fn penn_tags_of_caption_sentences() {
         tags("In the room, an organized office desk is near a bed"),
         ["IN", "DT", "NN", ".", "DT", "JJ", "NN", "NN", "VBZ", "IN", "DT", "NN"]
     );
-    assert_eq!(
-        tags("Eve sits on the couch"),
-        ["NNP", "VBZ", "IN", "DT", "NN"]
-    );
+    assert_eq!(tags("Eve sits on the couch"), ["NNP", "VBZ", "IN", "DT", "NN"]);
     assert_eq!(tags("There are two chairs"), ["EX", "VBP", "CD", "NNS"]);
     assert_eq!(
         tags("Anny walks to the recorder and pushes the record button"),
@@ -36,22 +30,14 @@ fn penn_tags_of_caption_sentences() {
         tags("There is a boxing ring above which a boxingbag hangs"),
         ["EX", "VBZ", "DT", "JJ", "NN", "IN", "WDT", "DT", "NN", "VBZ"]
     );
-    assert_eq!(
-        tags("Tom sat on his chair"),
-        ["NNP", "VBD", "IN", "PRP$", "NN"]
-    );
+    assert_eq!(tags("Tom sat on his chair"), ["NNP", "VBD", "IN", "PRP$", "NN"]);
 }
 
 #[test]
 fn lemmas() {
-    for (w, l) in [
-        ("sits", "sit"),
-        ("sat", "sit"),
-        ("hangs", "hang"),
-        ("hung", "hang"),
-        ("writes", "write"),
-        ("wrote", "write"),
-    ] {
+    for (w, l) in
+        [("sits", "sit"), ("sat", "sit"), ("hangs", "hang"), ("hung", "hang"), ("writes", "write"), ("wrote", "write")]
+    {
         assert_eq!(lemmatize_verb(w), l);
     }
     for (w, l) in [
@@ -66,10 +52,7 @@ fn lemmas() {
     assert_eq!(lemmatize("Sitting", Tag::VBG), "sit");
     assert_eq!(lemmatize("Stopped", Tag::VBD), "stop");
     // "is"/"are" are "be": the tagger lemmatises auxiliaries.
-    let t = tag(
-        &tokenize("The chairs are near the desk and the lamp is on it"),
-        &paper_catalogue(),
-    );
+    let t = tag(&tokenize("The chairs are near the desk and the lamp is on it"), &paper_catalogue());
     assert_eq!(t[2].lemma, "be");
     assert_eq!(t[9].lemma, "be");
     assert_eq!(t[1].lemma, "chair");
@@ -81,28 +64,19 @@ fn counts() {
     assert_eq!(number_value("12"), Some(12));
     assert_eq!(number_value("chair"), None);
     let cat = paper_catalogue();
-    let p = parse_script("Two chairs are near a table$ There are 3 lamps and an old piano$ A couple of stools are by the bed$", &cat);
+    let p = parse_script(
+        "Two chairs are near a table$ There are 3 lamps and an old piano$ A couple of stools are by the bed$",
+        &cat,
+    );
     let g = &p.sentences[0].ssg;
-    assert_eq!(
-        (g.objects[0].category.as_str(), g.objects[0].count),
-        ("chair", 2)
-    );
-    assert_eq!(
-        (g.objects[1].category.as_str(), g.objects[1].count),
-        ("table", 1)
-    );
+    assert_eq!((g.objects[0].category.as_str(), g.objects[0].count), ("chair", 2));
+    assert_eq!((g.objects[1].category.as_str(), g.objects[1].count), ("table", 1));
     assert_eq!(g.objects[0].word, "chairs");
     let g = &p.sentences[1].ssg;
     assert_eq!(g.objects[0].count, 3);
-    assert_eq!(
-        (g.objects[1].count, g.objects[1].attributes.clone()),
-        (1, vec!["old".to_string()])
-    );
+    assert_eq!((g.objects[1].count, g.objects[1].attributes.clone()), (1, vec!["old".to_string()]));
     let g = &p.sentences[2].ssg;
-    assert_eq!(
-        (g.objects[0].category.as_str(), g.objects[0].count),
-        ("stool", 2)
-    );
+    assert_eq!((g.objects[0].category.as_str(), g.objects[0].count), ("stool", 2));
     assert_eq!(g.relations[0].relation, Relation::Near);
 }
 
@@ -130,10 +104,7 @@ fn relation_phrases() {
     // The relation first: "On the desk there is a lamp" → lamp On desk.
     let (g, _) = parse_sentence(&split("On the desk there is a lamp$")[0], &cat);
     assert_eq!(
-        (
-            g.objects[g.relations[0].active].category.as_str(),
-            g.objects[g.relations[0].anchor].category.as_str()
-        ),
+        (g.objects[g.relations[0].active].category.as_str(), g.objects[g.relations[0].anchor].category.as_str()),
         ("lamp", "desk")
     );
 }
@@ -144,20 +115,13 @@ fn unknown_words_get_suggestions_and_the_rest_runs() {
     let p = parse_script("A chiar is near the dsk$\nEve jumsp to the desk.\nA lamp is across the desk$\ncamera lefft\nEve sits on the sofa.", &cat);
     let d = &p.diagnostics;
     let find = |w: &str| {
-        d.iter()
-            .find(|x| x.word.as_deref() == Some(w))
-            .unwrap_or_else(|| panic!("no diagnostic for {w}: {d:?}"))
+        d.iter().find(|x| x.word.as_deref() == Some(w)).unwrap_or_else(|| panic!("no diagnostic for {w}: {d:?}"))
     };
     let chiar = find("chiar");
     assert_eq!(chiar.suggestions.first().map(String::as_str), Some("chair"));
     assert_eq!((chiar.at.line, chiar.at.sentence), (1, 1));
-    assert!(
-        chiar.to_string().contains("line 1, sentence 1") && chiar.to_string().contains("chair")
-    );
-    assert_eq!(
-        find("dsk").suggestions.first().map(String::as_str),
-        Some("desk")
-    );
+    assert!(chiar.to_string().contains("line 1, sentence 1") && chiar.to_string().contains("chair"));
+    assert_eq!(find("dsk").suggestions.first().map(String::as_str), Some("desk"));
     let jumsp = find("jumsp");
     assert_eq!(jumsp.suggestions.first().map(String::as_str), Some("jump"));
     assert_eq!(jumsp.at.line, 2);
@@ -178,16 +142,8 @@ fn unusable_sentences_get_a_diagnostic() {
     let cat = paper_catalogue();
     let p = parse_script("Very quickly!\nIt is near$\nEve walks to the sofa.", &cat);
     assert_eq!(p.sentences.len(), 3);
-    assert!(
-        p.diagnostics.iter().any(|d| d.at.sentence == 1),
-        "{:?}",
-        p.diagnostics
-    );
-    assert!(
-        p.diagnostics.iter().any(|d| d.at.sentence == 2),
-        "{:?}",
-        p.diagnostics
-    );
+    assert!(p.diagnostics.iter().any(|d| d.at.sentence == 1), "{:?}", p.diagnostics);
+    assert!(p.diagnostics.iter().any(|d| d.at.sentence == 2), "{:?}", p.diagnostics);
     assert!(p.diagnostics.iter().all(|d| d.at.sentence != 3));
     assert_eq!(p.sentences[2].ssg.characters[0].name, "Eve");
 }
@@ -199,10 +155,7 @@ fn pronouns_carry_over_sentences() {
     let g = &p.sentences[1].ssg;
     assert_eq!(g.characters[0].name, "Tom");
     let a = &g.characters[0].actions[0];
-    assert_eq!(
-        (a.verb.as_str(), a.manner.clone()),
-        ("play", vec!["madly".to_string()])
-    );
+    assert_eq!((a.verb.as_str(), a.manner.clone()), ("play", vec!["madly".to_string()]));
     assert_eq!(g.objects[a.target.unwrap()].category, "piano");
     assert_eq!(g.objects[0].sentence, 1);
     // Alone, "it" refers to nothing: a diagnostic, not a panic.
@@ -214,25 +167,12 @@ fn pronouns_carry_over_sentences() {
 #[test]
 fn names_and_leading_adverbs() {
     let cat = paper_catalogue();
-    let p = parse_script(
-        "Emily sits on the chair and plays piano. Slowly, Tom walks to the sofa.",
-        &cat,
-    );
+    let p = parse_script("Emily sits on the chair and plays piano. Slowly, Tom walks to the sofa.", &cat);
     let emily = &p.sentences[0].ssg.characters[0];
     assert_eq!(emily.name, "Emily");
-    assert_eq!(
-        emily
-            .actions
-            .iter()
-            .map(|a| a.verb.as_str())
-            .collect::<Vec<_>>(),
-        ["sit", "play"]
-    );
+    assert_eq!(emily.actions.iter().map(|a| a.verb.as_str()).collect::<Vec<_>>(), ["sit", "play"]);
     let g = &p.sentences[1].ssg;
     assert_eq!(g.characters[0].name, "Tom");
     assert_eq!(g.characters[0].actions[0].manner, ["slowly"]);
-    assert_eq!(
-        g.objects[g.characters[0].actions[0].target.unwrap()].category,
-        "sofa"
-    );
+    assert_eq!(g.objects[g.characters[0].actions[0].target.unwrap()].category, "sofa");
 }

@@ -15,8 +15,8 @@ use inbetween_script::motion::kenney::{read_character, KenneyCharacter};
 use inbetween_script::motion::rig::{clip, Rig};
 use inbetween_script::output::gltf::{glb_bytes, parse_glb};
 use inbetween_script::output::skinned::{
-    bind_body, bind_pose, character_file, first_character_dir, joint_matrices, render_skinned_frame, skin_positions, skinned_gltf_document, SkinnedBody, SkinnedCast,
-    BLOCKY_DIR,
+    bind_body, bind_pose, character_file, first_character_dir, joint_matrices, render_skinned_frame, skin_positions,
+    skinned_gltf_document, SkinnedBody, SkinnedCast, BLOCKY_DIR,
 };
 use inbetween_script::scene::{Room, Scene};
 use serde_json::{json, Value};
@@ -88,7 +88,9 @@ fn kenney_like_glb(with_torso: bool) -> Vec<u8> {
         let f = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
         let a0 = accessors.len();
         let vp = view(&mut bin, &f(&p.concat()));
-        accessors.push(json!({"bufferView": vp, "componentType": 5126, "count": p.len(), "type": "VEC3", "min": lo, "max": hi}));
+        accessors.push(
+            json!({"bufferView": vp, "componentType": 5126, "count": p.len(), "type": "VEC3", "min": lo, "max": hi}),
+        );
         let vn = view(&mut bin, &f(&n.concat()));
         accessors.push(json!({"bufferView": vn, "componentType": 5126, "count": n.len(), "type": "VEC3"}));
         let vu = view(&mut bin, &f(&uv.concat()));
@@ -135,7 +137,12 @@ fn fixture(dir: &Path, with_torso: bool) -> PathBuf {
 }
 
 fn room() -> Scene {
-    Scene { room: Room { name: "studio".into(), width: 4.0, depth: 4.0, height: 2.8 }, objects: vec![], camera: vec![], weather: None }
+    Scene {
+        room: Room { name: "studio".into(), width: 4.0, depth: 4.0, height: 2.8 },
+        objects: vec![],
+        camera: vec![],
+        weather: None,
+    }
 }
 
 fn camera(_: usize) -> ([f32; 3], [f32; 3], f32) {
@@ -170,9 +177,16 @@ fn node_worlds(doc: &Value, bin: &[u8], k: usize) -> Vec<Mat4> {
     let mut trs: Vec<(Vec3, Quat)> = nodes
         .iter()
         .map(|n| {
-            let t = n["translation"].as_array().map_or(Vec3::ZERO, |a| Vec3::new(a[0].as_f64().unwrap() as f32, a[1].as_f64().unwrap() as f32, a[2].as_f64().unwrap() as f32));
+            let t = n["translation"].as_array().map_or(Vec3::ZERO, |a| {
+                Vec3::new(a[0].as_f64().unwrap() as f32, a[1].as_f64().unwrap() as f32, a[2].as_f64().unwrap() as f32)
+            });
             let r = n["rotation"].as_array().map_or(Quat::IDENTITY, |a| {
-                Quat::from_xyzw(a[0].as_f64().unwrap() as f32, a[1].as_f64().unwrap() as f32, a[2].as_f64().unwrap() as f32, a[3].as_f64().unwrap() as f32)
+                Quat::from_xyzw(
+                    a[0].as_f64().unwrap() as f32,
+                    a[1].as_f64().unwrap() as f32,
+                    a[2].as_f64().unwrap() as f32,
+                    a[3].as_f64().unwrap() as f32,
+                )
             });
             (t, r)
         })
@@ -183,7 +197,9 @@ fn node_worlds(doc: &Value, bin: &[u8], k: usize) -> Vec<Mat4> {
         let s = &anim["samplers"][ch["sampler"].as_u64().unwrap() as usize];
         let out = accessor_floats(doc, bin, s["output"].as_u64().unwrap() as usize);
         match ch["target"]["path"].as_str().unwrap() {
-            "translation" if out.len() >= 3 * (k + 1) => trs[node as usize].0 = Vec3::from_slice(&out[3 * k..3 * k + 3]),
+            "translation" if out.len() >= 3 * (k + 1) => {
+                trs[node as usize].0 = Vec3::from_slice(&out[3 * k..3 * k + 3])
+            }
             "rotation" if out.len() >= 4 * (k + 1) => trs[node as usize].1 = Quat::from_slice(&out[4 * k..4 * k + 4]),
             _ => {}
         }
@@ -219,7 +235,8 @@ fn doc_skinned(doc: &Value, bin: &[u8], k: usize) -> Vec<Vec3> {
     let ibm = accessor_floats(doc, bin, skin["inverseBindMatrices"].as_u64().unwrap() as usize);
     let joints: Vec<usize> = skin["joints"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as usize).collect();
     let worlds = node_worlds(doc, bin, k);
-    let mats: Vec<Mat4> = joints.iter().enumerate().map(|(i, &n)| worlds[n] * Mat4::from_cols_slice(&ibm[16 * i..16 * i + 16])).collect();
+    let mats: Vec<Mat4> =
+        joints.iter().enumerate().map(|(i, &n)| worlds[n] * Mat4::from_cols_slice(&ibm[16 * i..16 * i + 16])).collect();
     (0..pos.len() / 3)
         .map(|v| {
             let p = Vec3::from_slice(&pos[3 * v..3 * v + 3]);
@@ -245,11 +262,20 @@ fn reads_kenney_parts_at_rest_with_their_texture() {
     // Node transforms applied: legs from the floor to the hips, the head (0.1 × its 10× mesh) on
     // the torso at 1.9, the arms under the torso node.
     let (lo, hi) = bounds("leg-left");
-    assert!(lo.abs_diff_eq(Vec3::new(0.0, 0.0, -0.2), 1e-5) && hi.abs_diff_eq(Vec3::new(0.4, 1.0, 0.2), 1e-5), "{lo} {hi}");
+    assert!(
+        lo.abs_diff_eq(Vec3::new(0.0, 0.0, -0.2), 1e-5) && hi.abs_diff_eq(Vec3::new(0.4, 1.0, 0.2), 1e-5),
+        "{lo} {hi}"
+    );
     let (lo, hi) = bounds("head");
-    assert!(lo.abs_diff_eq(Vec3::new(-0.4, 1.9, -0.4), 1e-5) && hi.abs_diff_eq(Vec3::new(0.4, 2.7, 0.4), 1e-5), "{lo} {hi}");
+    assert!(
+        lo.abs_diff_eq(Vec3::new(-0.4, 1.9, -0.4), 1e-5) && hi.abs_diff_eq(Vec3::new(0.4, 2.7, 0.4), 1e-5),
+        "{lo} {hi}"
+    );
     let (lo, hi) = bounds("arm-left");
-    assert!(lo.abs_diff_eq(Vec3::new(0.4, 0.8, -0.3), 1e-5) && hi.abs_diff_eq(Vec3::new(0.8, 1.9, 0.1), 1e-5), "{lo} {hi}");
+    assert!(
+        lo.abs_diff_eq(Vec3::new(0.4, 0.8, -0.3), 1e-5) && hi.abs_diff_eq(Vec3::new(0.8, 1.9, 0.1), 1e-5),
+        "{lo} {hi}"
+    );
     // Normals stay unit length under the head's 0.1 scale.
     assert!(ch.part("head").unwrap().normals.iter().all(|n| (Vec3::from(*n).length() - 1.0).abs() < 1e-5));
     let img = ch.image.as_ref().unwrap();
@@ -305,7 +331,17 @@ fn check_bind(ch: &KenneyCharacter, body: &SkinnedBody, rig: &Rig) {
     for part in ["torso", "head", "leg-left", "leg-right", "arm-left", "arm-right"] {
         assert!(ch.part(part).is_some(), "{part}");
     }
-    for j in [rig.legs[0][0], rig.legs[0][1], rig.legs[0][2], rig.arms[1][1], rig.arms[1][2], rig.arms[1][3], rig.lower_back, rig.spine1, rig.head] {
+    for j in [
+        rig.legs[0][0],
+        rig.legs[0][1],
+        rig.legs[0][2],
+        rig.arms[1][1],
+        rig.arms[1][2],
+        rig.arms[1][3],
+        rig.lower_back,
+        rig.spine1,
+        rig.head,
+    ] {
         assert!(body.joints.iter().any(|&x| x as usize == j), "no vertex bound to {}", sk.joint(j).name);
     }
 }
@@ -359,7 +395,8 @@ fn check_document(doc: &Value, bin: &[u8], body: &SkinnedBody, m: &Motion) {
     }
     let skins = doc["skins"].as_array().unwrap();
     assert_eq!(skins.len(), 1);
-    let joints: Vec<usize> = skins[0]["joints"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as usize).collect();
+    let joints: Vec<usize> =
+        skins[0]["joints"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as usize).collect();
     assert_eq!(joints.len(), sk.len());
     for (j, &n) in joints.iter().enumerate() {
         assert_eq!(nodes[n]["name"].as_str().unwrap(), sk.joint(j).name);
@@ -419,18 +456,46 @@ fn fixture_character_skins_onto_the_rig_and_follows_its_joints() {
     check_bind(&ch, &body, &rig);
     let m = test_motion(&rig);
     let cat = builtin();
-    let (doc, bin, _) = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &cat, characters: &[("Eve", &m)], bodies: &[Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap();
+    let (doc, bin, _) = skinned_gltf_document(
+        &SkinnedCast {
+            scene: &room(),
+            cat: &cat,
+            characters: &[("Eve", &m)],
+            bodies: &[Some(&body)],
+            camera: &camera,
+            fps: 30.0,
+        },
+        &|_| None,
+    )
+    .unwrap();
     // Through GLB bytes and back.
     let glb = parse_glb(&glb_bytes(&doc, &bin)).unwrap();
     check_document(&glb.json, &glb.bin, &body, &m);
     // The bent knee lifts the left shin: its lowest vertex rises from the floor to about knee height.
     let last = doc_skinned(&glb.json, &glb.bin, m.num_frames() - 1);
     let knee = forward(&rig.skeleton, &m.pose(m.num_frames() - 1)).positions[rig.legs[0][1]].y as f32;
-    let shin_low = body.joints.iter().zip(&last).filter(|(j, _)| **j as usize == rig.legs[0][1]).map(|(_, p)| p.y).fold(f32::MAX, f32::min);
+    let shin_low = body
+        .joints
+        .iter()
+        .zip(&last)
+        .filter(|(j, _)| **j as usize == rig.legs[0][1])
+        .map(|(_, p)| p.y)
+        .fold(f32::MAX, f32::min);
     assert!(shin_low > knee - 0.15, "shin horizontal: lowest {shin_low} vs knee {knee}");
     // A preview frame shows the character's texture colours where the body is.
     let refs = [Some(&body)];
-    let img = render_skinned_frame(&SkinnedCast { scene: &room(), cat: &cat, characters: &[("Eve", &m)], bodies: &refs, camera: &camera, fps: 30.0 }, 0, (160, 120));
+    let img = render_skinned_frame(
+        &SkinnedCast {
+            scene: &room(),
+            cat: &cat,
+            characters: &[("Eve", &m)],
+            bodies: &refs,
+            camera: &camera,
+            fps: 30.0,
+        },
+        0,
+        (160, 120),
+    );
     let blueish = img.pixels().filter(|p| p.0[2] > 120 && p.0[0] < 200 && p.0[2] > p.0[1].saturating_add(20)).count();
     assert!(blueish > 50, "textured body pixels: {blueish}");
 }
@@ -443,14 +508,37 @@ fn characters_without_a_body_keep_the_stick_figure() {
     let body = bind_body(&ch, &rig.skeleton).unwrap();
     let m = test_motion(&rig);
     let chars = [("Eve", &m), ("Bob", &m)];
-    let (doc, _, _) = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &builtin(), characters: &chars, bodies: &[None, Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap();
+    let (doc, _, _) = skinned_gltf_document(
+        &SkinnedCast {
+            scene: &room(),
+            cat: &builtin(),
+            characters: &chars,
+            bodies: &[None, Some(&body)],
+            camera: &camera,
+            fps: 30.0,
+        },
+        &|_| None,
+    )
+    .unwrap();
     let nodes = doc["nodes"].as_array().unwrap();
     let bones = nodes.iter().filter(|n| n["name"].as_str().unwrap_or("").ends_with(" bone")).count();
     assert!(bones > 10, "Eve's bone boxes stay: {bones}");
     assert_eq!(doc["skins"].as_array().unwrap().len(), 1);
     let skinned = nodes.iter().find(|n| n.get("skin").is_some()).unwrap();
     assert_eq!(skinned["name"], "Bob body");
-    let e = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &builtin(), characters: &chars, bodies: &[Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap_err().to_string();
+    let e = skinned_gltf_document(
+        &SkinnedCast {
+            scene: &room(),
+            cat: &builtin(),
+            characters: &chars,
+            bodies: &[Some(&body)],
+            camera: &camera,
+            fps: 30.0,
+        },
+        &|_| None,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("1 bodies for 2 characters"), "{e}");
 }
 
@@ -469,9 +557,25 @@ fn real_kenney_characters_skin_onto_the_rig() {
             assert_eq!((img.width(), img.height()), (1024, 1024));
             let h = body.height();
             assert!((1.3..1.8).contains(&h), "{}: {h} m", file.display());
-            println!("{}: {} vertices, {} triangles, {h:.3} m", file.display(), body.positions.len(), body.indices.len() / 3);
+            println!(
+                "{}: {} vertices, {} triangles, {h:.3} m",
+                file.display(),
+                body.positions.len(),
+                body.indices.len() / 3
+            );
             if i == 0 {
-                let (doc, bin, _) = skinned_gltf_document(&SkinnedCast { scene: &room(), cat: &builtin(), characters: &[("Eve", &m)], bodies: &[Some(&body)], camera: &camera, fps: 30.0 }, &|_| None).unwrap();
+                let (doc, bin, _) = skinned_gltf_document(
+                    &SkinnedCast {
+                        scene: &room(),
+                        cat: &builtin(),
+                        characters: &[("Eve", &m)],
+                        bodies: &[Some(&body)],
+                        camera: &camera,
+                        fps: 30.0,
+                    },
+                    &|_| None,
+                )
+                .unwrap();
                 let glb = parse_glb(&glb_bytes(&doc, &bin)).unwrap();
                 check_document(&glb.json, &glb.bin, &body, &m);
             }

@@ -57,7 +57,8 @@ impl VideoBenchConfig {
 
     /// Procedural clips plus the real clips found in `video_dir` (`../shared/data/video`).
     pub fn full(video_dir: Option<&Path>, cache_dir: PathBuf) -> VideoBenchConfig {
-        let mut clips = vec![BenchClip::Procedural { kind: ProceduralKind::Mixed, frames: 72, width: 320, height: 180 }];
+        let mut clips =
+            vec![BenchClip::Procedural { kind: ProceduralKind::Mixed, frames: 72, width: 320, height: 180 }];
         if let Some(dir) = video_dir {
             for f in ["bigbuckbunny.mp4", "bbb_png_seq"] {
                 if dir.join(f).exists() {
@@ -82,11 +83,27 @@ impl VideoBenchConfig {
 /// τ = 1 on latent units).
 /// The last two are the baselines: the shortest-path walk of Fig. 3(a) on our graph, and
 /// the same walk on plain pixel distances.
-const CONFIGS: [&str; 8] =
-    ["full", "w/o C_t", "w/o C_d", "w/o RSFNet", "w/o L_d", "Eq. 20 as printed", "SSPF (shortest path)", "SSPF on pixel distance"];
+const CONFIGS: [&str; 8] = [
+    "full",
+    "w/o C_t",
+    "w/o C_d",
+    "w/o RSFNet",
+    "w/o L_d",
+    "Eq. 20 as printed",
+    "SSPF (shortest path)",
+    "SSPF on pixel distance",
+];
 /// The paper's Table 3 (M_D, Δ_o), same order, and its ground truth.
-const PAPER_TABLE3: [Option<(f64, f64)>; 8] =
-    [Some((0.0648, 0.706)), Some((0.118, 0.783)), Some((0.079, 0.827)), Some((0.082, 0.731)), Some((0.281, 0.816)), None, None, None];
+const PAPER_TABLE3: [Option<(f64, f64)>; 8] = [
+    Some((0.0648, 0.706)),
+    Some((0.118, 0.783)),
+    Some((0.079, 0.827)),
+    Some((0.082, 0.731)),
+    Some((0.281, 0.816)),
+    None,
+    None,
+    None,
+];
 const PAPER_GT_MD: f64 = 0.0535;
 
 struct ClipResult {
@@ -151,7 +168,13 @@ fn load(clip: &BenchClip) -> Result<(Clip, String, f64), VideoError> {
 }
 
 /// The analysis of an ablation, reusing the full one's flows.
-fn ablated(full: &Analysis, clip: &Clip, cfg: &VideoBenchConfig, which: &str, progress: &Progress) -> Result<Analysis, VideoError> {
+fn ablated(
+    full: &Analysis,
+    clip: &Clip,
+    cfg: &VideoBenchConfig,
+    which: &str,
+    progress: &Progress,
+) -> Result<Analysis, VideoError> {
     let mut a = full.clone();
     match which {
         "w/o RSFNet" | "SSPF on pixel distance" => a.graph = pixel_graph(&clip.frames, 32),
@@ -167,7 +190,13 @@ fn ablated(full: &Analysis, clip: &Clip, cfg: &VideoBenchConfig, which: &str, pr
 }
 
 fn params_for(which: &str, length: usize, seed: u64) -> SdpfParams {
-    let p = SdpfParams { use_ct: which != "w/o C_t", use_cd: which != "w/o C_d", length: Some(length), seed, ..SdpfParams::default() };
+    let p = SdpfParams {
+        use_ct: which != "w/o C_t",
+        use_cd: which != "w/o C_d",
+        length: Some(length),
+        seed,
+        ..SdpfParams::default()
+    };
     if which == "Eq. 20 as printed" {
         p.paper_choice()
     } else {
@@ -186,7 +215,10 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
     };
     let full = analyse(&clip, &rcfg, progress)?;
     let n = clip.len();
-    let starts: Vec<usize> = (0..cfg.starts.max(1)).map(|i| (i * n) / cfg.starts.max(1) + n / (2 * cfg.starts.max(1))).map(|s| s.min(n - 1)).collect();
+    let starts: Vec<usize> = (0..cfg.starts.max(1))
+        .map(|i| (i * n) / cfg.starts.max(1) + n / (2 * cfg.starts.max(1)))
+        .map(|s| s.min(n - 1))
+        .collect();
     let planes = ssim_planes(&clip.frames, SSIM_SIDE);
     let mut configs = Vec::new();
     let mut ssim_configs = Vec::new();
@@ -205,7 +237,12 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
             let order = if which.starts_with("SSPF") {
                 crate::sdpf::sspf(&a.graph, s, cfg.length, Some(&shots))
             } else {
-                let (paths, secs) = resequence(&a, s, &params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64)), 1)?;
+                let (paths, secs) = resequence(
+                    &a,
+                    s,
+                    &params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64)),
+                    1,
+                )?;
                 if which == "full" {
                     walk_s += secs;
                     walks += 1;
@@ -253,9 +290,23 @@ pub fn run(cfg: &VideoBenchConfig, progress: &Progress) -> Result<Report, VideoE
 }
 
 fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
-    let mut t = Table::new("table2", "Table 2 analogue: stability M_D (Eq. 21) and overlap Δo (Eq. 23) per clip, full method", &[
-        "clip", "frames", "md_source", "md_ours", "md_ratio", "delta_o", "mean_length", "ssim_source", "ssim_ours", "ssim_ratio", "ssim_p10",
-    ]);
+    let mut t = Table::new(
+        "table2",
+        "Table 2 analogue: stability M_D (Eq. 21) and overlap Δo (Eq. 23) per clip, full method",
+        &[
+            "clip",
+            "frames",
+            "md_source",
+            "md_ours",
+            "md_ratio",
+            "delta_o",
+            "mean_length",
+            "ssim_source",
+            "ssim_ours",
+            "ssim_ratio",
+            "ssim_p10",
+        ],
+    );
     for r in results {
         let (md, dq, len) = r.configs[0];
         let (ss, sr, sp) = r.ssim(0);
@@ -273,7 +324,10 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
             num(sp, 3),
         ]);
     }
-    t.note(format!("{} start frames per clip, target length {}; M_D = mean RMS step of pixels in [0, 1]", cfg.starts, cfg.length));
+    t.note(format!(
+        "{} start frames per clip, target length {}; M_D = mean RMS step of pixels in [0, 1]",
+        cfg.starts, cfg.length
+    ));
     t.note("paper (12 clips, their own): ground truth M_D 0.050, ours 0.055 (ratio 1.10), Δo 0.73; Morace et al. 0.069, Δo 0.74");
     t.note(SSIM_NOTE);
     t
@@ -282,9 +336,22 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
 const SSIM_NOTE: &str = "ssim (ours; the paper reports none): mean SSIM (Wang et al. 2004, 11x11 Gaussian window, sigma 1.5, on luma at most 160 px on the longer side) of the transitions i -> i+1 of the new orders; ssim_source over the clip's own adjacent pairs; ssim_ratio = ours / source (1 = transitions as similar as real ones); ssim_p10 = 10th percentile of the new transitions (the worst jumps)";
 
 fn table3(results: &[ClipResult]) -> Table {
-    let mut t = Table::new("table3", "Table 3 analogue: ablations, mean over clips", &[
-        "method", "md", "md_ratio", "delta_o", "ssim", "ssim_ratio", "ssim_p10", "paper_md", "paper_md_ratio", "paper_delta_o",
-    ]);
+    let mut t = Table::new(
+        "table3",
+        "Table 3 analogue: ablations, mean over clips",
+        &[
+            "method",
+            "md",
+            "md_ratio",
+            "delta_o",
+            "ssim",
+            "ssim_ratio",
+            "ssim_p10",
+            "paper_md",
+            "paper_md_ratio",
+            "paper_delta_o",
+        ],
+    );
     let k = results.len().max(1) as f64;
     let gt: f64 = results.iter().map(|r| r.md_source).sum::<f64>() / k;
     let gt_ssim = results.iter().map(|r| mean(&r.ssim_source)).sum::<f64>() / k;
@@ -312,7 +379,18 @@ fn table3(results: &[ClipResult]) -> Table {
         let [pm, pr, pd] = paper;
         let ssim = |f: fn((f64, f64, f64)) -> f64| results.iter().map(|r| f(r.ssim(i))).sum::<f64>() / k;
         let (ss, sr, sp) = (ssim(|s| s.0), ssim(|s| s.1), ssim(|s| s.2));
-        t.row([name.to_string(), num(md, 4), num(ratio, 2), num(dq, 3), num(ss, 3), num(sr, 3), num(sp, 3), pm, pr, pd]);
+        t.row([
+            name.to_string(),
+            num(md, 4),
+            num(ratio, 2),
+            num(dq, 3),
+            num(ss, 3),
+            num(sr, 3),
+            num(sp, 3),
+            pm,
+            pr,
+            pd,
+        ]);
     }
     t.note("md_ratio: M_D of the new orders over the clip's own (lower is smoother); the paper's clips differ from ours, so compare ratios");
     t.note("w/o RSFNet: Euclidean distance of 32-pixel thumbnails; w/o L_d: the same network untrained (our backbone is not pretrained)");
@@ -324,9 +402,11 @@ fn table3(results: &[ClipResult]) -> Table {
 
 /// SSIM per clip and method: the source's adjacent pairs, then every configuration.
 fn ssim_table(results: &[ClipResult]) -> Table {
-    let mut t = Table::new("ssim", "SSIM of transitions per clip and method (ours; not in the paper)", &[
-        "clip", "method", "transitions", "ssim", "ssim_ratio", "ssim_p10", "ssim_min",
-    ]);
+    let mut t = Table::new(
+        "ssim",
+        "SSIM of transitions per clip and method (ours; not in the paper)",
+        &["clip", "method", "transitions", "ssim", "ssim_ratio", "ssim_p10", "ssim_min"],
+    );
     for r in results {
         let src = mean(&r.ssim_source);
         let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
@@ -342,7 +422,15 @@ fn ssim_table(results: &[ClipResult]) -> Table {
         for (i, name) in CONFIGS.iter().enumerate() {
             let (ss, sr, sp) = r.ssim(i);
             let v = &r.ssim_configs[i];
-            t.row([r.name.clone(), name.to_string(), v.len().to_string(), num(ss, 3), num(sr, 3), num(sp, 3), num(min(v), 3)]);
+            t.row([
+                r.name.clone(),
+                name.to_string(),
+                v.len().to_string(),
+                num(ss, 3),
+                num(sr, 3),
+                num(sp, 3),
+                num(min(v), 3),
+            ]);
         }
     }
     t.note(SSIM_NOTE);
@@ -358,13 +446,23 @@ fn ssim_png(results: &[ClipResult]) -> Result<Vec<u8>, VideoError> {
         series.push((name.to_string(), results.iter().map(|r| r.ssim_configs[i].clone()).collect()));
     }
     inbetween_render::rendered_bytes("ssim.png", |p| {
-        inbetween_render::plot::box_plot(p, "SSIM of transitions (source's adjacent pairs vs new orders)", "SSIM (luma, <= 160 px)", &groups, &series)
+        inbetween_render::plot::box_plot(
+            p,
+            "SSIM of transitions (source's adjacent pairs vs new orders)",
+            "SSIM (luma, <= 160 px)",
+            &groups,
+            &series,
+        )
     })
     .map_err(|e| VideoError::Invalid(format!("ssim.png: {e}")))
 }
 
 fn stage_table(results: &[ClipResult]) -> Table {
-    let mut t = Table::new("stages", "Seconds per stage (this machine, 2 cores)", &["clip", "size", "frames", "stage", "seconds"]);
+    let mut t = Table::new(
+        "stages",
+        "Seconds per stage (this machine, 2 cores)",
+        &["clip", "size", "frames", "stage", "seconds"],
+    );
     for r in results {
         let size = format!("{}x{}", r.size.0, r.size.1);
         t.row([r.name.clone(), size.clone(), r.frames.to_string(), "decode or render".into(), num(r.decode_s, 2)]);
@@ -400,7 +498,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let report = run(&VideoBenchConfig::quick(dir.path().to_path_buf()), &Progress::hidden()).unwrap();
         let text = report.to_text();
-        for needle in ["Table 2 analogue", "Table 3 analogue", "w/o C_t", "w/o L_d", "ground truth", "SDPF walk", "ssim_ratio", "source (adjacent pairs)"] {
+        for needle in [
+            "Table 2 analogue",
+            "Table 3 analogue",
+            "w/o C_t",
+            "w/o L_d",
+            "ground truth",
+            "SDPF walk",
+            "ssim_ratio",
+            "source (adjacent pairs)",
+        ] {
             assert!(text.contains(needle), "{needle} missing:\n{text}");
         }
         assert_eq!(report.tables().count(), 4);

@@ -79,7 +79,11 @@ pub struct Analysis {
 /// Flows, metric, graph and shots of `clip`.
 pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Result<Analysis, VideoError> {
     if clip.len() < 2 {
-        return Err(VideoError::Invalid(format!("{}: a clip needs at least 2 frames to resequence, it has {}", clip.source, clip.len())));
+        return Err(VideoError::Invalid(format!(
+            "{}: a clip needs at least 2 frames to resequence, it has {}",
+            clip.source,
+            clip.len()
+        )));
     }
     let mut stages = Vec::new();
     let t = Instant::now();
@@ -170,7 +174,12 @@ impl MotionDistance for Pmsm<'_> {
 }
 
 /// `count` distinct new orders from `start` (SDPF on the analysed clip), and the walk's wall time.
-pub fn resequence(analysis: &Analysis, start: usize, params: &SdpfParams, count: usize) -> Result<(Vec<SdpfPath>, f64), VideoError> {
+pub fn resequence(
+    analysis: &Analysis,
+    start: usize,
+    params: &SdpfParams,
+    count: usize,
+) -> Result<(Vec<SdpfPath>, f64), VideoError> {
     let t = Instant::now();
     let pmsm = Pmsm { backward: &analysis.motion.backward, embedder: &analysis.embedder };
     let paths = several(&analysis.graph, &analysis.info, &pmsm, start, params, count.max(1))?;
@@ -179,7 +188,11 @@ pub fn resequence(analysis: &Analysis, start: usize, params: &SdpfParams, count:
 
 /// A clip of `order`'s frames at the source rate.
 pub fn reorder(clip: &Clip, order: &[usize]) -> Clip {
-    Clip { frames: order.iter().map(|&f| clip.frames[f].clone()).collect(), fps: clip.fps, source: format!("{} resequenced", clip.source) }
+    Clip {
+        frames: order.iter().map(|&f| clip.frames[f].clone()).collect(),
+        fps: clip.fps,
+        source: format!("{} resequenced", clip.source),
+    }
 }
 
 #[cfg(test)]

@@ -72,7 +72,13 @@ pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) 
         if i > 0 {
             for inset in 0..2 {
                 let k = inset as f32;
-                canvas.rect_outline(x as f32 - 1.0 - k, y as f32 - 1.0 - k, (tw + 2) as f32 + 2.0 * k, (th + 2) as f32 + 2.0 * k, border);
+                canvas.rect_outline(
+                    x as f32 - 1.0 - k,
+                    y as f32 - 1.0 - k,
+                    (tw + 2) as f32 + 2.0 * k,
+                    (th + 2) as f32 + 2.0 * k,
+                    border,
+                );
             }
         }
         let label = format!("{i}: frame {src}");
@@ -83,7 +89,12 @@ pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) 
 }
 
 /// [`contact_sheet`] written as a PNG (atomic write).
-pub fn write_contact_sheet(path: &Path, frames: &[RgbImage], order: &[usize], opts: &SheetOptions) -> Result<(), VideoError> {
+pub fn write_contact_sheet(
+    path: &Path,
+    frames: &[RgbImage],
+    order: &[usize],
+    opts: &SheetOptions,
+) -> Result<(), VideoError> {
     let img = contact_sheet(frames, order, opts)?;
     write_png(path, &img).map_err(|e| VideoError::Encode { path: path.to_path_buf(), message: e.to_string() })
 }
@@ -92,7 +103,10 @@ pub fn write_contact_sheet(path: &Path, frames: &[RgbImage], order: &[usize], op
 /// each cell is at least `cell` pixels (the paper's Fig. 12).
 pub fn distance_heatmap(dist: &[f32], n: usize, cell: u32) -> Result<RgbImage, VideoError> {
     if n == 0 || dist.len() != n * n {
-        return Err(VideoError::Invalid(format!("a distance heat map needs n×n values, got {} for n = {n}", dist.len())));
+        return Err(VideoError::Invalid(format!(
+            "a distance heat map needs n×n values, got {} for n = {n}",
+            dist.len()
+        )));
     }
     let finite = dist.iter().copied().filter(|d| d.is_finite());
     let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));

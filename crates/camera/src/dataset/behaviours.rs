@@ -167,7 +167,11 @@ pub fn film(
                 let arc = arc_of(w);
                 let beta_main = (p.offset + sigma).clamp(0.15, arc - 0.15);
                 let frac_main = beta_main / arc;
-                if main_is_a { frac_main } else { 1.0 - frac_main }
+                if main_is_a {
+                    frac_main
+                } else {
+                    1.0 - frac_main
+                }
             }
             Behaviour::Side => {
                 let d = (fb.target() - fa.target()).length();
@@ -255,7 +259,8 @@ mod tests {
             let scene = Scene::procedural(seed, 900, 30.0);
             let p = BehaviourParams { lag: 0.2, ..params(seed) };
             for main_is_a in [true, false] {
-                let th: Vec<f64> = film(&scene, 0, 1, main_is_a, Behaviour::Direct, &p, &lens).iter().map(|x| x.theta).collect();
+                let th: Vec<f64> =
+                    film(&scene, 0, 1, main_is_a, Behaviour::Direct, &p, &lens).iter().map(|x| x.theta).collect();
                 worst = th.windows(2).map(|w| (w[1] - w[0]).abs()).fold(worst, f64::max);
             }
         }

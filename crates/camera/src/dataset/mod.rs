@@ -18,7 +18,6 @@ pub const FPS: f64 = 30.0;
 /// The networks see every 5th frame (§4.5).
 pub const DOWNSAMPLE: usize = 5;
 
-
 /// One filmed sequence: character features and the camera track, frame by frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Sequence {
@@ -44,7 +43,10 @@ impl Sequence {
     /// Network-ready arrays at every `step`-th frame: (character encodings, camera features).
     pub fn encoded(&self, step: usize) -> (Vec<[f32; CHAR_ENC]>, Vec<[f32; CAM_DIM]>) {
         let idx = (0..self.len()).step_by(step);
-        (idx.clone().map(|i| encode_character(&self.characters[i])).collect(), idx.map(|i| encode_camera(&self.camera[i])).collect())
+        (
+            idx.clone().map(|i| encode_character(&self.characters[i])).collect(),
+            idx.map(|i| encode_camera(&self.camera[i])).collect(),
+        )
     }
 }
 

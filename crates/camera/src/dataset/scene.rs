@@ -68,9 +68,10 @@ impl Scene {
 
     /// Index of a character by name or by decimal index.
     pub fn character_index(&self, key: &str) -> Option<usize> {
-        self.characters.iter().position(|c| c.name == key).or_else(|| {
-            key.parse::<usize>().ok().filter(|&i| i < self.characters.len())
-        })
+        self.characters
+            .iter()
+            .position(|c| c.name == key)
+            .or_else(|| key.parse::<usize>().ok().filter(|&i| i < self.characters.len()))
     }
 
     /// Eq. 1 features of the pair (a, b) at every frame.
@@ -112,7 +113,8 @@ pub enum Action {
     Converse,
 }
 
-pub const ACTIONS: [Action; 6] = [Action::Walk, Action::Turn, Action::Approach, Action::Part, Action::Circle, Action::Converse];
+pub const ACTIONS: [Action; 6] =
+    [Action::Walk, Action::Turn, Action::Approach, Action::Part, Action::Circle, Action::Converse];
 
 /// Kinematic state of one procedural character (ground position, heading, velocity).
 #[derive(Debug, Clone, Copy)]
@@ -226,7 +228,13 @@ impl Choreographer {
             }
         }
         // Never walk through each other nor drift further than 9 m apart.
-        let correction = if d < 0.8 { n01 * (0.8 - d) * 2.0 } else if d > 9.0 { -n01 * (d - 9.0) } else { DVec2::ZERO };
+        let correction = if d < 0.8 {
+            n01 * (0.8 - d) * 2.0
+        } else if d > 9.0 {
+            -n01 * (d - 9.0)
+        } else {
+            DVec2::ZERO
+        };
         let dt = self.dt;
         for (i, body) in self.bodies.iter_mut().enumerate() {
             let (v, yaw) = want[i];
@@ -280,7 +288,10 @@ mod tests {
         let s = Scene::procedural(1, 40, 30.0);
         s.save(&path).unwrap();
         let back = Scene::load(&path).unwrap();
-        let max_diff = back.characters.iter().zip(&s.characters)
+        let max_diff = back
+            .characters
+            .iter()
+            .zip(&s.characters)
             .flat_map(|(x, y)| x.root.iter().zip(&y.root).map(|(p, q)| (*p - *q).abs().max_element()))
             .fold(0.0, f64::max);
         assert!(max_diff < 1e-12, "JSON keeps positions (max diff {max_diff})");

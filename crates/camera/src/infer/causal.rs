@@ -24,7 +24,13 @@ pub struct CausalCamera<'a> {
 
 impl<'a> CausalCamera<'a> {
     /// Starts at `start` (frame 0) with an optional velocity (x^c per second) through H.
-    pub fn new(model: &'a FastModel, style: &[f32], start: &Toric, velocity: Option<[f64; 6]>, fps: f64) -> CausalCamera<'a> {
+    pub fn new(
+        model: &'a FastModel,
+        style: &[f32],
+        start: &Toric,
+        velocity: Option<[f64; 6]>,
+        fps: f64,
+    ) -> CausalCamera<'a> {
         let dt = DOWNSAMPLE as f64 / fps;
         let v = velocity.unwrap_or([0.0; 6]);
         CausalCamera {
@@ -78,7 +84,13 @@ impl<'a> CausalCamera<'a> {
 pub(super) fn run_causal(job: &GenerateJob, keys: &ResolvedKeys) -> Result<CameraTrack, CameraError> {
     let (scene, k) = (job.scene, &keys.keys);
     let (first, last) = (keys.first_frame(), keys.last_frame(scene));
-    let feats = |f: usize, pair: (usize, usize)| CharacterFeatures::compute(&scene.characters[pair.0].frame(f), &scene.characters[pair.1].frame(f), keys.main_is_a(pair));
+    let feats = |f: usize, pair: (usize, usize)| {
+        CharacterFeatures::compute(
+            &scene.characters[pair.0].frame(f),
+            &scene.characters[pair.1].frame(f),
+            keys.main_is_a(pair),
+        )
+    };
     let mut live = CausalCamera::new(job.model, &job.style.code, &k[0].camera, k[0].velocity, scene.fps);
     let mut next = 1;
     let mut announced = 0;
@@ -103,7 +115,15 @@ pub(super) fn run_causal(job: &GenerateJob, keys: &ResolvedKeys) -> Result<Camer
         frames.push(camera_frame(scene, frame, target.pair, toric, &job.options.lens)?);
     }
     let max_corrected_residual = residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
-    Ok(CameraTrack { fps: scene.fps, style: job.style.name.clone(), style_code: job.style.code.clone(), lens: job.options.lens, frames, key_residuals: residuals, max_corrected_residual })
+    Ok(CameraTrack {
+        fps: scene.fps,
+        style: job.style.name.clone(),
+        style_code: job.style.code.clone(),
+        lens: job.options.lens,
+        frames,
+        key_residuals: residuals,
+        max_corrected_residual,
+    })
 }
 
 /// [`GenerateJob::run`] in causal mode (kept for callers that hold the pieces).
@@ -137,14 +157,23 @@ mod tests {
         let mut prev = encode_camera(&keys.keys[0].camera);
         let key = key_vector(&encode_camera(&keys.keys[1].camera), &encode_character(&feats[59]));
         for f in (5..60).step_by(5) {
-            let input = crate::infer::StepIn { style: &style, prev, character: encode_character(&feats[f]), key, tta_frames: 59 - f };
+            let input = crate::infer::StepIn {
+                style: &style,
+                prev,
+                character: encode_character(&feats[f]),
+                key,
+                tta_frames: 59 - f,
+            };
             prev = fast.step(&[input], &mut state)[0];
             let got = encode_camera(&out[f - 1]);
             assert!((0..6).all(|j| (got[j] - prev[j]).abs() < 1e-6), "frame {f}");
         }
         // In between, the last step's motion is extrapolated.
         let (f0, f5, f7) = (encode_camera(&keys.keys[0].camera), encode_camera(&out[4]), encode_camera(&out[6]));
-        assert!((0..6).all(|j| (f7[j] - (f5[j] + (f5[j] - f0[j]) * 0.4)).abs() < 1e-6), "frame 7 extrapolates frames 0 → 5");
+        assert!(
+            (0..6).all(|j| (f7[j] - (f5[j] + (f5[j] - f0[j]) * 0.4)).abs() < 1e-6),
+            "frame 7 extrapolates frames 0 → 5"
+        );
     }
 
     #[test]
@@ -161,7 +190,10 @@ mod tests {
         live.set_key(59, &keys.keys[2].camera, &feats[59]);
         let expected = fast.map_state(&style, &steps);
         let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
-        assert!(close(&live.state().h, &expected.h) && close(&live.state().c, &expected.c), "H re-mapped the last five network steps");
+        assert!(
+            close(&live.state().h, &expected.h) && close(&live.state().c, &expected.c),
+            "H re-mapped the last five network steps"
+        );
     }
 
     #[test]
@@ -170,7 +202,10 @@ mod tests {
         let scene = Scene::procedural(6, 90, 30.0);
         let keys = example_keys(&scene, &[0, 45, 89]);
         let style = Style { name: "t".into(), code: vec![0.1, 0.0, -0.2, 0.3] };
-        let job = GenerateJob { options: GenerateOptions { causal: true, ..Default::default() }, ..GenerateJob::new(&fast, &scene, &keys, &style) };
+        let job = GenerateJob {
+            options: GenerateOptions { causal: true, ..Default::default() },
+            ..GenerateJob::new(&fast, &scene, &keys, &style)
+        };
         let track = job.run().unwrap();
         assert_eq!(track.frames.len(), 90);
         assert_eq!(track.key_residuals.iter().map(|r| r.frame).collect::<Vec<_>>(), [0, 45, 89]);

@@ -99,7 +99,10 @@ impl<'a> GenerateJob<'a> {
         self.scene.validate().map_err(|m| CameraError::invalid(self.origin, format!("scene: {m}")))?;
         let want = self.model.config.style_dim;
         if self.style.code.len() != want || self.style.code.iter().any(|v| !v.is_finite()) {
-            return Err(CameraError::invalid(self.origin, format!("style `{}`: expected {want} finite values, got {:?}", self.style.name, self.style.code)));
+            return Err(CameraError::invalid(
+                self.origin,
+                format!("style `{}`: expected {want} finite values, got {:?}", self.style.name, self.style.code),
+            ));
         }
         self.keys.resolve(self.scene, &self.options.lens, self.origin)
     }
@@ -136,8 +139,13 @@ impl<'a> GenerateJob<'a> {
         let (model, k) = (self.model, &keys.keys);
         let (first, last) = (keys.first_frame(), keys.last_frame(self.scene));
         let grid = |f: usize| first + ((f - first) as f64 / DOWNSAMPLE as f64).round() as usize * DOWNSAMPLE;
-        let mut rollout = Rollout::mapped(model, &self.style.code, &velocity_frames(&k[0].camera, k[0].velocity, self.scene.fps));
-        let mut out = NetworkSamples { samples: vec![(first, k[0].camera.to_array())], pairs: vec![(first, k[0].pair)], residuals: vec![KeyResidual { frame: first, residual: 0.0 }] };
+        let mut rollout =
+            Rollout::mapped(model, &self.style.code, &velocity_frames(&k[0].camera, k[0].velocity, self.scene.fps));
+        let mut out = NetworkSamples {
+            samples: vec![(first, k[0].camera.to_array())],
+            pairs: vec![(first, k[0].pair)],
+            residuals: vec![KeyResidual { frame: first, residual: 0.0 }],
+        };
         // With a single key the camera runs free to the end, aiming at that key forever (tta capped).
         let single = k.len() == 1;
         let targets: &[ResolvedKey] = if single { &k[..1] } else { &k[1..] };
@@ -156,7 +164,8 @@ impl<'a> GenerateJob<'a> {
                 continue;
             }
             let hit = out.samples.last().expect("samples").1;
-            out.residuals.push(KeyResidual { frame: target.frame, residual: toric_distance(&hit, &target.camera.to_array()) });
+            out.residuals
+                .push(KeyResidual { frame: target.frame, residual: toric_distance(&hit, &target.camera.to_array()) });
             // The key frame itself carries the network's value; exact correction moves it onto the key.
             let n = out.samples.len() - 1;
             out.samples[n].0 = target.frame.min(last).max(out.samples[n.saturating_sub(1)].0 + 1);
@@ -175,11 +184,17 @@ impl<'a> GenerateJob<'a> {
     /// Catmull-Rom fill of the network samples to every frame (§4.5 "filled with cubic
     /// interpolation"), bent onto the keys when `exact_keys`; returns the per-frame values from the
     /// first key on and the largest miss left at a key.
-    fn fill_and_correct(&self, keys: &ResolvedKeys, samples: &[(usize, [f64; 6])]) -> Result<(Vec<[f64; 6]>, f64), CameraError> {
+    fn fill_and_correct(
+        &self,
+        keys: &ResolvedKeys,
+        samples: &[(usize, [f64; 6])],
+    ) -> Result<(Vec<[f64; 6]>, f64), CameraError> {
         let (times, values): (Vec<f64>, Vec<[f64; 6]>) = samples.iter().map(|&(f, x)| (f as f64, x)).unzip();
-        let spline = Track::catmull_rom(&times, &values).map_err(|e| CameraError::Model(format!("{}: network samples: {e}", self.origin.display())))?;
+        let spline = Track::catmull_rom(&times, &values)
+            .map_err(|e| CameraError::Model(format!("{}: network samples: {e}", self.origin.display())))?;
         let last = keys.last_frame(self.scene);
-        let key_values: Vec<(f64, [f64; 6])> = keys.keys.iter().filter(|k| k.frame <= last).map(|k| (k.frame as f64, k.camera.to_array())).collect();
+        let key_values: Vec<(f64, [f64; 6])> =
+            keys.keys.iter().filter(|k| k.frame <= last).map(|k| (k.frame as f64, k.camera.to_array())).collect();
         let frames = keys.first_frame()..=last;
         let track: Vec<[f64; 6]> = if self.options.exact_keys {
             let bent = (&spline).corrected_to_keys(&key_values);
@@ -193,7 +208,12 @@ impl<'a> GenerateJob<'a> {
     }
 
     /// World poses of the per-frame Toric values, framing each segment's pair (clamped to the lens).
-    fn posed(&self, keys: &ResolvedKeys, pairs: &[(usize, (usize, usize))], track: &[[f64; 6]]) -> Result<Vec<CameraFrame>, CameraError> {
+    fn posed(
+        &self,
+        keys: &ResolvedKeys,
+        pairs: &[(usize, (usize, usize))],
+        track: &[[f64; 6]],
+    ) -> Result<Vec<CameraFrame>, CameraError> {
         let first = keys.first_frame();
         let lens = &self.options.lens;
         track
@@ -216,7 +236,13 @@ struct NetworkSamples {
 }
 
 /// One output frame: `toric` clamped to the lens, posed in the world on `pair`'s targets.
-pub(super) fn camera_frame(scene: &Scene, frame: usize, pair: (usize, usize), toric: Toric, lens: &Lens) -> Result<CameraFrame, CameraError> {
+pub(super) fn camera_frame(
+    scene: &Scene,
+    frame: usize,
+    pair: (usize, usize),
+    toric: Toric,
+    lens: &Lens,
+) -> Result<CameraFrame, CameraError> {
     let (a, b) = (scene.characters[pair.0].frame(frame).target(), scene.characters[pair.1].frame(frame).target());
     let toric = toric.clamped(lens, 0.02);
     let pose = to_pose(&toric, a, b, lens).map_err(|e| CameraError::Model(format!("frame {frame}: {e}")))?;
@@ -256,7 +282,12 @@ mod tests {
         // Same inputs, same track.
         assert_eq!(GenerateJob::new(&fast, &scene, &keys, &style).run().unwrap(), track);
         // Without correction the network's own miss stays, and is what was reported.
-        let raw = GenerateJob { options: GenerateOptions { exact_keys: false, ..Default::default() }, ..GenerateJob::new(&fast, &scene, &keys, &style) }.run().unwrap();
+        let raw = GenerateJob {
+            options: GenerateOptions { exact_keys: false, ..Default::default() },
+            ..GenerateJob::new(&fast, &scene, &keys, &style)
+        }
+        .run()
+        .unwrap();
         assert!(raw.max_corrected_residual > 1e-6);
         assert!((raw.max_corrected_residual - raw.worst_key_miss()).abs() < 1e-9);
     }
@@ -269,7 +300,10 @@ mod tests {
         // Second segment frames the pair the other way round: a transition at frame 60.
         let lens = Lens::default();
         let (a, b) = (scene.characters[1].frame(119).target(), scene.characters[0].frame(119).target());
-        let pose = CameraPose::look_at((a + b) * 0.5 + DVec3::new(0.0, 1.0, 0.0) + (b - a).cross(DVec3::Y).normalize() * 4.0, (a + b) * 0.5);
+        let pose = CameraPose::look_at(
+            (a + b) * 0.5 + DVec3::new(0.0, 1.0, 0.0) + (b - a).cross(DVec3::Y).normalize() * 4.0,
+            (a + b) * 0.5,
+        );
         keys.keys[2].camera = crate::toric::from_pose(&pose, a, b, &lens).unwrap();
         keys.keys[2].targets = Some(["B".into(), "A".into()]);
         let track = GenerateJob::new(&fast, &scene, &keys, &style).run().unwrap();
@@ -286,7 +320,10 @@ mod tests {
         let mut keys = example_keys(&scene, &[0, 50]);
         keys.keys[1].frame = 150;
         let style = zero_style();
-        let e = GenerateJob { origin: Path::new("keys.json"), ..GenerateJob::new(&fast, &scene, &keys, &style) }.run().unwrap_err().to_string();
+        let e = GenerateJob { origin: Path::new("keys.json"), ..GenerateJob::new(&fast, &scene, &keys, &style) }
+            .run()
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("keys.json") && e.contains("key 1") && e.contains("frame 150"), "{e}");
         let keys = example_keys(&scene, &[0, 50]);
         let short = Style { name: "odd".into(), code: vec![0.0; 3] };
@@ -332,8 +369,14 @@ mod tests {
             let scene = Scene::procedural(seed, 300, 30.0);
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
             let truth = film_sequence(&scene, seed, Behaviour::Orbit, true, &mut rng, &lens);
-            let names = [scene.characters[truth.a_index].name.clone(), scene.characters[1 - truth.a_index].name.clone()];
-            let key = |f: usize| crate::infer::Keyframe { frame: f, camera: truth.camera[f], targets: Some(names.clone()), velocity: None };
+            let names =
+                [scene.characters[truth.a_index].name.clone(), scene.characters[1 - truth.a_index].name.clone()];
+            let key = |f: usize| crate::infer::Keyframe {
+                frame: f,
+                camera: truth.camera[f],
+                targets: Some(names.clone()),
+                velocity: None,
+            };
             let keys = Keys { main: Some(names[0].clone()), keys: vec![key(0), key(150), key(299)] };
             let options = GenerateOptions { remap_at_keys, ..Default::default() };
             let track = GenerateJob { options, ..GenerateJob::new(&w.model, &scene, &keys, &style) }.run().unwrap();
@@ -351,7 +394,11 @@ mod tests {
         // stopped orbit tracks there (README: §6.3 orbit error 0.378 without the restart, 0.063
         // with it). Measured against the filmed ground truth, after the middle key.
         let w = crate::weights::committed().unwrap();
-        let (remapped, ran_on) = (orbit_error_after_the_middle_key(&w, true), orbit_error_after_the_middle_key(&w, false));
-        assert!(remapped < 0.7 * ran_on, "orbit error after the middle key: restarted {remapped:.3}, ran on {ran_on:.3}");
+        let (remapped, ran_on) =
+            (orbit_error_after_the_middle_key(&w, true), orbit_error_after_the_middle_key(&w, false));
+        assert!(
+            remapped < 0.7 * ran_on,
+            "orbit error after the middle key: restarted {remapped:.3}, ran on {ran_on:.3}"
+        );
     }
 }

@@ -57,7 +57,11 @@ impl ResolvedKeys {
 
     /// The last generated frame: the last key, or the scene's end with a single key.
     pub fn last_frame(&self, scene: &Scene) -> usize {
-        if self.keys.len() == 1 { scene.num_frames() - 1 } else { self.keys[self.keys.len() - 1].frame }
+        if self.keys.len() == 1 {
+            scene.num_frames() - 1
+        } else {
+            self.keys[self.keys.len() - 1].frame
+        }
     }
 
     /// Whether character `pair.0` is the main one (x^v's M, Eq. 1).
@@ -80,17 +84,26 @@ impl Keys {
         let find = |k: usize, name: &str| {
             scene.character_index(name).ok_or_else(|| {
                 let names: Vec<&str> = scene.characters.iter().map(|c| c.name.as_str()).collect();
-                CameraError::invalid(origin, format!("key {k}: unknown target `{name}` (characters: {})", names.join(", ")))
+                CameraError::invalid(
+                    origin,
+                    format!("key {k}: unknown target `{name}` (characters: {})", names.join(", ")),
+                )
             })
         };
         let mut out: Vec<ResolvedKey> = Vec::new();
         for (k, key) in self.keys.iter().enumerate() {
             if key.frame >= n {
-                return Err(CameraError::invalid(origin, format!("key {k}: frame {} is past the scene's last frame {}", key.frame, n.saturating_sub(1))));
+                return Err(CameraError::invalid(
+                    origin,
+                    format!("key {k}: frame {} is past the scene's last frame {}", key.frame, n.saturating_sub(1)),
+                ));
             }
             if let Some(prev) = out.last() {
                 if key.frame <= prev.frame {
-                    return Err(CameraError::invalid(origin, format!("key {k}: frame {} does not come after frame {}", key.frame, prev.frame)));
+                    return Err(CameraError::invalid(
+                        origin,
+                        format!("key {k}: frame {} does not come after frame {}", key.frame, prev.frame),
+                    ));
                 }
             }
             if let Some(v) = key.velocity.filter(|v| v.iter().any(|x| !x.is_finite())) {
@@ -103,12 +116,20 @@ impl Keys {
             if pair.0 == pair.1 {
                 return Err(CameraError::invalid(origin, format!("key {k}: both targets are the same character")));
             }
-            let (a, b) = (scene.characters[pair.0].frame(key.frame).target(), scene.characters[pair.1].frame(key.frame).target());
-            to_pose(&key.camera, a, b, lens).map_err(|e| CameraError::invalid(origin, format!("key {k}: camera: {e}")))?;
+            let (a, b) = (
+                scene.characters[pair.0].frame(key.frame).target(),
+                scene.characters[pair.1].frame(key.frame).target(),
+            );
+            to_pose(&key.camera, a, b, lens)
+                .map_err(|e| CameraError::invalid(origin, format!("key {k}: camera: {e}")))?;
             out.push(ResolvedKey { frame: key.frame, camera: key.camera, pair, velocity: key.velocity });
         }
         let main = match &self.main {
-            Some(m) => Some(scene.character_index(m).ok_or_else(|| CameraError::invalid(origin, format!("main: unknown character `{m}`")))?),
+            Some(m) => Some(
+                scene
+                    .character_index(m)
+                    .ok_or_else(|| CameraError::invalid(origin, format!("main: unknown character `{m}`")))?,
+            ),
             None => None,
         };
         Ok(ResolvedKeys { keys: out, main })

@@ -130,7 +130,13 @@ impl FastModel {
 
     /// [`FastModel::map_state`] into an existing one-row state, without allocating once `scratch`
     /// has its size.
-    pub fn map_state_into(&self, style: &[f32], frames: &[Cam; MAP_FRAMES], state: &mut LstmState, scratch: &mut Scratch) {
+    pub fn map_state_into(
+        &self,
+        style: &[f32],
+        frames: &[Cam; MAP_FRAMES],
+        state: &mut LstmState,
+        scratch: &mut Scratch,
+    ) {
         scratch.reserve(self, 1);
         let hd = self.config.hidden;
         let sd = style.len();
@@ -234,7 +240,13 @@ mod tests {
         let cfg = ModelConfig { hidden: 16, tta_dim: 8, ..ModelConfig::default() };
         let fast = FastModel::from_burn(&inbetween_nn::backend::seeded_module(&device, 5, |d| cfg.init(d)), cfg);
         let style = [0.1f32, 0.2, -0.3, 0.0];
-        let input = |i: usize| StepIn { style: &style, prev: [i as f32 * 0.1; 6], character: [0.5; 8], key: [0.2; 14], tta_frames: 10 * i };
+        let input = |i: usize| StepIn {
+            style: &style,
+            prev: [i as f32 * 0.1; 6],
+            character: [0.5; 8],
+            key: [0.2; 14],
+            tta_frames: 10 * i,
+        };
         let inputs = [input(0), input(1), input(2)];
         let mut batched = LstmState::zeros(3, 16);
         let together = fast.step(&inputs, &mut batched);

@@ -32,7 +32,14 @@ impl<'m> Rollout<'m> {
 
     /// Starts at `start` with a given state (Table 1's zero, Gaussian and warm-start rows).
     pub fn with_state(model: &'m FastModel, style: &[f32], state: LstmState, start: Cam) -> Rollout<'m> {
-        Rollout { model, style: style.to_vec(), state, prev: start, recent: [start; MAP_FRAMES], scratch: Scratch::for_rows(model, 1) }
+        Rollout {
+            model,
+            style: style.to_vec(),
+            state,
+            prev: start,
+            recent: [start; MAP_FRAMES],
+            scratch: Scratch::for_rows(model, 1),
+        }
     }
 
     /// One network step: the camera `tta_frames` frames before key `key`, with the characters

@@ -61,7 +61,10 @@ impl FastModel {
 
 /// The code of `behaviour` with the main character on the left, from `styles`.
 pub fn behaviour_code(styles: &[NamedStyle], behaviour: Behaviour) -> Option<Style> {
-    styles.iter().find(|s| s.behaviour == behaviour && s.main_is_a).map(|s| Style { name: behaviour.name().into(), code: s.code.clone() })
+    styles
+        .iter()
+        .find(|s| s.behaviour == behaviour && s.main_is_a)
+        .map(|s| Style { name: behaviour.name().into(), code: s.code.clone() })
 }
 
 /// A reference clip for style extraction: Eq. 1 and Eq. 2 features per frame (30 fps). A dataset
@@ -77,7 +80,10 @@ impl ReferenceClip {
     pub fn style(&self, model: &FastModel, origin: &Path) -> Result<Vec<f32>, CameraError> {
         let n = self.characters.len().min(self.camera.len());
         if n < DOWNSAMPLE * 10 {
-            return Err(CameraError::invalid(origin, format!("reference clip has {n} frames; at least {} are needed (300 recommended)", DOWNSAMPLE * 10)));
+            return Err(CameraError::invalid(
+                origin,
+                format!("reference clip has {n} frames; at least {} are needed (300 recommended)", DOWNSAMPLE * 10),
+            ));
         }
         let chars: Vec<_> = (0..n).step_by(DOWNSAMPLE).map(|i| encode_character(&self.characters[i])).collect();
         let cams: Vec<_> = (0..n).step_by(DOWNSAMPLE).map(|i| encode_camera(&self.camera[i])).collect();

@@ -7,9 +7,9 @@
 
 use super::ModelConfig;
 use burn::module::Module;
+use burn::module::Param;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::activation::leaky_relu;
-use burn::module::Param;
 use burn::tensor::{Device, Tensor, TensorData};
 use inbetween_nn::lstm::{FusedLstm, FusedLstmConfig, LstmState};
 

@@ -115,7 +115,8 @@ mod tests {
         assert!((c.arrival_weight(195.0) - 5.0 / 200.0).abs() < 1e-6);
         assert_eq!(c.arrival_weight(400.0), c.arrival_weight(200.0), "capped like the tta embedding");
         // Summaries written before the option existed load with the plain residual.
-        let old: ModelConfig = serde_json::from_str(r#"{"hidden":256,"style_dim":4,"tta_dim":128,"tta_max":200.0}"#).unwrap();
+        let old: ModelConfig =
+            serde_json::from_str(r#"{"hidden":256,"style_dim":4,"tta_dim":128,"tta_max":200.0}"#).unwrap();
         assert!(!old.arrival_base);
         assert_eq!(old.arrival_weight(0.0), 0.0);
     }

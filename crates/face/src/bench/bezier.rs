@@ -74,10 +74,12 @@ mod tests {
 
     #[test]
     fn a_cubic_needs_two_keys_and_noise_needs_many() {
-        let cubic: Vec<f32> = (0..50).map(|i| {
-            let t = i as f32 / 49.0;
-            0.2 + 0.5 * t * t * t - 0.3 * t * t
-        }).collect();
+        let cubic: Vec<f32> = (0..50)
+            .map(|i| {
+                let t = i as f32 / 49.0;
+                0.2 + 0.5 * t * t * t - 0.3 * t * t
+            })
+            .collect();
         assert_eq!(bezier_keys(&cubic, 0.01), 2);
         let zigzag: Vec<f32> = (0..50).map(|i| if i % 2 == 0 { 0.0 } else { 0.5 }).collect();
         assert!(bezier_keys(&zigzag, 0.01) > 20);

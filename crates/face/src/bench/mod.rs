@@ -28,7 +28,8 @@ use crate::visemes::Viseme;
 
 /// Held-out capture files (relative to `face/neurosync/`): one file of each emotion that has two or
 /// more takes, so every emotion is still seen in training.
-pub const TEST_FILES: [&str; 2] = ["livelink/Fearful/MySlate_162_iPhone_cal.csv", "livelink/Sad/MySlate_168_iPhone_cal.csv"];
+pub const TEST_FILES: [&str; 2] =
+    ["livelink/Fearful/MySlate_162_iPhone_cal.csv", "livelink/Sad/MySlate_168_iPhone_cal.csv"];
 
 /// Training capture files: every Live Link capture not in [`TEST_FILES`].
 pub const TRAIN_FILES: [&str; 6] = [
@@ -76,12 +77,26 @@ pub struct FaceBenchConfig {
 impl FaceBenchConfig {
     /// The full evaluation.
     pub fn full(captures: PathBuf) -> Self {
-        FaceBenchConfig { captures, edits_per_gap: 12, procedural_clips: 6, procedural_seconds: 20.0, one_test_file: false, seed: 2026 }
+        FaceBenchConfig {
+            captures,
+            edits_per_gap: 12,
+            procedural_clips: 6,
+            procedural_seconds: 20.0,
+            one_test_file: false,
+            seed: 2026,
+        }
     }
 
     /// A small run for tests.
     pub fn quick(captures: PathBuf) -> Self {
-        FaceBenchConfig { captures, edits_per_gap: 2, procedural_clips: 1, procedural_seconds: 10.0, one_test_file: true, seed: 7 }
+        FaceBenchConfig {
+            captures,
+            edits_per_gap: 2,
+            procedural_clips: 1,
+            procedural_seconds: 10.0,
+            one_test_file: true,
+            seed: 7,
+        }
     }
 }
 
@@ -139,7 +154,8 @@ fn frames_of(clip: &BlendshapeClip) -> Vec<Frame> {
 /// A 25 fps clip of the given frames (times from 0).
 pub fn clip_of(frames: &[Frame]) -> BlendshapeClip {
     let times = (0..frames.len()).map(|f| f as f64 / MODEL_FPS).collect();
-    BlendshapeClip::new(MODEL_FPS, times, false, vec![], frames.iter().flatten().copied().collect()).expect("frames make a valid clip")
+    BlendshapeClip::new(MODEL_FPS, times, false, vec![], frames.iter().flatten().copied().collect())
+        .expect("frames make a valid clip")
 }
 
 /// The guide a test edit gets, drawn from the truth.
@@ -184,7 +200,13 @@ fn methods<'a>(kind: ConstraintKind, sets: &'a [NetworkSet]) -> Vec<(String, Met
 }
 
 /// One edit of `truth` (25 fps) on `seg` with `method`; returns the model-rate output and mask.
-fn edit(truth: &BlendshapeClip, seg: Segment, guide: &Guide, method: Method, seed: u64) -> Result<(Vec<Frame>, Mask), FaceError> {
+fn edit(
+    truth: &BlendshapeClip,
+    seg: Segment,
+    guide: &Guide,
+    method: Method,
+    seed: u64,
+) -> Result<(Vec<Frame>, Mask), FaceError> {
     let spans = vec![(seg.start as f64 / MODEL_FPS, seg.end as f64 / MODEL_FPS)];
     let job = EditJob { clip: truth, spans, channels: [true; NUM_ARKIT], guide: guide.clone(), method, seed };
     let out = job.run()?;
@@ -239,7 +261,11 @@ fn evaluate_clip(
                     cell(cells, (*kind, *gap_s, name)).add(&truth, &out, &mask);
                 }
                 if *kind == ConstraintKind::Noisy {
-                    cell(cells, (*kind, *gap_s, "noisy guide as is".into())).add(&truth, &guide_as_is(&truth, &mask, &guide), &mask);
+                    cell(cells, (*kind, *gap_s, "noisy guide as is".into())).add(
+                        &truth,
+                        &guide_as_is(&truth, &mask, &guide),
+                        &mask,
+                    );
                 }
             }
             progress.inc(1);
@@ -295,16 +321,42 @@ pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> R
     progress.set_message("held-out edits");
     let mut cells: Cells = Vec::new();
     for (i, (_, clip)) in tests.iter().enumerate() {
-        evaluate_clip(clip, None, &real_kinds, sets, cfg.edits_per_gap, derive(cfg.seed, i as u64), &mut cells, progress)?;
+        evaluate_clip(
+            clip,
+            None,
+            &real_kinds,
+            sets,
+            cfg.edits_per_gap,
+            derive(cfg.seed, i as u64),
+            &mut cells,
+            progress,
+        )?;
     }
-    report.table(heldout_table("heldout_by_gap", "Held-out captures: error inside the gap by constraint, gap length and method", &cells));
+    report.table(heldout_table(
+        "heldout_by_gap",
+        "Held-out captures: error inside the gap by constraint, gap length and method",
+        &cells,
+    ));
     report.table(heldout_table("heldout", "Held-out captures: all gap lengths together", &by_constraint(&cells)));
     let mut vcells: Cells = Vec::new();
     for (i, p) in proc_clips.iter().enumerate() {
         let kinds = [ConstraintKind::Visemes, ConstraintKind::None];
-        evaluate_clip(&p.clip, Some(&p.visemes), &kinds, sets, cfg.edits_per_gap, derive(cfg.seed, 1000 + i as u64), &mut vcells, progress)?;
+        evaluate_clip(
+            &p.clip,
+            Some(&p.visemes),
+            &kinds,
+            sets,
+            cfg.edits_per_gap,
+            derive(cfg.seed, 1000 + i as u64),
+            &mut vcells,
+            progress,
+        )?;
     }
-    report.table(heldout_table("visemes", "Viseme editing on held-out procedural clips (the captures have no phoneme labels)", &by_constraint(&vcells)));
+    report.table(heldout_table(
+        "visemes",
+        "Viseme editing on held-out procedural clips (the captures have no phoneme labels)",
+        &by_constraint(&vcells),
+    ));
     report.table(table4(&tests, &proc_clips, sets, cfg.seed)?);
     report.table(table3(&tests, &proc_clips, sets, cfg.seed)?);
     charts(&mut report, &cells);
@@ -313,11 +365,24 @@ pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> R
 }
 
 /// Table 4 protocol: the whole window masked, guidance only (10 s windows of each held-out clip).
-fn table4(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralClip], sets: &[NetworkSet], seed: u64) -> Result<Table, FaceError> {
-    let mut t = Table::new("table4", "Table 4 protocol: whole window masked, guidance only (MSE of the weights)", &["guidance", "method", "mse", "windows"]);
+fn table4(
+    tests: &[(String, BlendshapeClip)],
+    procs: &[procedural::ProceduralClip],
+    sets: &[NetworkSet],
+    seed: u64,
+) -> Result<Table, FaceError> {
+    let mut t = Table::new(
+        "table4",
+        "Table 4 protocol: whole window masked, guidance only (MSE of the weights)",
+        &["guidance", "method", "mse", "windows"],
+    );
     let window = (10.0 * MODEL_FPS) as usize;
     let mut cells: Cells = Vec::new();
-    let mut add = |truth_clip: &BlendshapeClip, visemes: Option<&[Viseme]>, kind: ConstraintKind, s: u64| -> Result<(), FaceError> {
+    let mut add = |truth_clip: &BlendshapeClip,
+                   visemes: Option<&[Viseme]>,
+                   kind: ConstraintKind,
+                   s: u64|
+     -> Result<(), FaceError> {
         let all = frames_of(truth_clip);
         for (w, chunk) in all.chunks_exact(window).enumerate() {
             let truth = chunk.to_vec();
@@ -331,7 +396,11 @@ fn table4(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralCli
                 cell(&mut cells, (kind, 0.0, name)).add(&truth, &out, &mask);
             }
             if kind == ConstraintKind::Noisy {
-                cell(&mut cells, (kind, 0.0, "noisy guide as is".into())).add(&truth, &guide_as_is(&truth, &mask, &guide), &mask);
+                cell(&mut cells, (kind, 0.0, "noisy guide as is".into())).add(
+                    &truth,
+                    &guide_as_is(&truth, &mask, &guide),
+                    &mask,
+                );
             }
         }
         Ok(())
@@ -345,20 +414,36 @@ fn table4(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralCli
         add(&p.clip, Some(&p.visemes), ConstraintKind::Visemes, derive(seed, 600 + i as u64))?;
     }
     for ((kind, _, method), acc) in &cells {
-        let guidance = if *kind == ConstraintKind::Visemes { "visemes (procedural)".to_string() } else { kind.name().to_string() };
+        let guidance =
+            if *kind == ConstraintKind::Visemes { "visemes (procedural)".to_string() } else { kind.name().to_string() };
         t.row([guidance, method.clone(), num(acc.mse(), 5), acc.edits.to_string()]);
     }
-    t.note("paper (8 dense control parameters, B3D(AC)^2 test set): ours 0.014, Holden et al. 0.016, Berson et al. 0.018");
+    t.note(
+        "paper (8 dense control parameters, B3D(AC)^2 test set): ours 0.014, Holden et al. 0.016, Berson et al. 0.018",
+    );
     t.note("we have no control-parameter network; the dense noisy guide is the closest guidance we have");
     Ok(t)
 }
 
 /// Table 3: keys an animator would need (cubic Bézier at tolerance 0.01) and CPU time per edit.
-fn table3(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralClip], sets: &[NetworkSet], seed: u64) -> Result<Table, FaceError> {
+fn table3(
+    tests: &[(String, BlendshapeClip)],
+    procs: &[procedural::ProceduralClip],
+    sets: &[NetworkSet],
+    seed: u64,
+) -> Result<Table, FaceError> {
     let mut t = Table::new(
         "table3",
         "Table 3: keys per edit (cubic Bézier, tolerance 0.01) and CPU time of one edit",
-        &["edit", "frames", "bezier_keys_per_shape", "bezier_keys_all_shapes", "ms_per_edit", "paper_bezier_points", "paper_cpu_s"],
+        &[
+            "edit",
+            "frames",
+            "bezier_keys_per_shape",
+            "bezier_keys_all_shapes",
+            "ms_per_edit",
+            "paper_bezier_points",
+            "paper_cpu_s",
+        ],
     );
     let Some(set) = sets.first() else {
         t.note("no network given: nothing to time");
@@ -385,7 +470,8 @@ fn table3(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralCli
         let (out, _) = edit(&clip, seg, &guide, Method::Network(net), derive(seed, 301))?;
         let keys: Vec<usize> = (0..NUM_ARKIT)
             .map(|c| {
-                let curve: Vec<f32> = out[seg.start.saturating_sub(1)..(seg.end + 1).min(out.len())].iter().map(|f| f[c]).collect();
+                let curve: Vec<f32> =
+                    out[seg.start.saturating_sub(1)..(seg.end + 1).min(out.len())].iter().map(|f| f[c]).collect();
                 bezier::bezier_keys(&curve, 0.01)
             })
             .collect();
@@ -403,7 +489,10 @@ fn table3(tests: &[(String, BlendshapeClip)], procs: &[procedural::ProceduralCli
             paper_s.to_string(),
         ]);
     }
-    t.note(format!("keys per shape averaged over the {} ARKit shapes; an animator sets each key with two tangent handles", ARKIT_NAMES.len()));
+    t.note(format!(
+        "keys per shape averaged over the {} ARKit shapes; an animator sets each key with two tangent handles",
+        ARKIT_NAMES.len()
+    ));
     t.note("ms_per_edit: the whole EditJob (resampling, network on the gap plus 2 s of context each side, post-processing) on one thread of this machine");
     Ok(t)
 }
@@ -422,7 +511,12 @@ fn charts(report: &mut Report, cells: &Cells) {
             .map(|m| {
                 let v = GAPS_S
                     .iter()
-                    .map(|g| cells.iter().find(|((k, gg, mm), _)| *k == kind && gg == g && mm == m).map_or(0.0, |(_, a)| a.mse()))
+                    .map(|g| {
+                        cells
+                            .iter()
+                            .find(|((k, gg, mm), _)| *k == kind && gg == g && mm == m)
+                            .map_or(0.0, |(_, a)| a.mse())
+                    })
                     .collect();
                 (m.clone(), v)
             })
@@ -455,7 +549,10 @@ mod tests {
                 assert!(names.contains(&n), "{names:?}");
             }
             let csv = report.tables().find(|t| t.name == "heldout").unwrap().to_csv();
-            assert!(csv.contains("ours (procedural)") && csv.contains("cubic") && csv.contains("noisy guide as is"), "{csv}");
+            assert!(
+                csv.contains("ours (procedural)") && csv.contains("cubic") && csv.contains("noisy guide as is"),
+                "{csv}"
+            );
             for line in csv.lines().skip(1) {
                 let mse: f64 = line.split(',').nth(3).unwrap().parse().unwrap();
                 assert!(mse.is_finite() && mse >= 0.0, "{line}");

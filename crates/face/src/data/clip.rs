@@ -70,7 +70,12 @@ impl BlendshapeClip {
             ));
         }
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return invalid(format!("value of frame {}, channel {} is {}; expected a finite number", i / stride, i % stride, values[i]));
+            return invalid(format!(
+                "value of frame {}, channel {} is {}; expected a finite number",
+                i / stride,
+                i % stride,
+                values[i]
+            ));
         }
         Ok(BlendshapeClip { fps, times, head_eye, extras, values })
     }
@@ -242,7 +247,9 @@ impl Layout {
         let mut head_at = [usize::MAX; NUM_HEAD_EYE];
         let mut extras: Vec<(usize, String)> = Vec::new();
         for (c, name) in names.iter().enumerate() {
-            let dup = |first: usize| Err((Some(c), format!("duplicate column '{name}' (first at column index {})", first + 1)));
+            let dup = |first: usize| {
+                Err((Some(c), format!("duplicate column '{name}' (first at column index {})", first + 1)))
+            };
             if let Some(i) = arkit_index(name) {
                 if arkit_at[i] != usize::MAX {
                     return dup(arkit_at[i]);
@@ -265,7 +272,8 @@ impl Layout {
                 return Err((Some(c), format!("unknown column '{name}'")));
             }
         }
-        let missing: Vec<&str> = (0..NUM_ARKIT).filter(|&i| arkit_at[i] == usize::MAX).map(|i| ARKIT_NAMES[i]).collect();
+        let missing: Vec<&str> =
+            (0..NUM_ARKIT).filter(|&i| arkit_at[i] == usize::MAX).map(|i| ARKIT_NAMES[i]).collect();
         if !missing.is_empty() {
             return Err((None, format!("missing {} of the 52 ARKit columns: {}", missing.len(), list(&missing))));
         }

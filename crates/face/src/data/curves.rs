@@ -80,7 +80,14 @@ pub fn parse_curve_csv(text: &str, file: &str) -> Result<BlendshapeClip, FaceErr
                 let v = v.trim();
                 match v.parse::<f64>() {
                     Ok(x) if x.is_finite() && x > 0.0 => fps = Some(x),
-                    _ => return Err(at(file, line, None, format!("expected '# fps=<positive number>', found fps {}", shown(v)))),
+                    _ => {
+                        return Err(at(
+                            file,
+                            line,
+                            None,
+                            format!("expected '# fps=<positive number>', found fps {}", shown(v)),
+                        ))
+                    }
                 }
             }
             continue;
@@ -103,7 +110,12 @@ pub fn parse_curve_csv(text: &str, file: &str) -> Result<BlendshapeClip, FaceErr
                 file,
                 line,
                 None,
-                format!("expected {} fields as in the header (time_s and {} channels), found {}", head.len(), head.len() - 1, row.len()),
+                format!(
+                    "expected {} fields as in the header (time_s and {} channels), found {}",
+                    head.len(),
+                    head.len() - 1,
+                    row.len()
+                ),
             ));
         }
         let t: f64 = number(row[0]).map_err(|m| at(file, line, column(head, 0), m))?;
@@ -141,7 +153,10 @@ pub fn parse_curve_csv(text: &str, file: &str) -> Result<BlendshapeClip, FaceErr
 /// Parses curve JSON text; `file` names it in errors.
 pub fn parse_curve_json(text: &str, file: &str) -> Result<BlendshapeClip, FaceError> {
     if text.trim().is_empty() {
-        return Err(FaceError::Empty { file: file.into(), expected: "a JSON object {\"time_s\": […], \"channels\": […]}".into() });
+        return Err(FaceError::Empty {
+            file: file.into(),
+            expected: "a JSON object {\"time_s\": […], \"channels\": […]}".into(),
+        });
     }
     let cf: CurveFile = serde_json::from_str(text).map_err(|e| {
         FaceError::parse(
@@ -158,7 +173,8 @@ pub fn parse_curve_json(text: &str, file: &str) -> Result<BlendshapeClip, FaceEr
         }
     }
     let fps = cf.fps.unwrap_or_else(|| estimate_fps(&cf.time_s));
-    let channels = cf.channels.into_iter().map(|c| (c.name, c.values.into_iter().map(|v| v as f32).collect())).collect();
+    let channels =
+        cf.channels.into_iter().map(|c| (c.name, c.values.into_iter().map(|v| v as f32).collect())).collect();
     BlendshapeClip::from_named(fps, cf.time_s, channels).map_err(to_file)
 }
 
@@ -209,7 +225,10 @@ pub fn to_curve_json_string(clip: &BlendshapeClip) -> String {
             .channel_names()
             .iter()
             .enumerate()
-            .map(|(c, n)| NamedCurve { name: n.to_string(), values: clip.channel(c).into_iter().map(f64::from).collect() })
+            .map(|(c, n)| NamedCurve {
+                name: n.to_string(),
+                values: clip.channel(c).into_iter().map(f64::from).collect(),
+            })
             .collect(),
     };
     let mut s = serde_json::to_string(&cf).expect("finite numbers and string keys always serialise");
@@ -220,7 +239,8 @@ pub fn to_curve_json_string(clip: &BlendshapeClip) -> String {
 /// Writes a curve file, CSV or JSON by extension, atomically (temp file + rename).
 pub fn write_curves(path: &Path, clip: &BlendshapeClip) -> Result<(), FaceError> {
     let text = if is_json(path) { to_curve_json_string(clip) } else { to_curve_csv_string(clip) };
-    inbetween_io::write_atomic(path, text.as_bytes()).map_err(|source| FaceError::Io { file: path.display().to_string(), source })
+    inbetween_io::write_atomic(path, text.as_bytes())
+        .map_err(|source| FaceError::Io { file: path.display().to_string(), source })
 }
 
 #[cfg(test)]

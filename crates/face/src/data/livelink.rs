@@ -120,14 +120,8 @@ fn format_timecode(t: f64) -> Option<(u64, String)> {
     let per_second = 60_000;
     let secs = u / per_second;
     let sub = u % per_second;
-    let text = format!(
-        "{:02}:{:02}:{:02}:{:02}.{:03}",
-        secs / 3600,
-        (secs / 60) % 60,
-        secs % 60,
-        sub / 1000,
-        sub % 1000
-    );
+    let text =
+        format!("{:02}:{:02}:{:02}:{:02}.{:03}", secs / 3600, (secs / 60) % 60, secs % 60, sub / 1000, sub % 1000);
     Some((u, text))
 }
 
@@ -144,7 +138,14 @@ pub fn parse_live_link(text: &str, file: &str) -> Result<BlendshapeClip, FaceErr
             Some(h) => {
                 return Err(at(file, hline, column(&[], i), format!("expected header '{want}', found {}", shown(h))));
             }
-            None => return Err(at(file, hline, column(&[], i), format!("expected header '{want}', found the end of the line"))),
+            None => {
+                return Err(at(
+                    file,
+                    hline,
+                    column(&[], i),
+                    format!("expected header '{want}', found the end of the line"),
+                ))
+            }
         }
     }
     let layout = Layout::from_names(&header[2..], is_emotion).map_err(|(c, m)| {
@@ -259,8 +260,9 @@ pub fn to_live_link_string(clip: &BlendshapeClip) -> Result<String, FaceError> {
     let mut prev: Option<u64> = None;
     for f in 0..clip.num_frames() {
         let t = clip.times()[f];
-        let (u, tc) = format_timecode(t)
-            .ok_or_else(|| FaceError::Invalid(format!("time {t} s of frame {f} cannot be written as a timecode (0 ≤ t < 1000 h)")))?;
+        let (u, tc) = format_timecode(t).ok_or_else(|| {
+            FaceError::Invalid(format!("time {t} s of frame {f} cannot be written as a timecode (0 ≤ t < 1000 h)"))
+        })?;
         if prev.is_some_and(|p| u <= p) {
             return Err(FaceError::Invalid(format!(
                 "frames {} and {f} fall on the same timecode {tc} (resolution 1/60000 s)",
@@ -301,7 +303,13 @@ pub(crate) mod tests {
         for f in 0..frames {
             for c in 0..stride {
                 let x = (f as f32 * 0.07 + c as f32 * 0.9).sin();
-                values.push(if c < 52 { 0.5 + 0.5 * x } else if c < 61 && head { 0.3 * x } else { 50.0 + 50.0 * x });
+                values.push(if c < 52 {
+                    0.5 + 0.5 * x
+                } else if c < 61 && head {
+                    0.3 * x
+                } else {
+                    50.0 + 50.0 * x
+                });
             }
         }
         BlendshapeClip::new(60.0, times, head, extras, values).unwrap()
@@ -309,7 +317,8 @@ pub(crate) mod tests {
 
     fn header(n_head: usize, emotions: bool) -> String {
         let mut h = String::from("Timecode,BlendshapeCount");
-        let names = ARKIT_NAMES.iter().chain(&HEAD_EYE_NAMES[..n_head]).chain(if emotions { &EMOTION_NAMES[..] } else { &[] });
+        let names =
+            ARKIT_NAMES.iter().chain(&HEAD_EYE_NAMES[..n_head]).chain(if emotions { &EMOTION_NAMES[..] } else { &[] });
         let mut n = 0;
         for name in names {
             h.push(',');
@@ -339,7 +348,16 @@ pub(crate) mod tests {
         assert!((parse_timecode("00:00:00:04.083").unwrap().millis_time() - 0.083).abs() < 1e-12);
         assert_eq!(parse_timecode("00:00:01:02").unwrap().frac, 0);
         assert_eq!(parse_timecode("00:00:01:02.5").unwrap().frac, 500);
-        for bad in ["", "1:2:3", "00:00:00:60.000", "00:61:00:00.000", "00:00:00:00.", "00:00:00:00.1234", "a:b:c:d", "00:00:00:-1.0"] {
+        for bad in [
+            "",
+            "1:2:3",
+            "00:00:00:60.000",
+            "00:61:00:00.000",
+            "00:00:00:00.",
+            "00:00:00:00.1234",
+            "a:b:c:d",
+            "00:00:00:-1.0",
+        ] {
             assert!(parse_timecode(bad).is_err(), "{bad}");
         }
         let (_, s) = format_timecode(14.0 * 3600.0 + 58.0 * 60.0 + 2.0 + 44.643 / 60.0).unwrap();
@@ -350,7 +368,9 @@ pub(crate) mod tests {
 
     #[test]
     fn generated_clips_round_trip() {
-        for (head, emotions, t0) in [(false, false, 0.0), (true, false, 53882.74405), (true, true, 0.0), (false, true, 12.5)] {
+        for (head, emotions, t0) in
+            [(false, false, 0.0), (true, false, 53882.74405), (true, true, 0.0), (false, true, 12.5)]
+        {
             let c = generated(130, head, emotions, t0);
             let text = to_live_link_string(&c).unwrap();
             let back = parse_live_link(&text, "gen.csv").unwrap();

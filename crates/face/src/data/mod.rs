@@ -21,7 +21,9 @@ mod resample;
 pub(crate) mod text;
 
 pub use clip::BlendshapeClip;
-pub use curves::{parse_curve_csv, parse_curve_json, read_curves, to_curve_csv_string, to_curve_json_string, write_curves};
+pub use curves::{
+    parse_curve_csv, parse_curve_json, read_curves, to_curve_csv_string, to_curve_json_string, write_curves,
+};
 pub use error::{Column, FaceError};
 pub use livelink::{parse_live_link, read_live_link, to_live_link_string, write_live_link};
 pub use names::{
@@ -43,7 +45,8 @@ pub fn read_clip(path: &std::path::Path) -> Result<BlendshapeClip, FaceError> {
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
         return parse_curve_json(&text, &file);
     }
-    let header = text.lines().map(|l| l.trim_start_matches('\u{feff}').trim()).find(|l| !l.is_empty() && !l.starts_with('#'));
+    let header =
+        text.lines().map(|l| l.trim_start_matches('\u{feff}').trim()).find(|l| !l.is_empty() && !l.starts_with('#'));
     if header.is_some_and(|h| h.to_ascii_lowercase().starts_with("timecode")) {
         parse_live_link(&text, &file)
     } else {

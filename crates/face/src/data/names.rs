@@ -105,12 +105,8 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_counted() {
-        let mut all: Vec<String> = ARKIT_NAMES
-            .iter()
-            .chain(&HEAD_EYE_NAMES)
-            .chain(&EMOTION_NAMES)
-            .map(|n| n.to_ascii_lowercase())
-            .collect();
+        let mut all: Vec<String> =
+            ARKIT_NAMES.iter().chain(&HEAD_EYE_NAMES).chain(&EMOTION_NAMES).map(|n| n.to_ascii_lowercase()).collect();
         assert_eq!(all.len(), 52 + 9 + 7);
         all.sort();
         all.dedup();

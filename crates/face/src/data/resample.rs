@@ -20,7 +20,10 @@ impl BlendshapeClip {
         let t0 = self.times()[0];
         let steps = (self.duration() * fps + 1e-9).floor();
         if steps > 1e8 {
-            return Err(FaceError::Invalid(format!("resampling {} s at {fps} fps gives more than 1e8 frames", self.duration())));
+            return Err(FaceError::Invalid(format!(
+                "resampling {} s at {fps} fps gives more than 1e8 frames",
+                self.duration()
+            )));
         }
         let times: Vec<f64> = (0..=steps as usize).map(|k| t0 + k as f64 / fps).collect();
         self.resample_at(&times, fps)
@@ -92,7 +95,8 @@ mod tests {
         for c in 0..52 {
             let w = 2.0 * PI * (0.5 + 0.1 * c as f64);
             let bound = (1.0 / 60.0f64).powi(2) / 8.0 * 0.4 * w * w + 1e-6;
-            let err = low.channel(c).iter().zip(exact.channel(c)).map(|(a, b)| (a - b).abs() as f64).fold(0.0, f64::max);
+            let err =
+                low.channel(c).iter().zip(exact.channel(c)).map(|(a, b)| (a - b).abs() as f64).fold(0.0, f64::max);
             assert!(err <= bound, "channel {c}: error {err} > bound {bound}");
         }
         // A linear channel is reproduced exactly (to f32).
@@ -105,7 +109,8 @@ mod tests {
         for c in [0usize, 10, 51] {
             let w = 2.0 * PI * (0.5 + 0.1 * c as f64);
             let bound = 2.0 * (1.0 / 25.0f64).powi(2) / 8.0 * 0.4 * w * w + 1e-6;
-            let err = back.channel(c).iter().zip(clip.channel(c)).map(|(a, b)| (a - b).abs() as f64).fold(0.0, f64::max);
+            let err =
+                back.channel(c).iter().zip(clip.channel(c)).map(|(a, b)| (a - b).abs() as f64).fold(0.0, f64::max);
             assert!(err <= bound, "channel {c}: round-trip error {err} > bound {bound}");
         }
         for (a, b) in back.channel(52).iter().zip(clip.channel(52)) {

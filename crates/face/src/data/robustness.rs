@@ -8,7 +8,8 @@ use proptest::prelude::*;
 
 fn check_all(text: &str) {
     if let Ok(c) = parse_live_link(text, "p.csv") {
-        let again = parse_live_link(&to_live_link_string(&c).expect("a parsed clip writes"), "p.csv").expect("re-reads");
+        let again =
+            parse_live_link(&to_live_link_string(&c).expect("a parsed clip writes"), "p.csv").expect("re-reads");
         assert_eq!(again.values(), c.values());
     }
     if let Ok(c) = parse_curve_csv(text, "p.csv") {

@@ -4,8 +4,8 @@
 //! animation is erased, plus a constraint mask `M_C` with ones on the frames where `C` holds
 //! information. One network is trained per [`ConstraintKind`].
 
-use rand::Rng;
 use inbetween_core::seed::normal;
+use rand::Rng;
 
 use crate::data::NUM_ARKIT;
 use crate::visemes::{Viseme, NUM_VISEMES};

@@ -233,7 +233,8 @@ impl EditJob<'_> {
         let stride = clip.num_channels();
         let mut values = clip.values().to_vec();
         let last = after.len() - 1;
-        let inside: Vec<bool> = clip.times().iter().map(|t| self.spans.iter().any(|(a, b)| t - t0 >= *a && t - t0 <= *b)).collect();
+        let inside: Vec<bool> =
+            clip.times().iter().map(|t| self.spans.iter().any(|(a, b)| t - t0 >= *a && t - t0 <= *b)).collect();
         for (i, t) in clip.times().iter().enumerate() {
             let x = ((t - t0) * MODEL_FPS).clamp(0.0, last as f64);
             let (f0, f1) = (x.floor() as usize, (x.ceil() as usize).min(last));
@@ -269,7 +270,8 @@ fn generate_in_window(
     let first = segments.iter().map(|s| s.start).min().unwrap_or(0);
     let last = segments.iter().map(|s| s.end).max().unwrap_or(n);
     let (w0, w1) = (first.saturating_sub(CONTEXT_FRAMES), (last + CONTEXT_FRAMES).min(n));
-    let local: Vec<Segment> = segments.iter().map(|s| Segment { start: s.start - w0, end: s.end.min(w1) - w0 }).collect();
+    let local: Vec<Segment> =
+        segments.iter().map(|s| Segment { start: s.start - w0, end: s.end.min(w1) - w0 }).collect();
     let mask = Mask::from_segments(w1 - w0, &local, channels);
     let noise = input::noise(&mut inbetween_core::seed::rng(seed), w1 - w0);
     let x = input::assemble(&before[w0..w1], &mask, &constraint.crop(w0, w1), &noise);

@@ -33,9 +33,7 @@ struct KeyJson {
 #[derive(Deserialize)]
 #[serde(untagged)]
 enum KeysJson {
-    Wrapped {
-        keys: Vec<KeyJson>,
-    },
+    Wrapped { keys: Vec<KeyJson> },
     Bare(Vec<KeyJson>),
 }
 
@@ -70,7 +68,12 @@ fn check_time(t: f64) -> Result<f64, String> {
 pub fn parse_keys_json(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError> {
     let bad = |message: String| FaceError::File { file: file.into(), message };
     let parsed: KeysJson = serde_json::from_str(text).map_err(|e| {
-        FaceError::parse(file, e.line(), None, format!("{e}; expected {{\"keys\": [{{\"time_s\": 1.5, \"shapes\": {{\"JawOpen\": 0.8}}}}]}}"))
+        FaceError::parse(
+            file,
+            e.line(),
+            None,
+            format!("{e}; expected {{\"keys\": [{{\"time_s\": 1.5, \"shapes\": {{\"JawOpen\": 0.8}}}}]}}"),
+        )
     })?;
     let keys = match parsed {
         KeysJson::Wrapped { keys } | KeysJson::Bare(keys) => keys,
@@ -86,7 +89,8 @@ pub fn parse_keys_json(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError
                 .shapes
                 .iter()
                 .map(|(name, v)| {
-                    let c = arkit_index(name).ok_or_else(|| bad(format!("key {i}: '{name}' is not an ARKit blendshape name")))?;
+                    let c = arkit_index(name)
+                        .ok_or_else(|| bad(format!("key {i}: '{name}' is not an ARKit blendshape name")))?;
                     Ok((c, check_value(*v).map_err(|m| bad(format!("key {i}: {name}: {m}")))?))
                 })
                 .collect::<Result<Vec<_>, FaceError>>()?;
@@ -102,7 +106,10 @@ pub fn parse_keys_json(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError
 pub fn parse_keys_csv(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError> {
     let mut rows = lines(text).filter(|(_, l)| !l.trim_start().starts_with('#'));
     let Some((hline, header)) = rows.next() else {
-        return Err(FaceError::Empty { file: file.into(), expected: "a header 'time_s,<shape>,…' and one row per key".into() });
+        return Err(FaceError::Empty {
+            file: file.into(),
+            expected: "a header 'time_s,<shape>,…' and one row per key".into(),
+        });
     };
     let names = fields(header);
     if !names[0].eq_ignore_ascii_case("time_s") {
@@ -110,7 +117,8 @@ pub fn parse_keys_csv(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError>
     }
     let mut channels = Vec::new();
     for (i, name) in names.iter().enumerate().skip(1) {
-        let c = arkit_index(name).ok_or_else(|| at(file, hline, column(&names, i), format!("'{name}' is not an ARKit blendshape name")))?;
+        let c = arkit_index(name)
+            .ok_or_else(|| at(file, hline, column(&names, i), format!("'{name}' is not an ARKit blendshape name")))?;
         if channels.contains(&c) {
             return Err(at(file, hline, column(&names, i), format!("'{}' appears twice", ARKIT_NAMES[c])));
         }
@@ -131,7 +139,8 @@ pub fn parse_keys_csv(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError>
             if f[i + 1].is_empty() {
                 continue; // an empty cell leaves the shape free
             }
-            let v = number::<f64>(f[i + 1]).and_then(check_value).map_err(|m| at(file, line, column(&names, i + 1), m))?;
+            let v =
+                number::<f64>(f[i + 1]).and_then(check_value).map_err(|m| at(file, line, column(&names, i + 1), m))?;
             shapes.push((*c, v));
         }
         keys.push(KeyPose { time_s, shapes });
@@ -148,7 +157,8 @@ mod tests {
 
     #[test]
     fn json_and_csv_forms_read_the_same_keys() {
-        let j = parse_keys_json(r#"{"keys":[{"time_s":1.5,"shapes":{"JawOpen":0.8,"eyeBlinkLeft":1}}]}"#, "k.json").unwrap();
+        let j = parse_keys_json(r#"{"keys":[{"time_s":1.5,"shapes":{"JawOpen":0.8,"eyeBlinkLeft":1}}]}"#, "k.json")
+            .unwrap();
         let c = parse_keys_csv("time_s,EyeBlinkLeft,JawOpen\n1.5,1,0.8\n", "k.csv").unwrap();
         let mut a = j[0].shapes.clone();
         let mut b = c[0].shapes.clone();
@@ -166,7 +176,8 @@ mod tests {
         assert!(e.contains("k.csv:1") && e.contains("'Smile'"), "{e}");
         let e = parse_keys_csv("time_s,JawOpen\n", "k.csv").unwrap_err().to_string();
         assert!(e.contains("at least one key"), "{e}");
-        let e = parse_keys_json(r#"{"keys":[{"time_s":-1,"shapes":{"JawOpen":0.5}}]}"#, "k.json").unwrap_err().to_string();
+        let e =
+            parse_keys_json(r#"{"keys":[{"time_s":-1,"shapes":{"JawOpen":0.5}}]}"#, "k.json").unwrap_err().to_string();
         assert!(e.contains("k.json") && e.contains("key 0"), "{e}");
         let e = parse_keys_json("{\n\"keys\": [1,", "k.json").unwrap_err().to_string();
         assert!(e.starts_with("k.json:2"), "{e}");

@@ -298,7 +298,10 @@ mod tests {
             let i = argmax(grad);
             let fd = (perturbed_penalty(which, i, h) - perturbed_penalty(which, i, -h)) / (2.0 * f64::from(h));
             let g = f64::from(grad[i]);
-            println!("penalty gradient, {} entry {i}: autodiff {g:.6}, finite differences {fd:.6}", ["kernel", "dense"][which]);
+            println!(
+                "penalty gradient, {} entry {i}: autodiff {g:.6}, finite differences {fd:.6}",
+                ["kernel", "dense"][which]
+            );
             assert!(g.abs() > 1e-4, "gradient too small to compare: {g}");
             assert!((fd - g).abs() < 0.05 * g.abs(), "autodiff {g} vs finite differences {fd}");
         }

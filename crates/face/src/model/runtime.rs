@@ -131,10 +131,11 @@ pub fn edit_time_rows(d_hidden: usize, layers: usize, frames: usize, repeats: us
 /// constraint kind it reads. Weights of another model, format or layout are refused, naming the file.
 pub fn load_generator(weights: &Weights) -> Result<(GeneratorRuntime, ConstraintKind), NnError> {
     let generator = load_generator_module(weights, &inbetween_nn::backend::cpu())?;
-    let kind = weights.config::<FaceWeightsConfig>()?.generator.config().map_err(|message| NnError::Mismatch {
-        path: weights.origin().to_path_buf(),
-        message,
-    })?;
+    let kind = weights
+        .config::<FaceWeightsConfig>()?
+        .generator
+        .config()
+        .map_err(|message| NnError::Mismatch { path: weights.origin().to_path_buf(), message })?;
     Ok((GeneratorRuntime::from_generator(&generator), kind.kind))
 }
 
@@ -225,7 +226,12 @@ mod tests {
         let err = load_generator(&Weights::from_path(&path).unwrap()).unwrap_err().to_string();
         assert!(err.contains("g.bpk") && err.contains("expected face"), "{err}");
         let wrong = FaceWeightsConfig { generator: GeneratorConfig { d_hidden: 16, ..config }.to_card(), window: 100 };
-        let card = inbetween_nn::weights::WeightsCard::new(WEIGHTS_KIND, WEIGHTS_FORMAT, serde_json::to_value(&wrong).unwrap(), "t");
+        let card = inbetween_nn::weights::WeightsCard::new(
+            WEIGHTS_KIND,
+            WEIGHTS_FORMAT,
+            serde_json::to_value(&wrong).unwrap(),
+            "t",
+        );
         inbetween_nn::weights::save(&g, &card, &path).unwrap();
         assert!(load_generator(&Weights::from_path(&path).unwrap()).unwrap_err().to_string().contains("g.bpk"));
     }

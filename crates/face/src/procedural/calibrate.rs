@@ -119,10 +119,7 @@ impl FaceStats {
 
     /// Correlation of a listed pair (either order).
     pub fn correlation(&self, a: &str, b: &str) -> Option<f64> {
-        self.correlations
-            .iter()
-            .find(|p| (p.a == a && p.b == b) || (p.a == b && p.b == a))
-            .map(|p| p.r)
+        self.correlations.iter().find(|p| (p.a == a && p.b == b) || (p.a == b && p.b == a)).map(|p| p.r)
     }
 
     /// The statistics as a two-column table (`statistic`, `value`).
@@ -140,7 +137,8 @@ impl FaceStats {
 pub fn comparison_table(real: &FaceStats, procedural: &[(&str, &FaceStats)]) -> Table {
     let mut headers = vec!["statistic", "real"];
     headers.extend(procedural.iter().map(|(n, _)| *n));
-    let mut t = Table::new("face_procedural_calibration", "Procedural face animation vs real captures (25 fps)", &headers);
+    let mut t =
+        Table::new("face_procedural_calibration", "Procedural face animation vs real captures (25 fps)", &headers);
     let columns: Vec<Vec<(String, String)>> = procedural.iter().map(|(_, s)| stat_rows(s)).collect();
     for (i, (label, r)) in stat_rows(real).into_iter().enumerate() {
         let mut row = vec![label, r];
@@ -151,7 +149,9 @@ pub fn comparison_table(real: &FaceStats, procedural: &[(&str, &FaceStats)]) -> 
     for (name, s) in procedural {
         t.note(format!("{name}: {} clips, {:.0} s", s.clips, s.duration_s));
     }
-    t.note(format!("blinks: mean EyeBlinkL/R above {BLINK_THRESHOLD}; jaw spectrum: Welch, {WELCH_SEGMENT}-frame Hann segments"));
+    t.note(format!(
+        "blinks: mean EyeBlinkL/R above {BLINK_THRESHOLD}; jaw spectrum: Welch, {WELCH_SEGMENT}-frame Hann segments"
+    ));
     t
 }
 
@@ -226,7 +226,8 @@ impl Accumulator {
     }
 
     fn add(&mut self, clip: &BlendshapeClip) {
-        let channel = |name: &str| -> Vec<f32> { clip.channel(arkit_index(name).expect("statistics name ARKit shapes")) };
+        let channel =
+            |name: &str| -> Vec<f32> { clip.channel(arkit_index(name).expect("statistics name ARKit shapes")) };
         self.clips += 1;
         self.frames += clip.num_frames();
         let (l, r) = (channel("EyeBlinkLeft"), channel("EyeBlinkRight"));
@@ -413,7 +414,13 @@ mod tests {
             match c {
                 c if c == jaw => s,
                 c if c == close => 0.5 - s,
-                c if c == blink_l || c == blink_r => if f % 75 >= 30 && f % 75 < 33 { 0.9 } else { 0.05 },
+                c if c == blink_l || c == blink_r => {
+                    if f % 75 >= 30 && f % 75 < 33 {
+                        0.9
+                    } else {
+                        0.05
+                    }
+                }
                 _ => 0.1,
             }
         });
@@ -468,8 +475,18 @@ mod real_data {
     /// 0.03) and deviations within ×5.
     fn assert_close(name: &str, ours: &FaceStats, real: &FaceStats) {
         let within = |a: f64, b: f64, k: f64| a / b >= 1.0 / k && a / b <= k;
-        assert!(within(ours.blink_rate_per_min, real.blink_rate_per_min, 1.5), "{name}: blink rate {} vs real {}", ours.blink_rate_per_min, real.blink_rate_per_min);
-        assert!(within(ours.blink_duration_s, real.blink_duration_s, 1.5), "{name}: blink duration {} vs real {}", ours.blink_duration_s, real.blink_duration_s);
+        assert!(
+            within(ours.blink_rate_per_min, real.blink_rate_per_min, 1.5),
+            "{name}: blink rate {} vs real {}",
+            ours.blink_rate_per_min,
+            real.blink_rate_per_min
+        );
+        assert!(
+            within(ours.blink_duration_s, real.blink_duration_s, 1.5),
+            "{name}: blink duration {} vs real {}",
+            ours.blink_duration_s,
+            real.blink_duration_s
+        );
         assert!(
             ours.dominant_band().abs_diff(real.dominant_band()) <= 1,
             "{name}: JawOpen dominant band {:?} vs real {:?}",
@@ -477,7 +494,13 @@ mod real_data {
             real.jaw_bands
         );
         for (o, r) in ours.shapes.iter().zip(&real.shapes) {
-            assert!((o.mean - r.mean).abs() < 0.03 || within(o.mean, r.mean, 3.0), "{name}: {} mean {} vs real {}", o.name, o.mean, r.mean);
+            assert!(
+                (o.mean - r.mean).abs() < 0.03 || within(o.mean, r.mean, 3.0),
+                "{name}: {} mean {} vs real {}",
+                o.name,
+                o.mean,
+                r.mean
+            );
             assert!(within(o.std, r.std, 5.0), "{name}: {} std {} vs real {}", o.name, o.std, r.std);
         }
         for (o, r) in ours.correlations.iter().zip(&real.correlations) {
@@ -491,17 +514,25 @@ mod real_data {
             let mut files = Vec::new();
             csv_files(&data.join("face/neurosync/livelink"), &mut files);
             assert_eq!(files.len(), 8, "the 8 Live Link Face captures");
-            let clips: Vec<BlendshapeClip> = files.iter().map(|p| read_live_link(p).unwrap_or_else(|e| panic!("{e}"))).collect();
+            let clips: Vec<BlendshapeClip> =
+                files.iter().map(|p| read_live_link(p).unwrap_or_else(|e| panic!("{e}"))).collect();
             let real = measure_all(&clips).unwrap();
             let quiet = procedural(0.0, 20, 2024);
             let talking = procedural(ProceduralConfig::default().speech_fraction, 20, 2025);
-            println!("{}", comparison_table(&real, &[("procedural, no speech", &quiet), ("procedural, default", &talking)]).to_text());
+            println!(
+                "{}",
+                comparison_table(&real, &[("procedural, no speech", &quiet), ("procedural, default", &talking)])
+                    .to_text()
+            );
             // The real captures are expressions without speech (97 % of the JawOpen power under 1 Hz):
             // the speechless generator is the like-for-like comparison; the default one (60 % speech)
             // must stay within the same tolerances, with more syllable-rate jaw power.
             assert_close("no speech", &quiet, &real);
             assert_close("default", &talking, &real);
-            assert!(talking.jaw_bands[1] + talking.jaw_bands[2] > 2.0 * (real.jaw_bands[1] + real.jaw_bands[2]), "speech adds syllable-rate jaw motion");
+            assert!(
+                talking.jaw_bands[1] + talking.jaw_bands[2] > 2.0 * (real.jaw_bands[1] + real.jaw_bands[2]),
+                "speech adds syllable-rate jaw motion"
+            );
         });
     }
 }

@@ -200,7 +200,14 @@ impl Event {
 
 /// Expression events over `[0, duration)` at about `rate_per_min` per minute (Poisson), amplitudes
 /// scaled by `amp_scale`; then short brow raises on emphasised vowels with probability `brow_speech`.
-pub fn schedule(rng: &mut Rand, duration: f64, rate_per_min: f64, amp_scale: f64, phones: &[Phone], brow_speech: f64) -> Vec<Event> {
+pub fn schedule(
+    rng: &mut Rand,
+    duration: f64,
+    rate_per_min: f64,
+    amp_scale: f64,
+    phones: &[Phone],
+    brow_speech: f64,
+) -> Vec<Event> {
     let mut out = Vec::new();
     if rate_per_min > 0.0 && rate_per_min.is_finite() {
         let mut t = rng.exp(60.0 / rate_per_min) - 1.0;
@@ -260,8 +267,12 @@ pub fn lip_parting_envelope(events: &[Event], times: &[f64]) -> Vec<f32> {
 /// Adds the events to frame-major ARKit weights (`weights[f * stride + c]`, first 52 channels).
 pub fn render(events: &[Event], times: &[f64], weights: &mut [f32], stride: usize) {
     for e in events {
-        let resolved: Vec<(usize, f32, i8)> =
-            e.kind.shapes().iter().map(|(n, g, s)| (arkit_index(n).expect("expression shapes are ARKit names"), *g, *s)).collect();
+        let resolved: Vec<(usize, f32, i8)> = e
+            .kind
+            .shapes()
+            .iter()
+            .map(|(n, g, s)| (arkit_index(n).expect("expression shapes are ARKit names"), *g, *s))
+            .collect();
         let (a, b) = (e.t0, e.end());
         let f0 = times.partition_point(|t| *t < a);
         for (f, &t) in times.iter().enumerate().skip(f0) {
@@ -283,7 +294,8 @@ mod tests {
 
     #[test]
     fn envelope_rises_holds_and_falls() {
-        let e = Event { kind: Expression::Smile, t0: 1.0, onset_s: 0.5, hold_s: 1.0, offset_s: 0.5, amp: 0.5, asym: 0.0 };
+        let e =
+            Event { kind: Expression::Smile, t0: 1.0, onset_s: 0.5, hold_s: 1.0, offset_s: 0.5, amp: 0.5, asym: 0.0 };
         assert_eq!(e.envelope(0.9), 0.0);
         assert!((e.envelope(1.25) - 0.5).abs() < 1e-9);
         assert_eq!(e.envelope(2.0), 1.0);

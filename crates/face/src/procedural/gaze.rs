@@ -34,7 +34,11 @@ pub fn head(rng: &mut Rand, times: &[f64], amount: f64) -> Vec<[f32; 3]> {
     let scale = [0.05, 0.035, 0.025];
     for (axis, w) in waves.iter_mut().enumerate() {
         for wave in w.iter_mut() {
-            *wave = (amount * scale[axis] * rng.range(0.3, 1.0), rng.range(0.05, 0.6), rng.range(0.0, std::f64::consts::TAU));
+            *wave = (
+                amount * scale[axis] * rng.range(0.3, 1.0),
+                rng.range(0.05, 0.6),
+                rng.range(0.0, std::f64::consts::TAU),
+            );
         }
     }
     let offset = [0.02 * rng.normal(), 0.02 * rng.normal(), 0.01 * rng.normal()];
@@ -43,7 +47,8 @@ pub fn head(rng: &mut Rand, times: &[f64], amount: f64) -> Vec<[f32; 3]> {
         .map(|&t| {
             let mut a = [0.0f32; 3];
             for axis in 0..3 {
-                let v: f64 = waves[axis].iter().map(|(amp, f, ph)| amp * (std::f64::consts::TAU * f * t + ph).sin()).sum();
+                let v: f64 =
+                    waves[axis].iter().map(|(amp, f, ph)| amp * (std::f64::consts::TAU * f * t + ph).sin()).sum();
                 a[axis] = (v + amount * offset[axis]) as f32;
             }
             a

@@ -265,7 +265,17 @@ pub fn generate(config: &ProceduralConfig, seed: u64) -> ProceduralClip {
         use expressions::Expression as E;
         let speechless = phones.iter().all(|p| p.viseme == Viseme::Sil);
         let kinds: &[E] = if speechless {
-            &[E::Smile, E::Frown, E::BrowRaise, E::BrowFurrow, E::Squint, E::Sneer, E::Worry, E::OpenMouth, E::BareTeeth]
+            &[
+                E::Smile,
+                E::Frown,
+                E::BrowRaise,
+                E::BrowFurrow,
+                E::Squint,
+                E::Sneer,
+                E::Worry,
+                E::OpenMouth,
+                E::BareTeeth,
+            ]
         } else {
             &[E::Smile, E::Frown, E::BrowRaise, E::BrowFurrow, E::Squint, E::Sneer, E::Worry]
         };
@@ -350,7 +360,11 @@ pub fn generate_corpus_with(config: &ProceduralConfig, n_clips: usize, seed: u64
             let clip_seed = inbetween_core::seed::derive(seed, i as u64);
             let mut rng = Rand::new(clip_seed, 0);
             let cfg = ProceduralConfig {
-                speech_fraction: if rng.chance(0.2) { 0.0 } else { (config.speech_fraction * rng.range(0.5, 1.5)).clamp(0.0, 1.0) },
+                speech_fraction: if rng.chance(0.2) {
+                    0.0
+                } else {
+                    (config.speech_fraction * rng.range(0.5, 1.5)).clamp(0.0, 1.0)
+                },
                 speech_rate: config.speech_rate * rng.range(0.85, 1.2),
                 blink_rate_per_min: config.blink_rate_per_min * rng.range(0.6, 1.4),
                 expression_rate_per_min: config.expression_rate_per_min * rng.range(0.4, 1.6),
@@ -393,7 +407,8 @@ impl Indices {
     fn get() -> Indices {
         use crate::edit::distances::{distance_bases, distance_matrix, DISTANCE_NAMES, NUM_DISTANCES};
         let matrix = distance_matrix();
-        let gap_col = DISTANCE_NAMES.iter().position(|n| *n == "lip_gap_center").expect("the centre lip gap is a key distance");
+        let gap_col =
+            DISTANCE_NAMES.iter().position(|n| *n == "lip_gap_center").expect("the centre lip gap is a key distance");
         let i = |n: &str| arkit_index(n).expect("generator shapes are ARKit names");
         Indices {
             jaw: i("JawOpen"),
@@ -424,10 +439,7 @@ impl Indices {
             ],
             rest: REST_LEVELS.iter().map(|(n, v)| (i(n), *v)).collect(),
             gap_base: distance_bases()[gap_col],
-            gap: (0..NUM_ARKIT)
-                .map(|c| (c, matrix[c * NUM_DISTANCES + gap_col]))
-                .filter(|(_, k)| *k != 0.0)
-                .collect(),
+            gap: (0..NUM_ARKIT).map(|c| (c, matrix[c * NUM_DISTANCES + gap_col])).filter(|(_, k)| *k != 0.0).collect(),
         }
     }
 }
@@ -436,7 +448,8 @@ impl Indices {
 /// (0.03–0.3 Hz) mapped to [0, 1].
 fn jaw_drift(rng: &mut Rand, times: &[f64]) -> Vec<f32> {
     let level = rng.range(0.0, 0.08);
-    let waves: Vec<(f64, f64)> = (0..3).map(|_| (rng.range(0.03, 0.3), rng.range(0.0, std::f64::consts::TAU))).collect();
+    let waves: Vec<(f64, f64)> =
+        (0..3).map(|_| (rng.range(0.03, 0.3), rng.range(0.0, std::f64::consts::TAU))).collect();
     times
         .iter()
         .map(|&t| {

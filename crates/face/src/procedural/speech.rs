@@ -41,8 +41,9 @@ pub struct Phone {
 const VOWELS: [&str; 15] = ["AA", "AE", "AH", "AO", "AW", "AY", "EH", "ER", "EY", "IH", "IY", "OW", "OY", "UH", "UW"];
 /// Vowel weights (rough English frequencies: schwa-like AH and IH most common).
 const VOWEL_WEIGHTS: [f64; 15] = [4.0, 4.0, 10.0, 3.0, 1.0, 2.0, 4.0, 3.0, 2.0, 8.0, 5.0, 2.0, 0.5, 1.0, 3.0];
-const ONSETS: [&str; 22] =
-    ["B", "P", "M", "F", "V", "TH", "DH", "S", "Z", "SH", "CH", "JH", "T", "D", "N", "L", "K", "G", "HH", "W", "R", "Y"];
+const ONSETS: [&str; 22] = [
+    "B", "P", "M", "F", "V", "TH", "DH", "S", "Z", "SH", "CH", "JH", "T", "D", "N", "L", "K", "G", "HH", "W", "R", "Y",
+];
 const ONSET_WEIGHTS: [f64; 22] =
     [4.0, 4.0, 4.0, 3.0, 2.0, 1.0, 4.0, 4.0, 1.0, 2.0, 1.0, 1.0, 6.0, 5.0, 5.0, 4.0, 4.0, 2.0, 3.0, 3.0, 3.0, 1.0];
 const CLUSTERS: [[&str; 2]; 10] = [
@@ -78,7 +79,11 @@ pub fn phones(rng: &mut Rand, duration: f64, speech_fraction: f64, rate: f64, em
     while t < duration && f > 0.0 {
         let end = (t + rng.range(UTTERANCE_S.0, UTTERANCE_S.1)).min(duration);
         t = utterance(rng, &mut out, t, end, rate, emphasis_prob);
-        let gap = if f >= 1.0 { rng.range(PHRASE_PAUSE_S.0, PHRASE_PAUSE_S.1) } else { 0.3 + rng.exp((mean_silence - 0.3).max(0.05)) };
+        let gap = if f >= 1.0 {
+            rng.range(PHRASE_PAUSE_S.0, PHRASE_PAUSE_S.1)
+        } else {
+            0.3 + rng.exp((mean_silence - 0.3).max(0.05))
+        };
         let next = (t + gap).min(duration);
         push_sil(&mut out, t, next);
         t = next;
@@ -105,7 +110,15 @@ fn push_sil(out: &mut Vec<Phone>, a: f64, b: f64) {
             return;
         }
     }
-    out.push(Phone { start: a, end: b, label: "sil", viseme: Viseme::Sil, jaw_amp: 1.0, lip_amp: 1.0, emphasis: false });
+    out.push(Phone {
+        start: a,
+        end: b,
+        label: "sil",
+        viseme: Viseme::Sil,
+        jaw_amp: 1.0,
+        lip_amp: 1.0,
+        emphasis: false,
+    });
 }
 
 /// One utterance from `t` until about `end`: phrases separated by pauses. Returns when it ends.
@@ -153,7 +166,14 @@ fn word(rng: &mut Rand, out: &mut Vec<Phone>, mut t: f64, speed: f64, loud: f64,
             // Stressed vowels draw from the upper part of the range.
             let d = if vowel && stress { rng.range(0.5 * (lo + hi), hi) } else { rng.range(lo, hi) };
             let d = d / speed;
-            let jaw_amp = loud * if vowel && stress { 1.15 } else if vowel { 0.8 } else { 1.0 };
+            let jaw_amp = loud
+                * if vowel && stress {
+                    1.15
+                } else if vowel {
+                    0.8
+                } else {
+                    1.0
+                };
             let viseme = Viseme::from_arpabet(label).unwrap_or(Viseme::Sil);
             out.push(Phone {
                 start: t,

@@ -77,7 +77,13 @@ fn bilabials_close_the_lips_and_vowels_open_them() {
     }
     let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
     let max_mbp = mbp.iter().fold(f32::MIN, |m, x| m.max(*x));
-    println!("centre lip gap: M/B/P mean {:.3} max {max_mbp:.3} ({} frames); open vowels mean {:.3} ({} frames)", mean(&mbp), mbp.len(), mean(&open), open.len());
+    println!(
+        "centre lip gap: M/B/P mean {:.3} max {max_mbp:.3} ({} frames); open vowels mean {:.3} ({} frames)",
+        mean(&mbp),
+        mbp.len(),
+        mean(&open),
+        open.len()
+    );
     assert!(mbp.len() > 50 && open.len() > 100);
     // Closed: about 0 (slightly negative where rolled or pressed lips close them further).
     assert!(mean(&mbp).abs() < 0.04, "M/B/P mean gap {}", mean(&mbp));
@@ -125,7 +131,13 @@ fn eye_look_shapes_agree_with_the_eye_angles() {
 #[test]
 fn bad_settings_are_reported_by_validate_and_clamped_by_generate() {
     assert!(ProceduralConfig::default().validate().is_ok());
-    let bad = ProceduralConfig { duration_s: f64::NAN, fps: -1.0, speech_fraction: 3.0, micro_noise: f64::INFINITY, ..Default::default() };
+    let bad = ProceduralConfig {
+        duration_s: f64::NAN,
+        fps: -1.0,
+        speech_fraction: 3.0,
+        micro_noise: f64::INFINITY,
+        ..Default::default()
+    };
     let e = bad.validate().unwrap_err().to_string();
     assert!(e.contains("duration_s"), "{e}");
     let p = generate(&bad, 1);

@@ -278,8 +278,9 @@ mod tests {
                 // The input's first 52 features: the kept values, and the linear prior through the
                 // keys (read back from the constraint features) where erased.
                 let row_of = |t: usize| &a.inputs[(t * 4 + b) * d..(t * 4 + b + 1) * d];
-                let truth: Vec<Frame> =
-                    (0..16).map(|t| a.target[(b * 16 + t) * NUM_ARKIT..(b * 16 + t + 1) * NUM_ARKIT].try_into().unwrap()).collect();
+                let truth: Vec<Frame> = (0..16)
+                    .map(|t| a.target[(b * 16 + t) * NUM_ARKIT..(b * 16 + t + 1) * NUM_ARKIT].try_into().unwrap())
+                    .collect();
                 let erased = |t: usize, ch: usize| a.mask[(b * 16 + t) * NUM_ARKIT + ch] > 0.0;
                 // One channel's mask at a time (group edits erase some channels only).
                 let channel_mask = |ch: usize| {
@@ -298,7 +299,9 @@ mod tests {
                     Vec::new()
                 };
                 let prior: Vec<Vec<f32>> = (0..NUM_ARKIT)
-                    .map(|ch| interpolate(&truth, &channel_mask(ch), &keys, Interp::Linear).iter().map(|f| f[ch]).collect())
+                    .map(|ch| {
+                        interpolate(&truth, &channel_mask(ch), &keys, Interp::Linear).iter().map(|f| f[ch]).collect()
+                    })
                     .collect();
                 for t in 0..16 {
                     let row = row_of(t);

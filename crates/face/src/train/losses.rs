@@ -168,7 +168,8 @@ mod tests {
     use inbetween_nn::backend;
 
     fn anim(batch: usize, frames: usize, phase: f32, device: &Device) -> (Vec<f32>, Tensor<3>) {
-        let v: Vec<f32> = (0..batch * frames * NUM_ARKIT).map(|i| 0.5 + 0.45 * (i as f32 * 0.13 + phase).sin()).collect();
+        let v: Vec<f32> =
+            (0..batch * frames * NUM_ARKIT).map(|i| 0.5 + 0.45 * (i as f32 * 0.13 + phase).sin()).collect();
         (v.clone(), Tensor::from_data(TensorData::new(v, [batch, frames, NUM_ARKIT]), device))
     }
 

@@ -166,7 +166,8 @@ mod kind_name {
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<ConstraintKind, D::Error> {
         let name = String::deserialize(d)?;
-        ConstraintKind::from_name(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown constraint kind \"{name}\"")))
+        ConstraintKind::from_name(&name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown constraint kind \"{name}\"")))
     }
 }
 
@@ -219,7 +220,11 @@ impl FaceTrainReport {
 
 /// Train (or resume from `config.checkpoint_dir`) one face network on the CPU, reporting to
 /// `progress` (one unit per step).
-pub fn train_face(config: &FaceTrainConfig, pool: &ClipPool, progress: &Progress) -> Result<FaceTrainReport, TrainError> {
+pub fn train_face(
+    config: &FaceTrainConfig,
+    pool: &ClipPool,
+    progress: &Progress,
+) -> Result<FaceTrainReport, TrainError> {
     train_face_on(config, pool, progress, &inbetween_nn::backend::cpu_autodiff())
 }
 
@@ -326,7 +331,9 @@ mod tests {
         let mut out = Vec::new();
         for layer in &g.lstm.layers {
             for cell in [&layer.forward, &layer.backward] {
-                out.extend(cell.gates.weight.val().into_data().try_to_vec::<f32>().unwrap().iter().map(|v| v.to_bits()));
+                out.extend(
+                    cell.gates.weight.val().into_data().try_to_vec::<f32>().unwrap().iter().map(|v| v.to_bits()),
+                );
             }
         }
         out.extend(g.output.weight.val().into_data().try_to_vec::<f32>().unwrap().iter().map(|v| v.to_bits()));

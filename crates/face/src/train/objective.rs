@@ -120,8 +120,9 @@ impl<'a> GanObjective<'a> {
     ) -> Result<GanObjective<'a>, String> {
         let usable = pool.usable(cfg.kind, cfg.window)?;
         let critic_config = CriticConfig::new(cfg.window);
-        let critic =
-            inbetween_nn::backend::seeded_module(device, derive(cfg.seed, STREAM_CRITIC_INIT), |d| critic_config.init(d));
+        let critic = inbetween_nn::backend::seeded_module(device, derive(cfg.seed, STREAM_CRITIC_INIT), |d| {
+            critic_config.init(d)
+        });
         Ok(GanObjective {
             cfg,
             pool,
@@ -189,14 +190,7 @@ impl Objective<Generator> for GanObjective<'_> {
         let critic = self.critic.as_ref().expect("the critic is always put back");
         let weights = critic.weights();
         let loss = generator_loss(critic, &weights, generated, batch.target, batch.mask, &self.dist, &self.cfg.lambdas);
-        let terms = [
-            scalar(loss.total.clone()),
-            scalar(loss.rec),
-            scalar(loss.dist),
-            scalar(loss.adv),
-            hinge,
-            gp,
-        ];
+        let terms = [scalar(loss.total.clone()), scalar(loss.rec), scalar(loss.dist), scalar(loss.adv), hinge, gp];
         self.stats.add(terms);
         Some(loss.total)
     }
@@ -318,8 +312,12 @@ mod tests {
         a.stats.close_epoch();
         let mut b = GanObjective::new(&cfg, &pool, &device, &progress).unwrap();
         b.restore(&a.state().unwrap()).unwrap();
-        let u = |o: &GanObjective| o.critic.as_ref().unwrap().convs[2].spectral.u.value_sync().into_data().try_to_vec::<f32>().unwrap();
-        let w = |o: &GanObjective| o.critic.as_ref().unwrap().convs[0].weight.val().into_data().try_to_vec::<f32>().unwrap();
+        let u = |o: &GanObjective| {
+            o.critic.as_ref().unwrap().convs[2].spectral.u.value_sync().into_data().try_to_vec::<f32>().unwrap()
+        };
+        let w = |o: &GanObjective| {
+            o.critic.as_ref().unwrap().convs[0].weight.val().into_data().try_to_vec::<f32>().unwrap()
+        };
         assert_eq!(w(&a), w(&b));
         assert_eq!(u(&a), u(&b));
         assert_eq!(a.history(), b.history());

@@ -37,8 +37,9 @@ static DICT: OnceLock<Result<Cmudict, String>> = OnceLock::new();
 
 /// The embedded CMUdict, parsed on first use (later calls return the same dictionary).
 pub fn dictionary() -> Result<&'static Cmudict, FaceError> {
-    DICT.get_or_init(|| Cmudict::from_str(DICT_TEXT).map_err(|e| e.to_string())).as_ref().map_err(|e| {
-        FaceError::File { file: "embedded CMUdict".into(), message: format!("cannot parse the dictionary: {e}") }
+    DICT.get_or_init(|| Cmudict::from_str(DICT_TEXT).map_err(|e| e.to_string())).as_ref().map_err(|e| FaceError::File {
+        file: "embedded CMUdict".into(),
+        message: format!("cannot parse the dictionary: {e}"),
     })
 }
 
@@ -181,7 +182,11 @@ fn applies(rule: &Rule, w: &[u8], i: usize) -> bool {
         When::End => after == w.len(),
         When::BeforeFrontVowel => matches!(w.get(after), Some(b'e' | b'i' | b'y')),
         When::MagicE => {
-            after + 2 == w.len() && w[after + 1] == b'e' && !is_vowel_letter(w[after]) && w[after] != b'y' && w[after] != b'r'
+            after + 2 == w.len()
+                && w[after + 1] == b'e'
+                && !is_vowel_letter(w[after])
+                && w[after] != b'y'
+                && w[after] != b'r'
         }
         When::SilentFinalE => after == w.len() && w.len() >= 3 && !is_vowel_letter(w[i - 1]),
     }
@@ -447,7 +452,14 @@ mod tests {
 
     #[test]
     fn bad_text_or_span_is_an_error() {
-        for (text, a, b) in [("hi", 1.0, 1.0), ("hi", 1.0, 0.5), ("hi", f64::NAN, 1.0), ("", 0.0, 1.0), (" ,.!? ", 0.0, 1.0), ("''", 0.0, 1.0)] {
+        for (text, a, b) in [
+            ("hi", 1.0, 1.0),
+            ("hi", 1.0, 0.5),
+            ("hi", f64::NAN, 1.0),
+            ("", 0.0, 1.0),
+            (" ,.!? ", 0.0, 1.0),
+            ("''", 0.0, 1.0),
+        ] {
             assert!(matches!(text_to_phonemes(text, a, b), Err(FaceError::Invalid(_))), "{text:?} {a} {b}");
         }
     }

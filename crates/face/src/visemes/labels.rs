@@ -82,9 +82,7 @@ mod tests {
 
     #[test]
     fn every_class_has_an_ipa_phone() {
-        let phones = [
-            "ɔ", "æ", "ɛ", "ɪ", "ow", "ə", "u", "dʒ", "k", "l", "s", "ʃ", "θ", "f", "m", "w", "ɹ",
-        ];
+        let phones = ["ɔ", "æ", "ɛ", "ɪ", "ow", "ə", "u", "dʒ", "k", "l", "s", "ʃ", "θ", "f", "m", "w", "ɹ"];
         let mut seen = [false; super::super::NUM_VISEMES];
         seen[Viseme::Sil.index()] = true;
         for p in phones {

@@ -48,10 +48,7 @@ pub(crate) enum SpanField {
 
 /// Checks span `span` against the rules, given the span before it; says which field is wrong and why.
 /// `prev_where` names the previous span in the message (e.g. "line 12").
-pub(crate) fn check_span(
-    span: &PhonemeSpan,
-    prev: Option<(&PhonemeSpan, String)>,
-) -> Result<(), (SpanField, String)> {
+pub(crate) fn check_span(span: &PhonemeSpan, prev: Option<(&PhonemeSpan, String)>) -> Result<(), (SpanField, String)> {
     if !span.start_s.is_finite() {
         return Err((SpanField::Start, format!("expected a finite start time, found {}", span.start_s)));
     }
@@ -76,7 +73,10 @@ pub(crate) fn check_span(
         }
     }
     if phoneme_viseme(&span.phoneme).is_none() {
-        return Err((SpanField::Phoneme, format!("unknown phoneme {}; expected {EXPECTED_LABEL}", shown(&span.phoneme))));
+        return Err((
+            SpanField::Phoneme,
+            format!("unknown phoneme {}; expected {EXPECTED_LABEL}", shown(&span.phoneme)),
+        ));
     }
     Ok(())
 }
@@ -107,16 +107,24 @@ pub fn decode_text(bytes: &[u8], file: &str) -> Result<String, FaceError> {
         if !rest.len().is_multiple_of(2) {
             return Err(FaceError::File {
                 file: file.into(),
-                message: "UTF-16 text (by its byte-order mark) with an odd number of bytes; expected whole 2-byte units".into(),
+                message:
+                    "UTF-16 text (by its byte-order mark) with an odd number of bytes; expected whole 2-byte units"
+                        .into(),
             });
         }
-        let units = rest.chunks_exact(2).map(|c| if be { u16::from_be_bytes([c[0], c[1]]) } else { u16::from_le_bytes([c[0], c[1]]) });
-        char::decode_utf16(units).enumerate().map(|(i, r)| r.map_err(|_| i)).collect::<Result<String, usize>>().map_err(|i| {
-            FaceError::File {
+        let units = rest.chunks_exact(2).map(|c| {
+            if be {
+                u16::from_be_bytes([c[0], c[1]])
+            } else {
+                u16::from_le_bytes([c[0], c[1]])
+            }
+        });
+        char::decode_utf16(units).enumerate().map(|(i, r)| r.map_err(|_| i)).collect::<Result<String, usize>>().map_err(
+            |i| FaceError::File {
                 file: file.into(),
                 message: format!("invalid UTF-16 (unpaired surrogate at unit {}); expected UTF-16 text", i + 1),
-            }
-        })
+            },
+        )
     };
     match bytes {
         [0xFF, 0xFE, rest @ ..] => utf16(rest, false),

@@ -136,7 +136,13 @@ fn tokenize(text: &str, file: &str) -> Result<Vec<Token>, FaceError> {
                         out.push(Token { value: Value::Flag(text[i..=e].to_string()), line, key: pending_key.take() });
                         i = e + 1;
                     }
-                    _ => return Err(parse_err(file, line, "a '<' without '>' on the same line; expected a flag like <exists>")),
+                    _ => {
+                        return Err(parse_err(
+                            file,
+                            line,
+                            "a '<' without '>' on the same line; expected a flag like <exists>",
+                        ))
+                    }
                 }
             }
             b'[' => {
@@ -247,7 +253,11 @@ impl Reader<'_> {
         let t = self.next(keys, what)?;
         match t.value {
             Value::Text(s) => Ok((s, t.line)),
-            _ => Err(parse_err(self.file, t.line, format!("expected {what} (a \"quoted string\"), found {}", describe(&t)))),
+            _ => Err(parse_err(
+                self.file,
+                t.line,
+                format!("expected {what} (a \"quoted string\"), found {}", describe(&t)),
+            )),
         }
     }
 }
@@ -309,7 +319,8 @@ fn read_tier(reader: &mut Reader, k: usize) -> Result<Tier, FaceError> {
     let mut intervals = Vec::new();
     for j in 1..=n {
         if interval_tier {
-            let (start, l0) = reader.number(&["xmin"], &format!("interval {j}'s start 'xmin = <number>' (tier {k})"))?;
+            let (start, l0) =
+                reader.number(&["xmin"], &format!("interval {j}'s start 'xmin = <number>' (tier {k})"))?;
             let (end, l1) = reader.number(&["xmax"], &format!("interval {j}'s end 'xmax = <number>' (tier {k})"))?;
             let (label, l2) = reader.text(&["text"], &format!("interval {j}'s label 'text = \"…\"' (tier {k})"))?;
             let label = label.trim();
@@ -345,9 +356,10 @@ fn tier_list(tiers: &[Tier]) -> String {
 fn choose_tier<'t>(tiers: &'t [Tier], wanted: Option<&str>, file: &str) -> Result<&'t Tier, FaceError> {
     let err = |message: String| FaceError::File { file: file.into(), message };
     if let Some(w) = wanted {
-        return tiers.iter().find(|t| t.name.trim().eq_ignore_ascii_case(w.trim())).ok_or_else(|| {
-            err(format!("no tier named {}; tiers found: {}", shown(w), tier_list(tiers)))
-        });
+        return tiers
+            .iter()
+            .find(|t| t.name.trim().eq_ignore_ascii_case(w.trim()))
+            .ok_or_else(|| err(format!("no tier named {}; tiers found: {}", shown(w), tier_list(tiers))));
     }
     let exact: Vec<&Tier> = tiers.iter().filter(|t| phone_tier_match(&t.name) == Some(true)).collect();
     let any: Vec<&Tier> = tiers.iter().filter(|t| phone_tier_match(&t.name).is_some()).collect();
@@ -371,7 +383,10 @@ fn choose_tier<'t>(tiers: &'t [Tier], wanted: Option<&str>, file: &str) -> Resul
 pub fn parse_textgrid(text: &str, file: &str, tier: Option<&str>) -> Result<Vec<PhonemeSpan>, FaceError> {
     let tokens = tokenize(text, file)?;
     if tokens.is_empty() {
-        return Err(FaceError::Empty { file: file.into(), expected: "a Praat TextGrid ('File type = \"ooTextFile\"')".into() });
+        return Err(FaceError::Empty {
+            file: file.into(),
+            expected: "a Praat TextGrid ('File type = \"ooTextFile\"')".into(),
+        });
     }
     let mut reader = Reader { tokens, pos: 0, file };
     let tiers = read_tiers(&mut reader)?;
@@ -384,7 +399,8 @@ pub fn parse_textgrid(text: &str, file: &str, tier: Option<&str>) -> Result<Vec<
         ));
     }
     for (j, iv) in chosen.intervals.iter().enumerate() {
-        let prev = j.checked_sub(1).map(|p| (&chosen.intervals[p].span, format!("line {}", chosen.intervals[p].lines[0])));
+        let prev =
+            j.checked_sub(1).map(|p| (&chosen.intervals[p].span, format!("line {}", chosen.intervals[p].lines[0])));
         check_span(&iv.span, prev).map_err(|(field, m)| {
             let line = match field {
                 SpanField::Start => iv.lines[0],
@@ -474,7 +490,14 @@ item []:
     #[test]
     fn reads_the_long_layout_phone_tier() {
         let got = parse_textgrid(LONG, "a.TextGrid", None).unwrap();
-        let want = spans(&[(0.0, 0.1, "B"), (0.1, 0.2, "R"), (0.2, 0.3, "AH1"), (0.3, 0.4, "DH"), (0.4, 0.5, "ER0"), (0.5, 1.0, "sil")]);
+        let want = spans(&[
+            (0.0, 0.1, "B"),
+            (0.1, 0.2, "R"),
+            (0.2, 0.3, "AH1"),
+            (0.3, 0.4, "DH"),
+            (0.4, 0.5, "ER0"),
+            (0.5, 1.0, "sil"),
+        ]);
         assert_eq!(got, want);
         // CRLF and a UTF-8 BOM read the same.
         let crlf = format!("\u{feff}{}", LONG.replace('\n', "\r\n"));
@@ -549,7 +572,8 @@ item []:
 
     #[test]
     fn strings_unescape_doubled_quotes_and_span_lines() {
-        let text = "\"ooTextFile\" \"TextGrid\" 0 1 <exists> 1 \"IntervalTier\" \"say \"\"hi\"\"\n again\" 0 1 1 0 1 \"sil\"";
+        let text =
+            "\"ooTextFile\" \"TextGrid\" 0 1 <exists> 1 \"IntervalTier\" \"say \"\"hi\"\"\n again\" 0 1 1 0 1 \"sil\"";
         let e = parse_textgrid(text, "q", None).unwrap_err().to_string();
         assert!(e.contains("'say \"hi\"\n again' (line 1)"), "{e}");
         let got = parse_textgrid(text, "q", Some("say \"hi\"\n again")).unwrap();

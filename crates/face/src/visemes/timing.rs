@@ -88,14 +88,23 @@ fn read_header(h: &[&str], file: &str, line: usize) -> Result<HeaderMap, FaceErr
                 file,
                 line,
                 Some(Column { index: i + 1, name: String::new() }),
-                format!("column {} repeats column {}; expected each of start, end, phoneme once", shown(name), first + 1),
+                format!(
+                    "column {} repeats column {}; expected each of start, end, phoneme once",
+                    shown(name),
+                    first + 1
+                ),
             ));
         }
     }
     let missing: Vec<&str> =
         ["start", "end", "phoneme"].iter().zip(pos).filter(|(_, p)| p.is_none()).map(|(n, _)| *n).collect();
     if !missing.is_empty() {
-        return Err(at(file, line, None, format!("missing column(s) {}; expected {EXPECTED_HEADER}", missing.join(", "))));
+        return Err(at(
+            file,
+            line,
+            None,
+            format!("missing column(s) {}; expected {EXPECTED_HEADER}", missing.join(", ")),
+        ));
     }
     Ok(HeaderMap { names: h.iter().map(|s| s.to_string()).collect(), pos: pos.map(|p| p.unwrap_or(0)) })
 }
@@ -125,11 +134,17 @@ pub fn parse_phoneme_csv(text: &str, file: &str) -> Result<Vec<PhonemeSpan>, Fac
                 file,
                 line,
                 None,
-                format!("expected {} fields as in the header ({}), found {}", header.names.len(), header.names.join(","), row.len()),
+                format!(
+                    "expected {} fields as in the header ({}), found {}",
+                    header.names.len(),
+                    header.names.join(","),
+                    row.len()
+                ),
             ));
         }
         let get = |f: SpanField| row[header.pos[f as usize]];
-        let start_s = time_field(get(SpanField::Start)).map_err(|m| at(file, line, header.column(SpanField::Start), m))?;
+        let start_s =
+            time_field(get(SpanField::Start)).map_err(|m| at(file, line, header.column(SpanField::Start), m))?;
         let end_s = time_field(get(SpanField::End)).map_err(|m| at(file, line, header.column(SpanField::End), m))?;
         let label = get(SpanField::Phoneme);
         let phoneme = if label.is_empty() { SILENCE.to_string() } else { label.to_string() };
@@ -140,7 +155,12 @@ pub fn parse_phoneme_csv(text: &str, file: &str) -> Result<Vec<PhonemeSpan>, Fac
         prev_line = line;
     }
     if spans.is_empty() {
-        return Err(at(file, hline, None, "no phoneme rows after the header; expected at least one 'start,end,phoneme' row"));
+        return Err(at(
+            file,
+            hline,
+            None,
+            "no phoneme rows after the header; expected at least one 'start,end,phoneme' row",
+        ));
     }
     Ok(spans)
 }
@@ -205,10 +225,14 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 pub fn parse_phoneme_json(text: &str, file: &str) -> Result<Vec<PhonemeSpan>, FaceError> {
     let body = text.strip_prefix('\u{feff}').unwrap_or(text);
     if body.trim().is_empty() {
-        return Err(FaceError::Empty { file: file.into(), expected: "a JSON array of {\"start\", \"end\", \"phoneme\"} objects".into() });
+        return Err(FaceError::Empty {
+            file: file.into(),
+            expected: "a JSON array of {\"start\", \"end\", \"phoneme\"} objects".into(),
+        });
     }
     let raw: Vec<JsonSpan> = serde_json::from_str(body).map_err(|e| {
-        let message = format!("{e}; expected a JSON array of {{\"start\": <s>, \"end\": <s>, \"phoneme\": \"…\"}} objects");
+        let message =
+            format!("{e}; expected a JSON array of {{\"start\": <s>, \"end\": <s>, \"phoneme\": \"…\"}} objects");
         let message = message.replacen(&format!(" at line {} column {}", e.line(), e.column()), "", 1);
         at(file, e.line().max(1), Some(Column { index: e.column().max(1), name: String::new() }), message)
     })?;
@@ -225,7 +249,12 @@ pub fn parse_phoneme_json(text: &str, file: &str) -> Result<Vec<PhonemeSpan>, Fa
         spans.push(span);
     }
     if spans.is_empty() {
-        return Err(at(file, 1, None, "an empty array; expected at least one {\"start\", \"end\", \"phoneme\"} object"));
+        return Err(at(
+            file,
+            1,
+            None,
+            "an empty array; expected at least one {\"start\", \"end\", \"phoneme\"} object",
+        ));
     }
     Ok(spans)
 }
@@ -293,7 +322,10 @@ mod tests {
     #[test]
     fn reads_csv_with_either_header_spelling_and_comments() {
         let got = parse_phoneme_csv(CSV, "t.csv").unwrap();
-        assert_eq!(got, vec![PhonemeSpan::new(0.0, 0.1, "B"), PhonemeSpan::new(0.1, 0.2, "R"), PhonemeSpan::new(0.2, 0.35, "AH1")]);
+        assert_eq!(
+            got,
+            vec![PhonemeSpan::new(0.0, 0.1, "B"), PhonemeSpan::new(0.1, 0.2, "R"), PhonemeSpan::new(0.2, 0.35, "AH1")]
+        );
         let alt = "\u{feff}Phoneme,End_s,Start_s\r\n\"B\",0.1,0\r\n,0.3,0.1\r\n";
         let got = parse_phoneme_csv(alt, "t.csv").unwrap();
         assert_eq!(got, vec![PhonemeSpan::new(0.0, 0.1, "B"), PhonemeSpan::new(0.1, 0.3, "sil")]);
@@ -310,10 +342,19 @@ mod tests {
             ("start,end,phoneme\n0,0.1\n", "t.csv:2: expected 3 fields as in the header (start,end,phoneme), found 2"),
             ("start,end,phoneme\n0,x,B\n", "t.csv:2: column 2 (end): expected a time in seconds, found 'x'"),
             ("start,end,phoneme\n0,NaN,B\n", "t.csv:2: column 2 (end): expected a finite time in seconds, found 'NaN'"),
-            ("start,end,phoneme\n,0.1,B\n", "t.csv:2: column 1 (start): expected a time in seconds, found an empty field"),
+            (
+                "start,end,phoneme\n,0.1,B\n",
+                "t.csv:2: column 1 (start): expected a time in seconds, found an empty field",
+            ),
             ("start,end,phoneme\n0.2,0.1,B\n", "t.csv:2: column 2 (end): end 0.1 s is not after start 0.2 s"),
-            ("start,end,phoneme\n0,0.2,B\n# c\n0.1,0.3,M\n", "t.csv:4: column 1 (start): start 0.1 s is before the end 0.2 s of the previous phoneme (line 2)"),
-            ("start,end,phoneme\n0,0.2,B\n0.2,0.3,BB\n", "t.csv:3: column 3 (phoneme): unknown phoneme 'BB'; expected an ARPAbet phoneme"),
+            (
+                "start,end,phoneme\n0,0.2,B\n# c\n0.1,0.3,M\n",
+                "t.csv:4: column 1 (start): start 0.1 s is before the end 0.2 s of the previous phoneme (line 2)",
+            ),
+            (
+                "start,end,phoneme\n0,0.2,B\n0.2,0.3,BB\n",
+                "t.csv:3: column 3 (phoneme): unknown phoneme 'BB'; expected an ARPAbet phoneme",
+            ),
         ];
         for (text, want) in cases {
             let e = parse_phoneme_csv(text, "t.csv").unwrap_err().to_string();

@@ -54,11 +54,8 @@ mod tests {
 
     #[test]
     fn frames_take_the_covering_span_and_silence_elsewhere() {
-        let spans = vec![
-            PhonemeSpan::new(0.5, 1.0, "M"),
-            PhonemeSpan::new(1.0, 1.25, "ɪ"),
-            PhonemeSpan::new(1.5, 2.0, "sp"),
-        ];
+        let spans =
+            vec![PhonemeSpan::new(0.5, 1.0, "M"), PhonemeSpan::new(1.0, 1.25, "ɪ"), PhonemeSpan::new(1.5, 2.0, "sp")];
         // 4 fps from 0.25 s: 0.25 0.5 0.75 1.0 1.25 1.5 1.75 2.0
         let got = viseme_frames(&spans, 4.0, 0.25, 8).unwrap();
         use Viseme::*;

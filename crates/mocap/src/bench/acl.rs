@@ -188,7 +188,10 @@ fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<Tak
             std::hint::black_box(f.decode_all().expect("and decodes").poses());
         });
         let file = v3::File::open(&c.bytes)?;
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(inbetween_core::seed::derive(cfg.seed, t.motion.num_frames() as u64));
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(inbetween_core::seed::derive(
+            cfg.seed,
+            t.motion.num_frames() as u64,
+        ));
         let duration = (t.motion.num_frames() - 1) as f64 * t.motion.frame_time;
         let times: Vec<f64> = (0..cfg.seek_poses.max(1)).map(|_| rng.random::<f64>() * duration).collect();
         let (mut pose, mut sc) = (inbetween_core::Pose::rest(&t.motion.skeleton), v3::Scratch::default());
@@ -208,7 +211,15 @@ fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<Tak
         });
         playback_s = per_play / ticks.len() as f64;
     }
-    Ok(TakeResult { bytes: c.bytes.len(), errors_max: c.max_error_cm, errors, compress_s, decompress_s, pose_s, playback_s })
+    Ok(TakeResult {
+        bytes: c.bytes.len(),
+        errors_max: c.max_error_cm,
+        errors,
+        compress_s,
+        decompress_s,
+        pose_s,
+        playback_s,
+    })
 }
 
 /// Runs the protocol: every group at every bound (timings single-threaded, so MB/s is per core).
@@ -241,7 +252,8 @@ pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
     let mut rows = Vec::new();
     for (group, members) in groups(&takes) {
         for (bi, &b) in bounds.iter().enumerate() {
-            let idx: Vec<usize> = members.iter().map(|m| takes.iter().position(|t| std::ptr::eq(t, *m)).expect("member")).collect();
+            let idx: Vec<usize> =
+                members.iter().map(|m| takes.iter().position(|t| std::ptr::eq(t, *m)).expect("member")).collect();
             let rs: Vec<&TakeResult> = idx.iter().map(|&i| &results[bi][i]).collect();
             let raw: usize = idx.iter().map(|&i| takes[i].raw_bytes()).sum();
             let mut errors: Vec<f64> = rs.iter().flat_map(|r| r.errors.iter().copied()).collect();
@@ -287,7 +299,10 @@ pub fn raw_floats(m: &Motion) -> Vec<u8> {
 
 fn gzip(data: &[u8]) -> Result<usize> {
     let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
-    e.write_all(data).and_then(|_| e.finish()).map(|v| v.len()).map_err(|source| MocapError::Io { path: "gzip".into(), source })
+    e.write_all(data)
+        .and_then(|_| e.finish())
+        .map(|v| v.len())
+        .map_err(|source| MocapError::Io { path: "gzip".into(), source })
 }
 
 fn zstd19(data: &[u8]) -> Result<usize> {
@@ -307,11 +322,13 @@ pub fn baselines(takes: &[Take]) -> Result<Vec<BaselineRow>> {
     let mut rows = Vec::new();
     for (group, members) in groups(takes) {
         let raw: usize = members.iter().map(|t| t.raw_bytes()).sum();
-        let bvh: Vec<Vec<u8>> = members.iter().map(|t| inbetween_io::bvh::to_bvh_string(&t.motion).into_bytes()).collect();
+        let bvh: Vec<Vec<u8>> =
+            members.iter().map(|t| inbetween_io::bvh::to_bvh_string(&t.motion).into_bytes()).collect();
         let floats: Vec<Vec<u8>> = members.iter().map(|t| raw_floats(&t.motion)).collect();
         for (input, data) in [("BVH text", &bvh), ("raw f32 (40 B per bone)", &floats)] {
             type Compressor = fn(&[u8]) -> Result<usize>;
-            let compressors: [(&'static str, Compressor); 3] = [("gzip -9", gzip), ("zstd -19", zstd19), ("xz -9", xz9)];
+            let compressors: [(&'static str, Compressor); 3] =
+                [("gzip -9", gzip), ("zstd -19", zstd19), ("xz -9", xz9)];
             for (name, c) in compressors {
                 let mut bytes = 0;
                 for d in data.iter() {
@@ -381,7 +398,9 @@ impl AclResults {
             "speeds: raw MB per second on one core; decompress = open + decode every pose; µs per pose = one pose at a random time (two frames, slerp), file opened once; playback = every 1/60 s from the start with one scratch (each frame decoded once); timed at {} cm only",
             self.headline_cm
         ));
-        t.note("ACL's bound column: its threshold setting; its errors are measured, ours are bounded by the bound column");
+        t.note(
+            "ACL's bound column: its threshold setting; its errors are measured, ours are bounded by the bound column",
+        );
         t
     }
 
@@ -423,10 +442,19 @@ impl AclResults {
         }
         // ACL's single published point, drawn as a small cross of two segments.
         let (x, y) = (ACL_MAX_CM, ACL_RATIO);
-        series.push(Series { color: Some([0, 0, 0]), ..Series::new("ACL 2.1 (published)", vec![(x * 0.7, y), (x * 1.3, y)]) });
+        series.push(Series {
+            color: Some([0, 0, 0]),
+            ..Series::new("ACL 2.1 (published)", vec![(x * 0.7, y), (x * 1.3, y)])
+        });
         series.push(Series { color: Some([0, 0, 0]), ..Series::new("", vec![(x, y * 0.93), (x, y * 1.07)]) });
-        line_plot(path, "Rate-error curve (ACL protocol, 24 fps)", "max virtual-vertex error (cm)", "compression ratio (40-byte raw)", &series)
-            .map_err(|e| MocapError::Invalid(format!("plot {}: {e}", path.display())))
+        line_plot(
+            path,
+            "Rate-error curve (ACL protocol, 24 fps)",
+            "max virtual-vertex error (cm)",
+            "compression ratio (40-byte raw)",
+            &series,
+        )
+        .map_err(|e| MocapError::Invalid(format!("plot {}: {e}", path.display())))
     }
 
     /// The report: both tables and the unit notes.
@@ -441,7 +469,11 @@ impl AclResults {
 
 /// Measures and writes the report (`acl_codec.txt/.md`, `acl_codec.csv`, `acl_baselines.csv`)
 /// and the chart (`acl_rate_error.png`) into `output_dir` when given.
-pub fn run(cfg: &AclConfig, output_dir: Option<&std::path::Path>, progress: &Progress) -> Result<(AclResults, Report, Vec<PathBuf>)> {
+pub fn run(
+    cfg: &AclConfig,
+    output_dir: Option<&std::path::Path>,
+    progress: &Progress,
+) -> Result<(AclResults, Report, Vec<PathBuf>)> {
     let results = measure(cfg, progress)?;
     let report = results.report();
     let mut written = Vec::new();
@@ -484,8 +516,12 @@ mod tests {
         assert_eq!(fine.raw_bytes, 40 * 31 * fine.frames);
         assert_eq!(r.baselines.len(), 6);
         assert!(r.baselines.iter().all(|b| b.ratio() > 1.0), "{:?}", r.baselines);
-        let names: Vec<String> = written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-        assert_eq!(names, ["acl_codec.txt", "acl_codec.md", "acl_codec.csv", "acl_baselines.csv", "acl_rate_error.png"]);
+        let names: Vec<String> =
+            written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        assert_eq!(
+            names,
+            ["acl_codec.txt", "acl_codec.md", "acl_codec.csv", "acl_baselines.csv", "acl_rate_error.png"]
+        );
         let text = report.to_text();
         assert!(text.contains("ACL 2.1, published") && text.contains("21.77"), "{text}");
         let csv = std::fs::read_to_string(out.join("acl_codec.csv")).unwrap();

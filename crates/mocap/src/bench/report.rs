@@ -105,13 +105,20 @@ impl KFold {
                 (_, Some(g)) => format!("{} %", num(g, 1)),
             }));
             cells.extend(ks.iter().map(|&k| self.get(v, k).map(|r| num(r.paper_units, 4)).unwrap_or_default()));
-            cells.push(ks.iter().filter_map(|&k| self.get(v, k)).map(|r| fmt_ms(r.decision_ms)).collect::<Vec<_>>().join(" / "));
+            cells.push(
+                ks.iter()
+                    .filter_map(|&k| self.get(v, k))
+                    .map(|r| fmt_ms(r.decision_ms))
+                    .collect::<Vec<_>>()
+                    .join(" / "),
+            );
             t.row(cells);
         }
         let paper: Vec<String> = ks
             .iter()
             .filter_map(|&k| {
-                let (uc, g, s) = (paper_value(Method::Uc, k)?, paper_value(Method::Greedy, k)?, paper_value(Method::Sidql, k)?);
+                let (uc, g, s) =
+                    (paper_value(Method::Uc, k)?, paper_value(Method::Greedy, k)?, paper_value(Method::Sidql, k)?);
                 Some(format!("{} % at K={k}", num(100.0 * (uc - s) / (uc - g), 1)))
             })
             .collect();
@@ -473,7 +480,17 @@ mod tests {
         let t = results(true).table3();
         assert_eq!(
             t.headers,
-            ["method", "K=5 ours", "paper units", "paper", "K=10 ours", "paper units", "paper", "decision ms (K=5/10)", "paper ms (K=5)"]
+            [
+                "method",
+                "K=5 ours",
+                "paper units",
+                "paper",
+                "K=10 ours",
+                "paper units",
+                "paper",
+                "decision ms (K=5/10)",
+                "paper ms (K=5)"
+            ]
         );
         assert_eq!(t.rows.len(), 3, "only the methods measured");
         assert_eq!(t.rows[0][..4], ["UC", "0.0210 / 0.0200", "0.0630 / 0.0600", "0.0945"]);
@@ -481,7 +498,12 @@ mod tests {
         assert_eq!(t.rows[1][8], "900");
         assert_eq!(t.rows[2][3], "", "the paper has no optimal row");
         let md = t.to_markdown();
-        assert!(md.contains("| UC | 0.0210 / 0.0200 | 0.0630 / 0.0600 | 0.0945 | 0.0110 / 0.0100 | 0.0330 / 0.0300 | 0.0490 |"), "{md}");
+        assert!(
+            md.contains(
+                "| UC | 0.0210 / 0.0200 | 0.0630 / 0.0600 | 0.0945 | 0.0110 / 0.0100 | 0.0330 / 0.0300 | 0.0490 |"
+            ),
+            "{md}"
+        );
     }
 
     #[test]

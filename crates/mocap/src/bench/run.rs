@@ -6,11 +6,11 @@
 
 use super::measure::{both_reconstructions, codec_ratio, reconstruction_throughput};
 use super::report::BenchResults;
+use super::report::{KFold, KFoldRow};
 use super::{
     clip_windows, describe_sources, evaluate_with_progress, split_clips, training_windows, Clip, Method, PolicyFn,
     Protocol, Window,
 };
-use super::report::{KFold, KFoldRow};
 use crate::dqn::{DqnConfig, Finish, SidqlPolicy, TrainOptions};
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
@@ -140,14 +140,24 @@ pub enum TrainingData {
 }
 
 /// SIDQL's training windows and their description in words (written in the policy's card).
-pub fn training_set(data_choice: TrainingData, data: Option<&Path>, unit: Option<LengthUnit>, seed: u64, stride: usize) -> Result<(Vec<SphericalMotion>, String)> {
+pub fn training_set(
+    data_choice: TrainingData,
+    data: Option<&Path>,
+    unit: Option<LengthUnit>,
+    seed: u64,
+    stride: usize,
+) -> Result<(Vec<SphericalMotion>, String)> {
     let protocol = Protocol { seed, ..Protocol::paper() };
     if data_choice == TrainingData::Procedural {
         let clips = super::procedural_clips(seed, 24);
         let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
         let p = Protocol { skip_first_frame: false, ..protocol };
         let windows = super::training_windows(&clips, &names, &p, stride)?;
-        let data = format!("{} procedural gaits (seed {seed}), {} windows of 60 frames at stride {stride}", clips.len(), windows.len());
+        let data = format!(
+            "{} procedural gaits (seed {seed}), {} windows of 60 frames at stride {stride}",
+            clips.len(),
+            windows.len()
+        );
         return Ok((windows, data));
     }
     let dir = data_dir(data)?;
@@ -155,7 +165,11 @@ pub fn training_set(data_choice: TrainingData, data: Option<&Path>, unit: Option
     let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
     if data_choice == TrainingData::CmuAll {
         let windows = super::training_windows(&clips, &names, &protocol, stride)?;
-        let data = format!("every CMU take of the corpus ({} takes), {} windows of 60 frames at stride {stride}", clips.len(), windows.len());
+        let data = format!(
+            "every CMU take of the corpus ({} takes), {} windows of 60 frames at stride {stride}",
+            clips.len(),
+            windows.len()
+        );
         return Ok((windows, data));
     }
     let (train, test) = super::split_clips(&names, &protocol);
@@ -184,7 +198,14 @@ pub fn fold_takes(all: &[Window], folds: usize, seed: u64) -> Vec<Vec<String>> {
 
 /// The take-level k-fold ([`KFoldConfig`]): per fold, train on the other takes and score UC,
 /// Greedy, both SIDQL stages and Optimal on the fold's windows; rows pooled over every window.
-pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldConfig, ks: &[usize], progress: &Progress) -> Result<KFold> {
+pub fn kfold(
+    clips: &[Clip],
+    all: &[Window],
+    protocol: &Protocol,
+    cfg: &KFoldConfig,
+    ks: &[usize],
+    progress: &Progress,
+) -> Result<KFold> {
     let groups = fold_takes(all, cfg.folds, protocol.seed);
     progress.phase(groups.len() as u64, "k-fold");
     let variants = [
@@ -202,9 +223,14 @@ pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldCon
     let (mut train_seconds, mut train_windows) = (Vec::new(), Vec::new());
     for (i, test) in groups.iter().enumerate() {
         progress.set_message(format!("fold {}/{}: training", i + 1, groups.len()));
-        let train: Vec<String> = groups.iter().enumerate().filter(|(j, _)| *j != i).flat_map(|(_, g)| g.clone()).collect();
+        let train: Vec<String> =
+            groups.iter().enumerate().filter(|(j, _)| *j != i).flat_map(|(_, g)| g.clone()).collect();
         let windows = training_windows(clips, &train, protocol, cfg.stride)?;
-        let opts = TrainOptions { seed: inbetween_core::seed::derive(protocol.seed, i as u64), data: format!("fold {i}"), ..cfg.train.clone() };
+        let opts = TrainOptions {
+            seed: inbetween_core::seed::derive(protocol.seed, i as u64),
+            data: format!("fold {i}"),
+            ..cfg.train.clone()
+        };
         let trained = crate::dqn::train(&windows, &DqnConfig::default(), &opts)?;
         train_seconds.push(trained.report.seconds);
         train_windows.push(windows.len());
@@ -215,7 +241,8 @@ pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldCon
                 let ki = ks.iter().position(|&k| k == r.k).expect("a K of the bench");
                 let s = &mut sums[v * ks.len() + ki];
                 let w = r.windows as f64;
-                (s.0, s.1, s.2, s.3) = (s.0 + r.mean_angle_error * w, s.1 + r.paper_units * w, s.2 + r.decision_ms * w, s.3 + r.windows);
+                (s.0, s.1, s.2, s.3) =
+                    (s.0 + r.mean_angle_error * w, s.1 + r.paper_units * w, s.2 + r.decision_ms * w, s.3 + r.windows);
             }
         };
         let seed = protocol.seed;
@@ -241,7 +268,14 @@ pub fn kfold(clips: &[Clip], all: &[Window], protocol: &Protocol, cfg: &KFoldCon
         for (ki, &k) in ks.iter().enumerate() {
             let s = sums[v * ks.len() + ki];
             let n = s.3.max(1) as f64;
-            rows.push(KFoldRow { variant: name.to_string(), k, mean_angle_error: s.0 / n, paper_units: s.1 / n, decision_ms: s.2 / n, windows: s.3 });
+            rows.push(KFoldRow {
+                variant: name.to_string(),
+                k,
+                mean_angle_error: s.0 / n,
+                paper_units: s.1 / n,
+                decision_ms: s.2 / n,
+                windows: s.3,
+            });
         }
     }
     Ok(KFold { folds: groups, rows, train_seconds, train_windows, options: cfg.train.clone(), stride: cfg.stride })
@@ -280,7 +314,9 @@ pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
     }
     // A k-fold needs at least two takes with windows (one to train on, one to test).
     let kfold = match &cfg.kfold {
-        Some(k) if fold_takes(&all, k.folds, seed).len() >= 2 => Some(kfold(clips, &all, protocol, k, &cfg.ks, progress)?),
+        Some(k) if fold_takes(&all, k.folds, seed).len() >= 2 => {
+            Some(kfold(clips, &all, protocol, k, &cfg.ks, progress)?)
+        }
         _ => None,
     };
     progress.phase(1, "throughput");
@@ -409,7 +445,18 @@ mod tests {
             codec_bounds_cm: vec![1.0],
             output_dir: Some(dir.path().join("report")),
             csv: Some(dir.path().join("rows.csv")),
-            kfold: Some(KFoldConfig { folds: 2, stride: 30, train: TrainOptions { pretrain_steps: 100, pretrain_batch: 4, episodes: 4, batch: 8, progress: false, ..TrainOptions::default() } }),
+            kfold: Some(KFoldConfig {
+                folds: 2,
+                stride: 30,
+                train: TrainOptions {
+                    pretrain_steps: 100,
+                    pretrain_batch: 4,
+                    episodes: 4,
+                    batch: 8,
+                    progress: false,
+                    ..TrainOptions::default()
+                },
+            }),
             ..BenchConfig::default()
         };
         let progress = Progress::hidden();
@@ -439,7 +486,9 @@ mod tests {
         let mut p = inbetween_core::procedural::GaitParams::walk();
         p.frames = 40;
         inbetween_io::write_bvh(&short.join("w.bvh"), &inbetween_core::procedural::gait(&p)).unwrap();
-        let e = run(&BenchConfig { data: Some(short), kfold: None, ..BenchConfig::default() }, &progress).unwrap_err().to_string();
+        let e = run(&BenchConfig { data: Some(short), kfold: None, ..BenchConfig::default() }, &progress)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("long enough") && e.contains("short"), "{e}");
     }
 }
@@ -473,7 +522,15 @@ mod recipe {
         inbetween_io::data::with_shared_data("SIDQL k-fold", |dir| {
             let corpus = crate::corpus::load(&dir, None).unwrap();
             let all = windows(&corpus.clips, &Protocol::paper(), &Progress::hidden()).unwrap();
-            let k = kfold(&corpus.clips, &all, &Protocol::paper(), &KFoldConfig::default(), &[5, 10, 15], &Progress::hidden()).unwrap();
+            let k = kfold(
+                &corpus.clips,
+                &all,
+                &Protocol::paper(),
+                &KFoldConfig::default(),
+                &[5, 10, 15],
+                &Progress::hidden(),
+            )
+            .unwrap();
             println!("{}", k.table(&[5, 10, 15]).to_text());
         });
     }

@@ -74,7 +74,11 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, opts: &Options) -> Result<
         return Err(MocapError::Invalid(format!("virtual vertex distance {} cm must be non-negative", opts.shell_cm)));
     }
     if !(1..=v3::MAX_SEGMENT_LEN).contains(&opts.segment_len) {
-        return Err(MocapError::Invalid(format!("segment length {} must be 1 to {}", opts.segment_len, v3::MAX_SEGMENT_LEN)));
+        return Err(MocapError::Invalid(format!(
+            "segment length {} must be 1 to {}",
+            opts.segment_len,
+            v3::MAX_SEGMENT_LEN
+        )));
     }
     if motion.num_frames() == 0 {
         return Err(MocapError::Invalid("a clip of 0 frames has nothing to compress".into()));
@@ -257,9 +261,8 @@ impl Context {
             let p = sk.parent(j).expect("non-root joints have parents");
             down[p] = down[p].max(own[p] + down[j]);
         }
-        let max_abs: Vec<f64> = (0..nt)
-            .map(|t| (0..n).map(|f| self.values[f * nt + t].abs().max_element()).fold(0.0, f64::max))
-            .collect();
+        let max_abs: Vec<f64> =
+            (0..nt).map(|t| (0..n).map(|f| self.values[f * nt + t].abs().max_element()).fold(0.0, f64::max)).collect();
         (0..nt)
             .map(|t| {
                 let j = self.tracks[t].joint;
@@ -325,7 +328,10 @@ impl Context {
         let animated: Vec<usize> = (0..self.tracks.len()).filter(|&t| self.constants[t].is_none()).collect();
         let base = s.codes.clone();
         let shifted = |d: i64| -> Vec<u8> {
-            base.iter().enumerate().map(|(t, &c)| if self.constants[t].is_none() { (c as i64 + d).clamp(0, 255) as u8 } else { c }).collect()
+            base.iter()
+                .enumerate()
+                .map(|(t, &c)| if self.constants[t].is_none() { (c as i64 + d).clamp(0, 255) as u8 } else { c })
+                .collect()
         };
         // The starting codes hold by construction; should rounding say otherwise, go finer.
         let mut lo = 0i64;
@@ -450,7 +456,14 @@ impl<'a> Segment<'a> {
     /// Object-space transforms of `joints` (a subtree, in order) at frame `i` into `pos`/`rot`
     /// (indexed like `joints`), with the local rotation of `over` replaced; false as soon as a
     /// vertex leaves the bound.
-    fn fk_check(&self, i: usize, joints: &[usize], over: Option<(usize, DQuat)>, pos: &mut [DVec3], rot: &mut [DQuat]) -> bool {
+    fn fk_check(
+        &self,
+        i: usize,
+        joints: &[usize],
+        over: Option<(usize, DQuat)>,
+        pos: &mut [DVec3],
+        rot: &mut [DQuat],
+    ) -> bool {
         let nj = self.ctx.skeleton.len();
         for (a, &j) in joints.iter().enumerate() {
             let lr = match over {
@@ -570,7 +583,10 @@ mod tests {
     fn oracle_max_cm(source: &Motion, decoded: &Motion, cm: f64) -> f64 {
         let mut max = 0.0f64;
         for f in 0..source.num_frames() {
-            let (a, b) = (inbetween_core::forward(&source.skeleton, &source.pose(f)), inbetween_core::forward(&decoded.skeleton, &decoded.pose(f)));
+            let (a, b) = (
+                inbetween_core::forward(&source.skeleton, &source.pose(f)),
+                inbetween_core::forward(&decoded.skeleton, &decoded.pose(f)),
+            );
             for j in 0..source.skeleton.len() {
                 for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
                     let v = axis * (SHELL_CM / cm);
@@ -648,10 +664,14 @@ mod tests {
         let static_joints = (0..v3::tracks(&m.skeleton).len())
             .filter(|&t| {
                 let tr = v3::tracks(&m.skeleton)[t];
-                tr.kind == TrackKind::Rotation && (0..m.num_frames()).all(|f| m.pose(f).rotations[tr.joint] == m.pose(0).rotations[tr.joint])
+                tr.kind == TrackKind::Rotation
+                    && (0..m.num_frames()).all(|f| m.pose(f).rotations[tr.joint] == m.pose(0).rotations[tr.joint])
             })
             .count();
-        assert!(static_joints > 0 && constant >= static_joints, "{constant} constant tracks, {static_joints} static joints");
+        assert!(
+            static_joints > 0 && constant >= static_joints,
+            "{constant} constant tracks, {static_joints} static joints"
+        );
         for bad in [0.0, -1.0, f64::NAN] {
             let e = compress(m, &Options::bound(bad)).unwrap_err().to_string();
             assert!(e.contains("must be a positive number"), "{e}");

@@ -171,7 +171,10 @@ fn as_decimal(x: f64) -> Option<i64> {
 /// mirrored offsets of a body compress well: on a 31-joint CMU skeleton 1443 bytes become a few
 /// hundred, a few per cent of a short clip's file.
 pub fn write_compact_skeleton(out: &mut Vec<u8>, sk: &Skeleton) {
-    let lengths = sk.joints().iter().flat_map(|j| j.offset.to_array().into_iter().chain(j.end_site.map(|e| e.to_array()).into_iter().flatten()));
+    let lengths = sk
+        .joints()
+        .iter()
+        .flat_map(|j| j.offset.to_array().into_iter().chain(j.end_site.map(|e| e.to_array()).into_iter().flatten()));
     let decimal = lengths.clone().all(|x| as_decimal(x).is_some());
     let mut raw = vec![decimal as u8];
     write_skeleton_with(&mut raw, sk, |out, v| {
@@ -206,7 +209,10 @@ pub fn read_compact_skeleton(r: &mut Reader) -> Result<Skeleton> {
     }
     let packed = r.take(packed_len as usize, "deflated skeleton")?;
     let mut raw = Vec::with_capacity(raw_len as usize);
-    let inflated = std::io::Read::read_to_end(&mut std::io::Read::take(flate2::read::DeflateDecoder::new(packed), raw_len as u64 + 1), &mut raw);
+    let inflated = std::io::Read::read_to_end(
+        &mut std::io::Read::take(flate2::read::DeflateDecoder::new(packed), raw_len as u64 + 1),
+        &mut raw,
+    );
     if inflated.is_err() || raw.len() != raw_len as usize {
         return Err(MocapError::Codec(format!(
             "skeleton at byte {at}: the deflated bytes do not inflate to the {raw_len} bytes announced"
@@ -216,7 +222,11 @@ pub fn read_compact_skeleton(r: &mut Reader) -> Result<Skeleton> {
     let decimal = match sr.u8("skeleton length format")? {
         0 => false,
         1 => true,
-        f => return Err(MocapError::Codec(format!("skeleton at byte {at}: length format {f}, expected 0 (f64) or 1 (decimal)"))),
+        f => {
+            return Err(MocapError::Codec(format!(
+                "skeleton at byte {at}: length format {f}, expected 0 (f64) or 1 (decimal)"
+            )))
+        }
     };
     let nj = sr.u16("joint count")? as usize;
     if nj == 0 {
@@ -235,7 +245,10 @@ pub fn read_compact_skeleton(r: &mut Reader) -> Result<Skeleton> {
         Ok(DVec3::from_array(v))
     })?;
     if sr.remaining() != 0 {
-        return Err(MocapError::Codec(format!("skeleton at byte {at}: {} bytes left after its {nj} joints", sr.remaining())));
+        return Err(MocapError::Codec(format!(
+            "skeleton at byte {at}: {} bytes left after its {nj} joints",
+            sr.remaining()
+        )));
     }
     Ok(sk)
 }
@@ -375,7 +388,11 @@ pub fn read_skeleton_joints(r: &mut Reader, nj: usize) -> Result<Skeleton> {
 }
 
 /// [`read_skeleton_joints`] with lengths read by `vec3`.
-fn read_skeleton_joints_with(r: &mut Reader, nj: usize, vec3: impl Fn(&mut Reader, &str) -> Result<DVec3>) -> Result<Skeleton> {
+fn read_skeleton_joints_with(
+    r: &mut Reader,
+    nj: usize,
+    vec3: impl Fn(&mut Reader, &str) -> Result<DVec3>,
+) -> Result<Skeleton> {
     let mut joints = Vec::with_capacity(nj);
     for i in 0..nj {
         let len = r.u16("joint name length")? as usize;
@@ -464,7 +481,11 @@ pub(crate) fn check_envelope(bytes: &[u8], oldest: u16, newest: u16) -> Result<(
     let stored = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("4 bytes"));
     let version = u16::from_le_bytes([bytes[4], bytes[5]]);
     if !(oldest..=newest).contains(&version) {
-        let hint = if version == v3::VERSION { " (a version 3 file holds samples, not keys: read it with codec::read)" } else { "" };
+        let hint = if version == v3::VERSION {
+            " (a version 3 file holds samples, not keys: read it with codec::read)"
+        } else {
+            ""
+        };
         return Err(MocapError::Codec(format!(
             "unsupported .ibk version {version}; this reader reads versions {oldest} to {newest}{hint}"
         )));

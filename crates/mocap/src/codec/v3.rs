@@ -78,8 +78,11 @@ pub struct Track {
 /// translating joints, each in joint order.
 pub fn tracks(sk: &Skeleton) -> Vec<Track> {
     let js = sk.joints();
-    let rot = (0..js.len()).filter(|&j| js[j].rotation_order().is_some()).map(|joint| Track { joint, kind: TrackKind::Rotation });
-    let trans = (0..js.len()).filter(|&j| js[j].has_translation()).map(|joint| Track { joint, kind: TrackKind::Translation });
+    let rot = (0..js.len())
+        .filter(|&j| js[j].rotation_order().is_some())
+        .map(|joint| Track { joint, kind: TrackKind::Rotation });
+    let trans =
+        (0..js.len()).filter(|&j| js[j].has_translation()).map(|joint| Track { joint, kind: TrackKind::Translation });
     rot.chain(trans).collect()
 }
 
@@ -361,9 +364,16 @@ impl<'a> File<'a> {
             constants.push(match r.u8("track kind")? {
                 0 => None,
                 1 => {
-                    let v = [r.f32("constant track value")?, r.f32("constant track value")?, r.f32("constant track value")?];
+                    let v = [
+                        r.f32("constant track value")?,
+                        r.f32("constant track value")?,
+                        r.f32("constant track value")?,
+                    ];
                     if v.iter().any(|x| !x.is_finite()) {
-                        return Err(MocapError::Codec(format!("track {i} (joint {}): constant value is not finite", t.joint)));
+                        return Err(MocapError::Codec(format!(
+                            "track {i} (joint {}): constant value is not finite",
+                            t.joint
+                        )));
                     }
                     Some(v.map(|x| x as f32))
                 }
@@ -518,7 +528,11 @@ impl<'a> File<'a> {
     /// clip's length; with the same `sc`, a later time in the same segment only decodes the
     /// frames after the last one decoded (playback forwards: O(joints) per pose).
     pub fn pose_at(&self, time: f64, out: &mut Pose, sc: &mut Scratch) -> Result<()> {
-        let x = if time.is_finite() { (time / self.header.frame_time).clamp(0.0, (self.header.num_frames - 1) as f64) } else { 0.0 };
+        let x = if time.is_finite() {
+            (time / self.header.frame_time).clamp(0.0, (self.header.num_frames - 1) as f64)
+        } else {
+            0.0
+        };
         let f = (x.floor() as usize).min(self.header.num_frames - 1);
         let u = x - f as f64;
         let interpolate = u > 0.0 && f + 1 < self.header.num_frames;
@@ -621,7 +635,8 @@ mod tests {
             .collect();
         let segments = n.div_ceil(segment_len);
         // Step codes over the whole range; constant tracks have none (read back as 0).
-        let codes = (0..segments * nt).map(|i| if constants[i % nt].is_some() { 0 } else { (i * 37 % 256) as u8 }).collect();
+        let codes =
+            (0..segments * nt).map(|i| if constants[i % nt].is_some() { 0 } else { (i * 37 % 256) as u8 }).collect();
         let header = Header {
             skeleton: m.skeleton,
             frame_time: 1.0 / 24.0,
@@ -642,7 +657,13 @@ mod tests {
         let d = decode(&bytes).unwrap();
         assert_eq!(d.codes, qz.codes);
         if let Some(i) = (0..qz.q.len()).find(|&i| d.q[i] != qz.q[i]) {
-            panic!("value {i} (frame {}, track {}): {:?} vs {:?}", i / qz.header.tracks.len(), i % qz.header.tracks.len(), d.q[i], qz.q[i]);
+            panic!(
+                "value {i} (frame {}, track {}): {:?} vs {:?}",
+                i / qz.header.tracks.len(),
+                i % qz.header.tracks.len(),
+                d.q[i],
+                qz.q[i]
+            );
         }
         assert_eq!(d, qz);
         assert_eq!(&bytes[4..6], &3u16.to_le_bytes());
@@ -658,8 +679,14 @@ mod tests {
             file.pose_at(f as f64 * qz.header.frame_time, &mut pose, &mut sc).unwrap();
             let want = qz.pose(f);
             for j in 0..qz.header.skeleton.len() {
-                assert!(inbetween_core::rotation::angle_between(pose.rotations[j], want.rotations[j]) < 1e-9, "frame {f}, joint {j}");
-                assert!((pose.translations[j] - want.translations[j]).length() < 1e-9 * (1.0 + want.translations[j].length()));
+                assert!(
+                    inbetween_core::rotation::angle_between(pose.rotations[j], want.rotations[j]) < 1e-9,
+                    "frame {f}, joint {j}"
+                );
+                assert!(
+                    (pose.translations[j] - want.translations[j]).length()
+                        < 1e-9 * (1.0 + want.translations[j].length())
+                );
             }
         }
         // Halfway between frames 7 and 8 (the second starts a segment): the slerp midpoint.

@@ -255,11 +255,8 @@ pub fn motion_descriptors(rep: &SphericalMotion, f: usize) -> [f32; MOTION_INPUT
     let metres = rep.cm_per_unit / 100.0;
     let (lo, hi) = (f.saturating_sub(1), (f + 1).min(n - 1));
     let root_speed = rep.root_vel[f].length() * metres;
-    let root_acc = if hi > lo {
-        (rep.root_vel[hi] - rep.root_vel[lo]).length() / ((hi - lo) as f64 * dt) * metres
-    } else {
-        0.0
-    };
+    let root_acc =
+        if hi > lo { (rep.root_vel[hi] - rep.root_vel[lo]).length() / ((hi - lo) as f64 * dt) * metres } else { 0.0 };
     let (mut sum_w, mut max_w, mut sum_a, mut bones) = (0.0, 0.0f64, 0.0, 0usize);
     let dir = |j: usize, g: usize| -> DVec3 { direction(rep.theta[j * n + g], rep.phi[j * n + g]) };
     for j in (0..rep.num_joints).filter(|&j| rep.has_angles[j]) {

@@ -66,7 +66,8 @@ impl QNet {
     /// Q-values `[batch, frames]` of states `[batch, frames, inputs]`.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<2> {
         let [batch, frames, inputs] = x.dims();
-        let scale = x.clone().reshape([batch * frames, inputs]).slice([0..batch * frames, SCALE_INPUT..SCALE_INPUT + 1]);
+        let scale =
+            x.clone().reshape([batch * frames, inputs]).slice([0..batch * frames, SCALE_INPUT..SCALE_INPUT + 1]);
         self.forward_unscaled(x) * scale.reshape([batch, frames])
     }
 

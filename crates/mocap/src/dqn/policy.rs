@@ -35,7 +35,8 @@ pub struct PolicyInfo {
 impl PolicyInfo {
     fn to_card(&self) -> Result<WeightsCard> {
         let json = |v: serde_json::Result<serde_json::Value>| v.map_err(|e| MocapError::Model(e.to_string()));
-        let mut card = WeightsCard::new(POLICY_KIND, POLICY_FORMAT, json(serde_json::to_value(&self.config))?, &self.trained_on);
+        let mut card =
+            WeightsCard::new(POLICY_KIND, POLICY_FORMAT, json(serde_json::to_value(&self.config))?, &self.trained_on);
         card.training = json(serde_json::to_value(&self.options))?;
         card.metrics.insert("episodes".into(), self.episodes as f64);
         card.metrics.insert("updates".into(), self.updates as f64);
@@ -206,7 +207,6 @@ pub(crate) fn q_values(net: &QNet, states: &[f32], batch: usize, frames: usize, 
     net.forward(x).into_data().try_to_vec::<f32>().expect("f32 Q-values")
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -237,12 +237,16 @@ mod tests {
             let rep = SphericalMotion::from_motion(&m).unwrap();
             for k in [3, 5, 10, 15] {
                 let err = |finish: Finish| rep.error(&policy.select_with(&rep, k, finish).unwrap()).mean_angle;
-                let (alone, checked, refined) = (err(Finish::NetworkAlone), err(Finish::CheckedAgainstUc), err(Finish::CheckedAndRefined));
+                let (alone, checked, refined) =
+                    (err(Finish::NetworkAlone), err(Finish::CheckedAgainstUc), err(Finish::CheckedAndRefined));
                 let uniform = rep.error(&KeyframeSet::uniform(60, k).unwrap()).mean_angle;
                 let tol = 1e-12;
                 assert!(checked <= alone + tol && checked <= uniform + tol, "K={k}: {checked} vs {alone}, {uniform}");
                 assert!(refined <= checked + tol, "K={k}: refined {refined} vs checked {checked}");
-                assert_eq!(policy.select(&rep, k).unwrap(), policy.select_with(&rep, k, Finish::CheckedAndRefined).unwrap());
+                assert_eq!(
+                    policy.select(&rep, k).unwrap(),
+                    policy.select_with(&rep, k, Finish::CheckedAndRefined).unwrap()
+                );
                 refined_better += usize::from(refined < checked - tol);
             }
         }
@@ -256,14 +260,20 @@ mod tests {
         use crate::bench::{clip_windows, evaluate, Method, Protocol};
         inbetween_io::data::with_shared_data("SIDQL policy real-data test", |dir| {
             let corpus = crate::corpus::load(&dir, None).unwrap();
-            let windows: Vec<_> = corpus.clips.iter().flat_map(|c| clip_windows(c, &Protocol::paper()).unwrap()).collect();
+            let windows: Vec<_> =
+                corpus.clips.iter().flat_map(|c| clip_windows(c, &Protocol::paper()).unwrap()).collect();
             assert!(windows.len() >= 100, "{} windows", windows.len());
             let policy = SidqlPolicy::committed().unwrap();
             let f = |rep: &SphericalMotion, k: usize| policy.select(rep, k);
             let rows = evaluate("all", &windows, &[Method::Uc, Method::Sidql], &[5, 10, 15], 0, Some(&f)).unwrap();
             for k in [5, 10, 15] {
                 let get = |m: Method| rows.iter().find(|r| r.method == m && r.k == k).unwrap().mean_angle_error;
-                assert!(get(Method::Sidql) <= get(Method::Uc), "K={k}: SIDQL {} vs UC {}", get(Method::Sidql), get(Method::Uc));
+                assert!(
+                    get(Method::Sidql) <= get(Method::Uc),
+                    "K={k}: SIDQL {} vs UC {}",
+                    get(Method::Sidql),
+                    get(Method::Uc)
+                );
             }
         });
     }

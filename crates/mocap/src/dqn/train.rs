@@ -268,7 +268,13 @@ impl TrainObjective<QNet> for Pretrain<'_> {
             w.fit_scratch(&mut self.scratch);
             let e = w.state(ep.mask, ep.budget(), &mut self.scratch, &mut x).max(1e-12 * w.e0);
             self.values.resize(n, 0.0);
-            completion_values(w.cost_table().expect("training windows carry their cost table"), n, ep.mask, ep.budget(), &mut self.values);
+            completion_values(
+                w.cost_table().expect("training windows carry their cost table"),
+                n,
+                ep.mask,
+                ep.budget(),
+                &mut self.values,
+            );
             let mut arg = (f64::INFINITY, 0);
             for a in free_frames(ep.mask, n) {
                 // Undiscounted optimal Q ÷ (E(s)/E(s₀)): the share of E(s) the best completion through a removes.
@@ -292,7 +298,8 @@ impl TrainObjective<QNet> for Pretrain<'_> {
         let per_state = weight.clone().sum_dim(1).clamp_min(1.0);
         let mean_q = ((q.clone() * weight.clone()).sum_dim(1) / per_state.clone()).repeat_dim(1, n);
         let mean_y = ((y.clone() * weight.clone()).sum_dim(1) / per_state).repeat_dim(1, n);
-        let centred = (self.huber.forward_no_reduction(q.clone() - mean_q, y.clone() - mean_y) * weight.clone()).sum() / count;
+        let centred =
+            (self.huber.forward_no_reduction(q.clone() - mean_q, y.clone() - mean_y) * weight.clone()).sum() / count;
         let loss = centred + (self.huber.forward_no_reduction(q, y) * weight).sum() / count * 0.1;
         // Advance every episode one key: the optimal action, the network's, or a random one.
         for (i, ep) in self.s.episodes.iter_mut().enumerate() {
@@ -436,7 +443,15 @@ impl<'a> Dqn<'a> {
         let reward = w.reward(f(ep.err_bits), next_err);
         let done = next.count_ones() as usize == ep.k;
         self.s.ret_sum_bits = (f(self.s.ret_sum_bits) + reward as f64).to_bits();
-        self.s.replay.push(Transition { window: ep.window, mask: ep.mask, action, reward, next_mask: next, done, k: ep.k });
+        self.s.replay.push(Transition {
+            window: ep.window,
+            mask: ep.mask,
+            action,
+            reward,
+            next_mask: next,
+            done,
+            k: ep.k,
+        });
         if done {
             self.s.ret_n += 1;
             self.s.episodes_done += 1;
@@ -490,7 +505,8 @@ impl TrainObjective<QNet> for Dqn<'_> {
         }
         let mut rng = inbetween_core::seed::rng(step.seed);
         self.act(step, &mut rng);
-        let ready = self.s.replay.len() >= self.opts.batch && self.s.env_steps.is_multiple_of(self.opts.train_every.max(1));
+        let ready =
+            self.s.replay.len() >= self.opts.batch && self.s.env_steps.is_multiple_of(self.opts.train_every.max(1));
         if !ready {
             return None;
         }
@@ -529,7 +545,10 @@ impl TrainObjective<QNet> for Dqn<'_> {
     fn state(&self) -> std::result::Result<Vec<u8>, String> {
         let origin = Path::new("dqn-state");
         let (target, acting) = match &self.nets {
-            Some(n) => (module_bytes(&n.target, origin).map_err(|e| e.to_string())?, module_bytes(&n.acting, origin).map_err(|e| e.to_string())?),
+            Some(n) => (
+                module_bytes(&n.target, origin).map_err(|e| e.to_string())?,
+                module_bytes(&n.acting, origin).map_err(|e| e.to_string())?,
+            ),
             None => (Vec::new(), Vec::new()),
         };
         let state = DqnState { target, acting, replay: self.s.replay.clone(), ..self.s.clone_counters() };
@@ -540,7 +559,9 @@ impl TrainObjective<QNet> for Dqn<'_> {
         let mut state: DqnState = serde_json::from_slice(bytes).map_err(|e| e.to_string())?;
         if !state.target.is_empty() {
             let origin = Path::new("dqn-state");
-            let load = |b: &[u8]| load_module_bytes(self.config.init(&self.plain), b.to_vec(), origin).map_err(|e| e.to_string());
+            let load = |b: &[u8]| {
+                load_module_bytes(self.config.init(&self.plain), b.to_vec(), origin).map_err(|e| e.to_string())
+            };
             self.nets = Some(Nets::new(load(&state.target)?, load(&state.acting)?));
         }
         (state.target, state.acting) = (Vec::new(), Vec::new());
@@ -592,7 +613,10 @@ fn check_inputs(windows: &[SphericalMotion], config: &DqnConfig, opts: &TrainOpt
         return Err(MocapError::Model("pretrain_batch must be at least 1".into()));
     }
     if config.inputs_per_frame != INPUTS {
-        return Err(MocapError::Model(format!("the state has {INPUTS} inputs per frame, not {}", config.inputs_per_frame)));
+        return Err(MocapError::Model(format!(
+            "the state has {INPUTS} inputs per frame, not {}",
+            config.inputs_per_frame
+        )));
     }
     Ok(())
 }
@@ -616,7 +640,8 @@ pub fn train(windows: &[SphericalMotion], config: &DqnConfig, opts: &TrainOption
         s: PretrainState::default(),
     };
     let epochs = opts.pretrain_steps.div_ceil(PRETRAIN_EPOCH);
-    let cfg = opts.loop_config(epochs.max(1), PRETRAIN_EPOCH.min(opts.pretrain_steps.max(1)), opts.pretrain_lr, "pretrain");
+    let cfg =
+        opts.loop_config(epochs.max(1), PRETRAIN_EPOCH.min(opts.pretrain_steps.max(1)), opts.pretrain_lr, "pretrain");
     let pre_model = if opts.pretrain_steps > 0 {
         let run = fit_with(&cfg, &ad, |d| config.init(d), &mut pre)?;
         report.pretrain_steps = run.optimizer_steps as usize;
@@ -713,7 +738,10 @@ mod tests {
 
     /// Small windows so the tests stay fast: 24 frames, 23 joints.
     fn windows() -> Vec<SphericalMotion> {
-        gait_library(3, 6, 24, 30.0).iter().map(|m| SphericalMotion::from_motion(&JointFilter::paper().apply(m)).unwrap()).collect()
+        gait_library(3, 6, 24, 30.0)
+            .iter()
+            .map(|m| SphericalMotion::from_motion(&JointFilter::paper().apply(m)).unwrap())
+            .collect()
     }
 
     fn small() -> DqnConfig {
@@ -752,7 +780,11 @@ mod tests {
         assert_eq!(t.report.pretrain_steps, 400);
         assert_eq!(t.report.pretrain_loss.len(), 4);
         assert!(t.report.pretrain_loss.iter().all(|l| l.is_finite()), "{:?}", t.report.pretrain_loss);
-        assert!(t.report.pretrain_loss[3] < t.report.pretrain_loss[0], "pretraining learns: {:?}", t.report.pretrain_loss);
+        assert!(
+            t.report.pretrain_loss[3] < t.report.pretrain_loss[0],
+            "pretraining learns: {:?}",
+            t.report.pretrain_loss
+        );
         assert_eq!(t.report.episodes, 30);
         assert!(t.report.updates > 50, "{} updates", t.report.updates);
         let policy = t.policy();
@@ -782,13 +814,16 @@ mod tests {
         let t = train(&reps, &small(), &TrainOptions { pretrain_steps: 1500, episodes: 0, ..opts() }).unwrap();
         assert!(t.finetuned.is_none());
         for k in [4, 5, 6] {
-            let mean = |f: &dyn Fn(&SphericalMotion) -> KeyframeSet| reps.iter().map(|r| r.error(&f(r)).mean_angle).sum::<f64>() / reps.len() as f64;
+            let mean = |f: &dyn Fn(&SphericalMotion) -> KeyframeSet| {
+                reps.iter().map(|r| r.error(&f(r)).mean_angle).sum::<f64>() / reps.len() as f64
+            };
             let sidql = mean(&|r| t.pretrained.select_unchecked(r, k).unwrap());
             let mut rng = inbetween_core::seed::rng(9);
             let mut random = 0.0;
             for _ in 0..20 {
                 for r in &reps {
-                    random += r.error(&crate::select::random(r.num_frames, k, &mut rng).unwrap()).mean_angle / (20 * reps.len()) as f64;
+                    random += r.error(&crate::select::random(r.num_frames, k, &mut rng).unwrap()).mean_angle
+                        / (20 * reps.len()) as f64;
                 }
             }
             assert!(sidql < random, "K={k}: SIDQL {sidql:.5} vs random {random:.5}");
@@ -801,11 +836,17 @@ mod tests {
         let base = TrainOptions { pretrain_steps: 300, episodes: 12, ..opts() };
         let straight_dir = tempfile::tempdir().unwrap();
         let split_dir = tempfile::tempdir().unwrap();
-        let straight = train(&reps, &small(), &TrainOptions { checkpoint_dir: Some(straight_dir.path().into()), ..base.clone() }).unwrap();
+        let straight =
+            train(&reps, &small(), &TrainOptions { checkpoint_dir: Some(straight_dir.path().into()), ..base.clone() })
+                .unwrap();
         // Stopped by a time limit after every epoch, resumed each time, until done.
         let mut sittings = 0;
         loop {
-            let short = TrainOptions { time_limit_s: Some(1e-9), checkpoint_dir: Some(split_dir.path().into()), ..base.clone() };
+            let short = TrainOptions {
+                time_limit_s: Some(1e-9),
+                checkpoint_dir: Some(split_dir.path().into()),
+                ..base.clone()
+            };
             let t = train(&reps, &small(), &short).unwrap();
             sittings += 1;
             if !t.report.stopped_early {

@@ -130,7 +130,10 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     fn windows(frames: usize) -> Vec<SphericalMotion> {
-        gait_library(21, 3, frames, 30.0).iter().map(|m| SphericalMotion::from_motion(&JointFilter::paper().apply(m)).unwrap()).collect()
+        gait_library(21, 3, frames, 30.0)
+            .iter()
+            .map(|m| SphericalMotion::from_motion(&JointFilter::paper().apply(m)).unwrap())
+            .collect()
     }
 
     /// The least total over every way of adding `extra` keys to `mask`, by enumeration.
@@ -164,7 +167,11 @@ mod tests {
         let mut s = rep.scratch();
         for a in 0..14 {
             for b in a + 1..14 {
-                assert_eq!(costs[a * 14 + b].to_bits(), rep.segment_cost(a, b, &mut s).angle_sum.to_bits(), "({a}, {b})");
+                assert_eq!(
+                    costs[a * 14 + b].to_bits(),
+                    rep.segment_cost(a, b, &mut s).angle_sum.to_bits(),
+                    "({a}, {b})"
+                );
             }
         }
     }
@@ -210,7 +217,8 @@ mod tests {
         for rep in windows(40) {
             let costs = angle_segment_costs(&rep);
             for k in [3, 5, 10, 15] {
-                let (_, total) = super::super::optimal::optimal_spherical_with_total(&rep, k, Objective::Angle).unwrap();
+                let (_, total) =
+                    super::super::optimal::optimal_spherical_with_total(&rep, k, Objective::Angle).unwrap();
                 let ctg = cost_to_go(&costs, 40, 1 | 1 << 39, k - 2);
                 assert!(close(ctg, total), "K={k}: {ctg} vs {total}");
                 let uniform = KeyframeSet::uniform(40, k).unwrap();

@@ -91,7 +91,8 @@ mod tests {
             let n = rng.random_range(5..13);
             let k = rng.random_range(3..n.min(7));
             let c = table(n, &mut rng);
-            let mut keys: Vec<usize> = rand::seq::index::sample(&mut rng, n - 2, k - 2).into_iter().map(|i| i + 1).collect();
+            let mut keys: Vec<usize> =
+                rand::seq::index::sample(&mut rng, n - 2, k - 2).into_iter().map(|i| i + 1).collect();
             keys.push(0);
             keys.push(n - 1);
             keys.sort_unstable();

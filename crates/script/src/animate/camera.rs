@@ -50,10 +50,13 @@ pub fn camera_shots(anim: &Animation, query: &Ssg, marks: &[(usize, usize)]) -> 
     }
     kept[0].0 = 0;
     (0..kept.len())
-        .map(|k| CameraShot { view: kept[k].1.clone(), start: kept[k].0, end: kept.get(k + 1).map(|n| n.0).unwrap_or(total) })
+        .map(|k| CameraShot {
+            view: kept[k].1.clone(),
+            start: kept[k].0,
+            end: kept.get(k + 1).map(|n| n.0).unwrap_or(total),
+        })
         .collect()
 }
-
 
 /// The view at a frame ("front" when no shot covers it).
 pub fn view_at(anim: &Animation, frame: usize) -> &str {
@@ -142,7 +145,14 @@ fn two_shot(anim: &Animation, frame: usize) -> Option<([f32; 3], [f32; 3], f32)>
     }
     let lens = Lens { fovy: TWO_SHOT_FOV.to_radians(), aspect: TWO_SHOT_ASPECT };
     let room = &anim.scene.room;
-    let inside = |p: DVec3| p.x >= 0.0 && p.x <= room.width as f64 && p.z >= 0.0 && p.z <= room.depth as f64 && p.y > 0.1 && p.y < room.height as f64;
+    let inside = |p: DVec3| {
+        p.x >= 0.0
+            && p.x <= room.width as f64
+            && p.z >= 0.0
+            && p.z <= room.depth as f64
+            && p.y > 0.1
+            && p.y < room.height as f64
+    };
     let mid = (a + b) * 0.5;
     // Tightest framing whose camera fits in the room: heads further apart on screen bring the
     // camera closer. Swapping A and B puts the camera on the other side of the pair.
@@ -210,7 +220,12 @@ mod tests {
     fn two_people(view: &str) -> Animation {
         let rig = Rig::standard();
         let room = Room { name: "room".into(), width: 6.0, depth: 5.0, height: 2.8 };
-        let track = |name: &str, x: f64| CharacterTrack { name: name.into(), motion: standing_at(&rig, x, 2.5, 0.0, 40), segments: Vec::new(), props: Vec::new() };
+        let track = |name: &str, x: f64| CharacterTrack {
+            name: name.into(),
+            motion: standing_at(&rig, x, 2.5, 0.0, 40),
+            segments: Vec::new(),
+            props: Vec::new(),
+        };
         Animation {
             fps: FPS,
             scene: Scene { room, objects: Vec::new(), camera: Vec::new(), weather: None },

@@ -84,7 +84,8 @@ pub fn root_track(m: &inbetween_core::Motion) -> Result<Vec<[f32; 2]>, crate::Sc
 /// (a character holds its last position after its track ends); None with fewer than two (a
 /// character not on the common rig has no root track and is left out).
 pub fn min_clearance(anim: &Animation) -> Option<Clearance> {
-    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().filter_map(|c| root_track(&c.motion).ok()).filter(|t| !t.is_empty()).collect();
+    let trajs: Vec<Vec<[f32; 2]>> =
+        anim.characters.iter().filter_map(|c| root_track(&c.motion).ok()).filter(|t| !t.is_empty()).collect();
     closest(&trajs, &[])
 }
 
@@ -115,7 +116,9 @@ fn first_conflict(trajs: &[&[[f32; 2]]], accepted: &[(usize, usize, usize, usize
     for f in 0..horizon {
         for a in 0..trajs.len() {
             for b in a + 1..trajs.len() {
-                if dist(at(trajs[a], f), at(trajs[b], f)) < PASSING_DISTANCE && !accepted.iter().any(|&(x, y, s, e)| x == a && y == b && (s..e).contains(&f)) {
+                if dist(at(trajs[a], f), at(trajs[b], f)) < PASSING_DISTANCE
+                    && !accepted.iter().any(|&(x, y, s, e)| x == a && y == b && (s..e).contains(&f))
+                {
                     return Some((f, a, b));
                 }
             }
@@ -134,7 +137,14 @@ fn conflict_end(trajs: &[&[[f32; 2]]], a: usize, b: usize, f: usize) -> usize {
 /// marks characters built in this call; a character not resolved (kept from a previous run) is
 /// changed only when the other one of a conflict cannot solve it, and is then marked resolved.
 /// Returns notes on the conflicts left.
-pub(crate) fn separate(ctx: &Ctx, names: &[String], plans: &mut [CharacterPlan], resolved: &mut [bool], builds: &mut [usize], cache: &mut WalkCache) -> Vec<String> {
+pub(crate) fn separate(
+    ctx: &Ctx,
+    names: &[String],
+    plans: &mut [CharacterPlan],
+    resolved: &mut [bool],
+    builds: &mut [usize],
+    cache: &mut WalkCache,
+) -> Vec<String> {
     let n = plans.len();
     if n < 2 {
         return Vec::new();
@@ -159,7 +169,17 @@ pub(crate) fn separate(ctx: &Ctx, names: &[String], plans: &mut [CharacterPlan],
         match fix {
             Some((x, choices)) => {
                 let p = &plans[x];
-                plans[x] = build_character(ctx, &names[x], p.actions.clone(), p.start, p.grid.clone(), p.blocked_by.clone(), p.avoid.clone(), choices, cache);
+                plans[x] = build_character(
+                    ctx,
+                    &names[x],
+                    p.actions.clone(),
+                    p.start,
+                    p.grid.clone(),
+                    p.blocked_by.clone(),
+                    p.avoid.clone(),
+                    choices,
+                    cache,
+                );
                 resolved[x] = true;
                 builds[x] += 1;
                 accepted.retain(|&(p, q, _, _)| p != x && q != x);
@@ -205,14 +225,21 @@ fn walk_roots(ctx: &Ctx, cache: &mut WalkCache, route: &[[f32; 2]], params: &Wal
 
 /// New walk choices for character `x` that clear its conflict at frame `f` (see the module
 /// comment), or None when no wait up to [`MAX_WAIT`] and no detour does.
-fn improve(ctx: &Ctx, plans: &[CharacterPlan], x: usize, f: usize, cache: &mut WalkCache) -> Option<Vec<super::WalkChoice>> {
+fn improve(
+    ctx: &Ctx,
+    plans: &[CharacterPlan],
+    x: usize,
+    f: usize,
+    cache: &mut WalkCache,
+) -> Option<Vec<super::WalkChoice>> {
     let p = &plans[x];
     // Standing where it started, before its first walk: only the other character can move.
     let w = p.walks.iter().rposition(|w| w.wait_start <= f)?;
     let info = &p.walks[w];
     let next = p.walks.get(w + 1).map(|n| n.wait_start);
     let dwell = &p.traj[info.end.min(p.traj.len())..next.unwrap_or(p.traj.len())];
-    let others: Vec<&[[f32; 2]]> = plans.iter().enumerate().filter(|(i, _)| *i != x).map(|(_, q)| q.traj.as_slice()).collect();
+    let others: Vec<&[[f32; 2]]> =
+        plans.iter().enumerate().filter(|(i, _)| *i != x).map(|(_, q)| q.traj.as_slice()).collect();
     let horizon = others.iter().map(|t| t.len()).max().unwrap_or(0);
     let cur = p.choices.get(w).cloned().unwrap_or_default();
     let from = info.route[0];
@@ -236,7 +263,9 @@ fn improve(ctx: &Ctx, plans: &[CharacterPlan], x: usize, f: usize, cache: &mut W
     };
     // Until when the current plan stays too close to someone from `f` on: a change that only
     // clears part of its window must at least get past this.
-    let run_end = (f..horizon.max(p.traj.len())).find(|&t| others.iter().all(|o| dist(at(o, t), at(&p.traj, t)) >= PASSING_DISTANCE)).unwrap_or(usize::MAX);
+    let run_end = (f..horizon.max(p.traj.len()))
+        .find(|&t| others.iter().all(|o| dist(at(o, t), at(&p.traj, t)) >= PASSING_DISTANCE))
+        .unwrap_or(usize::MAX);
     let current = walk_roots(ctx, cache, &info.route, &info.params);
     // A detour around where the others stand still while this walk could happen.
     let detour = {
@@ -274,7 +303,13 @@ fn improve(ctx: &Ctx, plans: &[CharacterPlan], x: usize, f: usize, cache: &mut W
                 None => return Some(with_choice(p, w, choice)),
                 // A partial clear only when it gains at least a second and the plan stays short
                 // (pushing a conflict on and on would only stretch the timeline).
-                Some(t) if t >= run_end + FPS as usize && extra <= 3 * WAIT_STEP && partial.as_ref().is_none_or(|(b, _)| t > *b) => partial = Some((t, choice)),
+                Some(t)
+                    if t >= run_end + FPS as usize
+                        && extra <= 3 * WAIT_STEP
+                        && partial.as_ref().is_none_or(|(b, _)| t > *b) =>
+                {
+                    partial = Some((t, choice))
+                }
                 Some(_) => {}
             }
         }

@@ -95,7 +95,14 @@ pub struct StorySession {
 
 impl StorySession {
     /// A session; `optimize`: run §4.3 with these settings (None: animate only).
-    pub fn new(catalogue: Catalogue, database: SceneDatabase, compose: ComposeConfig, lib: MotionLibrary, animate: AnimateConfig, optimize: Option<OptimizeConfig>) -> StorySession {
+    pub fn new(
+        catalogue: Catalogue,
+        database: SceneDatabase,
+        compose: ComposeConfig,
+        lib: MotionLibrary,
+        animate: AnimateConfig,
+        optimize: Option<OptimizeConfig>,
+    ) -> StorySession {
         StorySession { session: Session::new(catalogue, database, compose), lib, animate, optimize, prev: None }
     }
 
@@ -126,17 +133,49 @@ impl StorySession {
                 (o.scene, o.before, o.after, Some(o.curves), o.movable)
             }
             None => {
-                let c = costs(&animate_planned(&comp.scene, &comp.query, cat, &self.lib, &self.animate, &mut WalkCache::default(), &HashMap::new()).animation, &OptimizeConfig::default());
+                let c = costs(
+                    &animate_planned(
+                        &comp.scene,
+                        &comp.query,
+                        cat,
+                        &self.lib,
+                        &self.animate,
+                        &mut WalkCache::default(),
+                        &HashMap::new(),
+                    )
+                    .animation,
+                    &OptimizeConfig::default(),
+                );
                 (comp.scene.clone(), c, c, None, Vec::new())
             }
         };
         // The best state again, with its plans (animation is deterministic: the same motion).
-        let planned = animate_planned(&scene, &comp.query, cat, &self.lib, &self.animate, &mut WalkCache::default(), &HashMap::new());
+        let planned = animate_planned(
+            &scene,
+            &comp.query,
+            cat,
+            &self.lib,
+            &self.animate,
+            &mut WalkCache::default(),
+            &HashMap::new(),
+        );
         let names: Vec<String> = planned.animation.characters.iter().map(|c| c.name.clone()).collect();
         let resolved_objects = movable.iter().map(|&i| scene.objects[i].label.clone()).collect();
         let builds = names.iter().map(|n| (n.clone(), 1)).collect();
         self.remember(&up, &scene, planned.plans);
-        StoryUpdate { scene: up, animation: planned.animation, before, after, curves, full: true, resolved_characters: names, kept_characters: Vec::new(), resolved_objects, character_builds: builds, seconds: 0.0 }
+        StoryUpdate {
+            scene: up,
+            animation: planned.animation,
+            before,
+            after,
+            curves,
+            full: true,
+            resolved_characters: names,
+            kept_characters: Vec::new(),
+            resolved_objects,
+            character_builds: builds,
+            seconds: 0.0,
+        }
     }
 
     /// A later version: keep what the edit did not touch.
@@ -176,12 +215,21 @@ impl StorySession {
         let planned = animate_planned(&scene, &comp.query, cat, lib, acfg, &mut cache, &frozen);
         let mut builds = planned.builds.clone();
         let kept_flags: Vec<bool> = planned.resolved.iter().map(|r| !r).collect();
-        let kept: HashMap<String, CharacterPlan> = planned.plans.iter().zip(&kept_flags).filter(|(_, k)| **k).map(|(p, _)| (p.track.name.to_lowercase(), p.clone())).collect();
-        let kept_clearance: Vec<(CharacterPlan, f32)> = kept.values().map(|p| (p.clone(), walk_clearance(p, &scene))).collect();
+        let kept: HashMap<String, CharacterPlan> = planned
+            .plans
+            .iter()
+            .zip(&kept_flags)
+            .filter(|(_, k)| **k)
+            .map(|(p, _)| (p.track.name.to_lowercase(), p.clone()))
+            .collect();
+        let kept_clearance: Vec<(CharacterPlan, f32)> =
+            kept.values().map(|p| (p.clone(), walk_clearance(p, &scene))).collect();
         let ocfg = self.optimize.clone().unwrap_or_default();
         let c0 = costs(&planned.animation, &ocfg);
         let movable = match &self.optimize {
-            Some(_) if kept_flags.iter().any(|k| !k) => restricted_movable(&planned.animation, &kept_flags, &comp.relations, cat),
+            Some(_) if kept_flags.iter().any(|k| !k) => {
+                restricted_movable(&planned.animation, &kept_flags, &comp.relations, cat)
+            }
             _ => Vec::new(),
         };
         let (final_scene, before, after, curves) = if movable.is_empty() {
@@ -201,7 +249,15 @@ impl StorySession {
                 }
                 Some(pl.animation)
             };
-            let o = anneal(&scene, &comp.relations, &ocfg, planned.animation.clone(), c0, movable.clone(), &mut animate_state);
+            let o = anneal(
+                &scene,
+                &comp.relations,
+                &ocfg,
+                planned.animation.clone(),
+                c0,
+                movable.clone(),
+                &mut animate_state,
+            );
             (o.scene, o.before, o.after, Some(o.curves))
         };
         let planned = if curves.is_some() {
@@ -219,7 +275,19 @@ impl StorySession {
         let resolved_objects = movable.iter().map(|&i| final_scene.objects[i].label.clone()).collect();
         let character_builds = names.iter().cloned().zip(builds).collect();
         self.remember(&up, &final_scene, planned.plans);
-        StoryUpdate { scene: up, animation: planned.animation, before, after, curves, full: false, resolved_characters, kept_characters, resolved_objects, character_builds, seconds: 0.0 }
+        StoryUpdate {
+            scene: up,
+            animation: planned.animation,
+            before,
+            after,
+            curves,
+            full: false,
+            resolved_characters,
+            kept_characters,
+            resolved_objects,
+            character_builds,
+            seconds: 0.0,
+        }
     }
 
     /// Keeps this version for the next update.
@@ -247,13 +315,21 @@ fn same_pose(a: &PlacedObject, b: &PlacedObject) -> bool {
 fn action_signature(actions: &Actions, scene: &Scene, query: &Ssg, keys: &[ObjectKey]) -> Vec<ActionSignature> {
     actions
         .iter()
-        .map(|(_, a)| (a.verb.clone(), a.preposition.clone(), a.manner.clone(), a.target.and_then(|t| object_of_node(scene, query, t)).and_then(|i| keys.get(i).cloned())))
+        .map(|(_, a)| {
+            (
+                a.verb.clone(),
+                a.preposition.clone(),
+                a.manner.clone(),
+                a.target.and_then(|t| object_of_node(scene, query, t)).and_then(|i| keys.get(i).cloned()),
+            )
+        })
         .collect()
 }
 
 /// Objects `plan` touches (segment targets and touched objects) and their supports, transitively.
 fn touched(plan: &CharacterPlan, scene: &Scene) -> Vec<usize> {
-    let mut set: Vec<usize> = plan.track.segments.iter().flat_map(|s| s.object.into_iter().chain(s.touching.iter().copied())).collect();
+    let mut set: Vec<usize> =
+        plan.track.segments.iter().flat_map(|s| s.object.into_iter().chain(s.touching.iter().copied())).collect();
     let mut k = 0;
     while k < set.len() {
         if let Some(s) = scene.objects.get(set[k]).and_then(|o| o.support) {
@@ -271,7 +347,14 @@ fn touched(plan: &CharacterPlan, scene: &Scene) -> Vec<usize> {
 
 /// The previous plan in the new scene's object numbering, with the new version's actions (same
 /// meaning, maybe other sentence numbers); None when an object it touches is gone or moved.
-fn remap(plan: &CharacterPlan, old: &Scene, new: &Scene, new_index: &[Option<usize>], name: &str, actions: &Actions) -> Option<CharacterPlan> {
+fn remap(
+    plan: &CharacterPlan,
+    old: &Scene,
+    new: &Scene,
+    new_index: &[Option<usize>],
+    name: &str,
+    actions: &Actions,
+) -> Option<CharacterPlan> {
     for i in touched(plan, old) {
         let j = (*new_index.get(i)?)?;
         if !same_pose(&old.objects[i], new.objects.get(j)?) {
@@ -307,7 +390,13 @@ fn remap(plan: &CharacterPlan, old: &Scene, new: &Scene, new_index: &[Option<usi
 pub(crate) fn walk_clearance(plan: &CharacterPlan, scene: &Scene) -> f32 {
     let mut best = f32::INFINITY;
     for w in &plan.walks {
-        let touching: &[usize] = plan.track.segments.iter().find(|s| s.start <= w.walk_start && w.walk_start < s.end).map(|s| s.touching.as_slice()).unwrap_or(&[]);
+        let touching: &[usize] = plan
+            .track
+            .segments
+            .iter()
+            .find(|s| s.start <= w.walk_start && w.walk_start < s.end)
+            .map(|s| s.touching.as_slice())
+            .unwrap_or(&[]);
         for (i, o) in scene.objects.iter().enumerate() {
             if touching.contains(&i) || !grid::blocks_walking(o) {
                 continue;
@@ -326,11 +415,22 @@ pub(crate) fn walk_clearance(plan: &CharacterPlan, scene: &Scene) -> f32 {
 /// The objects the optimisation may move when only the characters not `kept` were re-solved:
 /// [`movable_objects`] of those characters, without any object a kept character touches or that
 /// would carry one along.
-fn restricted_movable(anim: &Animation, kept: &[bool], relations: &[(crate::ssg::Relation, usize, usize)], cat: &Catalogue) -> Vec<usize> {
+fn restricted_movable(
+    anim: &Animation,
+    kept: &[bool],
+    relations: &[(crate::ssg::Relation, usize, usize)],
+    cat: &Catalogue,
+) -> Vec<usize> {
     let mut sub = anim.clone();
     sub.characters = anim.characters.iter().zip(kept).filter(|(_, k)| !**k).map(|(c, _)| c.clone()).collect();
     let objs = &anim.scene.objects;
-    let mut fixed: Vec<usize> = anim.characters.iter().zip(kept).filter(|(_, k)| **k).flat_map(|(c, _)| c.segments.iter().flat_map(|s| s.object.into_iter().chain(s.touching.iter().copied()))).collect();
+    let mut fixed: Vec<usize> = anim
+        .characters
+        .iter()
+        .zip(kept)
+        .filter(|(_, k)| **k)
+        .flat_map(|(c, _)| c.segments.iter().flat_map(|s| s.object.into_iter().chain(s.touching.iter().copied())))
+        .collect();
     // Their supports stay too (moving a support carries what rests on it).
     let mut k = 0;
     while k < fixed.len() {

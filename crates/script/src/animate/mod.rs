@@ -50,8 +50,8 @@ use inbetween_core::{Motion, Pose};
 use crate::catalogue::{Catalogue, ContactKind};
 use crate::compose::Composition;
 use crate::layout::{self, geom, grid, grid::Grid};
-use crate::motion::ik::{solve_limb, Limb, PELVIS_ABOVE_SEAT};
 use crate::motion::blend::{blend_upper_on, reach_contacts_on};
+use crate::motion::ik::{solve_limb, Limb, PELVIS_ABOVE_SEAT};
 use crate::motion::locomotion::place_clip_on;
 use crate::motion::procedural::{seat_point, SEAT_HEIGHT};
 use crate::motion::rig::{Rig, FPS};
@@ -161,7 +161,8 @@ pub fn carried_from(anim: &Animation, obj: usize) -> Option<usize> {
 }
 
 /// Verb lemmas that take an object into the hand.
-const TAKE_VERBS: &[&str] = &["pick", "take", "grab", "hold", "carry", "fetch", "lift", "get", "collect", "bring", "raise"];
+const TAKE_VERBS: &[&str] =
+    &["pick", "take", "grab", "hold", "carry", "fetch", "lift", "get", "collect", "bring", "raise"];
 
 /// Largest side (metres) of an object one hand carries.
 const PROP_SIZE: f32 = 0.45;
@@ -231,7 +232,15 @@ pub struct AnimateConfig {
 
 impl Default for AnimateConfig {
     fn default() -> AnimateConfig {
-        AnimateConfig { min_action_seconds: 2.0, reach: true, lock_feet: true, slow_speed: 0.7, start_spacing: 0.7, crossfade: 6, approach_distance: 0.6 }
+        AnimateConfig {
+            min_action_seconds: 2.0,
+            reach: true,
+            lock_feet: true,
+            slow_speed: 0.7,
+            start_spacing: 0.7,
+            crossfade: 6,
+            approach_distance: 0.6,
+        }
     }
 }
 
@@ -242,7 +251,13 @@ pub fn animate(comp: &Composition, cat: &Catalogue, lib: &MotionLibrary, cfg: &A
 
 /// [`animate`] for a scene and query graph given separately (the optimiser animates disturbed
 /// copies of the scene).
-pub fn animate_scene(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: &MotionLibrary, cfg: &AnimateConfig) -> Animation {
+pub fn animate_scene(
+    scene: &Scene,
+    query: &Ssg,
+    cat: &Catalogue,
+    lib: &MotionLibrary,
+    cfg: &AnimateConfig,
+) -> Animation {
     animate_cached(scene, query, cat, lib, cfg, &mut WalkCache::default())
 }
 
@@ -273,14 +288,10 @@ impl WalkCache {
 /// The scene object a query node became: the object placed for that node, else the first of the
 /// same category.
 pub fn object_of_node(scene: &Scene, query: &Ssg, node: NodeId) -> Option<usize> {
-    scene
-        .objects
-        .iter()
-        .position(|o| matches!(o.origin, Origin::Script { node: n, .. } if n == node))
-        .or_else(|| {
-            let cat = &query.objects.get(node)?.category;
-            scene.objects.iter().position(|o| &o.category == cat)
-        })
+    scene.objects.iter().position(|o| matches!(o.origin, Origin::Script { node: n, .. } if n == node)).or_else(|| {
+        let cat = &query.objects.get(node)?.category;
+        scene.objects.iter().position(|o| &o.category == cat)
+    })
 }
 
 /// World position of an object's contact point: the catalogue's local point scaled by the
@@ -410,7 +421,15 @@ impl<'a> Builder<'a> {
         poses
     }
 
-    fn push_segment(&mut self, verb: &str, start: usize, object: Option<usize>, scene: &Scene, touching: Vec<usize>, contacts: Vec<JointContact>) {
+    fn push_segment(
+        &mut self,
+        verb: &str,
+        start: usize,
+        object: Option<usize>,
+        scene: &Scene,
+        touching: Vec<usize>,
+        contacts: Vec<JointContact>,
+    ) {
         self.segments.push(Segment {
             verb: verb.to_string(),
             start,
@@ -439,7 +458,19 @@ impl<'a> Builder<'a> {
     /// Walks to the point in front of seat `s` of object `o`, sits down (pelvis onto the seat) and
     /// stays seated `hold` frames: a "walk" and a "sit" segment, the latter with the hips contact.
     #[allow(clippy::too_many_arguments)]
-    fn sit_on(&mut self, st: &mut State, scene: &Scene, g: &Grid, o: usize, s: [f32; 3], hold: usize, speed: Option<f64>, cache: &mut WalkCache, notes: &mut Vec<String>, name: &str) {
+    fn sit_on(
+        &mut self,
+        st: &mut State,
+        scene: &Scene,
+        g: &Grid,
+        o: usize,
+        s: [f32; 3],
+        hold: usize,
+        speed: Option<f64>,
+        cache: &mut WalkCache,
+        notes: &mut Vec<String>,
+        name: &str,
+    ) {
         let yaw = scene.objects[o].yaw as f64;
         let sp = seat_point();
         let f = [yaw.sin(), yaw.cos()];
@@ -460,7 +491,13 @@ impl<'a> Builder<'a> {
         self.append(poses);
         st.seated = Some((st.pos, s, o));
         self.seats.push([s[0], s[2]]);
-        let hips = JointContact { joint: ContactJoint::Hips, kind: ContactKind::Seat, point: [s[0], s[1] + PELVIS_ABOVE_SEAT as f32, s[2]], start: seated_from, end: self.frames.len() };
+        let hips = JointContact {
+            joint: ContactJoint::Hips,
+            kind: ContactKind::Seat,
+            point: [s[0], s[1] + PELVIS_ABOVE_SEAT as f32, s[2]],
+            start: seated_from,
+            end: self.frames.len(),
+        };
         self.push_segment("sit", start, Some(o), scene, vec![o], vec![hips]);
     }
 
@@ -470,7 +507,19 @@ impl<'a> Builder<'a> {
     /// root lowered, legs bent, for a prop low down); at the frame the hand is there the prop is
     /// taken ([`CarriedProp`]), and a "pick_up" segment measures the wrist on the grip.
     #[allow(clippy::too_many_arguments)]
-    fn pick_up(&mut self, st: &mut State, scene: &Scene, cat: &Catalogue, g: &Grid, o: usize, avoid: &[[f32; 2]], speed: Option<f64>, cache: &mut WalkCache, notes: &mut Vec<String>, name: &str) {
+    fn pick_up(
+        &mut self,
+        st: &mut State,
+        scene: &Scene,
+        cat: &Catalogue,
+        g: &Grid,
+        o: usize,
+        avoid: &[[f32; 2]],
+        speed: Option<f64>,
+        cache: &mut WalkCache,
+        notes: &mut Vec<String>,
+        name: &str,
+    ) {
         let Some(grip) = contacts_of(scene, cat, o, ContactKind::Grip).into_iter().next() else { return };
         let gxz = [grip[0], grip[2]];
         let seat_before = st.seated;
@@ -499,10 +548,21 @@ impl<'a> Builder<'a> {
             }
         };
         let base = crate::motion::rig::clip(&rig, &base);
-        let m = blend_upper_on(&rig, &base, &clip, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: false, action_offset: 0 });
+        let m = blend_upper_on(
+            &rig,
+            &base,
+            &clip,
+            &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: false, action_offset: 0 },
+        );
         // The hand closes at frame `grab`: IK weight rises to 1 there and falls after.
         let grab = n / 2;
-        let bump = |k: usize| if k <= grab { smooth(k as f64 / grab as f64) } else { smooth((n - 1 - k) as f64 / (n - 1 - grab) as f64) };
+        let bump = |k: usize| {
+            if k <= grab {
+                smooth(k as f64 / grab as f64)
+            } else {
+                smooth((n - 1 - k) as f64 / (n - 1 - grab) as f64)
+            }
+        };
         let mut poses = m.poses();
         if st.seated.is_none() {
             // For a prop below the hands' reach (a microphone on the floor) bend the knees and
@@ -521,7 +581,14 @@ impl<'a> Builder<'a> {
             }
         }
         let m = crate::motion::rig::clip(&rig, &poses);
-        let window = BlendParams { start: 0, end: Some(n), blend_in: grab, blend_out: n - grab, looping: false, action_offset: 0 };
+        let window = BlendParams {
+            start: 0,
+            end: Some(n),
+            blend_in: grab,
+            blend_out: n - grab,
+            looping: false,
+            action_offset: 0,
+        };
         let target = DVec3::new(grip[0] as f64, grip[1] as f64, grip[2] as f64);
         let m = reach_contacts_on(&rig, &m, &[Contact { limb: Limb::RightArm, target, window }]).0;
         // The prop's grip goes to the hand joint; its rotation relative to the hand stays as it
@@ -538,7 +605,13 @@ impl<'a> Builder<'a> {
         let start = self.frames.len();
         self.append(m.poses());
         self.props.push(CarriedProp { object: o, joint: hand, from: start + grab, offset, rotation });
-        let contact = JointContact { joint: ContactJoint::RightWrist, kind: ContactKind::Grip, point: grip, start: start + grab.saturating_sub(2), end: start + grab + 3 };
+        let contact = JointContact {
+            joint: ContactJoint::RightWrist,
+            kind: ContactKind::Grip,
+            point: grip,
+            start: start + grab.saturating_sub(2),
+            end: start + grab + 3,
+        };
         let mut touching = vec![o];
         touching.extend(st.seated.map(|s| s.2));
         self.push_segment("pick_up", start, Some(o), scene, touching, vec![contact]);
@@ -551,12 +624,26 @@ impl<'a> Builder<'a> {
     /// Walks along a route to `to`, turning to `final_heading`, after waiting in place as this
     /// walk's [`WalkChoice`] says.
     #[allow(clippy::too_many_arguments)]
-    fn walk(&mut self, st: &mut State, grid: &Grid, to: [f32; 2], final_heading: f64, verb: &str, speed: Option<f64>, cache: &mut WalkCache, notes: &mut Vec<String>, name: &str) {
+    fn walk(
+        &mut self,
+        st: &mut State,
+        grid: &Grid,
+        to: [f32; 2],
+        final_heading: f64,
+        verb: &str,
+        speed: Option<f64>,
+        cache: &mut WalkCache,
+        notes: &mut Vec<String>,
+        name: &str,
+    ) {
         let choice = self.choices.get(self.walks.len()).cloned().unwrap_or_default();
         let route = match choice.route {
             Some(r) => r,
             None => route(grid, st.pos, to).unwrap_or_else(|| {
-                notes.push(format!("{name}: no route from ({:.2}, {:.2}) to ({:.2}, {:.2}); walking straight", st.pos[0], st.pos[1], to[0], to[1]));
+                notes.push(format!(
+                    "{name}: no route from ({:.2}, {:.2}) to ({:.2}, {:.2}); walking straight",
+                    st.pos[0], st.pos[1], to[0], to[1]
+                ));
                 vec![st.pos, to]
             }),
         };
@@ -611,7 +698,14 @@ const SPOT_MARGIN: f32 = 0.1;
 /// also shifted sideways along its side, and moved to the nearest free cell reachable from `from`.
 /// The candidate chosen keeps clear of `avoid` (where earlier characters stand or sit: two
 /// characters never share a spot), then stays close to the object, then to `from`.
-fn stand_point(scene: &Scene, cat: &Catalogue, grid: &Grid, obj: usize, from: [f32; 2], avoid: &[[f32; 2]]) -> [f32; 2] {
+fn stand_point(
+    scene: &Scene,
+    cat: &Catalogue,
+    grid: &Grid,
+    obj: usize,
+    from: [f32; 2],
+    avoid: &[[f32; 2]],
+) -> [f32; 2] {
     let o = &scene.objects[obj];
     // (point, where the character would ideally be for it, extra cost of the side).
     let mut candidates: Vec<([f32; 2], [f32; 2], f32)> = Vec::new();
@@ -656,7 +750,11 @@ fn stand_point(scene: &Scene, cat: &Catalogue, grid: &Grid, obj: usize, from: [f
             }
         }
     }
-    let reach = grid.cell_of(from).filter(|c| !grid.is_blocked(*c)).or_else(|| grid.nearest_free(from)).map(|c| grid.reachable_from(c));
+    let reach = grid
+        .cell_of(from)
+        .filter(|c| !grid.is_blocked(*c))
+        .or_else(|| grid.nearest_free(from))
+        .map(|c| grid.reachable_from(c));
     let snap = |p: [f32; 2]| -> Option<[f32; 2]> {
         let p = if grid.is_free_at(p) { p } else { grid.center(grid.nearest_free(p)?) };
         let ok = match (&reach, grid.cell_of(p)) {
@@ -665,7 +763,9 @@ fn stand_point(scene: &Scene, cat: &Catalogue, grid: &Grid, obj: usize, from: [f
         };
         ok.then_some(p)
     };
-    let crowd = |p: [f32; 2]| avoid.iter().map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2(p, *a).sqrt()).max(0.0)).sum::<f32>();
+    let crowd = |p: [f32; 2]| {
+        avoid.iter().map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2(p, *a).sqrt()).max(0.0)).sum::<f32>()
+    };
     let best = candidates
         .into_iter()
         .filter_map(|(p, ideal, penalty)| {
@@ -693,7 +793,14 @@ fn heading_to(a: [f32; 2], b: [f32; 2], default: f64) -> f64 {
 }
 
 /// The animation with a walk cache (the optimiser re-animates many nearly equal scenes).
-pub(crate) fn animate_cached(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: &MotionLibrary, cfg: &AnimateConfig, cache: &mut WalkCache) -> Animation {
+pub(crate) fn animate_cached(
+    scene: &Scene,
+    query: &Ssg,
+    cat: &Catalogue,
+    lib: &MotionLibrary,
+    cfg: &AnimateConfig,
+    cache: &mut WalkCache,
+) -> Animation {
     animate_planned(scene, query, cat, lib, cfg, cache, &HashMap::new()).animation
 }
 
@@ -751,7 +858,15 @@ pub(crate) struct Planned {
 /// of roots keeps [`PASSING_DISTANCE`] at every frame. A character found in `frozen` (by lower-case
 /// name) whose start and blocked spots are unchanged is taken as it is, and only rebuilt when a
 /// conflict cannot be solved otherwise.
-pub(crate) fn animate_planned(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: &MotionLibrary, cfg: &AnimateConfig, cache: &mut WalkCache, frozen: &HashMap<String, CharacterPlan>) -> Planned {
+pub(crate) fn animate_planned(
+    scene: &Scene,
+    query: &Ssg,
+    cat: &Catalogue,
+    lib: &MotionLibrary,
+    cfg: &AnimateConfig,
+    cache: &mut WalkCache,
+    frozen: &HashMap<String, CharacterPlan>,
+) -> Planned {
     let ctx = Ctx { scene, query, cat, lib, cfg, rig: Rig::standard() };
     let base_grid = Grid::from_objects(&scene.room, &scene.objects, grid::CELL, grid::WALKER_RADIUS);
     let mut plans: Vec<CharacterPlan> = Vec::new();
@@ -798,7 +913,14 @@ pub(crate) fn animate_planned(scene: &Scene, query: &Ssg, cat: &Catalogue, lib: 
 /// Where character `ci` starts: along the door wall, `start_spacing` apart on alternating sides,
 /// on the free cell nearest that spot that is reachable from the door and at least
 /// [`PASSING_DISTANCE`] from the characters placed before (`starts`).
-fn start_spot(scene: &Scene, cfg: &AnimateConfig, base_grid: &Grid, g: &Grid, starts: &[[f32; 2]], ci: usize) -> [f32; 2] {
+fn start_spot(
+    scene: &Scene,
+    cfg: &AnimateConfig,
+    base_grid: &Grid,
+    g: &Grid,
+    starts: &[[f32; 2]],
+    ci: usize,
+) -> [f32; 2] {
     let door = layout::door(&scene.room);
     let side = if ci.is_multiple_of(2) { 1.0 } else { -1.0 };
     let want = [door[0] + side * cfg.start_spacing * ci.div_ceil(2) as f32, door[1]];
@@ -817,17 +939,40 @@ fn start_spot(scene: &Scene, cfg: &AnimateConfig, base_grid: &Grid, g: &Grid, st
             }
         }
     }
-    best.map(|b| b.1).or_else(|| base_grid.nearest_free(want).map(|c| g.center(c))).unwrap_or([scene.room.width / 2.0, scene.room.depth / 2.0])
+    best.map(|b| b.1)
+        .or_else(|| base_grid.nearest_free(want).map(|c| g.center(c)))
+        .unwrap_or([scene.room.width / 2.0, scene.room.depth / 2.0])
 }
 
 /// Builds one character's timeline from `start` on its grid `g`, walking as `choices` say.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f32; 2], g: Grid, blocked_by: Vec<[f32; 2]>, avoid: Vec<[f32; 2]>, choices: Vec<WalkChoice>, cache: &mut WalkCache) -> CharacterPlan {
+pub(crate) fn build_character(
+    ctx: &Ctx,
+    name: &str,
+    actions: Actions,
+    start: [f32; 2],
+    g: Grid,
+    blocked_by: Vec<[f32; 2]>,
+    avoid: Vec<[f32; 2]>,
+    choices: Vec<WalkChoice>,
+    cache: &mut WalkCache,
+) -> CharacterPlan {
     let (scene, query, cat, lib, cfg, rig) = (ctx.scene, ctx.query, ctx.cat, ctx.lib, ctx.cfg, &ctx.rig);
     let mut notes = Vec::new();
     let mut marks = Vec::new();
     let mut st = State { pos: start, heading: std::f64::consts::PI, seated: None };
-    let mut b = Builder { rig: rig.clone(), lib, fallback: None, cfg, frames: Vec::new(), segments: Vec::new(), choices: &choices, walks: Vec::new(), seats: Vec::new(), props: Vec::new() };
+    let mut b = Builder {
+        rig: rig.clone(),
+        lib,
+        fallback: None,
+        cfg,
+        frames: Vec::new(),
+        segments: Vec::new(),
+        choices: &choices,
+        walks: Vec::new(),
+        seats: Vec::new(),
+        props: Vec::new(),
+    };
     for (sentence, a) in &actions {
         marks.push((*sentence, b.frames.len()));
         let obj = a.target.and_then(|t| object_of_node(scene, query, t));
@@ -861,7 +1006,12 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
             let seat = obj.and_then(|o| {
                 let seats = contacts_of(scene, cat, o, ContactKind::Seat);
                 // The nearest seat, away from where earlier characters stand or sit.
-                let crowd = |p: &[f32; 3]| avoid.iter().map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2([p[0], p[2]], *a).sqrt()).max(0.0)).sum::<f32>();
+                let crowd = |p: &[f32; 3]| {
+                    avoid
+                        .iter()
+                        .map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2([p[0], p[2]], *a).sqrt()).max(0.0))
+                        .sum::<f32>()
+                };
                 let cost = |p: &[f32; 3]| 10.0 * crowd(p) + dist2([p[0], p[2]], st.pos).sqrt();
                 seats.into_iter().min_by(|p, q| cost(p).total_cmp(&cost(q))).map(|s| (o, s))
             });
@@ -911,7 +1061,16 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
         if let (Some(dh), None) = (turn, st.seated) {
             let start = b.frames.len();
             let to = st.heading + dh;
-            let m = cache.walk(&[st.pos], lib, &WalkParams { initial_heading: Some(st.heading), final_heading: Some(to), lock_feet: cfg.lock_feet, ..WalkParams::default() });
+            let m = cache.walk(
+                &[st.pos],
+                lib,
+                &WalkParams {
+                    initial_heading: Some(st.heading),
+                    final_heading: Some(to),
+                    lock_feet: cfg.lock_feet,
+                    ..WalkParams::default()
+                },
+            );
             b.append(m.poses());
             st.heading = to;
             b.push_segment("turn", start, obj, scene, Vec::new(), Vec::new());
@@ -957,7 +1116,12 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
         };
         let base = crate::motion::rig::clip(rig, &base);
         let mut m = match &action {
-            Some(act) => blend_upper_on(rig, &base, act, &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 }),
+            Some(act) => blend_upper_on(
+                rig,
+                &base,
+                act,
+                &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 },
+            ),
             None => base,
         };
         let start = b.frames.len();
@@ -989,19 +1153,41 @@ pub(crate) fn build_character(ctx: &Ctx, name: &str, actions: Actions, start: [f
         end_spots.push([s[0], s[2]]);
     }
     let motion = crate::motion::rig::clip(rig, &b.frames);
-    let traj: Vec<[f32; 2]> = b.frames.iter().map(|p| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32]).collect();
+    let traj: Vec<[f32; 2]> =
+        b.frames.iter().map(|p| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32]).collect();
     let walks = b.walks;
     let track = CharacterTrack { name: name.to_string(), motion, segments: b.segments, props: b.props };
     let mut spots = vec![start];
     spots.extend(walks.iter().filter_map(|w| traj.get(w.end.saturating_sub(1)).copied()));
     spots.extend(b.seats.iter().copied());
-    CharacterPlan { actions, start, blocked_by, grid: g, choices, track, traj, walks, marks, notes, end_spots, spots, avoid }
+    CharacterPlan {
+        actions,
+        start,
+        blocked_by,
+        grid: g,
+        choices,
+        track,
+        traj,
+        walks,
+        marks,
+        notes,
+        end_spots,
+        spots,
+        avoid,
+    }
 }
 
 /// IK contacts (wrist targets) and cost contacts for a hand action on object `o`: keys take both
 /// hands (fingers on the keys, ±10 cm along the object's width), a grip or strike point the right
 /// hand, a top surface both wrists ±20 cm apart.
-fn hand_contacts(rig: &Rig, m: &Motion, scene: &Scene, cat: &Catalogue, o: usize, start: usize) -> (Vec<Contact>, Vec<JointContact>) {
+fn hand_contacts(
+    rig: &Rig,
+    m: &Motion,
+    scene: &Scene,
+    cat: &Catalogue,
+    o: usize,
+    start: usize,
+) -> (Vec<Contact>, Vec<JointContact>) {
     let n = m.num_frames();
     let Some(c) = cat.get(&scene.objects[o].category) else { return (Vec::new(), Vec::new()) };
     // The character's left (heading 0 faces +Z with the left hand towards +X).
@@ -1010,7 +1196,9 @@ fn hand_contacts(rig: &Rig, m: &Motion, scene: &Scene, cat: &Catalogue, o: usize
     let window = BlendParams { start: 0, end: None, blend_in: 10, blend_out: 0, looping: false, action_offset: 0 };
     // Hand length (wrist → finger), to put the fingers, not the wrist, on the keys.
     let g0 = forward(&rig.skeleton, &m.pose(0));
-    let finger = |side: &str| rig.skeleton.find(&format!("{side}HandIndex1")).or_else(|| rig.skeleton.find(&format!("{side}FingerBase")));
+    let finger = |side: &str| {
+        rig.skeleton.find(&format!("{side}HandIndex1")).or_else(|| rig.skeleton.find(&format!("{side}FingerBase")))
+    };
     let hand_len = finger("Left").map(|f| (g0.positions[f] - g0.positions[rig.arms[0][3]]).length()).unwrap_or(0.1);
     let root = g0.positions[rig.hips];
     let mut ik = Vec::new();

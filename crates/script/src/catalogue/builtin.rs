@@ -118,11 +118,7 @@ pub fn has_leg_room(category: &str) -> bool {
 }
 
 fn room(name: &str, synonyms: &[&str], size: [f32; 3]) -> RoomKind {
-    RoomKind {
-        name: name.to_string(),
-        synonyms: synonyms.iter().map(|s| s.to_string()).collect(),
-        size,
-    }
+    RoomKind { name: name.to_string(), synonyms: synonyms.iter().map(|s| s.to_string()).collect(), size }
 }
 
 /// The built-in catalogue: 70 categories in classes (classmates match partially, §4.1) and the
@@ -130,106 +126,37 @@ fn room(name: &str, synonyms: &[&str], size: [f32; 3]) -> RoomKind {
 pub fn builtin() -> Catalogue {
     let categories = ROWS
         .iter()
-        .map(
-            |&(name, synonyms, _, size, support, surface, color, contacts)| Category {
-                name: name.to_string(),
-                synonyms: synonyms.iter().map(|s| s.to_string()).collect(),
-                size,
-                support,
-                surface,
-                contacts: contacts
-                    .iter()
-                    .map(|&(kind, local)| ContactPoint { kind, local })
-                    .collect(),
-                color,
-                model: None,
-            },
-        )
+        .map(|&(name, synonyms, _, size, support, surface, color, contacts)| Category {
+            name: name.to_string(),
+            synonyms: synonyms.iter().map(|s| s.to_string()).collect(),
+            size,
+            support,
+            surface,
+            contacts: contacts.iter().map(|&(kind, local)| ContactPoint { kind, local }).collect(),
+            color,
+            model: None,
+        })
         .collect();
     let rooms = vec![
-        room(
-            "room",
-            &["place", "space", "scene", "interior"],
-            [5.0, 2.8, 4.5],
-        ),
-        room(
-            "office",
-            &["study", "workplace", "officeroom"],
-            [5.0, 2.8, 4.5],
-        ),
-        room(
-            "bedroom",
-            &["bed room", "dormitory", "dorm"],
-            [4.5, 2.7, 4.0],
-        ),
+        room("room", &["place", "space", "scene", "interior"], [5.0, 2.8, 4.5]),
+        room("office", &["study", "workplace", "officeroom"], [5.0, 2.8, 4.5]),
+        room("bedroom", &["bed room", "dormitory", "dorm"], [4.5, 2.7, 4.0]),
         room(
             "livingroom",
-            &[
-                "living room",
-                "lounge",
-                "sittingroom",
-                "sitting room",
-                "parlour",
-                "parlor",
-            ],
+            &["living room", "lounge", "sittingroom", "sitting room", "parlour", "parlor"],
             [6.0, 2.8, 5.0],
         ),
-        room(
-            "gallery",
-            &[
-                "artgallery",
-                "art gallery",
-                "museum",
-                "exhibition",
-                "exhibitionhall",
-            ],
-            [8.0, 3.5, 6.0],
-        ),
-        room(
-            "musicroom",
-            &[
-                "music room",
-                "studio",
-                "recordingstudio",
-                "recording studio",
-            ],
-            [5.0, 2.8, 4.5],
-        ),
+        room("gallery", &["artgallery", "art gallery", "museum", "exhibition", "exhibitionhall"], [8.0, 3.5, 6.0]),
+        room("musicroom", &["music room", "studio", "recordingstudio", "recording studio"], [5.0, 2.8, 4.5]),
         room(
             "meetingroom",
-            &[
-                "meeting room",
-                "conferenceroom",
-                "conference room",
-                "classroom",
-                "boardroom",
-            ],
+            &["meeting room", "conferenceroom", "conference room", "classroom", "boardroom"],
             [6.0, 2.8, 5.0],
         ),
-        room(
-            "workshop",
-            &["working shop", "workingshop", "workroom", "garage", "shop"],
-            [6.0, 3.0, 5.0],
-        ),
-        room(
-            "boxinggym",
-            &[
-                "boxing gym",
-                "gym",
-                "boxingclub",
-                "boxing club",
-                "fitnessroom",
-            ],
-            [8.0, 3.5, 7.0],
-        ),
+        room("workshop", &["working shop", "workingshop", "workroom", "garage", "shop"], [6.0, 3.0, 5.0]),
+        room("boxinggym", &["boxing gym", "gym", "boxingclub", "boxing club", "fitnessroom"], [8.0, 3.5, 7.0]),
         room("kitchen", &["kitchenette", "cookroom"], [4.0, 2.7, 3.5]),
-        room(
-            "street",
-            &[
-                "outdoors", "outdoor", "outside", "park", "yard", "garden", "town",
-            ],
-            [20.0, 10.0, 24.0],
-        ),
+        room("street", &["outdoors", "outdoor", "outside", "park", "yard", "garden", "town"], [20.0, 10.0, 24.0]),
     ];
     Catalogue::new(categories, rooms).with_classes(ROWS.iter().map(|r| (r.0, r.2)))
 }
@@ -281,16 +208,9 @@ mod tests {
             assert!(c.resolve(w).is_some(), "{w}");
         }
         assert_eq!(c.resolve("couch").unwrap().name, "sofa");
-        for r in [
-            "office",
-            "gallery",
-            "meetingroom",
-            "working shop",
-            "music room",
-            "boxing gym",
-            "living room",
-            "street",
-        ] {
+        for r in
+            ["office", "gallery", "meetingroom", "working shop", "music room", "boxing gym", "living room", "street"]
+        {
             assert!(c.resolve_room(r).is_some(), "{r}");
         }
     }

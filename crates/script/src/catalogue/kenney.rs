@@ -47,10 +47,7 @@ pub const MODELS: &[(&str, &[&str])] = &[
 /// but cannot be read is an error naming it.
 pub fn with_models(mut cat: Catalogue, dir: &Path) -> Result<Catalogue, ScriptError> {
     if !dir.is_dir() {
-        return Err(ScriptError::Asset {
-            path: dir.to_path_buf(),
-            message: "not a folder of Kenney models".into(),
-        });
+        return Err(ScriptError::Asset { path: dir.to_path_buf(), message: "not a folder of Kenney models".into() });
     }
     for &(stem, categories) in MODELS {
         let path = dir.join(format!("{stem}.glb"));
@@ -58,16 +55,10 @@ pub fn with_models(mut cat: Catalogue, dir: &Path) -> Result<Catalogue, ScriptEr
             continue;
         }
         let bytes = std::fs::read(&path).map_err(|e| ScriptError::io(&path, e))?;
-        let (min, max) = glb_bounds(&bytes).map_err(|message| ScriptError::Asset {
-            path: path.clone(),
-            message,
-        })?;
+        let (min, max) = glb_bounds(&bytes).map_err(|message| ScriptError::Asset { path: path.clone(), message })?;
         let ext = [max[0] - min[0], max[1] - min[1], max[2] - min[2]];
         if ext.iter().any(|&e| !(e.is_finite() && e > 0.0)) {
-            return Err(ScriptError::Asset {
-                path,
-                message: format!("empty or degenerate bounding box {ext:?}"),
-            });
+            return Err(ScriptError::Asset { path, message: format!("empty or degenerate bounding box {ext:?}") });
         }
         for &name in categories {
             let Some(c) = cat.category_mut(name) else {
@@ -75,17 +66,9 @@ pub fn with_models(mut cat: Catalogue, dir: &Path) -> Result<Catalogue, ScriptEr
             };
             // Flat things keep their width; everything else its height.
             let flat = c.size[1] < 0.05;
-            let scale = if flat {
-                c.size[0] / ext[0]
-            } else {
-                c.size[1] / ext[1]
-            };
+            let scale = if flat { c.size[0] / ext[0] } else { c.size[1] / ext[1] };
             // A flat thing keeps its catalogue thickness too (a rug must not grow into a step).
-            let size = [
-                ext[0] * scale,
-                if flat { c.size[1] } else { ext[1] * scale },
-                ext[2] * scale,
-            ];
+            let size = [ext[0] * scale, if flat { c.size[1] } else { ext[1] * scale }, ext[2] * scale];
             // Contact points keep their place relative to the box.
             for p in &mut c.contacts {
                 for ((l, new), old) in p.local.iter_mut().zip(size).zip(c.size) {
@@ -94,15 +77,7 @@ pub fn with_models(mut cat: Catalogue, dir: &Path) -> Result<Catalogue, ScriptEr
             }
             c.size = size;
             c.model = Some(stem.to_string());
-            cat.set_model(
-                name,
-                ModelInfo {
-                    path: path.clone(),
-                    min,
-                    max,
-                    scale,
-                },
-            );
+            cat.set_model(name, ModelInfo { path: path.clone(), min, max, scale });
         }
     }
     Ok(cat)
@@ -111,40 +86,17 @@ pub fn with_models(mut cat: Catalogue, dir: &Path) -> Result<Catalogue, ScriptEr
 /// Bounding box (min, max) of a binary glTF's meshes in model units, after node transforms.
 pub fn glb_bounds(bytes: &[u8]) -> Result<([f32; 3], [f32; 3]), String> {
     let json = glb_json(bytes)?;
-    let nodes = json
-        .get("nodes")
-        .and_then(Value::as_array)
-        .cloned()
-        .unwrap_or_default();
-    let meshes = json
-        .get("meshes")
-        .and_then(Value::as_array)
-        .ok_or("no meshes")?;
-    let accessors = json
-        .get("accessors")
-        .and_then(Value::as_array)
-        .ok_or("no accessors")?;
+    let nodes = json.get("nodes").and_then(Value::as_array).cloned().unwrap_or_default();
+    let meshes = json.get("meshes").and_then(Value::as_array).ok_or("no meshes")?;
+    let accessors = json.get("accessors").and_then(Value::as_array).ok_or("no accessors")?;
     // Roots: the default scene's nodes, else every node that is nobody's child.
     let scene = json.get("scene").and_then(Value::as_u64).unwrap_or(0) as usize;
-    let roots: Vec<usize> = match json
-        .get("scenes")
-        .and_then(|s| s.get(scene))
-        .and_then(|s| s.get("nodes"))
-    {
-        Some(Value::Array(a)) => a
-            .iter()
-            .filter_map(Value::as_u64)
-            .map(|i| i as usize)
-            .collect(),
+    let roots: Vec<usize> = match json.get("scenes").and_then(|s| s.get(scene)).and_then(|s| s.get("nodes")) {
+        Some(Value::Array(a)) => a.iter().filter_map(Value::as_u64).map(|i| i as usize).collect(),
         _ => {
             let children: Vec<usize> = nodes
                 .iter()
-                .flat_map(|n| {
-                    n.get("children")
-                        .and_then(Value::as_array)
-                        .cloned()
-                        .unwrap_or_default()
-                })
+                .flat_map(|n| n.get("children").and_then(Value::as_array).cloned().unwrap_or_default())
                 .filter_map(|c| c.as_u64().map(|c| c as usize))
                 .collect();
             (0..nodes.len()).filter(|i| !children.contains(i)).collect()
@@ -152,36 +104,20 @@ pub fn glb_bounds(bytes: &[u8]) -> Result<([f32; 3], [f32; 3]), String> {
     };
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    let mut stack: Vec<(usize, Mat4, usize)> =
-        roots.into_iter().map(|r| (r, Mat4::IDENTITY, 0)).collect();
+    let mut stack: Vec<(usize, Mat4, usize)> = roots.into_iter().map(|r| (r, Mat4::IDENTITY, 0)).collect();
     while let Some((i, parent, depth)) = stack.pop() {
         if depth > 64 {
             return Err("node hierarchy deeper than 64 (a cycle?)".into());
         }
-        let node = nodes
-            .get(i)
-            .ok_or_else(|| format!("node {i} does not exist"))?;
+        let node = nodes.get(i).ok_or_else(|| format!("node {i} does not exist"))?;
         let world = parent * local_matrix(node)?;
         if let Some(m) = node.get("mesh").and_then(Value::as_u64) {
-            let mesh = meshes
-                .get(m as usize)
-                .ok_or_else(|| format!("mesh {m} does not exist"))?;
-            for prim in mesh
-                .get("primitives")
-                .and_then(Value::as_array)
-                .into_iter()
-                .flatten()
-            {
-                let Some(acc) = prim
-                    .get("attributes")
-                    .and_then(|a| a.get("POSITION"))
-                    .and_then(Value::as_u64)
-                else {
+            let mesh = meshes.get(m as usize).ok_or_else(|| format!("mesh {m} does not exist"))?;
+            for prim in mesh.get("primitives").and_then(Value::as_array).into_iter().flatten() {
+                let Some(acc) = prim.get("attributes").and_then(|a| a.get("POSITION")).and_then(Value::as_u64) else {
                     continue;
                 };
-                let a = accessors
-                    .get(acc as usize)
-                    .ok_or_else(|| format!("accessor {acc} does not exist"))?;
+                let a = accessors.get(acc as usize).ok_or_else(|| format!("accessor {acc} does not exist"))?;
                 let (amin, amax) = (vec3(a.get("min")), vec3(a.get("max")));
                 let (Some(amin), Some(amax)) = (amin, amax) else {
                     return Err(format!("POSITION accessor {acc} has no min/max"));
@@ -198,12 +134,7 @@ pub fn glb_bounds(bytes: &[u8]) -> Result<([f32; 3], [f32; 3]), String> {
                 }
             }
         }
-        for c in node
-            .get("children")
-            .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-        {
+        for c in node.get("children").and_then(Value::as_array).into_iter().flatten() {
             let c = c.as_u64().ok_or("bad child index")? as usize;
             stack.push((c, world, depth + 1));
         }
@@ -233,27 +164,18 @@ fn glb_json(bytes: &[u8]) -> Result<Value, String> {
     if u32_at(16)? != 0x4E4F_534A {
         return Err("first chunk is not JSON".into());
     }
-    let chunk = bytes
-        .get(20..20 + len)
-        .ok_or_else(|| format!("JSON chunk of {len} bytes runs past the file end"))?;
+    let chunk = bytes.get(20..20 + len).ok_or_else(|| format!("JSON chunk of {len} bytes runs past the file end"))?;
     serde_json::from_slice(chunk).map_err(|e| format!("JSON chunk: {e}"))
 }
 
 fn vec3(v: Option<&Value>) -> Option<Vec3> {
     let a = v?.as_array()?;
-    Some(Vec3::new(
-        a.first()?.as_f64()? as f32,
-        a.get(1)?.as_f64()? as f32,
-        a.get(2)?.as_f64()? as f32,
-    ))
+    Some(Vec3::new(a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32, a.get(2)?.as_f64()? as f32))
 }
 
 fn floats<const N: usize>(v: Option<&Value>) -> Result<Option<[f32; N]>, String> {
     let Some(v) = v else { return Ok(None) };
-    let a = v
-        .as_array()
-        .filter(|a| a.len() == N)
-        .ok_or_else(|| format!("expected {N} numbers"))?;
+    let a = v.as_array().filter(|a| a.len() == N).ok_or_else(|| format!("expected {N} numbers"))?;
     let mut out = [0.0; N];
     for (o, x) in out.iter_mut().zip(a) {
         *o = x.as_f64().ok_or("expected a number")? as f32;
@@ -268,11 +190,7 @@ fn local_matrix(node: &Value) -> Result<Mat4, String> {
     let t = floats::<3>(node.get("translation"))?.unwrap_or([0.0; 3]);
     let r = floats::<4>(node.get("rotation"))?.unwrap_or([0.0, 0.0, 0.0, 1.0]);
     let s = floats::<3>(node.get("scale"))?.unwrap_or([1.0; 3]);
-    Ok(Mat4::from_scale_rotation_translation(
-        Vec3::from(s),
-        Quat::from_array(r).normalize(),
-        Vec3::from(t),
-    ))
+    Ok(Mat4::from_scale_rotation_translation(Vec3::from(s), Quat::from_array(r).normalize(), Vec3::from(t)))
 }
 
 #[cfg(test)]

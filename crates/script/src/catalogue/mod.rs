@@ -120,21 +120,11 @@ impl Catalogue {
                 room_words.entry(w.to_lowercase()).or_insert(i);
             }
         }
-        Catalogue {
-            categories,
-            rooms,
-            words,
-            room_words,
-            classes: HashMap::new(),
-            models: HashMap::new(),
-        }
+        Catalogue { categories, rooms, words, room_words, classes: HashMap::new(), models: HashMap::new() }
     }
 
     /// Sets the class of categories (`(category, class)` pairs); a category without one is its own class.
-    pub fn with_classes<'a>(
-        mut self,
-        pairs: impl IntoIterator<Item = (&'a str, &'a str)>,
-    ) -> Catalogue {
+    pub fn with_classes<'a>(mut self, pairs: impl IntoIterator<Item = (&'a str, &'a str)>) -> Catalogue {
         for (c, k) in pairs {
             self.classes.insert(c.to_string(), k.to_string());
         }
@@ -143,10 +133,7 @@ impl Catalogue {
 
     /// The class of a category ("desk" → "table"); the name itself when it has none.
     pub fn class_of<'a>(&'a self, category: &'a str) -> &'a str {
-        self.classes
-            .get(category)
-            .map(String::as_str)
-            .unwrap_or(category)
+        self.classes.get(category).map(String::as_str).unwrap_or(category)
     }
 
     /// How well two categories match (§4.1: "same category or class"): 1 equal, 0.5 classmates, 0.
@@ -196,16 +183,12 @@ impl Catalogue {
 
     /// The category a (singular, lower-case) noun names, through synonyms.
     pub fn resolve(&self, word: &str) -> Option<&Category> {
-        self.words
-            .get(&word.to_lowercase())
-            .map(|&i| &self.categories[i])
+        self.words.get(&word.to_lowercase()).map(|&i| &self.categories[i])
     }
 
     /// The room kind a noun names ("office", "meetingroom").
     pub fn resolve_room(&self, word: &str) -> Option<&RoomKind> {
-        self.room_words
-            .get(&word.to_lowercase())
-            .map(|&i| &self.rooms[i])
+        self.room_words.get(&word.to_lowercase()).map(|&i| &self.rooms[i])
     }
 
     /// A category by its canonical name.
@@ -223,9 +206,6 @@ impl Catalogue {
 
     /// Every word the catalogue knows (objects and rooms), for "did you mean" suggestions.
     pub fn known_words(&self) -> impl Iterator<Item = &str> {
-        self.words
-            .keys()
-            .chain(self.room_words.keys())
-            .map(String::as_str)
+        self.words.keys().chain(self.room_words.keys()).map(String::as_str)
     }
 }

@@ -49,10 +49,7 @@ fn top(p: &Placement) -> f32 {
 /// Per-axis footprint separation (x, z): negative when the projections overlap.
 fn separation(a: &Placement, b: &Placement) -> [f32; 2] {
     let (ha, hb) = (half_xz(a), half_xz(b));
-    [
-        (a.position[0] - b.position[0]).abs() - ha[0] - hb[0],
-        (a.position[2] - b.position[2]).abs() - ha[1] - hb[1],
-    ]
+    [(a.position[0] - b.position[0]).abs() - ha[0] - hb[0], (a.position[2] - b.position[2]).abs() - ha[1] - hb[1]]
 }
 
 /// Euclidean distance between the two footprints, 0 when they touch or overlap.
@@ -68,8 +65,7 @@ fn footprints_overlap(a: &Placement, b: &Placement) -> bool {
 
 fn centre_inside(a: &Placement, b: &Placement) -> bool {
     let hb = half_xz(b);
-    (a.position[0] - b.position[0]).abs() <= hb[0] + 1e-4
-        && (a.position[2] - b.position[2]).abs() <= hb[1] + 1e-4
+    (a.position[0] - b.position[0]).abs() <= hb[0] + 1e-4 && (a.position[2] - b.position[2]).abs() <= hb[1] + 1e-4
 }
 
 fn footprint_inside(a: &Placement, b: &Placement) -> bool {
@@ -100,11 +96,7 @@ fn in_front(a: &Placement, b: &Placement, sign: f32) -> bool {
 pub fn holds(rel: Relation, a: &Placement, b: &Placement) -> bool {
     match rel {
         Relation::On => (a.position[1] - top(b)).abs() <= EPS && centre_inside(a, b),
-        Relation::In => {
-            footprint_inside(a, b)
-                && a.position[1] >= b.position[1] - EPS
-                && a.position[1] < top(b) - EPS
-        }
+        Relation::In => footprint_inside(a, b) && a.position[1] >= b.position[1] - EPS && a.position[1] < top(b) - EPS,
         Relation::Under => {
             footprints_overlap(a, b)
                 && (top(a) <= b.position[1] + EPS || (centre_inside(a, b) && top(a) < top(b) - EPS))
@@ -112,9 +104,7 @@ pub fn holds(rel: Relation, a: &Placement, b: &Placement) -> bool {
         Relation::Above => a.position[1] >= top(b) - EPS && footprints_overlap(a, b),
         Relation::InFrontOf => in_front(a, b, 1.0),
         Relation::Behind => in_front(a, b, -1.0),
-        Relation::NextTo => {
-            gap(a, b) <= NEXT_GAP && a.position[1] < top(b) - EPS && b.position[1] < top(a) - EPS
-        }
+        Relation::NextTo => gap(a, b) <= NEXT_GAP && a.position[1] < top(b) - EPS && b.position[1] < top(a) - EPS,
         Relation::Near => gap(a, b) <= NEAR_GAP,
     }
 }
@@ -160,12 +150,7 @@ pub fn strongest(a: &Placement, b: &Placement) -> Option<Relation> {
 /// specific relation of the two directions; on a tie the larger footprint is the anchor ("a chair
 /// in front of a desk", not the other way round), then the lower index is active.
 pub fn derive_relations(placements: &[Placement]) -> Vec<RelationNode> {
-    let rank = |r: Relation| {
-        SPECIFICITY
-            .iter()
-            .position(|&x| x == r)
-            .unwrap_or(usize::MAX)
-    };
+    let rank = |r: Relation| SPECIFICITY.iter().position(|&x| x == r).unwrap_or(usize::MAX);
     let area = |p: &Placement| p.size[0] * p.size[2];
     let mut out = Vec::new();
     for i in 0..placements.len() {
@@ -185,12 +170,7 @@ pub fn derive_relations(placements: &[Placement]) -> Vec<RelationNode> {
                 }),
             };
             if let Some((relation, active, anchor)) = pick {
-                out.push(RelationNode {
-                    relation,
-                    active,
-                    anchor,
-                    sentence: 0,
-                });
+                out.push(RelationNode { relation, active, anchor, sentence: 0 });
             }
         }
     }
@@ -202,11 +182,7 @@ mod tests {
     use super::*;
 
     fn p(x: f32, y: f32, z: f32, yaw: f32, size: [f32; 3]) -> Placement {
-        Placement {
-            position: [x, y, z],
-            yaw,
-            size,
-        }
+        Placement { position: [x, y, z], yaw, size }
     }
 
     #[test]
@@ -222,10 +198,7 @@ mod tests {
         assert_eq!(strongest(&chair, &desk), Some(Relation::InFrontOf));
         // The desk is in front of the chair too (the chair faces it); the larger one anchors.
         let rel = derive_relations(&[chair.clone(), desk.clone()]);
-        assert_eq!(
-            (rel[0].relation, rel[0].active, rel[0].anchor),
-            (Relation::InFrontOf, 0, 1)
-        );
+        assert_eq!((rel[0].relation, rel[0].active, rel[0].anchor), (Relation::InFrontOf, 0, 1));
         let bin = p(2.9, 0.0, 1.0, 0.0, [0.35, 0.5, 0.35]);
         assert!(holds(Relation::NextTo, &bin, &desk));
         assert!(!holds(Relation::NextTo, &cup, &desk));
@@ -238,25 +211,9 @@ mod tests {
         assert!(holds(Relation::In, &book, &shelf));
         // A turned desk faces +x: the chair must be on its +x side.
         let turned = p(2.0, 0.0, 1.0, std::f32::consts::FRAC_PI_2, [1.4, 0.75, 0.7]);
-        assert!(holds(
-            Relation::InFrontOf,
-            &p(2.7, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]),
-            &turned
-        ));
-        assert!(holds(
-            Relation::Behind,
-            &p(1.3, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]),
-            &turned
-        ));
-        assert!(holds(
-            Relation::Near,
-            &p(3.9, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]),
-            &desk
-        ));
-        assert!(!holds(
-            Relation::Near,
-            &p(4.5, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]),
-            &desk
-        ));
+        assert!(holds(Relation::InFrontOf, &p(2.7, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]), &turned));
+        assert!(holds(Relation::Behind, &p(1.3, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]), &turned));
+        assert!(holds(Relation::Near, &p(3.9, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]), &desk));
+        assert!(!holds(Relation::Near, &p(4.5, 0.0, 1.0, 0.0, [0.5, 0.9, 0.5]), &desk));
     }
 }

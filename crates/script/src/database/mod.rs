@@ -56,10 +56,7 @@ impl DbScene {
                 out.push(format!("{}: {} outside the room", self.name, label(i)));
             }
             for (j, q) in self.placements.iter().enumerate().skip(i + 1) {
-                if geometry::overlaps(p, q)
-                    && !holds(Relation::In, p, q)
-                    && !holds(Relation::In, q, p)
-                {
+                if geometry::overlaps(p, q) && !holds(Relation::In, p, q) && !holds(Relation::In, q, p) {
                     out.push(format!("{}: {} overlaps {}", self.name, label(i), label(j)));
                 }
             }
@@ -94,11 +91,7 @@ impl SceneDatabase {
     /// are installed; layout re-sizes what it places.
     pub fn builtin(cat: &Catalogue, variations_per_room: usize, seed: u64) -> SceneDatabase {
         let boxes = crate::catalogue::builtin::builtin();
-        let cat = if cat
-            .categories()
-            .iter()
-            .all(|c| boxes.get(&c.name).is_some_and(|b| b.size == c.size))
-        {
+        let cat = if cat.categories().iter().all(|c| boxes.get(&c.name).is_some_and(|b| b.size == c.size)) {
             cat
         } else {
             &boxes
@@ -128,11 +121,7 @@ impl SceneDatabase {
 pub fn authored_relations(cat: &Catalogue) -> Vec<(String, NodeId, Relation, NodeId)> {
     scenes::authored(cat)
         .into_iter()
-        .flat_map(|a| {
-            a.intended
-                .into_iter()
-                .map(move |(x, r, y)| (a.name.to_string(), x, r, y))
-        })
+        .flat_map(|a| a.intended.into_iter().map(move |(x, r, y)| (a.name.to_string(), x, r, y)))
         .collect()
 }
 
@@ -150,11 +139,7 @@ pub(crate) struct Item {
 
 impl Item {
     fn placement(&self) -> Placement {
-        Placement {
-            position: self.position,
-            yaw: self.yaw,
-            size: self.size,
-        }
+        Placement { position: self.position, yaw: self.yaw, size: self.size }
     }
 }
 
@@ -171,18 +156,8 @@ fn to_scene(name: String, room: Room, items: &[Item]) -> DbScene {
         })
         .collect();
     let relations = derive_relations(&placements);
-    let ssg = Ssg {
-        room: Some(room.name.clone()),
-        objects,
-        relations,
-        ..Ssg::default()
-    };
-    DbScene {
-        name,
-        room,
-        ssg,
-        placements,
-    }
+    let ssg = Ssg { room: Some(room.name.clone()), objects, relations, ..Ssg::default() };
+    DbScene { name, room, ssg, placements }
 }
 
 /// Recovers parents from geometry: the object something rests on (the highest), else sits in.
@@ -192,11 +167,8 @@ fn items_of(scene: &DbScene) -> Vec<Item> {
         .map(|i| {
             let on = (0..p.len())
                 .filter(|&j| j != i && holds(Relation::On, &p[i], &p[j]))
-                .max_by(|&a, &b| {
-                    (p[a].position[1] + p[a].size[1]).total_cmp(&(p[b].position[1] + p[b].size[1]))
-                });
-            let parent =
-                on.or_else(|| (0..p.len()).find(|&j| j != i && holds(Relation::In, &p[i], &p[j])));
+                .max_by(|&a, &b| (p[a].position[1] + p[a].size[1]).total_cmp(&(p[b].position[1] + p[b].size[1])));
+            let parent = on.or_else(|| (0..p.len()).find(|&j| j != i && holds(Relation::In, &p[i], &p[j])));
             let o = &scene.ssg.objects[i];
             Item {
                 category: o.category.clone(),
@@ -226,8 +198,7 @@ fn settle(items: &mut [Item], old: &[Item]) {
     for _ in 0..4 {
         for i in 0..items.len() {
             if let Some(p) = items[i].parent {
-                let was_on = (old[i].position[1] - (old[p].position[1] + old[p].size[1])).abs()
-                    <= geometry::EPS;
+                let was_on = (old[i].position[1] - (old[p].position[1] + old[p].size[1])).abs() <= geometry::EPS;
                 if was_on {
                     items[i].position[1] = items[p].position[1] + items[p].size[1];
                 }
@@ -328,11 +299,7 @@ pub fn vary(base: &DbScene, cat: &Catalogue, seed: u64) -> DbScene {
         let mates: Vec<_> = cat
             .categories()
             .iter()
-            .filter(|c| {
-                c.name != items[i].category
-                    && cat.class_of(&c.name) == class
-                    && Some(c.support) == support
-            })
+            .filter(|c| c.name != items[i].category && cat.class_of(&c.name) == class && Some(c.support) == support)
             .collect();
         if mates.is_empty() {
             continue;
@@ -357,10 +324,8 @@ pub fn vary(base: &DbScene, cat: &Catalogue, seed: u64) -> DbScene {
         try_change(&mut items, next);
     }
     for i in 0..items.len() {
-        let floor = items[i].parent.is_none()
-            && cat
-                .get(&items[i].category)
-                .is_some_and(|c| c.support == Support::Floor);
+        let floor =
+            items[i].parent.is_none() && cat.get(&items[i].category).is_some_and(|c| c.support == Support::Floor);
         if !floor {
             continue;
         }
@@ -383,10 +348,7 @@ pub fn vary(base: &DbScene, cat: &Catalogue, seed: u64) -> DbScene {
         for _attempt in 0..10 {
             let mut next = items.clone();
             let surfaces: Vec<usize> = (0..items.len())
-                .filter(|&k| {
-                    cat.get(&items[k].category).is_some_and(|c| c.surface)
-                        && items[k].parent.is_none()
-                })
+                .filter(|&k| cat.get(&items[k].category).is_some_and(|c| c.surface) && items[k].parent.is_none())
                 .collect();
             if !surfaces.is_empty() && rng.random_bool(0.6) {
                 let p = surfaces[rng.random_range(0..surfaces.len())];

@@ -26,39 +26,13 @@ struct B<'a> {
 
 impl<'a> B<'a> {
     fn new(cat: &'a Catalogue, name: &'static str) -> B<'a> {
-        let kind = cat
-            .resolve_room(name)
-            .unwrap_or_else(|| panic!("room kind {name}"));
-        let room = Room {
-            name: kind.name.clone(),
-            width: kind.size[0],
-            depth: kind.size[2],
-            height: kind.size[1],
-        };
-        B {
-            cat,
-            a: Authored {
-                name,
-                room,
-                items: Vec::new(),
-                intended: Vec::new(),
-            },
-        }
+        let kind = cat.resolve_room(name).unwrap_or_else(|| panic!("room kind {name}"));
+        let room = Room { name: kind.name.clone(), width: kind.size[0], depth: kind.size[2], height: kind.size[1] };
+        B { cat, a: Authored { name, room, items: Vec::new(), intended: Vec::new() } }
     }
 
-    fn push(
-        &mut self,
-        c: &str,
-        attrs: &[&str],
-        pos: [f32; 3],
-        yaw: f32,
-        parent: Option<usize>,
-    ) -> usize {
-        let size = self
-            .cat
-            .get(c)
-            .unwrap_or_else(|| panic!("category {c}"))
-            .size;
+    fn push(&mut self, c: &str, attrs: &[&str], pos: [f32; 3], yaw: f32, parent: Option<usize>) -> usize {
+        let size = self.cat.get(c).unwrap_or_else(|| panic!("category {c}")).size;
         self.a.items.push(Item {
             category: c.to_string(),
             attributes: attrs.iter().map(|s| s.to_string()).collect(),

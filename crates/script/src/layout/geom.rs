@@ -81,7 +81,12 @@ pub fn corners(o: &PlacedObject) -> [[f32; 2]; 4] {
 /// Whether two footprints (oriented rectangles) overlap by more than [`EPS`], by separating axes.
 pub fn footprints_overlap(a: &PlacedObject, b: &PlacedObject) -> bool {
     let (ca, cb) = (corners(a), corners(b));
-    let axes = [forward(a.yaw), forward(a.yaw + std::f32::consts::FRAC_PI_2), forward(b.yaw), forward(b.yaw + std::f32::consts::FRAC_PI_2)];
+    let axes = [
+        forward(a.yaw),
+        forward(a.yaw + std::f32::consts::FRAC_PI_2),
+        forward(b.yaw),
+        forward(b.yaw + std::f32::consts::FRAC_PI_2),
+    ];
     for ax in axes {
         let proj = |pts: &[[f32; 2]; 4]| {
             let mut lo = f32::INFINITY;

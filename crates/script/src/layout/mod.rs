@@ -124,9 +124,7 @@ pub fn strictly_holds(rel: Relation, active: &PlacedObject, anchor: &PlacedObjec
     let held = match rel {
         Relation::On => (active.position[1] - anchor.top()).abs() <= EPS && geom::center_inside(active, anchor),
         Relation::Near => gap <= NEAR_GAP - EPS,
-        Relation::NextTo => {
-            gap <= NEXT_TO_GAP - EPS && c[1].abs() < h[1] + ad && c[0].abs() >= h[0] + aw - EPS
-        }
+        Relation::NextTo => gap <= NEXT_TO_GAP - EPS && c[1].abs() < h[1] + ad && c[0].abs() >= h[0] + aw - EPS,
         Relation::InFrontOf => c[1] - h[1] >= ad - EPS && gap <= FRONT_GAP - EPS && centred,
         Relation::Behind => c[1] + h[1] <= -ad + EPS && gap <= FRONT_GAP - EPS && centred,
         Relation::Under => {
@@ -262,7 +260,8 @@ pub fn solve(problem: &LayoutProblem, seed: u64) -> LayoutOutcome {
     let order = placement_order(problem);
     let mut best: Option<(usize, usize, LayoutOutcome)> = None;
     for attempt in 0..ATTEMPTS {
-        let out = Solver::new(problem, inbetween_core::seed::rng(inbetween_core::seed::derive(seed, attempt as u64))).run(&order);
+        let out = Solver::new(problem, inbetween_core::seed::rng(inbetween_core::seed::derive(seed, attempt as u64)))
+            .run(&order);
         let key = (out.dropped.len(), out.violations.total());
         if best.as_ref().is_none_or(|(d, v, _)| key < (*d, *v)) {
             let done = key == (0, 0);
@@ -287,7 +286,12 @@ fn placement_order(p: &LayoutProblem) -> Vec<usize> {
     for _ in 0..n {
         let mut changed = false;
         for c in &p.relations {
-            if c.active < n && c.anchor < n && c.active != c.anchor && depth[c.active] < depth[c.anchor] + 1 && depth[c.anchor] < n {
+            if c.active < n
+                && c.anchor < n
+                && c.active != c.anchor
+                && depth[c.active] < depth[c.anchor] + 1
+                && depth[c.anchor] < n
+            {
                 depth[c.active] = depth[c.anchor] + 1;
                 changed = true;
             }
@@ -374,7 +378,11 @@ impl<'a, R: Rng> Solver<'a, R> {
             if self.p.items[i].pinned.is_none() {
                 continue;
             }
-            let Some((position, yaw)) = self.poses[i].as_ref().filter(|o| o.support.is_none()).map(|o| (o.position, o.yaw)) else { continue };
+            let Some((position, yaw)) =
+                self.poses[i].as_ref().filter(|o| o.support.is_none()).map(|o| (o.position, o.yaw))
+            else {
+                continue;
+            };
             let support = self.support_at(i, position, yaw);
             if let Some(o) = self.poses[i].as_mut() {
                 o.support = support;
@@ -400,9 +408,19 @@ impl<'a, R: Rng> Solver<'a, R> {
         if self.p.items[j].pinned.is_some() {
             return;
         }
-        let others_lean = self.poses.iter().enumerate().any(|(k, o)| k != i && k != j && o.as_ref().is_some_and(|o| o.support == Some(j)))
+        let others_lean = self
+            .poses
+            .iter()
+            .enumerate()
+            .any(|(k, o)| k != i && k != j && o.as_ref().is_some_and(|o| o.support == Some(j)))
             || self.p.relations.iter().any(|r| {
-                let other = if r.anchor == j { r.active } else if r.active == j { r.anchor } else { return false };
+                let other = if r.anchor == j {
+                    r.active
+                } else if r.active == j {
+                    r.anchor
+                } else {
+                    return false;
+                };
                 other != i && self.poses[other].is_some()
             });
         if others_lean {
@@ -441,7 +459,9 @@ impl<'a, R: Rng> Solver<'a, R> {
             .relations
             .iter()
             .filter(|c| c.active < n && c.anchor < n && c.active != c.anchor)
-            .filter(|c| (c.active == i && self.poses[c.anchor].is_some()) || (c.anchor == i && self.poses[c.active].is_some()))
+            .filter(|c| {
+                (c.active == i && self.poses[c.anchor].is_some()) || (c.anchor == i && self.poses[c.active].is_some())
+            })
             .copied()
             .collect()
     }
@@ -451,7 +471,13 @@ impl<'a, R: Rng> Solver<'a, R> {
         let r = &self.p.room;
         let finite = |v: &[f32]| v.iter().all(|x| x.is_finite() && *x > 0.0);
         if !finite(&[r.width, r.depth, r.height]) {
-            self.dropped.push((i, format!("cannot place '{}': the room's size {} × {} × {} m is not usable", item.label, r.width, r.depth, r.height)));
+            self.dropped.push((
+                i,
+                format!(
+                    "cannot place '{}': the room's size {} × {} × {} m is not usable",
+                    item.label, r.width, r.depth, r.height
+                ),
+            ));
             return;
         }
         if !finite(&item.size) {
@@ -517,7 +543,8 @@ impl<'a, R: Rng> Solver<'a, R> {
             Support::Wall => "free wall space",
             Support::Ceiling => "free ceiling space",
         };
-        self.dropped.push((i, format!("no {space} for '{}' in the {:.1} × {:.1} m room", item.label, r.width, r.depth)));
+        self.dropped
+            .push((i, format!("no {space} for '{}' in the {:.1} × {:.1} m room", item.label, r.width, r.depth)));
     }
 
     /// Item indices (placed, plus `extra`) that cannot be walked up to.
@@ -536,12 +563,8 @@ impl<'a, R: Rng> Solver<'a, R> {
         }
         // Supports are item indices here; only their presence matters to reachability.
         let pos = |item: usize| ids.iter().position(|&k| k == item);
-        let rels: Vec<(Relation, usize, usize)> = self
-            .p
-            .relations
-            .iter()
-            .filter_map(|c| Some((c.relation, pos(c.active)?, pos(c.anchor)?)))
-            .collect();
+        let rels: Vec<(Relation, usize, usize)> =
+            self.p.relations.iter().filter_map(|c| Some((c.relation, pos(c.active)?, pos(c.anchor)?))).collect();
         unreachable(&self.p.room, &objs, &rels).into_iter().map(|k| ids[k]).collect()
     }
 
@@ -569,12 +592,15 @@ impl<'a, R: Rng> Solver<'a, R> {
         if position[1] < 0.05 {
             return None;
         }
-        let probe = PlacedObject { position, yaw, ..self.object(i, &Pose { position, yaw, support: None, penalty: 0.0 }) };
+        let probe =
+            PlacedObject { position, yaw, ..self.object(i, &Pose { position, yaw, support: None, penalty: 0.0 }) };
         self.poses
             .iter()
             .enumerate()
             .filter(|&(j, _)| j != i)
-            .find(|(_, o)| o.as_ref().is_some_and(|o| (o.top() - position[1]).abs() <= EPS && geom::center_inside(&probe, o)))
+            .find(|(_, o)| {
+                o.as_ref().is_some_and(|o| (o.top() - position[1]).abs() <= EPS && geom::center_inside(&probe, o))
+            })
             .map(|(j, _)| j)
     }
 
@@ -601,16 +627,21 @@ impl<'a, R: Rng> Solver<'a, R> {
             }
         }
         let generic_from = out.len();
-        let anchors_above_wall = self
-            .p
-            .relations
-            .iter()
-            .any(|c| c.anchor == i && c.relation == Relation::Above && self.p.items[c.active].support == Support::Wall);
+        let anchors_above_wall =
+            self.p.relations.iter().any(|c| {
+                c.anchor == i && c.relation == Relation::Above && self.p.items[c.active].support == Support::Wall
+            });
         let free = !self.p.relations.iter().any(|c| c.active == i);
         match item.support {
             Support::Floor => {
                 // Free furniture goes against walls; anchors of wall pictures "above" must.
-                let wall_weight = if anchors_above_wall { 8.0 } else if free { 0.6 } else { 0.0 };
+                let wall_weight = if anchors_above_wall {
+                    8.0
+                } else if free {
+                    0.6
+                } else {
+                    0.0
+                };
                 self.wall_candidates(i, 0.0, 10, 0.0, &mut out);
                 self.interior_candidates(i, 16, wall_weight, &mut out);
             }
@@ -669,7 +700,13 @@ impl<'a, R: Rng> Solver<'a, R> {
                 continue;
             }
             for s in 0..per_wall {
-                let t = if s == 0 { w / 2.0 } else if s == 1 { len - w / 2.0 } else { self.rng.random_range(w / 2.0..=len - w / 2.0) };
+                let t = if s == 0 {
+                    w / 2.0
+                } else if s == 1 {
+                    len - w / 2.0
+                } else {
+                    self.rng.random_range(w / 2.0..=len - w / 2.0)
+                };
                 let (x, z) = match k {
                     0 => (t, d / 2.0),
                     1 => (t, r.depth - d / 2.0),
@@ -689,7 +726,17 @@ impl<'a, R: Rng> Solver<'a, R> {
         let x = if r.width > 2.0 * m { self.rng.random_range(m..r.width - m) } else { r.width / 2.0 };
         let z = if r.depth > 2.0 * m { self.rng.random_range(m..r.depth - m) } else { r.depth / 2.0 };
         let (dx, dz) = (r.width / 2.0 - x, r.depth / 2.0 - z);
-        let yaw = if dx.abs() > dz.abs() { if dx > 0.0 { QUARTER } else { -QUARTER } } else if dz >= 0.0 { 0.0 } else { HALF };
+        let yaw = if dx.abs() > dz.abs() {
+            if dx > 0.0 {
+                QUARTER
+            } else {
+                -QUARTER
+            }
+        } else if dz >= 0.0 {
+            0.0
+        } else {
+            HALF
+        };
         Pose { position: [x, 0.0, z], yaw, support: None, penalty: 0.0 }
     }
 
@@ -709,7 +756,11 @@ impl<'a, R: Rng> Solver<'a, R> {
         let f = geom::forward(p.yaw);
         let back = [p.position[0] - f[0] * d, p.position[2] - f[1] * d];
         let along = if f[1].abs() >= f[0].abs() {
-            if f[1] > 0.0 { back[1] } else { r.depth - back[1] }
+            if f[1] > 0.0 {
+                back[1]
+            } else {
+                r.depth - back[1]
+            }
         } else if f[0] > 0.0 {
             back[0]
         } else {
@@ -740,7 +791,11 @@ impl<'a, R: Rng> Solver<'a, R> {
     /// A random offset that keeps an extent `inner` inside `outer` (0 when it cannot fit).
     fn random_within(&mut self, outer: f32, inner: f32) -> f32 {
         let room = (outer - inner) / 2.0;
-        if room > 1e-3 { self.rng.random_range(-room..room) } else { 0.0 }
+        if room > 1e-3 {
+            self.rng.random_range(-room..room)
+        } else {
+            0.0
+        }
     }
 
     /// Poses beside `other` on all four sides at a few gaps and the four yaws (for relations whose
@@ -754,7 +809,12 @@ impl<'a, R: Rng> Solver<'a, R> {
             let (s, c) = (yaw - other.yaw).sin_cos();
             let h = [w / 2.0 * c.abs() + d / 2.0 * s.abs(), w / 2.0 * s.abs() + d / 2.0 * c.abs()];
             for gap in [0.05, 0.25, 0.7] {
-                for l in [[0.0, od + h[1] + gap], [0.0, -(od + h[1] + gap)], [ow + h[0] + gap, 0.0], [-(ow + h[0] + gap), 0.0]] {
+                for l in [
+                    [0.0, od + h[1] + gap],
+                    [0.0, -(od + h[1] + gap)],
+                    [ow + h[0] + gap, 0.0],
+                    [-(ow + h[0] + gap), 0.0],
+                ] {
                     let p = geom::to_world(geom::center(other), other.yaw, l);
                     out.push(Pose { position: [p[0], y, p[1]], yaw, support: None, penalty: gap });
                 }
@@ -828,7 +888,12 @@ impl<'a, R: Rng> Solver<'a, R> {
                     let back = [ac[0] - f[0] * ad, ac[1] - f[1] * ad];
                     let y = (WALL_CENTER_HEIGHT - h / 2.0).max(anchor.top() + 0.1).min(self.p.room.height - h);
                     let r = &self.p.room;
-                    let walls = [(0.0, [back[0], d / 2.0]), (HALF, [back[0], r.depth - d / 2.0]), (QUARTER, [d / 2.0, back[1]]), (-QUARTER, [r.width - d / 2.0, back[1]])];
+                    let walls = [
+                        (0.0, [back[0], d / 2.0]),
+                        (HALF, [back[0], r.depth - d / 2.0]),
+                        (QUARTER, [d / 2.0, back[1]]),
+                        (-QUARTER, [r.width - d / 2.0, back[1]]),
+                    ];
                     for (yaw, p) in walls {
                         push(p, y, yaw, None, 0.0);
                     }
@@ -859,7 +924,9 @@ impl<'a, R: Rng> Solver<'a, R> {
             .p
             .relations
             .iter()
-            .filter_map(|c| Some((c.relation, placed.get(c.active).copied().flatten()?, placed.get(c.anchor).copied().flatten()?)))
+            .filter_map(|c| {
+                Some((c.relation, placed.get(c.active).copied().flatten()?, placed.get(c.anchor).copied().flatten()?))
+            })
             .collect();
         let violations = check(&self.p.room, &objects, &rels);
         let mut dropped = self.dropped;

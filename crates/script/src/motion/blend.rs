@@ -28,14 +28,7 @@ pub struct BlendParams {
 
 impl Default for BlendParams {
     fn default() -> BlendParams {
-        BlendParams {
-            start: 0,
-            end: None,
-            blend_in: 8,
-            blend_out: 8,
-            looping: true,
-            action_offset: 0,
-        }
+        BlendParams { start: 0, end: None, blend_in: 8, blend_out: 8, looping: true, action_offset: 0 }
     }
 }
 
@@ -51,11 +44,7 @@ impl BlendParams {
             let t = t.clamp(0.0, 1.0);
             t * t * (3.0 - 2.0 * t)
         };
-        let fade_in = if self.blend_in == 0 {
-            1.0
-        } else {
-            smooth((f - self.start + 1) as f64 / self.blend_in as f64)
-        };
+        let fade_in = if self.blend_in == 0 { 1.0 } else { smooth((f - self.start + 1) as f64 / self.blend_in as f64) };
         let fade_out = if self.blend_out == 0 || self.end.is_none() {
             1.0
         } else {
@@ -118,11 +107,7 @@ pub(crate) fn blend_upper_on(rig: &Rig, locomotion: &Motion, action: &Motion, pa
                 if !upper {
                     continue;
                 }
-                let target = if j == rig.lower_back {
-                    lb
-                } else {
-                    a.rotations[j]
-                };
+                let target = if j == rig.lower_back { lb } else { a.rotations[j] };
                 p.rotations[j] = p.rotations[j].slerp(target, w).normalize();
             }
             p
@@ -171,9 +156,5 @@ pub(crate) fn reach_contacts_on(rig: &Rig, m: &Motion, contacts: &[Contact]) -> 
             p
         })
         .collect();
-    (
-        Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses)
-            .expect("IK poses fit the skeleton"),
-        worst,
-    )
+    (Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("IK poses fit the skeleton"), worst)
 }

@@ -34,10 +34,7 @@ impl CmuTrial {
     }
 
     pub fn cgspeed_bvh(&self) -> Option<&str> {
-        self.files
-            .iter()
-            .map(|s| s.as_str())
-            .find(|f| f.starts_with("cgspeed/") && f.ends_with(".bvh"))
+        self.files.iter().map(|s| s.as_str()).find(|f| f.starts_with("cgspeed/") && f.ends_with(".bvh"))
     }
 }
 
@@ -57,18 +54,11 @@ pub fn read_index(path: &Path) -> Result<Vec<CmuTrial>, ScriptError> {
                 message: format!("line {}: expected 6 tab-separated columns", n + 1),
             });
         }
-        let bad = |what: &str| ScriptError::Asset {
-            path: path.into(),
-            message: format!("line {}: bad {what}", n + 1),
-        };
+        let bad = |what: &str| ScriptError::Asset { path: path.into(), message: format!("line {}: bad {what}", n + 1) };
         let files = cols
             .get(5)
             .map(|c| {
-                c.split(';')
-                    .map(|f| f.trim())
-                    .filter(|f| !f.is_empty() && !f.contains(' '))
-                    .map(String::from)
-                    .collect()
+                c.split(';').map(|f| f.trim()).filter(|f| !f.is_empty() && !f.contains(' ')).map(String::from).collect()
             })
             .unwrap_or_default();
         out.push(CmuTrial {
@@ -156,57 +146,27 @@ fn leg_length(s: &Skeleton, up: &str, leg: &str, foot: &str) -> Option<f64> {
 pub fn retarget(src: &Motion, rig: &Rig) -> Result<Motion, String> {
     let s = &src.skeleton;
     let max_style = s.find("LeftCollar").is_some() || s.find("LeftHip").is_some();
-    let names: Vec<String> = s
-        .joints()
-        .iter()
-        .map(|j| standard_name(&j.name, max_style))
-        .collect();
+    let names: Vec<String> = s.joints().iter().map(|j| standard_name(&j.name, max_style)).collect();
     let t = &rig.skeleton;
-    let map: Vec<Option<usize>> = t
-        .joints()
-        .iter()
-        .map(|j| names.iter().position(|n| *n == j.name))
-        .collect();
-    for need in [
-        "Hips",
-        "LeftUpLeg",
-        "LeftLeg",
-        "LeftFoot",
-        "RightFoot",
-        "LowerBack",
-        "LeftArm",
-        "RightArm",
-    ] {
+    let map: Vec<Option<usize>> = t.joints().iter().map(|j| names.iter().position(|n| *n == j.name)).collect();
+    for need in ["Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightFoot", "LowerBack", "LeftArm", "RightArm"] {
         if map[t.find(need).expect("standard joint")].is_none() {
             return Err(format!("no joint maps to {need}: not a CMU/cgspeed layout"));
         }
     }
     let src_leg = {
-        let find = |std: &str| {
-            names
-                .iter()
-                .position(|n| n == std)
-                .map(|i| s.joint(i).name.clone())
-                .unwrap_or_default()
-        };
-        leg_length(s, &find("LeftUpLeg"), &find("LeftLeg"), &find("LeftFoot"))
-            .ok_or("no left leg")?
+        let find = |std: &str| names.iter().position(|n| n == std).map(|i| s.joint(i).name.clone()).unwrap_or_default();
+        leg_length(s, &find("LeftUpLeg"), &find("LeftLeg"), &find("LeftFoot")).ok_or("no left leg")?
     };
     let tgt_leg = leg_length(t, "LeftUpLeg", "LeftLeg", "LeftFoot").expect("standard leg");
     let scale = tgt_leg / src_leg.max(1e-9);
     let corr: Vec<DQuat> = (0..t.len())
         .map(|j| match (map[j], bone_dir(t, j)) {
-            (Some(sj), Some(dt)) => bone_dir(s, sj)
-                .map(|ds| arc(dt, ds))
-                .unwrap_or(DQuat::IDENTITY),
+            (Some(sj), Some(dt)) => bone_dir(s, sj).map(|ds| arc(dt, ds)).unwrap_or(DQuat::IDENTITY),
             _ => DQuat::IDENTITY,
         })
         .collect();
-    let src = if (src.fps() - FPS).abs() > 1e-6 {
-        src.resample(FPS).map_err(|e| e.to_string())?
-    } else {
-        src.clone()
-    };
+    let src = if (src.fps() - FPS).abs() > 1e-6 { src.resample(FPS).map_err(|e| e.to_string())? } else { src.clone() };
     let mut poses: Vec<Pose> = Vec::with_capacity(src.num_frames());
     for f in 0..src.num_frames() {
         let g = forward(s, &src.pose(f));
@@ -258,17 +218,12 @@ pub(crate) fn grounded(rig: &Rig, t: &Skeleton, mut poses: Vec<Pose>) -> Result<
 /// Reads a CMU BVH and retargets it: cgspeed layouts with [`retarget`], Character Creator
 /// (iClone) layouts with [`super::cc::retarget_cc`] (its first frame, a T-pose, dropped).
 pub fn load_bvh(path: &Path, rig: &Rig) -> Result<Motion, ScriptError> {
-    let m = inbetween_io::read_bvh(path).map_err(|e| ScriptError::Asset {
-        path: path.into(),
-        message: e.to_string(),
-    })?;
+    let m =
+        inbetween_io::read_bvh(path).map_err(|e| ScriptError::Asset { path: path.into(), message: e.to_string() })?;
     let result = if m.skeleton.find("CC_Base_Hip").is_some() {
         super::cc::retarget_cc(&m, rig, false, true)
     } else {
         retarget(&m, rig)
     };
-    result.map_err(|message| ScriptError::Asset {
-        path: path.into(),
-        message,
-    })
+    result.map_err(|message| ScriptError::Asset { path: path.into(), message })
 }

@@ -107,7 +107,8 @@ pub fn cut_cycle(m: &Motion, rig: &Rig, cut: &CycleCut) -> Motion {
     let first = oriented(&poses[s]);
     let after = oriented(&poses[e]);
     // Per-joint seam error, removed progressively: corrected(f) = slerp(I, error⁻¹, f / period) · q(f).
-    let errors: Vec<DQuat> = first.rotations.iter().zip(&after.rotations).map(|(a, b)| (*b * a.inverse()).normalize()).collect();
+    let errors: Vec<DQuat> =
+        first.rotations.iter().zip(&after.rotations).map(|(a, b)| (*b * a.inverse()).normalize()).collect();
     let dy = after.translations[rig.hips].y - first.translations[rig.hips].y;
     let mut out: Vec<Pose> = (s..e)
         .map(|f| {
@@ -221,8 +222,14 @@ mod tests {
         let c = cycle.poses();
         let (clean, _) = captured_walk(&rig, 0.0, 1);
         let o = clean.poses();
-        let step = |a: &Pose, b: &Pose| (a.rotations[rig.spine1].angle_between(b.rotations[rig.spine1]), (a.translations[rig.hips].y - b.translations[rig.hips].y).abs());
-        let (max_turn, max_rise) = o.windows(2).map(|w| step(&w[0], &w[1])).fold((0.0f64, 0.0f64), |m, s| (m.0.max(s.0), m.1.max(s.1)));
+        let step = |a: &Pose, b: &Pose| {
+            (
+                a.rotations[rig.spine1].angle_between(b.rotations[rig.spine1]),
+                (a.translations[rig.hips].y - b.translations[rig.hips].y).abs(),
+            )
+        };
+        let (max_turn, max_rise) =
+            o.windows(2).map(|w| step(&w[0], &w[1])).fold((0.0f64, 0.0f64), |m, s| (m.0.max(s.0), m.1.max(s.1)));
         let (turn, rise) = step(&c[c.len() - 1], &c[0]);
         assert!(turn <= max_turn + 0.01, "spine {turn} vs {max_turn}");
         assert!(rise <= max_rise + 0.002, "hips {rise} vs {max_rise}");

@@ -26,11 +26,7 @@ pub fn two_bone(root: DVec3, mid: DVec3, end: DVec3, target: DVec3, pole: DVec3)
     let l2 = (end - mid).length();
     let to = target - root;
     let mut d = to.length();
-    let u = if d > 1e-12 {
-        to / d
-    } else {
-        (end - root).normalize_or(DVec3::NEG_Y)
-    };
+    let u = if d > 1e-12 { to / d } else { (end - root).normalize_or(DVec3::NEG_Y) };
     let (lo, hi) = ((l1 - l2).abs(), l1 + l2);
     let clamped = d > hi || d < lo;
     d = d.clamp(lo, hi);
@@ -43,18 +39,10 @@ pub fn two_bone(root: DVec3, mid: DVec3, end: DVec3, target: DVec3, pole: DVec3)
         n = u.any_orthonormal_vector();
     }
     let n = n.normalize();
-    let cos_a = if d > 1e-12 {
-        ((l1 * l1 + d * d - l2 * l2) / (2.0 * l1 * d)).clamp(-1.0, 1.0)
-    } else {
-        1.0
-    };
+    let cos_a = if d > 1e-12 { ((l1 * l1 + d * d - l2 * l2) / (2.0 * l1 * d)).clamp(-1.0, 1.0) } else { 1.0 };
     let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
     let mid_new = root + l1 * (cos_a * u + sin_a * n);
-    TwoBone {
-        mid: mid_new,
-        end: root + d * u,
-        clamped,
-    }
+    TwoBone { mid: mid_new, end: root + d * u, clamped }
 }
 
 /// Which limb of the standard skeleton.
@@ -118,10 +106,7 @@ pub fn solve_chain(
     let pc1 = sol.mid + r1 * (pc - pb);
     let r2 = arc(pc1 - sol.mid, sol.end - sol.mid);
     let gb = (r2 * r1 * g.rotations[b]).normalize();
-    let parent_a = skeleton
-        .parent(a)
-        .map(|p| g.rotations[p])
-        .unwrap_or(DQuat::IDENTITY);
+    let parent_a = skeleton.parent(a).map(|p| g.rotations[p]).unwrap_or(DQuat::IDENTITY);
     pose.rotations[a] = local_from_global(parent_a, ga);
     pose.rotations[b] = local_from_global(ga, gb);
     pose.rotations[c] = local_from_global(gb, g.rotations[c]);
@@ -129,21 +114,8 @@ pub fn solve_chain(
 }
 
 /// [`solve_chain`] on a limb of the standard rig.
-pub fn solve_limb(
-    rig: &Rig,
-    pose: &mut Pose,
-    limb: Limb,
-    target: DVec3,
-    pole: Option<DVec3>,
-) -> f64 {
-    solve_chain(
-        &rig.skeleton,
-        pose,
-        limb.chain(rig),
-        target,
-        pole,
-        limb.default_bend(),
-    )
+pub fn solve_limb(rig: &Rig, pose: &mut Pose, limb: Limb, target: DVec3, pole: Option<DVec3>) -> f64 {
+    solve_chain(&rig.skeleton, pose, limb.chain(rig), target, pole, limb.default_bend())
 }
 
 /// Height of the pelvis contact (midpoint of the hip joints) above the seat surface when sitting.

@@ -17,7 +17,8 @@ fn bad(path: &Path, message: impl Into<String>) -> ScriptError {
 /// The JSON and binary chunks of a `.glb` file.
 fn read_glb(path: &Path) -> Result<(Value, Vec<u8>), ScriptError> {
     let bytes = std::fs::read(path).map_err(|e| ScriptError::io(path, e))?;
-    let u32_at = |o: usize| -> Option<u32> { bytes.get(o..o + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) };
+    let u32_at =
+        |o: usize| -> Option<u32> { bytes.get(o..o + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) };
     if bytes.len() < 20 || &bytes[0..4] != b"glTF" {
         return Err(bad(path, "not a binary glTF (.glb) file"));
     }
@@ -120,7 +121,9 @@ pub fn read_animations(path: &Path) -> Result<Vec<(String, Motion)>, ScriptError
             let Some(s) = ch["sampler"].as_u64().and_then(|s| samplers.get(s as usize)) else { continue };
             let comps = if rotation { 4 } else { 3 };
             let (Some(ti), Some(vi)) = (s["input"].as_u64(), s["output"].as_u64()) else { continue };
-            let (Some(times), Some(values)) = (floats(&json, &bin, ti as usize, 1), floats(&json, &bin, vi as usize, comps)) else {
+            let (Some(times), Some(values)) =
+                (floats(&json, &bin, ti as usize, 1), floats(&json, &bin, vi as usize, comps))
+            else {
                 return Err(bad(path, format!("animation '{name}': unreadable keys")));
             };
             if times.is_empty() || values.len() != times.len() * comps {
@@ -225,7 +228,8 @@ fn node_matrix(node: &Value) -> glam::Mat4 {
         return glam::Mat4::from_cols_slice(&m);
     }
     let t = f("translation", 3).map_or(glam::Vec3::ZERO, |v| glam::Vec3::new(v[0], v[1], v[2]));
-    let r = f("rotation", 4).map_or(glam::Quat::IDENTITY, |v| glam::Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize());
+    let r =
+        f("rotation", 4).map_or(glam::Quat::IDENTITY, |v| glam::Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize());
     let s = f("scale", 3).map_or(glam::Vec3::ONE, |v| glam::Vec3::new(v[0], v[1], v[2]));
     glam::Mat4::from_scale_rotation_translation(s, r, t)
 }
@@ -261,24 +265,35 @@ fn material_image(path: &Path, json: &Value, bin: &[u8], m: &Value) -> Result<Op
     let Some(tex) = m["pbrMetallicRoughness"]["baseColorTexture"]["index"].as_u64() else { return Ok(None) };
     let Some(src) = json["textures"][tex as usize]["source"].as_u64() else { return Ok(None) };
     let img = &json["images"][src as usize];
-    let mime_of = |name: &str| if name.to_ascii_lowercase().ends_with(".jpg") || name.to_ascii_lowercase().ends_with(".jpeg") { "image/jpeg" } else { "image/png" };
+    let mime_of = |name: &str| {
+        if name.to_ascii_lowercase().ends_with(".jpg") || name.to_ascii_lowercase().ends_with(".jpeg") {
+            "image/jpeg"
+        } else {
+            "image/png"
+        }
+    };
     if let Some(v) = img["bufferView"].as_u64() {
         let view = &json["bufferViews"][v as usize];
-        let (off, len) = (view["byteOffset"].as_u64().unwrap_or(0) as usize, view["byteLength"].as_u64().unwrap_or(0) as usize);
-        let bytes = bin.get(off..off + len).ok_or_else(|| bad(path, format!("image {src}: buffer view {v} runs past the binary chunk")))?;
+        let (off, len) =
+            (view["byteOffset"].as_u64().unwrap_or(0) as usize, view["byteLength"].as_u64().unwrap_or(0) as usize);
+        let bytes = bin
+            .get(off..off + len)
+            .ok_or_else(|| bad(path, format!("image {src}: buffer view {v} runs past the binary chunk")))?;
         let mime = img["mimeType"].as_str().unwrap_or("image/png").to_string();
         return Ok(Some(KenneyImage { bytes: bytes.to_vec(), mime }));
     }
     let Some(uri) = img["uri"].as_str() else { return Ok(None) };
     if let Some(data) = uri.strip_prefix("data:") {
         let (head, b64) = data.split_once(',').ok_or_else(|| bad(path, format!("image {src}: malformed data URI")))?;
-        let bytes = crate::output::gltf::base64_decode(b64).ok_or_else(|| bad(path, format!("image {src}: bad base64 in data URI")))?;
+        let bytes = crate::output::gltf::base64_decode(b64)
+            .ok_or_else(|| bad(path, format!("image {src}: bad base64 in data URI")))?;
         let mime = head.split(';').next().filter(|m| !m.is_empty()).unwrap_or("image/png").to_string();
         return Ok(Some(KenneyImage { bytes, mime }));
     }
     // A relative file (Kenney blocky characters: `Textures/texture-a.png`), percent-escapes aside.
     let file = path.parent().unwrap_or(Path::new(".")).join(uri.replace("%20", " "));
-    let bytes = std::fs::read(&file).map_err(|e| bad(path, format!("texture '{uri}' (looked at {}): {e}", file.display())))?;
+    let bytes =
+        std::fs::read(&file).map_err(|e| bad(path, format!("texture '{uri}' (looked at {}): {e}", file.display())))?;
     Ok(Some(KenneyImage { bytes, mime: mime_of(uri).to_string() }))
 }
 
@@ -310,21 +325,29 @@ pub fn read_character(path: &Path) -> Result<KenneyCharacter, ScriptError> {
         let mesh = &json["meshes"][mesh as usize];
         let name = node["name"].as_str().or(mesh["name"].as_str()).unwrap_or("").to_string();
         let normal_m = glam::Mat3::from_mat4(world).inverse().transpose();
-        let mut part = KenneyPart { name: name.clone(), positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
+        let mut part =
+            KenneyPart { name: name.clone(), positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
         for prim in mesh["primitives"].as_array().into_iter().flatten() {
             if prim["mode"].as_u64().is_some_and(|m| m != 4) {
                 return Err(bad(path, format!("part '{name}': only triangle lists are supported")));
             }
             let attr = &prim["attributes"];
             let unreadable = |what: &str| bad(path, format!("part '{name}': unreadable {what}"));
-            let pos = attr["POSITION"].as_u64().and_then(|a| floats(&json, &bin, a as usize, 3)).ok_or_else(|| unreadable("POSITION"))?;
+            let pos = attr["POSITION"]
+                .as_u64()
+                .and_then(|a| floats(&json, &bin, a as usize, 3))
+                .ok_or_else(|| unreadable("POSITION"))?;
             let count = pos.len() / 3;
             let nor = match attr["NORMAL"].as_u64() {
-                Some(a) => floats(&json, &bin, a as usize, 3).filter(|v| v.len() == pos.len()).ok_or_else(|| unreadable("NORMAL"))?,
+                Some(a) => floats(&json, &bin, a as usize, 3)
+                    .filter(|v| v.len() == pos.len())
+                    .ok_or_else(|| unreadable("NORMAL"))?,
                 None => vec![0.0; pos.len()],
             };
             let uv = match attr["TEXCOORD_0"].as_u64() {
-                Some(a) => floats(&json, &bin, a as usize, 2).filter(|v| v.len() == 2 * count).ok_or_else(|| unreadable("TEXCOORD_0"))?,
+                Some(a) => floats(&json, &bin, a as usize, 2)
+                    .filter(|v| v.len() == 2 * count)
+                    .ok_or_else(|| unreadable("TEXCOORD_0"))?,
                 None => vec![0.0; 2 * count],
             };
             let idx = indices_of(&json, &bin, prim, count).ok_or_else(|| unreadable("indices"))?;

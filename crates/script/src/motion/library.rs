@@ -17,11 +17,7 @@ pub enum ClipSource {
     /// Built in ([`MotionLibrary::procedural`]).
     Procedural,
     /// A CMU trial's BVH, retargeted.
-    Cmu {
-        clip_id: String,
-        description: String,
-        path: PathBuf,
-    },
+    Cmu { clip_id: String, description: String, path: PathBuf },
     /// A named animation of a Kenney blocky character (glTF), retargeted.
     Kenney { animation: String, path: PathBuf },
 }
@@ -76,17 +72,9 @@ impl MotionLibrary {
     pub fn procedural(seed: u64) -> MotionLibrary {
         let clips = procedural::clips(seed)
             .into_iter()
-            .map(|(name, tags, motion)| LibraryClip {
-                name,
-                tags,
-                motion,
-                source: ClipSource::Procedural,
-            })
+            .map(|(name, tags, motion)| LibraryClip { name, tags, motion, source: ClipSource::Procedural })
             .collect();
-        MotionLibrary {
-            clips,
-            ..Default::default()
-        }
+        MotionLibrary { clips, ..Default::default() }
     }
 
     /// The procedural library plus the CMU corpus at `dir` (the folder holding `index.tsv`): every
@@ -105,25 +93,16 @@ impl MotionLibrary {
                 continue;
             }
             let Some(file) = trial.bvh() else {
-                lib.skipped.push((
-                    trial.clip_id.clone(),
-                    format!("no loadable BVH ({})", trial.files.join(", ")),
-                ));
+                lib.skipped.push((trial.clip_id.clone(), format!("no loadable BVH ({})", trial.files.join(", "))));
                 continue;
             };
             let path = dir.join(file);
             if loaded >= max_clips {
-                lib.skipped.push((
-                    trial.clip_id.clone(),
-                    format!("over max_clips = {max_clips}"),
-                ));
+                lib.skipped.push((trial.clip_id.clone(), format!("over max_clips = {max_clips}")));
                 continue;
             }
             if !path.is_file() {
-                lib.skipped.push((
-                    trial.clip_id.clone(),
-                    format!("{} is missing", path.display()),
-                ));
+                lib.skipped.push((trial.clip_id.clone(), format!("{} is missing", path.display())));
                 continue;
             }
             match load_bvh(&path, &rig) {
@@ -187,7 +166,10 @@ impl MotionLibrary {
         for path in files {
             for (animation, motion) in kenney::read_animations(&path)? {
                 let tags = kenney::tags_of_name(&animation);
-                let seen = self.clips.iter().any(|c| matches!(&c.source, ClipSource::Kenney { animation: a, .. } if *a == animation));
+                let seen = self
+                    .clips
+                    .iter()
+                    .any(|c| matches!(&c.source, ClipSource::Kenney { animation: a, .. } if *a == animation));
                 if tags.is_empty() || seen {
                     continue;
                 }
@@ -255,9 +237,7 @@ impl MotionLibrary {
     /// The locomotion cycle for a verb (walk, run): a clip tagged `cycle` with that action.
     pub fn cycle(&self, verb_lemma: &str) -> Option<&LibraryClip> {
         let tag = canonical(verb_lemma)?;
-        self.candidates(tag)
-            .into_iter()
-            .find(|c| c.has_tag("cycle"))
+        self.candidates(tag).into_iter().find(|c| c.has_tag("cycle"))
     }
 
     /// The clip with this exact name.

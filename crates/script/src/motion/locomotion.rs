@@ -98,16 +98,9 @@ impl Path {
             return self.pts[0];
         }
         let s = s.clamp(0.0, self.len());
-        let i = self
-            .cum
-            .partition_point(|&c| c <= s)
-            .clamp(1, self.pts.len() - 1);
+        let i = self.cum.partition_point(|&c| c <= s).clamp(1, self.pts.len() - 1);
         let seg = self.cum[i] - self.cum[i - 1];
-        let u = if seg > 0.0 {
-            (s - self.cum[i - 1]) / seg
-        } else {
-            0.0
-        };
+        let u = if seg > 0.0 { (s - self.cum[i - 1]) / seg } else { 0.0 };
         self.pts[i - 1].lerp(self.pts[i], u)
     }
 
@@ -139,11 +132,7 @@ impl Cycle {
         let mut poses = m.poses();
         let r0 = poses[0].translations[rig.hips];
         let r1 = poses[n - 1].translations[rig.hips];
-        let trend = if n > 1 {
-            (r1 - r0) / (n - 1) as f64
-        } else {
-            DVec3::ZERO
-        };
+        let trend = if n > 1 { (r1 - r0) / (n - 1) as f64 } else { DVec3::ZERO };
         let trend = DVec3::new(trend.x, 0.0, trend.z);
         for (f, p) in poses.iter_mut().enumerate() {
             let r = p.translations[rig.hips] - trend * f as f64;
@@ -181,10 +170,7 @@ impl Cycle {
 }
 
 fn idle_cycle(lib: &MotionLibrary, rig: &Rig) -> Cycle {
-    match lib
-        .retrieve("idle")
-        .filter(|c| c.motion.skeleton == rig.skeleton)
-    {
+    match lib.retrieve("idle").filter(|c| c.motion.skeleton == rig.skeleton) {
         Some(c) => {
             let mut cyc = Cycle::new(&c.motion, rig);
             // An idle has no progression: keep the root where it stands.
@@ -214,17 +200,9 @@ pub fn walk_route(route: &[[f32; 2]], library: &MotionLibrary, params: &WalkPara
 }
 
 /// [`walk_route`] plus measurements (foot skate before/after locking, route error).
-pub fn walk_route_stats(
-    route: &[[f32; 2]],
-    library: &MotionLibrary,
-    params: &WalkParams,
-) -> (Motion, WalkStats) {
+pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &WalkParams) -> (Motion, WalkStats) {
     let rig = Rig::standard();
-    let path = Path::new(if route.is_empty() {
-        &[[0.0, 0.0]]
-    } else {
-        route
-    });
+    let path = Path::new(if route.is_empty() { &[[0.0, 0.0]] } else { route });
     // The library's cycle for the verb, else its walk, else the built-in procedural walk.
     let cycle = Some(
         library
@@ -242,10 +220,7 @@ pub fn walk_route_stats(
     let len = path.len();
     let mut frames: Vec<Pose> = Vec::new();
     let mut t = 0.0;
-    let mut h = params
-        .initial_heading
-        .or_else(|| path.heading(0.0, 0.3))
-        .unwrap_or(0.0);
+    let mut h = params.initial_heading.or_else(|| path.heading(0.0, 0.3)).unwrap_or(0.0);
     let push = |frames: &mut Vec<Pose>, t: &mut f64, local: Pose, at: DVec3, h: f64| {
         frames.push(place(&rig, local, at, h));
         *t += dt;
@@ -336,11 +311,7 @@ pub fn walk_route_stats(
     }
     let raw = clip(&rig, &frames);
     let before = foot_skate_on(&rig, &raw);
-    let out = if params.lock_feet {
-        lock_feet_on(&rig, &raw, &LockParams::default())
-    } else {
-        raw
-    };
+    let out = if params.lock_feet { lock_feet_on(&rig, &raw, &LockParams::default()) } else { raw };
     let stats = WalkStats {
         length: len,
         frames: out.num_frames(),
@@ -388,10 +359,7 @@ impl Default for LockParams {
 }
 
 fn ankles(m: &Motion, rig: &Rig) -> Vec<[DVec3; 2]> {
-    forward_clip(m)
-        .into_iter()
-        .map(|g| [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]])
-        .collect()
+    forward_clip(m).into_iter().map(|g| [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]]).collect()
 }
 
 fn hspeed(a: DVec3, b: DVec3, dt: f64) -> f64 {
@@ -414,11 +382,7 @@ pub(crate) fn detect_contacts_on(rig: &Rig, m: &Motion, p: &LockParams) -> [Vec<
         let mut c: Vec<bool> = (0..n)
             .map(|f| {
                 let (f0, f1) = (f.saturating_sub(1), (f + 1).min(n - 1));
-                let v = if f1 > f0 {
-                    hspeed(a[f0][k], a[f1][k], dt * (f1 - f0) as f64)
-                } else {
-                    0.0
-                };
+                let v = if f1 > f0 { hspeed(a[f0][k], a[f1][k], dt * (f1 - f0) as f64) } else { 0.0 };
                 a[f][k].y <= rig.ankle_height + p.height_tol && v <= p.speed_tol
             })
             .collect();
@@ -523,14 +487,8 @@ pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
         }
     }
     let w = 3usize;
-    let grown: Vec<f64> = (0..n)
-        .map(|f| {
-            drop[f.saturating_sub(w)..(f + w + 1).min(n)]
-                .iter()
-                .cloned()
-                .fold(0.0, f64::max)
-        })
-        .collect();
+    let grown: Vec<f64> =
+        (0..n).map(|f| drop[f.saturating_sub(w)..(f + w + 1).min(n)].iter().cloned().fold(0.0, f64::max)).collect();
     let smooth: Vec<f64> = (0..n)
         .map(|f| {
             let s = &grown[f.saturating_sub(w)..(f + w + 1).min(n)];
@@ -545,8 +503,7 @@ pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
             }
         }
     }
-    Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses)
-        .expect("locked poses fit the skeleton")
+    Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("locked poses fit the skeleton")
 }
 
 /// Ankle height above rest at or below which [`foot_skate`] counts a foot as on the floor (m).
@@ -600,8 +557,7 @@ pub(crate) fn place_clip_on(rig: &Rig, m: &Motion, at: [f32; 2], heading: f64) -
             p
         })
         .collect();
-    Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses)
-        .expect("placed poses fit the skeleton")
+    Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("placed poses fit the skeleton")
 }
 
 /// Heading (yaw, 0 = +Z) of a clip's root at frame `f`.

@@ -26,7 +26,5 @@ pub mod verbs;
 pub use blend::{blend_upper, reach_contacts, BlendParams, Contact};
 pub use ik::{place_hips, solve_limb, two_bone, Limb, TwoBone};
 pub use library::{ClipSource, LibraryClip, MotionLibrary};
-pub use locomotion::{
-    foot_skate, lock_feet, walk_route, walk_route_stats, LockParams, WalkParams, WalkStats,
-};
+pub use locomotion::{foot_skate, lock_feet, walk_route, walk_route_stats, LockParams, WalkParams, WalkStats};
 pub use rig::Rig;

@@ -55,8 +55,7 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
     let stride = speed / p.cycle_hz;
     let n = base.num_frames();
     let s = &rig.skeleton;
-    let leg =
-        (s.joint(rig.legs[0][1]).offset.length() + s.joint(rig.legs[0][2]).offset.length()) * 0.985;
+    let leg = (s.joint(rig.legs[0][1]).offset.length() + s.joint(rig.legs[0][2]).offset.length()) * 0.985;
     let hip_x = s.joint(rig.legs[0][0]).offset.x.abs();
     // Foot targets relative to the progression point, per frame and foot.
     let targets: Vec<[DVec3; 2]> = (0..n)
@@ -72,10 +71,7 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
                         (stride * (duty / 2.0 - ph), rig.ankle_height)
                     } else {
                         let u = (ph - duty) / (1.0 - duty);
-                        (
-                            stride * (-duty / 2.0 + duty * smooth(u)),
-                            rig.ankle_height + lift * (PI * u).sin(),
-                        )
+                        (stride * (-duty / 2.0 + duty * smooth(u)), rig.ankle_height + lift * (PI * u).sin())
                     };
                     DVec3::new(side * hip_x, y, centre + z)
                 })
@@ -92,9 +88,7 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
             let mut y = poses[f].translations[rig.hips].y;
             for (k, &t) in targets[f].iter().enumerate() {
                 let hip = g.positions[rig.legs[k][0]];
-                let r = DVec3::new(t.x - hip.x, 0.0, t.z - hip.z)
-                    .length()
-                    .min(leg * 0.999);
+                let r = DVec3::new(t.x - hip.x, 0.0, t.z - hip.z).length().min(leg * 0.999);
                 let max_hip = t.y + (leg * leg - r * r).sqrt();
                 y = y.min(poses[f].translations[rig.hips].y - (hip.y - max_hip).max(0.0));
             }
@@ -103,16 +97,10 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
         .collect();
     let w = 2i64;
     let at = |v: &[f64], i: i64| v[i.rem_euclid(n as i64) as usize];
-    let low: Vec<f64> = (0..n as i64)
-        .map(|i| {
-            (-w..=w)
-                .map(|d| at(&need, i + d))
-                .fold(f64::INFINITY, f64::min)
-        })
-        .collect();
+    let low: Vec<f64> =
+        (0..n as i64).map(|i| (-w..=w).map(|d| at(&need, i + d)).fold(f64::INFINITY, f64::min)).collect();
     for (f, pose) in poses.iter_mut().enumerate() {
-        pose.translations[rig.hips].y =
-            (-w..=w).map(|d| at(&low, f as i64 + d)).sum::<f64>() / (2 * w + 1) as f64;
+        pose.translations[rig.hips].y = (-w..=w).map(|d| at(&low, f as i64 + d)).sum::<f64>() / (2 * w + 1) as f64;
         for (k, limb) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
             solve_limb(&rig, pose, limb, targets[f][k], None);
         }
@@ -136,8 +124,7 @@ fn breathe(rig: &Rig, p: &mut Pose, t: f64, amp: f64) {
     p.rotations[rig.spine1] = DQuat::from_rotation_x(0.015 * amp * b);
     p.rotations[rig.neck] = DQuat::from_rotation_x(-0.01 * amp * b);
     for (s, arm) in [1.0, -1.0].into_iter().zip(rig.arms) {
-        p.rotations[arm[1]] =
-            DQuat::from_rotation_z(s * 0.08) * DQuat::from_rotation_x(-0.03 * amp * b);
+        p.rotations[arm[1]] = DQuat::from_rotation_z(s * 0.08) * DQuat::from_rotation_x(-0.03 * amp * b);
         p.rotations[arm[2]] = DQuat::from_rotation_x(-0.15);
     }
 }
@@ -178,27 +165,15 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
     let mut jit = Jitter(inbetween_core::seed::rng(seed));
     let mut out: Vec<(String, Vec<String>, Motion)> = Vec::new();
     let mut add = |name: &str, tags: &[&str], m: Motion| {
-        out.push((
-            name.to_string(),
-            tags.iter().map(|s| s.to_string()).collect(),
-            m,
-        ))
+        out.push((name.to_string(), tags.iter().map(|s| s.to_string()).collect(), m))
     };
 
     let mut walk = GaitParams::walk();
     walk.speed *= jit.k();
-    add(
-        "procedural walk cycle",
-        &["walk", "cycle", "loop", "locomotion"],
-        gait_cycle(walk, 2, 0.6, 0.08),
-    );
+    add("procedural walk cycle", &["walk", "cycle", "loop", "locomotion"], gait_cycle(walk, 2, 0.6, 0.08));
     let mut run = GaitParams::run();
     run.speed *= jit.k();
-    add(
-        "procedural run cycle",
-        &["run", "cycle", "loop", "locomotion"],
-        gait_cycle(run, 2, 0.4, 0.12),
-    );
+    add("procedural run cycle", &["run", "cycle", "loop", "locomotion"], gait_cycle(run, 2, 0.4, 0.12));
     let k = jit.k();
     add("procedural idle", &["stand", "idle", "loop"], idle(&rig, k));
 
@@ -217,30 +192,17 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
         let lean = 0.45 * (PI * w).sin();
         p.rotations[rig.lower_back] = DQuat::from_rotation_x(lean) * p.rotations[rig.lower_back];
         for (k, leg) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
-            solve_limb(
-                &rig,
-                &mut p,
-                leg,
-                ankles0[k].lerp(ankles1[k], smooth(w)),
-                None,
-            );
+            solve_limb(&rig, &mut p, leg, ankles0[k].lerp(ankles1[k], smooth(w)), None);
         }
         for arm in rig.arms {
-            p.rotations[arm[1]] =
-                DQuat::from_rotation_x(-0.5 * (PI * w).sin()) * p.rotations[arm[1]];
+            p.rotations[arm[1]] = DQuat::from_rotation_x(-0.5 * (PI * w).sin()) * p.rotations[arm[1]];
         }
         p
     };
     let n = 45;
-    let down: Vec<Pose> = (0..n)
-        .map(|i| transition(i as f64 / (n - 1) as f64))
-        .collect();
+    let down: Vec<Pose> = (0..n).map(|i| transition(i as f64 / (n - 1) as f64)).collect();
     let up: Vec<Pose> = down.iter().rev().cloned().collect();
-    add(
-        "procedural sit down",
-        &["sit_down", "sit", "transition"],
-        clip(&rig, &down),
-    );
+    add("procedural sit down", &["sit_down", "sit", "transition"], clip(&rig, &down));
     let k = jit.k();
     let sit_loop: Vec<Pose> = (0..90)
         .map(|i| {
@@ -249,23 +211,14 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
             p.rotations[rig.spine1] = DQuat::from_rotation_x(0.02 * k * (TAU * 0.25 * t).sin());
             for (arm, s) in rig.arms.iter().zip([1.0, -1.0]) {
                 // Hands resting on the thighs.
-                p.rotations[arm[1]] =
-                    DQuat::from_rotation_z(0.15 * s) * DQuat::from_rotation_x(-0.35);
+                p.rotations[arm[1]] = DQuat::from_rotation_z(0.15 * s) * DQuat::from_rotation_x(-0.35);
                 p.rotations[arm[2]] = DQuat::from_rotation_x(-0.9);
             }
             p
         })
         .collect();
-    add(
-        "procedural sit",
-        &["sit", "loop", "seated"],
-        clip(&rig, &sit_loop),
-    );
-    add(
-        "procedural stand up",
-        &["stand_up", "stand", "transition"],
-        clip(&rig, &up),
-    );
+    add("procedural sit", &["sit", "loop", "seated"], clip(&rig, &sit_loop));
+    add("procedural stand up", &["stand_up", "stand", "transition"], clip(&rig, &up));
 
     let head = head_point(&rig);
     let k = jit.k();
@@ -328,12 +281,7 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
         build(&rig, 60, |t, p| {
             breathe(&rig, p, t, 1.0);
             p.rotations[rig.neck] = DQuat::from_rotation_z(0.12 * (TAU * 0.3 * t).sin());
-            hand_to(
-                &rig,
-                p,
-                Limb::RightArm,
-                DVec3::new(-0.1, head.y - 0.05, head.z + 0.02),
-            );
+            hand_to(&rig, p, Limb::RightArm, DVec3::new(-0.1, head.y - 0.05, head.z + 0.02));
         }),
     );
     add(
@@ -354,8 +302,8 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
         &["look", "head", "loop"],
         build(&rig, 90, |t, p| {
             breathe(&rig, p, t, 1.0);
-            p.rotations[rig.neck] = DQuat::from_rotation_y(0.35 * k * (TAU * t / 3.0).sin())
-                * DQuat::from_rotation_x(0.08);
+            p.rotations[rig.neck] =
+                DQuat::from_rotation_y(0.35 * k * (TAU * t / 3.0).sin()) * DQuat::from_rotation_x(0.08);
         }),
     );
     add(
@@ -363,14 +311,9 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
         &["think", "head", "loop"],
         build(&rig, 90, |t, p| {
             breathe(&rig, p, t, 1.0);
-            p.rotations[rig.neck] = DQuat::from_rotation_z(0.18 * k)
-                * DQuat::from_rotation_x(0.12 + 0.03 * (TAU * t / 3.0).sin());
-            hand_to(
-                &rig,
-                p,
-                Limb::RightArm,
-                DVec3::new(-0.02, head.y - 0.16, head.z + 0.12),
-            );
+            p.rotations[rig.neck] =
+                DQuat::from_rotation_z(0.18 * k) * DQuat::from_rotation_x(0.12 + 0.03 * (TAU * t / 3.0).sin());
+            hand_to(&rig, p, Limb::RightArm, DVec3::new(-0.02, head.y - 0.16, head.z + 0.12));
             hand_to(&rig, p, Limb::LeftArm, DVec3::new(0.05, 1.1, 0.16));
         }),
     );
@@ -381,11 +324,7 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
         build(&rig, 90, |t, p| {
             breathe(&rig, p, t, 1.0);
             let a = TAU * t / 1.5;
-            let target = DVec3::new(
-                -0.15 + 0.12 * k * a.sin(),
-                1.45 + 0.06 * (2.0 * a).sin(),
-                0.5,
-            );
+            let target = DVec3::new(-0.15 + 0.12 * k * a.sin(), 1.45 + 0.06 * (2.0 * a).sin(), 0.5);
             hand_to(&rig, p, Limb::RightArm, target);
         }),
     );
@@ -397,12 +336,7 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
             let ph = (t * FPS / 30.0).fract();
             let up = (PI * ph).sin();
             p.rotations[rig.lower_back] = DQuat::from_rotation_x(0.15);
-            hand_to(
-                &rig,
-                p,
-                Limb::RightArm,
-                DVec3::new(-0.18, 0.95 + 0.3 * up, 0.4 - 0.08 * up),
-            );
+            hand_to(&rig, p, Limb::RightArm, DVec3::new(-0.18, 0.95 + 0.3 * up, 0.4 - 0.08 * up));
             hand_to(&rig, p, Limb::LeftArm, DVec3::new(0.1, 0.92, 0.42));
         }),
     );

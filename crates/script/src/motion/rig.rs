@@ -56,7 +56,8 @@ impl Rig {
     /// The rig of a motion's skeleton for `what` (a helper's task, for the message), or an error
     /// naming the joint missing.
     pub fn for_motion(m: &Motion, what: &str) -> Result<Rig, crate::error::ScriptError> {
-        Rig::try_of(m.skeleton.clone()).map_err(|e| crate::error::ScriptError::Invalid(format!("{what} needs the common rig's joints: {e}")))
+        Rig::try_of(m.skeleton.clone())
+            .map_err(|e| crate::error::ScriptError::Invalid(format!("{what} needs the common rig's joints: {e}")))
     }
 
     /// Indices on a skeleton with the standard joint names, or which joint is missing.
@@ -77,7 +78,8 @@ impl Rig {
             limb(["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand"])?,
             limb(["RightShoulder", "RightArm", "RightForeArm", "RightHand"])?,
         ];
-        let (hips, lower_back, spine1, neck, head) = (f("Hips")?, f("LowerBack")?, f("Spine1")?, f("Neck")?, f("Head")?);
+        let (hips, lower_back, spine1, neck, head) =
+            (f("Hips")?, f("LowerBack")?, f("Spine1")?, f("Neck")?, f("Head")?);
         let mut rest = Pose::rest(&skeleton);
         rest.translations[hips] = DVec3::new(0.0, hip_height(), 0.0);
         let g = forward(&skeleton, &rest);
@@ -144,6 +146,5 @@ pub fn local_from_global(parent_global: DQuat, global: DQuat) -> DQuat {
 
 /// Clip from poses on the standard skeleton at [`FPS`].
 pub fn clip(rig: &Rig, poses: &[Pose]) -> Motion {
-    Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, poses)
-        .expect("poses fit the standard skeleton")
+    Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, poses).expect("poses fit the standard skeleton")
 }

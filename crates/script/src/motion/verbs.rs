@@ -7,89 +7,29 @@ pub const VERBS: &[(&str, &[&str])] = &[
     (
         "walk",
         &[
-            "walk", "stroll", "stride", "march", "wander", "go", "move", "step", "pace", "amble",
-            "limp", "come", "approach", "head",
+            "walk", "stroll", "stride", "march", "wander", "go", "move", "step", "pace", "amble", "limp", "come",
+            "approach", "head",
         ],
     ),
-    (
-        "run",
-        &["run", "jog", "sprint", "race", "dash", "rush", "hurry"],
-    ),
+    ("run", &["run", "jog", "sprint", "race", "dash", "rush", "hurry"]),
     ("jump", &["jump", "hop", "leap", "bound", "skip"]),
     ("sit", &["sit", "seat", "perch"]),
     ("sit_down", &["sit_down"]),
     ("stand_up", &["stand_up", "rise", "get_up"]),
-    (
-        "stand",
-        &[
-            "stand", "idle", "stay", "wait", "stop", "remain", "rest", "pause", "balance",
-        ],
-    ),
-    (
-        "punch",
-        &[
-            "punch",
-            "box",
-            "strike",
-            "hit",
-            "jab",
-            "fight",
-            "swordplay",
-            "sword",
-        ],
-    ),
+    ("stand", &["stand", "idle", "stay", "wait", "stop", "remain", "rest", "pause", "balance"]),
+    ("punch", &["punch", "box", "strike", "hit", "jab", "fight", "swordplay", "sword"]),
     ("kick", &["kick"]),
-    (
-        "dance",
-        &[
-            "dance",
-            "waltz",
-            "salsa",
-            "pirouette",
-            "twirl",
-            "spin",
-            "arabesque",
-            "jete",
-        ],
-    ),
+    ("dance", &["dance", "waltz", "salsa", "pirouette", "twirl", "spin", "arabesque", "jete"]),
     ("wave", &["wave", "greet", "beckon", "signal"]),
     ("climb", &["climb", "scale", "ascend", "hang", "dangle"]),
-    (
-        "reach",
-        &[
-            "reach", "grab", "pick", "take", "push", "press", "touch", "pull", "lift", "scoop",
-            "open", "fetch",
-        ],
-    ),
-    (
-        "type",
-        &[
-            "type", "play", "use", "operate", "work", "tap", "text", "dribble", "shoot",
-        ],
-    ),
-    (
-        "call",
-        &[
-            "call", "phone", "talk", "speak", "chat", "tell", "say", "sing", "shout", "ask",
-            "answer",
-        ],
-    ),
+    ("reach", &["reach", "grab", "pick", "take", "push", "press", "touch", "pull", "lift", "scoop", "open", "fetch"]),
+    ("type", &["type", "play", "use", "operate", "work", "tap", "text", "dribble", "shoot"]),
+    ("call", &["call", "phone", "talk", "speak", "chat", "tell", "say", "sing", "shout", "ask", "answer"]),
     ("drink", &["drink", "sip", "eat"]),
-    (
-        "look",
-        &[
-            "look", "watch", "see", "stare", "gaze", "observe", "view", "listen", "examine",
-        ],
-    ),
-    (
-        "think",
-        &["think", "ponder", "wonder", "consider", "contemplate"],
-    ),
+    ("look", &["look", "watch", "see", "stare", "gaze", "observe", "view", "listen", "examine"]),
+    ("think", &["think", "ponder", "wonder", "consider", "contemplate"]),
     ("write", &["write", "draw", "paint", "sketch", "design"]),
-    (
-        "hammer",
-        &["hammer", "saw", "nail", "chop", "serve", "build", "wash"],
-    ),
+    ("hammer", &["hammer", "saw", "nail", "chop", "serve", "build", "wash"]),
     ("bend", &["bend", "crouch", "squat", "kneel", "stoop"]),
     ("throw", &["throw", "toss", "pitch"]),
     ("turn", &["turn", "rotate"]),
@@ -102,22 +42,12 @@ pub fn canonical(lemma: &str) -> Option<&'static str> {
     if w.is_empty() {
         return None;
     }
-    let find = |w: &str| {
-        VERBS
-            .iter()
-            .find(|(_, syn)| syn.contains(&w))
-            .map(|(c, _)| *c)
-    };
+    let find = |w: &str| VERBS.iter().find(|(_, syn)| syn.contains(&w)).map(|(c, _)| *c);
     if let Some(c) = find(&w) {
         return Some(c);
     }
-    let stems = [
-        w.strip_suffix("ing"),
-        w.strip_suffix("es"),
-        w.strip_suffix('s'),
-        w.strip_suffix("ed"),
-        w.strip_suffix('d'),
-    ];
+    let stems =
+        [w.strip_suffix("ing"), w.strip_suffix("es"), w.strip_suffix('s'), w.strip_suffix("ed"), w.strip_suffix('d')];
     for s in stems.into_iter().flatten() {
         for cand in [s.to_string(), format!("{s}e"), undouble(s)] {
             if let Some(c) = find(&cand) {
@@ -169,10 +99,7 @@ pub fn tags_of_description(description: &str) -> Vec<String> {
             push(tag);
         }
     }
-    for word in lower
-        .split(|c: char| !c.is_ascii_alphabetic())
-        .filter(|w| w.len() > 1)
-    {
+    for word in lower.split(|c: char| !c.is_ascii_alphabetic()).filter(|w| w.len() > 1) {
         // Description words that are nouns of an activity.
         let t = match word {
             "boxing" | "punching" => Some("punch"),
@@ -204,15 +131,9 @@ mod tests {
 
     #[test]
     fn descriptions() {
-        assert_eq!(
-            tags_of_description("playground - forward jumps, turn around"),
-            vec!["jump", "turn"]
-        );
+        assert_eq!(tags_of_description("playground - forward jumps, turn around"), vec!["jump", "turn"]);
         assert_eq!(tags_of_description("run/jog"), vec!["run"]);
         assert_eq!(tags_of_description("punch/strike"), vec!["punch"]);
-        assert_eq!(
-            tags_of_description("Start Walk Stop"),
-            vec!["walk", "stand"]
-        );
+        assert_eq!(tags_of_description("Start Walk Stop"), vec!["walk", "stand"]);
     }
 }

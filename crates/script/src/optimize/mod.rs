@@ -72,7 +72,17 @@ impl OptimizeConfig {
 
 impl Default for OptimizeConfig {
     fn default() -> OptimizeConfig {
-        OptimizeConfig { iterations: 100, sigma: 0.02, initial_temperature: 1.0, relative_temperature: Some(RELATIVE_TEMPERATURE), cooling: 0.002, lambda_d: 1.0, lambda_t: 10.0, box_size: 0.25, seed: 1 }
+        OptimizeConfig {
+            iterations: 100,
+            sigma: 0.02,
+            initial_temperature: 1.0,
+            relative_temperature: Some(RELATIVE_TEMPERATURE),
+            cooling: 0.002,
+            lambda_d: 1.0,
+            lambda_t: 10.0,
+            box_size: 0.25,
+            seed: 1,
+        }
     }
 }
 
@@ -161,7 +171,8 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
     let model: Vec<Vec<boxes::LocalBox>> = objs.iter().map(|o| boxes::object_boxes(o, box_size)).collect();
     let mut hit: Vec<Vec<bool>> = model.iter().map(|b| vec![false; b.len()]).collect();
     // A prop in someone's hand has left its place: from then on nothing collides with it there.
-    let carried: Vec<usize> = (0..objs.len()).map(|i| crate::animate::carried_from(anim, i).unwrap_or(usize::MAX)).collect();
+    let carried: Vec<usize> =
+        (0..objs.len()).map(|i| crate::animate::carried_from(anim, i).unwrap_or(usize::MAX)).collect();
     let mut spheres = Vec::new();
     for c in &anim.characters {
         let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
@@ -217,7 +228,9 @@ pub fn contact_cost(anim: &Animation) -> (f64, usize) {
     for c in &anim.characters {
         let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
         let sk = &rig.skeleton;
-        let finger = |side: &str, hand: usize| sk.find(&format!("{side}HandIndex1")).or_else(|| sk.find(&format!("{side}FingerBase"))).unwrap_or(hand);
+        let finger = |side: &str, hand: usize| {
+            sk.find(&format!("{side}HandIndex1")).or_else(|| sk.find(&format!("{side}FingerBase"))).unwrap_or(hand)
+        };
         let (lh, rh) = (rig.arms[0][3], rig.arms[1][3]);
         let (lf, rf) = (finger("Left", lh), finger("Right", rh));
         for s in &c.segments {
@@ -251,14 +264,27 @@ pub fn contact_cost(anim: &Animation) -> (f64, usize) {
 pub fn costs(anim: &Animation, cfg: &OptimizeConfig) -> Costs {
     let (cd, boxes, objects) = collision_cost(anim, cfg.box_size);
     let (ct, pairs) = contact_cost(anim);
-    Costs { collision: cd, contact: ct, total: cfg.lambda_d * cd + cfg.lambda_t * ct, collided_boxes: boxes, collided_objects: objects, contact_pairs: pairs }
+    Costs {
+        collision: cd,
+        contact: ct,
+        total: cfg.lambda_d * cd + cfg.lambda_t * ct,
+        collided_boxes: boxes,
+        collided_objects: objects,
+        contact_pairs: pairs,
+    }
 }
 
 /// The objects the annealing moves: targets of segments with contacts, the objects related to
 /// them (layout relations, support either way); wall- and ceiling-hung objects stay.
 pub fn movable_objects(anim: &Animation, relations: &[(Relation, usize, usize)], cat: &Catalogue) -> Vec<usize> {
     let objs = &anim.scene.objects;
-    let mut interactive: Vec<usize> = anim.characters.iter().flat_map(|c| c.segments.iter()).filter(|s| !s.contacts.is_empty()).filter_map(|s| s.object).collect();
+    let mut interactive: Vec<usize> = anim
+        .characters
+        .iter()
+        .flat_map(|c| c.segments.iter())
+        .filter(|s| !s.contacts.is_empty())
+        .filter_map(|s| s.object)
+        .collect();
     interactive.sort_unstable();
     interactive.dedup();
     let mut set = interactive.clone();
@@ -275,7 +301,10 @@ pub fn movable_objects(anim: &Animation, relations: &[(Relation, usize, usize)],
     }
     set.sort_unstable();
     set.dedup();
-    set.retain(|&i| i < objs.len() && !matches!(cat.get(&objs[i].category).map(|c| c.support), Some(Support::Wall | Support::Ceiling)));
+    set.retain(|&i| {
+        i < objs.len()
+            && !matches!(cat.get(&objs[i].category).map(|c| c.support), Some(Support::Wall | Support::Ceiling))
+    });
     set
 }
 
@@ -333,21 +362,40 @@ fn disturb(objects: &mut [PlacedObject], k: usize, dx: f32, dz: f32, s: f32) {
 
 /// Whether `v` is no worse than `base` in every kind of violation.
 fn no_worse(v: &Violations, base: &Violations) -> bool {
-    v.overlaps.len() <= base.overlaps.len() && v.unmet.len() <= base.unmet.len() && v.outside.len() <= base.outside.len() && v.unreachable.len() <= base.unreachable.len()
+    v.overlaps.len() <= base.overlaps.len()
+        && v.unmet.len() <= base.unmet.len()
+        && v.outside.len() <= base.outside.len()
+        && v.unreachable.len() <= base.unreachable.len()
 }
 
 /// Algorithm 2 on a composition (see the module comment).
-pub fn optimize(comp: &Composition, cat: &Catalogue, lib: &MotionLibrary, acfg: &AnimateConfig, cfg: &OptimizeConfig) -> Optimized {
+pub fn optimize(
+    comp: &Composition,
+    cat: &Catalogue,
+    lib: &MotionLibrary,
+    acfg: &AnimateConfig,
+    cfg: &OptimizeConfig,
+) -> Optimized {
     optimize_scene(&comp.scene, &comp.query, &comp.relations, cat, lib, acfg, cfg)
 }
 
 /// [`optimize`] on a scene, its query graph and its layout relations (object indices).
-pub fn optimize_scene(scene: &Scene, query: &Ssg, relations: &[(Relation, usize, usize)], cat: &Catalogue, lib: &MotionLibrary, acfg: &AnimateConfig, cfg: &OptimizeConfig) -> Optimized {
+pub fn optimize_scene(
+    scene: &Scene,
+    query: &Ssg,
+    relations: &[(Relation, usize, usize)],
+    cat: &Catalogue,
+    lib: &MotionLibrary,
+    acfg: &AnimateConfig,
+    cfg: &OptimizeConfig,
+) -> Optimized {
     let mut cache = WalkCache::default();
     let anim0 = animate_cached(scene, query, cat, lib, acfg, &mut cache);
     let before = costs(&anim0, cfg);
     let movable = movable_objects(&anim0, relations, cat);
-    anneal(scene, relations, cfg, anim0, before, movable, &mut |s: &Scene| Some(animate_cached(s, query, cat, lib, acfg, &mut cache)))
+    anneal(scene, relations, cfg, anim0, before, movable, &mut |s: &Scene| {
+        Some(animate_cached(s, query, cat, lib, acfg, &mut cache))
+    })
 }
 
 /// The annealing of Algorithm 2 from `scene` (animated as `anim0`, with costs `before`), moving
@@ -356,12 +404,26 @@ pub fn optimize_scene(scene: &Scene, query: &Ssg, relations: &[(Relation, usize,
 /// ([`crate::animate::incremental`]) restricts `movable` to the objects of the characters it
 /// re-solves.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn anneal(scene: &Scene, relations: &[(Relation, usize, usize)], cfg: &OptimizeConfig, anim0: Animation, before: Costs, movable: Vec<usize>, animate: &mut dyn FnMut(&Scene) -> Option<Animation>) -> Optimized {
+pub(crate) fn anneal(
+    scene: &Scene,
+    relations: &[(Relation, usize, usize)],
+    cfg: &OptimizeConfig,
+    anim0: Animation,
+    before: Costs,
+    movable: Vec<usize>,
+    animate: &mut dyn FnMut(&Scene) -> Option<Animation>,
+) -> Optimized {
     let base_violations = layout::check(&scene.room, &scene.objects, relations);
     let mut rng = inbetween_core::seed::rng(cfg.seed);
     let mut cur = (scene.clone(), before);
     let mut best = (anim0, before);
-    let mut curves = CostCurves { collision: vec![before.collision], contact: vec![before.contact], total: vec![before.total], best: vec![before.total], accepted: vec![true] };
+    let mut curves = CostCurves {
+        collision: vec![before.collision],
+        contact: vec![before.contact],
+        total: vec![before.total],
+        best: vec![before.total],
+        accepted: vec![true],
+    };
     let mut rejected_layout = 0;
     for it in 0..cfg.iterations {
         let unit = cfg.relative_temperature.map_or(1.0, |f| f * before.total.max(1e-9));
@@ -406,8 +468,14 @@ pub(crate) fn anneal(scene: &Scene, relations: &[(Relation, usize, usize)], cfg:
 pub fn plot_costs(path: &Path, curves: &CostCurves) -> Result<(), ScriptError> {
     use inbetween_render::plot::{line_plot, Series};
     let s = |name: &str, v: &[f64]| Series::new(name, v.iter().enumerate().map(|(i, &y)| (i as f64, y)).collect());
-    let series = [s("C_D (collision)", &curves.collision), s("C_T (contact, m)", &curves.contact), s("C = C_D + 10 C_T", &curves.total), s("best C", &curves.best)];
-    line_plot(path, "Scene layout and motion optimisation", "iteration", "cost", &series).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
+    let series = [
+        s("C_D (collision)", &curves.collision),
+        s("C_T (contact, m)", &curves.contact),
+        s("C = C_D + 10 C_T", &curves.total),
+        s("best C", &curves.best),
+    ];
+    line_plot(path, "Scene layout and motion optimisation", "iteration", "cost", &series)
+        .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
 }
 
 /// Touched boxes per object (label, n_c, n_a), for reports.
@@ -424,7 +492,12 @@ pub fn collisions_by_object(anim: &Animation, box_size: f32) -> Vec<(String, usi
                 for s in &mut c.segments {
                     s.touching = if s.touching.contains(&i) { vec![0] } else { Vec::new() };
                 }
-                c.props = c.props.iter().filter(|p| p.object == i).map(|p| crate::animate::CarriedProp { object: 0, ..p.clone() }).collect();
+                c.props = c
+                    .props
+                    .iter()
+                    .filter(|p| p.object == i)
+                    .map(|p| crate::animate::CarriedProp { object: 0, ..p.clone() })
+                    .collect();
             }
             let (_, nc, _) = collision_cost(&one, box_size);
             (nc > 0).then(|| (o.label.clone(), nc, boxes::object_boxes(o, box_size).len()))

@@ -23,7 +23,8 @@ use crate::scene::Scene;
 pub type CameraFn<'a> = dyn Fn(usize) -> ([f32; 3], [f32; 3], f32) + 'a;
 
 /// Body colours of characters (sRGB), in order; repeats after six.
-pub const CHARACTER_COLORS: [[u8; 3]; 6] = [[214, 39, 40], [31, 119, 180], [44, 160, 44], [148, 103, 189], [255, 127, 14], [23, 190, 207]];
+pub const CHARACTER_COLORS: [[u8; 3]; 6] =
+    [[214, 39, 40], [31, 119, 180], [44, 160, 44], [148, 103, 189], [255, 127, 14], [23, 190, 207]];
 
 /// The extension that animates the camera's field of view when the camera closure changes it.
 pub const FOV_EXTENSION: &str = "KHR_animation_pointer";
@@ -114,7 +115,11 @@ impl Appender<'_> {
 
 fn srgb_to_linear(c: u8) -> f32 {
     let c = c as f32 / 255.0;
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Cross-section of the body box along the bone ending at `joint` (from its parent, or to its
@@ -195,10 +200,11 @@ pub fn animated_gltf_document(
         times.push((n, dt.to_bits(), acc));
         acc
     };
-    let channel = |samplers: &mut Vec<Value>, channels: &mut Vec<Value>, input: usize, output: usize, node: usize, path: &str| {
-        samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-        channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
-    };
+    let channel =
+        |samplers: &mut Vec<Value>, channels: &mut Vec<Value>, input: usize, output: usize, node: usize, path: &str| {
+            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+            channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
+        };
 
     for (ci, (name, m)) in characters.iter().enumerate() {
         let sk = &m.skeleton;
@@ -227,7 +233,9 @@ pub fn animated_gltf_document(
         }
         for (j, joint) in sk.joints().iter().enumerate() {
             if let Some(p) = joint.parent {
-                if let Some(b) = bone_node(format!("{} bone", joint.name), mesh, joint.offset, bone_thickness(&joint.name)) {
+                if let Some(b) =
+                    bone_node(format!("{} bone", joint.name), mesh, joint.offset, bone_thickness(&joint.name))
+                {
                     let k = a.push("nodes", b);
                     kids[p].push(k);
                 }
@@ -266,7 +274,10 @@ pub fn animated_gltf_document(
     let shots: Vec<([f32; 3], [f32; 3], f32)> = (0..n).map(camera).collect();
     let yfov = shots[0].2;
     if let Some(f) = shots.iter().position(|s| !(s.2.is_finite() && s.2 > 0.0 && s.2 < 180.0)) {
-        return Err(ScriptError::Invalid(format!("camera field of view {}° at frame {f} must lie in (0, 180)", shots[f].2)));
+        return Err(ScriptError::Invalid(format!(
+            "camera field of view {}° at frame {f} must lie in (0, 180)",
+            shots[f].2
+        )));
     }
     if let Some(f) = shots.iter().position(|s| !(s.0.iter().chain(&s.1).all(|v| v.is_finite()))) {
         return Err(ScriptError::Invalid(format!("camera pose at frame {f} is not finite")));
@@ -274,7 +285,8 @@ pub fn animated_gltf_document(
     let cam = a.push("cameras", json!({"name": "story camera", "type": "perspective", "perspective": {"yfov": yfov.to_radians(), "znear": 0.05, "zfar": 200.0}}));
     let eye0 = shots[0].0;
     let q0 = look_rotation(Vec3::from(shots[0].0), Vec3::from(shots[0].1));
-    let cam_node = a.push("nodes", json!({"name": "camera", "camera": cam, "translation": eye0, "rotation": q0.to_array()}));
+    let cam_node =
+        a.push("nodes", json!({"name": "camera", "camera": cam, "translation": eye0, "rotation": q0.to_array()}));
     roots.push(cam_node);
     let input = time_acc(&mut a, n, 1.0 / fps);
     let pos: Vec<f32> = shots.iter().flat_map(|s| s.0).collect();
@@ -327,7 +339,12 @@ pub fn write_animated_gltf(
 /// [`write_animated_gltf`] of a story: also the props its characters carry
 /// ([`crate::animate::CarriedProp`]) get translation and rotation channels on their object nodes,
 /// so they rest until picked up and then follow the hand.
-pub fn write_story_gltf(path: &Path, anim: &crate::animate::Animation, cat: &Catalogue, camera: &CameraFn) -> Result<(), ScriptError> {
+pub fn write_story_gltf(
+    path: &Path,
+    anim: &crate::animate::Animation,
+    cat: &Catalogue,
+    camera: &CameraFn,
+) -> Result<(), ScriptError> {
     let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
     let (mut doc, mut bin, _notes) = animated_gltf_document(&anim.scene, cat, &chars, camera, anim.fps, &lookup)?;
@@ -339,7 +356,8 @@ pub fn write_story_gltf(path: &Path, anim: &crate::animate::Animation, cat: &Cat
 /// Channels moving every carried prop's object node (the scene's node named by its label) over
 /// frames `0..n` at the animation's rate.
 pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate::animate::Animation, n: usize) {
-    let carried: Vec<usize> = (0..anim.scene.objects.len()).filter(|&i| crate::animate::carried_from(anim, i).is_some()).collect();
+    let carried: Vec<usize> =
+        (0..anim.scene.objects.len()).filter(|&i| crate::animate::carried_from(anim, i).is_some()).collect();
     if carried.is_empty() || n == 0 {
         return;
     }
@@ -349,7 +367,9 @@ pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate
     for i in carried {
         let label = anim.scene.objects[i].label.as_str();
         // Object nodes come first in the document (before the characters' joints).
-        let Some(node) = a.doc["nodes"].as_array().and_then(|ns| ns.iter().position(|x| x["name"] == label)) else { continue };
+        let Some(node) = a.doc["nodes"].as_array().and_then(|ns| ns.iter().position(|x| x["name"] == label)) else {
+            continue;
+        };
         let poses: Vec<(DVec3, DQuat)> = (0..n).map(|f| crate::animate::object_pose(anim, i, f)).collect();
         let pos: Vec<f32> = poses.iter().flat_map(|(p, _)| [p.x as f32, p.y as f32, p.z as f32]).collect();
         let rot = continuous_quats(poses.iter().map(|(_, q)| q.as_quat()));
@@ -367,4 +387,3 @@ pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate
     gltf_buffer::pad_to_4(bin);
     doc["buffers"] = json!([{"byteLength": bin.len()}]);
 }
-

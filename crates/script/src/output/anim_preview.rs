@@ -14,8 +14,8 @@ use inbetween_render::Canvas;
 use rayon::prelude::*;
 
 use super::anim_gltf::{animation_frames, check_inputs, CameraFn, CHARACTER_COLORS};
-use super::preview::{draw_object, draw_room, scale_color};
 pub use super::preview::plan_pixel;
+use super::preview::{draw_object, draw_room, scale_color};
 use super::{category_color, top_down};
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
@@ -54,7 +54,15 @@ pub struct AnimPreviewOptions {
 
 impl Default for AnimPreviewOptions {
     fn default() -> Self {
-        AnimPreviewOptions { width: MAX_GIF_WIDTH, height: None, max_fps: MAX_GIF_FPS, max_frames: 600, labels: true, title: None, moving: Vec::new() }
+        AnimPreviewOptions {
+            width: MAX_GIF_WIDTH,
+            height: None,
+            max_fps: MAX_GIF_FPS,
+            max_frames: 600,
+            labels: true,
+            title: None,
+            moving: Vec::new(),
+        }
     }
 }
 
@@ -70,7 +78,8 @@ impl AnimPreviewOptions {
 /// `opts.max_frames` frames are written.
 pub fn preview_frame_indices(characters: &[(&str, &Motion)], fps: f64, opts: &AnimPreviewOptions) -> (Vec<usize>, f64) {
     let n = animation_frames(characters, fps);
-    let max_fps = if opts.max_fps.is_finite() && opts.max_fps > 0.0 { opts.max_fps.min(MAX_GIF_FPS) } else { MAX_GIF_FPS };
+    let max_fps =
+        if opts.max_fps.is_finite() && opts.max_fps > 0.0 { opts.max_fps.min(MAX_GIF_FPS) } else { MAX_GIF_FPS };
     let mut step = ((fps / max_fps) - 1e-9).ceil().max(1.0) as usize;
     let cap = opts.max_frames.max(1);
     if n.div_ceil(step) > cap {
@@ -124,7 +133,16 @@ enum Item<'a> {
 
 /// One GIF frame: the scene and the figures at story frame `frame` through `cam`.
 #[allow(clippy::too_many_arguments)]
-fn draw_frame(scene: &Scene, cat: &Catalogue, figs: &[Figure], cam: &Camera3, frame: usize, frames: usize, fps: f64, opts: &AnimPreviewOptions) -> RgbImage {
+fn draw_frame(
+    scene: &Scene,
+    cat: &Catalogue,
+    figs: &[Figure],
+    cam: &Camera3,
+    frame: usize,
+    frames: usize,
+    fps: f64,
+    opts: &AnimPreviewOptions,
+) -> RgbImage {
     let mut cv = Canvas::new(cam.width, cam.height, SKY);
     draw_room(&mut cv, cam, scene);
     let t = frame as f64 / fps;
@@ -221,9 +239,16 @@ pub fn preview_frames(
         }
         cams.push(Camera3::new(eye, target, DVec3::Y, fov as f64).with_viewport(w, h));
     }
-    let figs: Vec<Figure> =
-        characters.iter().enumerate().map(|(i, (name, m))| Figure::new(name, m, CHARACTER_COLORS[i % CHARACTER_COLORS.len()])).collect();
-    let frames = idx.par_iter().zip(cams.par_iter()).map(|(&f, cam)| draw_frame(scene, cat, &figs, cam, f, n, fps, opts)).collect();
+    let figs: Vec<Figure> = characters
+        .iter()
+        .enumerate()
+        .map(|(i, (name, m))| Figure::new(name, m, CHARACTER_COLORS[i % CHARACTER_COLORS.len()]))
+        .collect();
+    let frames = idx
+        .par_iter()
+        .zip(cams.par_iter())
+        .map(|(&f, cam)| draw_frame(scene, cat, &figs, cam, f, n, fps, opts))
+        .collect();
     Ok((frames, gif_fps))
 }
 
@@ -239,7 +264,8 @@ pub fn render_preview_gif(
     opts: &AnimPreviewOptions,
 ) -> Result<(), ScriptError> {
     let (frames, gif_fps) = preview_frames(scene, cat, characters, camera, fps, opts)?;
-    inbetween_render::write_gif(path, &frames, gif_fps).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
+    inbetween_render::write_gif(path, &frames, gif_fps)
+        .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
 }
 
 /// Floor route of each character: its root joint's `[x, z]` per frame.
@@ -298,6 +324,11 @@ pub fn top_down_trails(scene: &Scene, cat: &Catalogue, characters: &[(&str, &Mot
 }
 
 /// Writes [`top_down_trails`] as PNG (atomic).
-pub fn render_top_down_trails(path: &Path, scene: &Scene, cat: &Catalogue, characters: &[(&str, &Motion)]) -> Result<(), ScriptError> {
+pub fn render_top_down_trails(
+    path: &Path,
+    scene: &Scene,
+    cat: &Catalogue,
+    characters: &[(&str, &Motion)],
+) -> Result<(), ScriptError> {
     super::write_png(path, &top_down_trails(scene, cat, characters))
 }

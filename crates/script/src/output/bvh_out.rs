@@ -23,7 +23,8 @@ pub fn write_character_bvh(path: &Path, motion: &Motion) -> Result<(), ScriptErr
     if motion.num_frames() == 0 {
         return Err(ScriptError::Invalid(format!("{}: the motion has no frames", path.display())));
     }
-    inbetween_io::bvh::write_bvh(path, motion).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })?;
+    inbetween_io::bvh::write_bvh(path, motion)
+        .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })?;
     let side = bvh_sidecar_path(path);
     let meta = json!({
         "unit": "m",
@@ -35,6 +36,7 @@ pub fn write_character_bvh(path: &Path, motion: &Motion) -> Result<(), ScriptErr
         "forward": "+Z",
         "rotations": "degrees, each joint's CHANNELS order",
     });
-    let text = serde_json::to_string_pretty(&meta).map_err(|e| ScriptError::Invalid(format!("BVH sidecar JSON: {e}")))?;
+    let text =
+        serde_json::to_string_pretty(&meta).map_err(|e| ScriptError::Invalid(format!("BVH sidecar JSON: {e}")))?;
     inbetween_io::write_atomic(&side, text.as_bytes()).map_err(|e| ScriptError::io(&side, e))
 }

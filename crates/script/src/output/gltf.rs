@@ -78,7 +78,11 @@ pub fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
 
 fn srgb_to_linear(c: u8) -> f32 {
     let c = c as f32 / 255.0;
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// The document under construction: arrays glTF indexes into, plus the one binary buffer (with
@@ -143,8 +147,15 @@ impl Doc {
         self.buf.align();
         let bin_off = self.buf.bin.len();
         self.buf.bin.extend_from_slice(&glb.bin);
-        let (v0, a0, m0, t0, i0, s0, me0) =
-            (self.buf.views.len(), self.buf.accessors.len(), self.materials.len(), self.textures.len(), self.images.len(), self.samplers.len(), self.meshes.len());
+        let (v0, a0, m0, t0, i0, s0, me0) = (
+            self.buf.views.len(),
+            self.buf.accessors.len(),
+            self.materials.len(),
+            self.textures.len(),
+            self.images.len(),
+            self.samplers.len(),
+            self.meshes.len(),
+        );
         let add = |v: &mut Value, key: &str, off: usize| {
             if let Some(x) = v.get(key).and_then(Value::as_u64) {
                 v[key] = json!(x as usize + off);
@@ -218,7 +229,8 @@ impl Doc {
         }
         for key in ["extensionsUsed", "extensionsRequired"] {
             for e in arr(key).iter().filter_map(Value::as_str) {
-                if key == "extensionsUsed" { &mut self.extensions_used } else { &mut self.extensions_required }.insert(e.to_string());
+                if key == "extensionsUsed" { &mut self.extensions_used } else { &mut self.extensions_required }
+                    .insert(e.to_string());
             }
         }
         // Node templates: meshes re-indexed, skins and cameras dropped.
@@ -235,10 +247,13 @@ impl Doc {
             })
             .collect();
         let scene = j.get("scene").and_then(Value::as_u64).unwrap_or(0) as usize;
-        let roots: Vec<usize> = match j.get("scenes").and_then(|s| s.get(scene)).and_then(|s| s.get("nodes")).and_then(Value::as_array) {
-            Some(r) => r.iter().filter_map(Value::as_u64).map(|x| x as usize).filter(|&x| x < nodes.len()).collect(),
-            None => (0..nodes.len()).collect(),
-        };
+        let roots: Vec<usize> =
+            match j.get("scenes").and_then(|s| s.get(scene)).and_then(|s| s.get("nodes")).and_then(Value::as_array) {
+                Some(r) => {
+                    r.iter().filter_map(Value::as_u64).map(|x| x as usize).filter(|&x| x < nodes.len()).collect()
+                }
+                None => (0..nodes.len()).collect(),
+            };
         // Bounds through the node transforms, from POSITION min/max.
         let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
         let accessors = arr("accessors");
@@ -251,15 +266,35 @@ impl Doc {
             }
             let m = parent * node_matrix(&n);
             if let Some(mi) = n.get("mesh").and_then(Value::as_u64) {
-                for p in meshes.get(mi as usize).and_then(|x| x.get("primitives")).and_then(Value::as_array).into_iter().flatten() {
-                    let Some(acc) = p.pointer("/attributes/POSITION").and_then(Value::as_u64).and_then(|a| accessors.get(a as usize)) else { continue };
+                for p in meshes
+                    .get(mi as usize)
+                    .and_then(|x| x.get("primitives"))
+                    .and_then(Value::as_array)
+                    .into_iter()
+                    .flatten()
+                {
+                    let Some(acc) = p
+                        .pointer("/attributes/POSITION")
+                        .and_then(Value::as_u64)
+                        .and_then(|a| accessors.get(a as usize))
+                    else {
+                        continue;
+                    };
                     let v3 = |key: &str| -> Option<Vec3> {
                         let a = acc.get(key)?.as_array()?;
-                        Some(Vec3::new(a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32, a.get(2)?.as_f64()? as f32))
+                        Some(Vec3::new(
+                            a.first()?.as_f64()? as f32,
+                            a.get(1)?.as_f64()? as f32,
+                            a.get(2)?.as_f64()? as f32,
+                        ))
                     };
                     let (Some(mn), Some(mx)) = (v3("min"), v3("max")) else { continue };
                     for c in 0..8 {
-                        let p = Vec3::new(if c & 1 == 0 { mn.x } else { mx.x }, if c & 2 == 0 { mn.y } else { mx.y }, if c & 4 == 0 { mn.z } else { mx.z });
+                        let p = Vec3::new(
+                            if c & 1 == 0 { mn.x } else { mx.x },
+                            if c & 2 == 0 { mn.y } else { mx.y },
+                            if c & 4 == 0 { mn.z } else { mx.z },
+                        );
                         let w = m.transform_point3(p);
                         lo = lo.min(w);
                         hi = hi.max(w);
@@ -280,7 +315,15 @@ impl Doc {
     fn instantiate(&mut self, m: &Merged, k: usize, depth: usize) -> usize {
         let mut n = m.nodes[k].clone();
         let children: Vec<usize> = if depth < 64 {
-            n.get("children").and_then(Value::as_array).cloned().unwrap_or_default().iter().filter_map(Value::as_u64).map(|c| c as usize).filter(|&c| c < m.nodes.len()).collect()
+            n.get("children")
+                .and_then(Value::as_array)
+                .cloned()
+                .unwrap_or_default()
+                .iter()
+                .filter_map(Value::as_u64)
+                .map(|c| c as usize)
+                .filter(|&c| c < m.nodes.len())
+                .collect()
         } else {
             Vec::new()
         };
@@ -299,12 +342,17 @@ impl Doc {
 
 /// A node's local matrix from `matrix` or translation/rotation/scale.
 fn node_matrix(n: &Value) -> Mat4 {
-    let nums = |k: &str| -> Option<Vec<f32>> { Some(n.get(k)?.as_array()?.iter().filter_map(|v| v.as_f64().map(|x| x as f32)).collect()) };
+    let nums = |k: &str| -> Option<Vec<f32>> {
+        Some(n.get(k)?.as_array()?.iter().filter_map(|v| v.as_f64().map(|x| x as f32)).collect())
+    };
     if let Some(m) = nums("matrix").filter(|m| m.len() == 16) {
         return Mat4::from_cols_slice(&m);
     }
     let t = nums("translation").filter(|v| v.len() == 3).map(|v| Vec3::new(v[0], v[1], v[2])).unwrap_or(Vec3::ZERO);
-    let r = nums("rotation").filter(|v| v.len() == 4).map(|v| Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize()).unwrap_or(Quat::IDENTITY);
+    let r = nums("rotation")
+        .filter(|v| v.len() == 4)
+        .map(|v| Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize())
+        .unwrap_or(Quat::IDENTITY);
     let s = nums("scale").filter(|v| v.len() == 3).map(|v| Vec3::new(v[0], v[1], v[2])).unwrap_or(Vec3::ONE);
     Mat4::from_scale_rotation_translation(s, r, t)
 }
@@ -312,7 +360,11 @@ fn node_matrix(n: &Value) -> Mat4 {
 /// The glTF document of `scene` and its binary buffer (buffer 0, no uri yet). `model` maps a
 /// category name to a GLB file to use instead of a box; models that cannot be read fall back to
 /// boxes and are named in the returned notes.
-pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Option<PathBuf>) -> (Value, Vec<u8>, Vec<String>) {
+pub fn gltf_document(
+    scene: &Scene,
+    cat: &Catalogue,
+    model: &dyn Fn(&str) -> Option<PathBuf>,
+) -> (Value, Vec<u8>, Vec<String>) {
     let mut d = Doc::default();
     let mut notes = Vec::new();
     let (bp, bn, bi) = d.unit_box();
@@ -333,7 +385,10 @@ pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Opt
     for o in &scene.objects {
         if !models.contains_key(&o.category) {
             let merged = model(&o.category).and_then(|path| {
-                let res = std::fs::read(&path).map_err(|e| e.to_string()).and_then(|b| parse_glb(&b)).and_then(|g| d.merge(&g));
+                let res = std::fs::read(&path)
+                    .map_err(|e| e.to_string())
+                    .and_then(|b| parse_glb(&b))
+                    .and_then(|g| d.merge(&g));
                 res.map_err(|e| notes.push(format!("{}: {e}; using a box for '{}'", path.display(), o.category))).ok()
             });
             models.insert(o.category.clone(), merged);
@@ -355,7 +410,8 @@ pub fn gltf_document(scene: &Scene, cat: &Catalogue, model: &dyn Fn(&str) -> Opt
         d.nodes.push(child);
         let c = d.nodes.len() - 1;
         let (s, co) = (o.yaw / 2.0).sin_cos();
-        d.nodes.push(json!({"name": o.label, "translation": o.position, "rotation": [0.0, s, 0.0, co], "children": [c]}));
+        d.nodes
+            .push(json!({"name": o.label, "translation": o.position, "rotation": [0.0, s, 0.0, co], "children": [c]}));
         children.push(d.nodes.len() - 1);
     }
     d.nodes.push(json!({"name": scene.room.name, "children": children}));
@@ -395,7 +451,12 @@ pub fn write_gltf(path: &Path, scene: &Scene, cat: &Catalogue) -> Result<(), Scr
 /// [`write_gltf`] also looking for `<models_dir>/<model>.glb` for categories that name a model
 /// ([`crate::catalogue::Category::model`]) the catalogue has no path for. Returns notes on
 /// models that could not be read and fell back to boxes.
-pub fn write_gltf_with_models(path: &Path, scene: &Scene, cat: &Catalogue, models_dir: Option<&Path>) -> Result<Vec<String>, ScriptError> {
+pub fn write_gltf_with_models(
+    path: &Path,
+    scene: &Scene,
+    cat: &Catalogue,
+    models_dir: Option<&Path>,
+) -> Result<Vec<String>, ScriptError> {
     let lookup = |category: &str| -> Option<PathBuf> {
         if let Some(p) = cat.model_path(category).filter(|p| p.is_file()) {
             return Some(p);

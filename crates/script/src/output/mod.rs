@@ -15,11 +15,11 @@ use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::scene::Scene;
 
-pub use gltf::{gltf_document, write_gltf, write_gltf_with_models};
-pub use preview::{perspective, top_down, VIEWS};
 pub use anim_gltf::{animated_gltf_document, write_animated_gltf, write_story_gltf};
 pub use anim_preview::{render_preview_gif, render_top_down_trails, AnimPreviewOptions};
 pub use bvh_out::write_character_bvh;
+pub use gltf::{gltf_document, write_gltf, write_gltf_with_models};
+pub use preview::{perspective, top_down, VIEWS};
 
 /// Writes the scene as pretty JSON (atomic).
 pub fn write_json(path: &Path, scene: &Scene) -> Result<(), ScriptError> {
@@ -30,12 +30,14 @@ pub fn write_json(path: &Path, scene: &Scene) -> Result<(), ScriptError> {
 /// Reads a scene written by [`write_json`].
 pub fn read_json(path: &Path) -> Result<Scene, ScriptError> {
     let text = std::fs::read_to_string(path).map_err(|e| ScriptError::io(path, e))?;
-    serde_json::from_str(&text).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: format!("not a scene JSON: {e}") })
+    serde_json::from_str(&text)
+        .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: format!("not a scene JSON: {e}") })
 }
 
 /// Writes an image as PNG (atomic).
 pub fn write_png(path: &Path, img: &image::RgbImage) -> Result<(), ScriptError> {
-    inbetween_render::write_png(path, img).map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
+    inbetween_render::write_png(path, img)
+        .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
 }
 
 /// Writes `top.png` (plan) and `view.png` (perspective from `view`) into `dir`; returns their paths.

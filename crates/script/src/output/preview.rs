@@ -244,12 +244,15 @@ pub fn view_camera(scene: &Scene, view: &str, width: u32, height: u32) -> Camera
     let fov = 45.0f64;
     let radius = 0.5 * (w * w + d * d + h * h).sqrt();
     let dist = radius / (fov.to_radians() / 2.0).sin() * 0.8;
-    let (elev, az) = (30f64.to_radians(), match view {
-        "back" => DVec3::NEG_Z,
-        "left" => DVec3::NEG_X,
-        "right" => DVec3::X,
-        _ => DVec3::Z,
-    });
+    let (elev, az) = (
+        30f64.to_radians(),
+        match view {
+            "back" => DVec3::NEG_Z,
+            "left" => DVec3::NEG_X,
+            "right" => DVec3::X,
+            _ => DVec3::Z,
+        },
+    );
     let (eye, up) = if view == "top" {
         (DVec3::new(w / 2.0, h + dist * 1.4, d / 2.0), DVec3::NEG_Z)
     } else {

@@ -28,9 +28,9 @@ use glam::{DVec3, Mat4, Quat, Vec3};
 use image::RgbImage;
 use inbetween_core::fk::{forward, GlobalPose};
 use inbetween_core::{Motion, Pose, Skeleton};
+use inbetween_io::gltf_buffer::{pad_to_4, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT};
 use inbetween_render::canvas::Camera3;
 use inbetween_render::Canvas;
-use inbetween_io::gltf_buffer::{pad_to_4, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT};
 use serde_json::{json, Value};
 
 use super::anim_gltf::{animated_gltf_document, Appender, CameraFn};
@@ -136,7 +136,11 @@ pub fn bind_pose(skeleton: &Skeleton) -> (Pose, GlobalPose) {
 /// World matrices (rotation and translation) of every joint of a global pose, as glTF nodes
 /// compose them.
 pub fn joint_matrices(g: &GlobalPose) -> Vec<Mat4> {
-    g.positions.iter().zip(&g.rotations).map(|(p, q)| Mat4::from_rotation_translation(q.as_quat().normalize(), p.as_vec3())).collect()
+    g.positions
+        .iter()
+        .zip(&g.rotations)
+        .map(|(p, q)| Mat4::from_rotation_translation(q.as_quat().normalize(), p.as_vec3()))
+        .collect()
 }
 
 /// Linear blend skinning, rigid case: every vertex moved by its joint's world matrix times its
@@ -189,7 +193,9 @@ impl Placement {
 
 /// Top and bottom centres of a part's bounding box.
 fn top_bottom(part: &KenneyPart) -> (Vec3, Vec3) {
-    let (lo, hi) = part.positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p))));
+    let (lo, hi) = part.positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
+        (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p)))
+    });
     let c = (lo + hi) / 2.0;
     (Vec3::new(c.x, hi.y, c.z), Vec3::new(c.x, lo.y, c.z))
 }
@@ -302,7 +308,8 @@ impl Builder {
                 let ids: Vec<u32> = piece.iter().map(|v| self.vertex(v, joint as u16)).collect();
                 for w in 1..ids.len() - 1 {
                     let (a, b, c) = (ids[0], ids[w], ids[w + 1]);
-                    let (pa, pb, pc) = (self.body_pos[a as usize], self.body_pos[b as usize], self.body_pos[c as usize]);
+                    let (pa, pb, pc) =
+                        (self.body_pos[a as usize], self.body_pos[b as usize], self.body_pos[c as usize]);
                     if (pb - pa).cross(pc - pa).length_squared() > 1e-14 {
                         self.indices.extend([a, b, c]);
                     }
@@ -317,11 +324,26 @@ impl Builder {
 /// part rides on the torso.
 pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBody, ScriptError> {
     let names = [
-        "LowerBack", "Spine1", "Head", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightUpLeg", "RightLeg", "RightFoot", "LeftArm", "LeftForeArm",
-        "LeftHand", "RightArm", "RightForeArm", "RightHand",
+        "LowerBack",
+        "Spine1",
+        "Head",
+        "LeftUpLeg",
+        "LeftLeg",
+        "LeftFoot",
+        "RightUpLeg",
+        "RightLeg",
+        "RightFoot",
+        "LeftArm",
+        "LeftForeArm",
+        "LeftHand",
+        "RightArm",
+        "RightForeArm",
+        "RightHand",
     ];
     let j = joints_named(skeleton, &names)?;
-    let [lower_back, spine1, head, lul, ll, lf, rul, rl, rf, la, lfa, lh, ra, rfa, rh] = j[..] else { unreachable!("15 names") };
+    let [lower_back, spine1, head, lul, ll, lf, rul, rl, rf, la, lfa, lh, ra, rfa, rh] = j[..] else {
+        unreachable!("15 names")
+    };
     let spine = skeleton.find("Spine");
     let (_, g) = bind_pose(skeleton);
     let p = |j: usize| g.positions[j].as_vec3();
@@ -331,7 +353,8 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
     // One width scale: the rig's shoulder half-span over the Kenney arm's centre offset.
     let (kt_top, kt_bot) = top_bottom(torso);
     let shoulder_half = (p(la) - p(ra)).length() / 2.0;
-    let arm_centre = ch.part("arm-left").or(ch.part("arm-right")).map(|a| (top_bottom(a).0 - kt_top).with_y(0.0).length());
+    let arm_centre =
+        ch.part("arm-left").or(ch.part("arm-right")).map(|a| (top_bottom(a).0 - kt_top).with_y(0.0).length());
     let torso_half = torso.positions.iter().map(|q| (q[0] - kt_top.x).abs()).fold(0.0f32, f32::max);
     let width = shoulder_half / arm_centre.filter(|c| *c > 1e-3).unwrap_or(torso_half.max(1e-3) * 1.5);
 
@@ -344,7 +367,16 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
         torso_cuts.push(((p(s) - hip_mid).dot(torso_axis), s));
     }
     torso_cuts.push(((p(spine1) - hip_mid).dot(torso_axis), spine1));
-    let torso_pl = Placement { from: kt_bot, axis_k: kt_axis, len_k: kt_len, to: hip_mid, axis_r: torso_axis, len_r: torso_len, width, cuts: torso_cuts };
+    let torso_pl = Placement {
+        from: kt_bot,
+        axis_k: kt_axis,
+        len_k: kt_len,
+        to: hip_mid,
+        axis_r: torso_axis,
+        len_r: torso_len,
+        width,
+        cuts: torso_cuts,
+    };
 
     let mut b = Builder::default();
     for part in &ch.parts {
@@ -357,7 +389,16 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
                 let to = Vec3::new(at.x, p(up).y, at.z);
                 let (axis_k, len_k) = segment(top, bot);
                 let along = |jj: usize| p(up).y - p(jj).y;
-                Placement { from: top, axis_k, len_k, to, axis_r: Vec3::NEG_Y, len_r: to.y, width, cuts: vec![(f32::MIN, up), (along(knee), knee), (along(ankle), ankle)] }
+                Placement {
+                    from: top,
+                    axis_k,
+                    len_k,
+                    to,
+                    axis_r: Vec3::NEG_Y,
+                    len_r: to.y,
+                    width,
+                    cuts: vec![(f32::MIN, up), (along(knee), knee), (along(ankle), ankle)],
+                }
             }
             "arm-left" | "arm-right" => {
                 let (arm, elbow, wrist) = if part.name == "arm-left" { (la, lfa, lh) } else { (ra, rfa, rh) };
@@ -365,12 +406,30 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
                 let (axis_r, len_r) = segment(p(arm), tip);
                 let (axis_k, len_k) = segment(top, bot);
                 let along = |jj: usize| (p(jj) - p(arm)).dot(axis_r);
-                Placement { from: top, axis_k, len_k, to: p(arm), axis_r, len_r, width, cuts: vec![(f32::MIN, arm), (along(elbow), elbow), (along(wrist), wrist)] }
+                Placement {
+                    from: top,
+                    axis_k,
+                    len_k,
+                    to: p(arm),
+                    axis_r,
+                    len_r,
+                    width,
+                    cuts: vec![(f32::MIN, arm), (along(elbow), elbow), (along(wrist), wrist)],
+                }
             }
             "head" => {
                 let (axis_k, len_k) = segment(bot, top);
                 let to = torso_pl.to + torso_pl.axis_r * torso_pl.len_r;
-                Placement { from: bot, axis_k, len_k, to, axis_r: Vec3::Y, len_r: len_k * width, width, cuts: vec![(f32::MIN, head)] }
+                Placement {
+                    from: bot,
+                    axis_k,
+                    len_k,
+                    to,
+                    axis_r: Vec3::Y,
+                    len_r: len_k * width,
+                    width,
+                    cuts: vec![(f32::MIN, head)],
+                }
             }
             // Anything else rides on the torso, on the head above the shoulders.
             _ => Placement { cuts: [torso_pl.cuts.clone(), vec![(torso_len, head)]].concat(), ..torso_pl.clone() },
@@ -411,7 +470,11 @@ fn joint_nodes(doc: &Value, name: &str, skeleton: &Skeleton, taken: &BTreeSet<us
             return None;
         }
         let first = n["children"].as_array().filter(|c| c.len() == 1)?[0].as_u64()? as usize;
-        let ok = skeleton.joints().iter().enumerate().all(|(j, jt)| nodes.get(first + j).is_some_and(|x| x["name"].as_str() == Some(jt.name.as_str())));
+        let ok = skeleton
+            .joints()
+            .iter()
+            .enumerate()
+            .all(|(j, jt)| nodes.get(first + j).is_some_and(|x| x["name"].as_str() == Some(jt.name.as_str())));
         (ok && nodes[first]["name"].as_str() == Some(root_name)).then_some((i, first))
     })
 }
@@ -422,11 +485,21 @@ fn remove_nodes(doc: &mut Value, drop: &BTreeSet<usize>) {
     let n = doc["nodes"].as_array().map_or(0, Vec::len);
     let map: Vec<Option<usize>> = {
         let mut k = 0;
-        (0..n).map(|i| if drop.contains(&i) { None } else { k += 1; Some(k - 1) }).collect()
+        (0..n)
+            .map(|i| {
+                if drop.contains(&i) {
+                    None
+                } else {
+                    k += 1;
+                    Some(k - 1)
+                }
+            })
+            .collect()
     };
     let re = |v: &Value| v.as_u64().and_then(|i| map.get(i as usize).copied().flatten()).map(|i| json!(i));
     let old: Vec<Value> = doc["nodes"].as_array().cloned().unwrap_or_default();
-    let mut nodes: Vec<Value> = old.into_iter().enumerate().filter(|(i, _)| !drop.contains(i)).map(|(_, v)| v).collect();
+    let mut nodes: Vec<Value> =
+        old.into_iter().enumerate().filter(|(i, _)| !drop.contains(i)).map(|(_, v)| v).collect();
     for node in &mut nodes {
         if let Some(c) = node["children"].as_array() {
             let kids: Vec<Value> = c.iter().filter_map(&re).collect();
@@ -458,15 +531,25 @@ fn remove_nodes(doc: &mut Value, drop: &BTreeSet<usize>) {
             skin["skeleton"] = s;
         }
     }
-    compact(doc, "meshes", |d| d["nodes"].as_array().into_iter().flatten().filter_map(|n| n["mesh"].as_u64()).collect(), |d, m| {
-        for node in d["nodes"].as_array_mut().into_iter().flatten() {
-            if let Some(i) = node["mesh"].as_u64() {
-                node["mesh"] = json!(m[i as usize]);
+    compact(
+        doc,
+        "meshes",
+        |d| d["nodes"].as_array().into_iter().flatten().filter_map(|n| n["mesh"].as_u64()).collect(),
+        |d, m| {
+            for node in d["nodes"].as_array_mut().into_iter().flatten() {
+                if let Some(i) = node["mesh"].as_u64() {
+                    node["mesh"] = json!(m[i as usize]);
+                }
             }
-        }
-    });
+        },
+    );
     let used_materials = |d: &Value| -> BTreeSet<u64> {
-        d["meshes"].as_array().into_iter().flatten().flat_map(|m| m["primitives"].as_array().into_iter().flatten().filter_map(|p| p["material"].as_u64())).collect()
+        d["meshes"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .flat_map(|m| m["primitives"].as_array().into_iter().flatten().filter_map(|p| p["material"].as_u64()))
+            .collect()
     };
     compact(doc, "materials", used_materials, |d, m| {
         for mesh in d["meshes"].as_array_mut().into_iter().flatten() {
@@ -477,16 +560,26 @@ fn remove_nodes(doc: &mut Value, drop: &BTreeSet<usize>) {
             }
         }
     });
-    compact(doc, "accessors", |d| accessor_refs(d).iter().filter_map(|r| r.as_u64()).collect(), |d, m| {
-        for r in accessor_refs_mut(d) {
-            if let Some(i) = r.as_u64() {
-                *r = json!(m[i as usize]);
+    compact(
+        doc,
+        "accessors",
+        |d| accessor_refs(d).iter().filter_map(|r| r.as_u64()).collect(),
+        |d, m| {
+            for r in accessor_refs_mut(d) {
+                if let Some(i) = r.as_u64() {
+                    *r = json!(m[i as usize]);
+                }
             }
-        }
-    });
+        },
+    );
     // Buffer views of the dropped accessors (their bytes stay in the buffer, unreferenced).
     let view_users = ["accessors", "images"];
-    let used_views = |d: &Value| -> BTreeSet<u64> { view_users.iter().flat_map(|k| d[*k].as_array().into_iter().flatten().filter_map(|x| x["bufferView"].as_u64())).collect() };
+    let used_views = |d: &Value| -> BTreeSet<u64> {
+        view_users
+            .iter()
+            .flat_map(|k| d[*k].as_array().into_iter().flatten().filter_map(|x| x["bufferView"].as_u64()))
+            .collect()
+    };
     compact(doc, "bufferViews", used_views, |d, m| {
         for k in view_users {
             for x in d[k].as_array_mut().into_iter().flatten() {
@@ -579,11 +672,14 @@ fn compact(doc: &mut Value, key: &str, used: impl Fn(&Value) -> BTreeSet<u64>, f
 fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) -> Result<(), ScriptError> {
     let joints = body.bind.len();
     if body.joints.iter().any(|&j| j as usize >= joints) {
-        return Err(ScriptError::Invalid(format!("character '{name}': a vertex is bound to a joint past the skeleton's {joints}")));
+        return Err(ScriptError::Invalid(format!(
+            "character '{name}': a vertex is bound to a joint past the skeleton's {joints}"
+        )));
     }
     let texture = body.image.as_ref().map(|img| {
         let view = out.view(&img.bytes, None);
-        let image = out.push("images", json!({"name": format!("{name} texture"), "bufferView": view, "mimeType": img.mime}));
+        let image =
+            out.push("images", json!({"name": format!("{name} texture"), "bufferView": view, "mimeType": img.mime}));
         let sampler = out.push("samplers", json!({"magFilter": 9729, "minFilter": 9729}));
         out.push("textures", json!({"sampler": sampler, "source": image}))
     });
@@ -592,7 +688,10 @@ fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) ->
         pbr["baseColorTexture"] = json!({"index": t});
     }
     // Kenney's characters are unlit; viewers without the extension shade them as plain PBR.
-    let material = out.push("materials", json!({"name": format!("{name} skin"), "pbrMetallicRoughness": pbr, "extensions": {"KHR_materials_unlit": {}}}));
+    let material = out.push(
+        "materials",
+        json!({"name": format!("{name} skin"), "pbrMetallicRoughness": pbr, "extensions": {"KHR_materials_unlit": {}}}),
+    );
     if !out.doc["extensionsUsed"].as_array().is_some_and(|u| u.iter().any(|e| e == "KHR_materials_unlit")) {
         out.push("extensionsUsed", json!("KHR_materials_unlit"));
     }
@@ -627,7 +726,11 @@ fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) ->
     let skin = out.push("skins", json!({"name": format!("{name} skin"), "joints": (first..first + joints).collect::<Vec<usize>>(), "inverseBindMatrices": ibm, "skeleton": first}));
     // A scene root (the skin's joints place it; parent transforms would not apply to it anyway).
     let node = out.push("nodes", json!({"name": format!("{name} body"), "mesh": mesh, "skin": skin}));
-    let roots = out.doc.pointer_mut("/scenes/0/nodes").and_then(Value::as_array_mut).ok_or_else(|| ScriptError::Invalid("the document has no scene".into()))?;
+    let roots = out
+        .doc
+        .pointer_mut("/scenes/0/nodes")
+        .and_then(Value::as_array_mut)
+        .ok_or_else(|| ScriptError::Invalid("the document has no scene".into()))?;
     roots.push(json!(node));
     Ok(())
 }
@@ -646,7 +749,10 @@ pub struct SkinnedCast<'a> {
 /// The animated document of [`animated_gltf_document`] with every character that has a body
 /// skinned: its bone boxes removed, the body added as a skinned mesh on its joint nodes (which keep
 /// their animation channels). Characters without a body (`None`) keep the stick figure.
-pub fn skinned_gltf_document(cast: &SkinnedCast, model: &dyn Fn(&str) -> Option<PathBuf>) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
+pub fn skinned_gltf_document(
+    cast: &SkinnedCast,
+    model: &dyn Fn(&str) -> Option<PathBuf>,
+) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
     let SkinnedCast { scene, cat, characters, bodies, camera, fps } = *cast;
     if bodies.len() != characters.len() {
         return Err(ScriptError::Invalid(format!("{} bodies for {} characters", bodies.len(), characters.len())));
@@ -655,15 +761,20 @@ pub fn skinned_gltf_document(cast: &SkinnedCast, model: &dyn Fn(&str) -> Option<
     let mut taken = BTreeSet::new();
     let mut found = Vec::new();
     for (name, m) in characters {
-        let (root, first) = joint_nodes(&doc, name, &m.skeleton, &taken)
-            .ok_or_else(|| ScriptError::Invalid(format!("character '{name}': no joint nodes in the animated document")))?;
+        let (root, first) = joint_nodes(&doc, name, &m.skeleton, &taken).ok_or_else(|| {
+            ScriptError::Invalid(format!("character '{name}': no joint nodes in the animated document"))
+        })?;
         taken.insert(root);
         found.push((root, first));
     }
     for ((_, m), body) in characters.iter().zip(bodies) {
         if let Some(b) = body {
             if b.bind.len() != m.skeleton.len() {
-                return Err(ScriptError::Invalid(format!("a body bound to {} joints for a skeleton of {}", b.bind.len(), m.skeleton.len())));
+                return Err(ScriptError::Invalid(format!(
+                    "a body bound to {} joints for a skeleton of {}",
+                    b.bind.len(),
+                    m.skeleton.len()
+                )));
             }
         }
     }
@@ -717,7 +828,11 @@ impl Paint {
     }
 
     fn at(&self, uv: [f32; 2]) -> [u8; 3] {
-        let lin_to_srgb = |c: f32| (255.0 * if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }).round().clamp(0.0, 255.0) as u8;
+        let lin_to_srgb = |c: f32| {
+            (255.0 * if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 })
+                .round()
+                .clamp(0.0, 255.0) as u8
+        };
         let base = [0, 1, 2].map(|k| lin_to_srgb(self.base[k]));
         let Some(t) = &self.texture else { return base };
         let (w, h) = (t.width() as f32, t.height() as f32);
@@ -734,7 +849,8 @@ impl Paint {
 pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) -> RgbImage {
     let SkinnedCast { scene, cat, characters, bodies, camera, fps } = *cast;
     let (eye, target, fov) = camera(frame);
-    let cam = Camera3::new(Vec3::from(eye).as_dvec3(), Vec3::from(target).as_dvec3(), DVec3::Y, fov as f64).with_viewport(size.0, size.1);
+    let cam = Camera3::new(Vec3::from(eye).as_dvec3(), Vec3::from(target).as_dvec3(), DVec3::Y, fov as f64)
+        .with_viewport(size.0, size.1);
     let mut cv = Canvas::new(size.0, size.1, [246, 247, 250]);
     draw_room(&mut cv, &cam, scene);
     let light = Vec3::new(0.4, 1.0, 0.6).normalize();
@@ -761,7 +877,11 @@ pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) 
             if n.dot(cam.eye.as_vec3() - centre) <= 0.0 {
                 continue;
             }
-            let (Some(pa), Some(pb), Some(pc)) = (cam.project(a.as_dvec3()), cam.project(b.as_dvec3()), cam.project(c.as_dvec3())) else { continue };
+            let (Some(pa), Some(pb), Some(pc)) =
+                (cam.project(a.as_dvec3()), cam.project(b.as_dvec3()), cam.project(c.as_dvec3()))
+            else {
+                continue;
+            };
             let depth = cam.to_camera(centre.as_dvec3()).z;
             let shade = 0.6 + 0.4 * n.dot(light).max(0.0);
             // Texture detail: the triangle split 4 × 4 (in pixels and uv alike), each piece
@@ -823,7 +943,12 @@ pub struct SkinnedStory {
 /// Kenney blocky character, `character-a.glb`, `-c`, … in story order, found by
 /// [`find_character_dir`]) and [`SKINNED_PNG`] (the story's middle frame through its camera).
 /// Without the Kenney files: an error naming where it looked, nothing written.
-pub fn write_skinned_story(dir: &Path, anim: &crate::animate::Animation, cat: &Catalogue, models: Option<&Path>) -> Result<SkinnedStory, ScriptError> {
+pub fn write_skinned_story(
+    dir: &Path,
+    anim: &crate::animate::Animation,
+    cat: &Catalogue,
+    models: Option<&Path>,
+) -> Result<SkinnedStory, ScriptError> {
     let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let glbs = find_character_dir(models)?;
     let mut bodies = Vec::new();
@@ -831,7 +956,12 @@ pub fn write_skinned_story(dir: &Path, anim: &crate::animate::Animation, cat: &C
     for (i, (name, m)) in chars.iter().enumerate() {
         let file = character_file(&glbs, i);
         let body = bind_body(&read_character(&file)?, &m.skeleton)?;
-        notes.push(format!("{name} wears {} ({} triangles, {:.2} m tall)", file.display(), body.indices.len() / 3, body.height()));
+        notes.push(format!(
+            "{name} wears {} ({} triangles, {:.2} m tall)",
+            file.display(),
+            body.indices.len() / 3,
+            body.height()
+        ));
         bodies.push(body);
     }
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();

@@ -43,9 +43,7 @@ pub fn known_verb_lemma(lower: &str) -> Option<String> {
     if contains(VERBS, lower) {
         return Some(lower.to_string());
     }
-    verb_candidates(lower)
-        .into_iter()
-        .find(|c| contains(VERBS, c))
+    verb_candidates(lower).into_iter().find(|c| contains(VERBS, c))
 }
 
 /// The base form of a verb: the list first, then suffix rules for verbs it does not know.
@@ -115,11 +113,8 @@ fn verb_candidates(lower: &str) -> Vec<String> {
 fn undouble(stem: &str) -> Option<String> {
     let b = stem.as_bytes();
     let n = b.len();
-    (stem.is_ascii()
-        && n >= 3
-        && b[n - 1] == b[n - 2]
-        && !matches!(b[n - 1], b'l' | b's' | b'z' | b'e' | b'o'))
-    .then(|| stem[..n - 1].to_string())
+    (stem.is_ascii() && n >= 3 && b[n - 1] == b[n - 2] && !matches!(b[n - 1], b'l' | b's' | b'z' | b'e' | b'o'))
+        .then(|| stem[..n - 1].to_string())
 }
 
 /// A stem for an unknown verb: undouble a doubled consonant, add the `e` that -ing/-ed dropped

@@ -3,15 +3,13 @@
 
 /// Determiners and quantifiers (Penn DT).
 pub const DETERMINERS: &[&str] = &[
-    "a", "an", "the", "this", "that", "these", "those", "some", "every", "each", "another", "no",
-    "any", "several", "many", "few", "all", "both", "other",
+    "a", "an", "the", "this", "that", "these", "those", "some", "every", "each", "another", "no", "any", "several",
+    "many", "few", "all", "both", "other",
 ];
 
 /// Personal pronouns (PRP).
-pub const PRONOUNS: &[&str] = &[
-    "i", "you", "he", "she", "it", "we", "they", "him", "her", "them", "me", "us", "himself",
-    "herself", "itself",
-];
+pub const PRONOUNS: &[&str] =
+    &["i", "you", "he", "she", "it", "we", "they", "him", "her", "them", "me", "us", "himself", "herself", "itself"];
 
 /// Possessive pronouns (PRP$). "her" is tagged PRP$ when a noun follows.
 pub const POSSESSIVES: &[&str] = &["my", "your", "his", "its", "our", "their"];
@@ -70,9 +68,7 @@ pub const PREPOSITIONS: &[&str] = &[
 pub const CONJUNCTIONS: &[&str] = &["and", "or", "but", "nor", "&"];
 
 /// Modals (MD).
-pub const MODALS: &[&str] = &[
-    "will", "would", "can", "could", "shall", "should", "may", "might", "must",
-];
+pub const MODALS: &[&str] = &["will", "would", "can", "could", "shall", "should", "may", "might", "must"];
 
 /// Adverbs the suffix rule `-ly` misses, and direction particles ("turns right").
 pub const ADVERBS: &[&str] = &[
@@ -120,9 +116,7 @@ pub const ADVERBS: &[&str] = &[
 ];
 
 /// Adverbs that only glue sentences together; they are not a verb's manner.
-pub const GLUE_ADVERBS: &[&str] = &[
-    "also", "then", "too", "now", "just", "even", "only", "still",
-];
+pub const GLUE_ADVERBS: &[&str] = &["also", "then", "too", "now", "just", "even", "only", "still"];
 
 /// Adjectives the suffix rules miss.
 pub const ADJECTIVES: &[&str] = &[
@@ -360,10 +354,8 @@ pub const COMMON_NOUNS: &[&str] = &[
 
 /// Object parts: a verb's target named by its part ("pushes the record button") is the object
 /// the previous action used (the recorder).
-pub const PART_NOUNS: &[&str] = &[
-    "button", "buttons", "key", "keys", "handle", "screen", "string", "strings", "pedal", "lid",
-    "knob", "switch",
-];
+pub const PART_NOUNS: &[&str] =
+    &["button", "buttons", "key", "keys", "handle", "screen", "string", "strings", "pedal", "lid", "knob", "switch"];
 
 /// Number words (CD) and their value.
 pub const NUMBERS: &[(&str, usize)] = &[
@@ -810,17 +802,8 @@ pub const IRREGULAR_NOUNS: &[(&str, &str)] = &[
 ];
 
 /// Nouns that are plural in form but name one object ("the headphones").
-pub const PLURALIA_TANTUM: &[&str] = &[
-    "headphones",
-    "earphones",
-    "glasses",
-    "scissors",
-    "pants",
-    "trousers",
-    "binoculars",
-    "stairs",
-    "drums",
-];
+pub const PLURALIA_TANTUM: &[&str] =
+    &["headphones", "earphones", "glasses", "scissors", "pants", "trousers", "binoculars", "stairs", "drums"];
 
 /// Value of a number word or numeral ("two" → 2, "3" → 3).
 pub fn number_value(lower: &str) -> Option<usize> {

@@ -2,9 +2,7 @@
 //! these patterns recover the same facts: objects with attributes and counts, relation nodes, and
 //! characters with verbs, prepositions and targets).
 
-use super::lexicon::{
-    contains, number_value, GLUE_ADVERBS, PART_NOUNS, PERSON_NOUNS, PLURALIA_TANTUM,
-};
+use super::lexicon::{contains, number_value, GLUE_ADVERBS, PART_NOUNS, PERSON_NOUNS, PLURALIA_TANTUM};
 use super::suggest::{closest, noun_suggestions, verb_suggestions};
 use super::tag::{known_noun, tag, Tag, Tagged};
 use super::token::tokenize;
@@ -135,12 +133,7 @@ fn relation_at(t: &[Tagged], i: usize) -> Option<RelMatch> {
                 (Relation::Behind, _) => "behind",
                 _ => rel.phrase(),
             };
-            return Some(RelMatch {
-                relation: *rel,
-                prep,
-                len: n,
-                dangling,
-            });
+            return Some(RelMatch { relation: *rel, prep, len: n, dangling });
         }
     }
     None
@@ -165,14 +158,7 @@ fn np_at(t: &[Tagged], i: usize) -> Option<Np> {
     let mut j = i;
     let mut count = None;
     if j < n && t[j].tag == Tag::PRP && matches!(t[j].lower.as_str(), "it" | "them") {
-        return Some(Np {
-            end: j + 1,
-            head: j,
-            modifiers: vec![],
-            count: None,
-            plural: false,
-            pronoun: true,
-        });
+        return Some(Np { end: j + 1, head: j, modifiers: vec![], count: None, plural: false, pronoun: true });
     }
     if j < n && t[j].tag == Tag::DT {
         count = match t[j].lower.as_str() {
@@ -207,20 +193,10 @@ fn np_at(t: &[Tagged], i: usize) -> Option<Np> {
         j += 1;
     }
     let run = start..j;
-    let head = run
-        .clone()
-        .rev()
-        .find(|&k| matches!(t[k].tag, Tag::NN | Tag::NNS))?;
+    let head = run.clone().rev().find(|&k| matches!(t[k].tag, Tag::NN | Tag::NNS))?;
     let modifiers: Vec<usize> = (start..head).collect();
     let plural = t[head].tag == Tag::NNS && !contains(PLURALIA_TANTUM, &t[head].lower);
-    Some(Np {
-        end: head + 1,
-        head,
-        modifiers,
-        count,
-        plural,
-        pronoun: false,
-    })
+    Some(Np { end: head + 1, head, modifiers, count, plural, pronoun: false })
 }
 
 /// What a noun phrase names.
@@ -237,9 +213,7 @@ enum Named {
 /// room, or unknown.
 fn resolve_np(t: &[Tagged], np: &Np, cat: &Catalogue, sentence: usize) -> Named {
     let head = &t[np.head];
-    let head_cat = cat
-        .resolve(&head.lower)
-        .or_else(|| cat.resolve(&head.lemma));
+    let head_cat = cat.resolve(&head.lower).or_else(|| cat.resolve(&head.lemma));
     let mut mods = np.modifiers.clone();
     let mut word = head.text.clone();
     // Compound of the last modifier and the head ("working shop", "music room", "boxing ring").
@@ -247,17 +221,11 @@ fn resolve_np(t: &[Tagged], np: &Np, cat: &Catalogue, sentence: usize) -> Named 
         let joined = format!("{}{}", t[last].lower, head.lemma);
         let joined_surface = format!("{}{}", t[last].lower, head.lower);
         let spaced = format!("{} {}", t[last].lower, head.lemma);
-        let jc = cat
-            .resolve(&joined_surface)
-            .or_else(|| cat.resolve(&joined))
-            .or_else(|| cat.resolve(&spaced));
+        let jc = cat.resolve(&joined_surface).or_else(|| cat.resolve(&joined)).or_else(|| cat.resolve(&spaced));
         if let Some(jc) = jc {
             // A compound that is the category's own name ("boxing ring" → boxingring) names it;
             // one that is only a synonym keeps its modifier ("office desk" → desk [office]).
-            if head_cat.is_none_or(|h| h.name != jc.name)
-                || jc.name == joined
-                || jc.name == joined_surface
-            {
+            if head_cat.is_none_or(|h| h.name != jc.name) || jc.name == joined || jc.name == joined_surface {
                 mods.pop();
                 return Named::Object(object(
                     jc.name.clone(),
@@ -285,10 +253,7 @@ fn resolve_np(t: &[Tagged], np: &Np, cat: &Catalogue, sentence: usize) -> Named 
         }
         return Named::Object(object(c.name.clone(), t, &mods, np, word, sentence));
     }
-    if let Some(r) = cat
-        .resolve_room(&head.lower)
-        .or_else(|| cat.resolve_room(&head.lemma))
-    {
+    if let Some(r) = cat.resolve_room(&head.lower).or_else(|| cat.resolve_room(&head.lemma)) {
         return Named::Room(r.name.clone());
     }
     if head.known || known_noun(&head.lower, cat) || head.tag == Tag::NNP {
@@ -297,40 +262,15 @@ fn resolve_np(t: &[Tagged], np: &Np, cat: &Catalogue, sentence: usize) -> Named 
     Named::Unknown(head.text.clone())
 }
 
-fn object(
-    category: String,
-    t: &[Tagged],
-    mods: &[usize],
-    np: &Np,
-    word: String,
-    sentence: usize,
-) -> ObjectNode {
-    let attributes = mods
-        .iter()
-        .map(|&k| {
-            if t[k].tag == Tag::NNS {
-                t[k].lemma.clone()
-            } else {
-                t[k].lower.clone()
-            }
-        })
-        .collect();
+fn object(category: String, t: &[Tagged], mods: &[usize], np: &Np, word: String, sentence: usize) -> ObjectNode {
+    let attributes =
+        mods.iter().map(|&k| if t[k].tag == Tag::NNS { t[k].lemma.clone() } else { t[k].lower.clone() }).collect();
     let count = np.count.unwrap_or(if np.plural { 2 } else { 1 }).max(1);
-    ObjectNode {
-        category,
-        attributes,
-        count,
-        word,
-        sentence,
-    }
+    ObjectNode { category, attributes, count, word, sentence }
 }
 
 /// Parses one sentence with the state carried over from earlier ones.
-pub fn parse_with(
-    raw: &RawSentence,
-    cat: &Catalogue,
-    state: &mut ParseState,
-) -> (Ssg, Vec<Diagnostic>) {
+pub fn parse_with(raw: &RawSentence, cat: &Catalogue, state: &mut ParseState) -> (Ssg, Vec<Diagnostic>) {
     let mut p = Parser {
         at: &raw.at,
         cat,
@@ -348,8 +288,7 @@ pub fn parse_with(
                 if !p.ssg.objects.is_empty() || p.ssg.room.is_some() {
                     p.diag(
                         None,
-                        "no `$` at the end, but it names only objects: read as a scene description"
-                            .into(),
+                        "no `$` at the end, but it names only objects: read as a scene description".into(),
                         vec![],
                     );
                 }
@@ -380,30 +319,17 @@ enum El {
 
 impl Parser<'_> {
     fn diag(&mut self, word: Option<String>, message: String, suggestions: Vec<String>) {
-        self.diags.push(Diagnostic {
-            at: self.at.clone(),
-            word,
-            message,
-            suggestions,
-        });
+        self.diags.push(Diagnostic { at: self.at.clone(), word, message, suggestions });
     }
 
     fn unknown_object(&mut self, word: &str) {
         let s = noun_suggestions(word, self.cat);
-        self.diag(
-            Some(word.to_string()),
-            format!("unknown object \"{word}\": not in the catalogue"),
-            s,
-        );
+        self.diag(Some(word.to_string()), format!("unknown object \"{word}\": not in the catalogue"), s);
     }
 
     fn command(&mut self) {
         let Some((what, value)) = command_parts(&self.at.text) else {
-            self.diag(
-                None,
-                "not a command (write \"camera left\", \"weather rainy\", \"time night\")".into(),
-                vec![],
-            );
+            self.diag(None, "not a command (write \"camera left\", \"weather rainy\", \"time night\")".into(), vec![]);
             return;
         };
         let sentence = self.sentence;
@@ -416,27 +342,15 @@ impl Parser<'_> {
             let s = closest(&value, allowed.iter().copied());
             self.diag(
                 Some(value.clone()),
-                format!(
-                    "unknown {what} setting \"{value}\" (known: {})",
-                    allowed.join(", ")
-                ),
+                format!("unknown {what} setting \"{value}\" (known: {})", allowed.join(", ")),
                 s,
             );
             return;
         }
         self.ssg.commands.push(match what.as_str() {
-            "camera" => Command::Camera {
-                view: value,
-                sentence,
-            },
-            "weather" => Command::Weather {
-                weather: value,
-                sentence,
-            },
-            _ => Command::Time {
-                time: value,
-                sentence,
-            },
+            "camera" => Command::Camera { view: value, sentence },
+            "weather" => Command::Weather { weather: value, sentence },
+            _ => Command::Time { time: value, sentence },
         });
     }
 
@@ -516,11 +430,7 @@ impl Parser<'_> {
                     let anchor_group = matches!(els.last(), Some(El::Rel(_)));
                     match np_at(t, k).filter(|np| !np.pronoun) {
                         // "near a table, and a chair is next to ...": a new clause, not one more anchor.
-                        Some(next)
-                            if anchor_group && t.get(next.end).is_some_and(|x| x.tag.is_verb()) =>
-                        {
-                            break
-                        }
+                        Some(next) if anchor_group && t.get(next.end).is_some_and(|x| x.tag.is_verb()) => break,
                         Some(next) if relation_at(t, k).is_none() => {
                             np = next;
                         }
@@ -538,8 +448,7 @@ impl Parser<'_> {
         if self.ssg.objects.is_empty() && self.ssg.room.is_none() && !unknown_any {
             self.diag(
                 None,
-                "could not read a scene description here (write e.g. \"A lamp is on the desk$\")"
-                    .into(),
+                "could not read a scene description here (write e.g. \"A lamp is on the desk$\")".into(),
                 vec![],
             );
         }
@@ -595,11 +504,7 @@ impl Parser<'_> {
             if t.iter().any(|x| x.tag == Tag::EX) || self.names_objects(t) {
                 return false;
             }
-            self.diag(
-                None,
-                "no verb found: write who does what (e.g. \"Eve walks to the desk\")".into(),
-                vec![],
-            );
+            self.diag(None, "no verb found: write who does what (e.g. \"Eve walks to the desk\")".into(), vec![]);
             return true;
         };
         let subject: Vec<&Tagged> = t[..v].iter().filter(|x| x.tag != Tag::Punct).collect();
@@ -607,25 +512,14 @@ impl Parser<'_> {
             return false;
         }
         let name = if let Some(first) = subject.iter().position(|x| x.tag == Tag::NNP) {
-            let names: Vec<&str> = subject[first..]
-                .iter()
-                .take_while(|x| x.tag == Tag::NNP)
-                .map(|x| x.text.as_str())
-                .collect();
+            let names: Vec<&str> =
+                subject[first..].iter().take_while(|x| x.tag == Tag::NNP).map(|x| x.text.as_str()).collect();
             names.join(" ")
-        } else if subject.is_empty()
-            || subject
-                .iter()
-                .all(|x| matches!(x.tag, Tag::PRP | Tag::RB | Tag::CC))
-        {
+        } else if subject.is_empty() || subject.iter().all(|x| matches!(x.tag, Tag::PRP | Tag::RB | Tag::CC)) {
             match &state.last_character {
                 Some(c) => c.clone(),
                 None => {
-                    self.diag(
-                        None,
-                        "no character: say who acts (e.g. \"Eve walks to the desk\")".into(),
-                        vec![],
-                    );
+                    self.diag(None, "no character: say who acts (e.g. \"Eve walks to the desk\")".into(), vec![]);
                     return true;
                 }
             }
@@ -635,27 +529,14 @@ impl Parser<'_> {
                 Some(h) if contains(PERSON_NOUNS, &h.lemma) || contains(PERSON_NOUNS, &h.lower) => {
                     let words: Vec<String> = subject
                         .iter()
-                        .map(|x| {
-                            if x.tag == Tag::DT {
-                                x.lower.clone()
-                            } else {
-                                x.text.clone()
-                            }
-                        })
+                        .map(|x| if x.tag == Tag::DT { x.lower.clone() } else { x.text.clone() })
                         .collect();
                     words.join(" ")
                 }
-                Some(h)
-                    if self.cat.resolve(&h.lower).is_some()
-                        || self.cat.resolve(&h.lemma).is_some() =>
-                {
+                Some(h) if self.cat.resolve(&h.lower).is_some() || self.cat.resolve(&h.lemma).is_some() => {
                     return false;
                 }
-                _ => subject
-                    .iter()
-                    .map(|x| x.text.as_str())
-                    .collect::<Vec<_>>()
-                    .join(" "),
+                _ => subject.iter().map(|x| x.text.as_str()).collect::<Vec<_>>().join(" "),
             }
         };
         state.last_character = Some(name.clone());
@@ -679,21 +560,14 @@ impl Parser<'_> {
                 continue;
             }
             if x.tag.is_verb() {
-                let next_verb = t[i + 1..]
-                    .iter()
-                    .find(|y| y.tag != Tag::RB)
-                    .is_some_and(|y| y.tag.is_verb());
+                let next_verb = t[i + 1..].iter().find(|y| y.tag != Tag::RB).is_some_and(|y| y.tag.is_verb());
                 if matches!(x.lemma.as_str(), "be" | "have" | "do") && next_verb {
                     i += 1;
                     continue;
                 }
                 if !x.known {
                     let s = verb_suggestions(&x.lower);
-                    self.diag(
-                        Some(x.text.clone()),
-                        format!("unknown verb \"{}\"", x.text),
-                        s,
-                    );
+                    self.diag(Some(x.text.clone()), format!("unknown verb \"{}\"", x.text), s);
                     cur = None;
                 } else {
                     actions.push(Action {
@@ -729,10 +603,7 @@ impl Parser<'_> {
                 (None, i)
             };
             let Some(np) = np_at(t, j) else {
-                if prep.is_some()
-                    && j == i + 1
-                    && matches!(x.lower.as_str(), "in" | "out" | "down" | "up" | "over")
-                {
+                if prep.is_some() && j == i + 1 && matches!(x.lower.as_str(), "in" | "out" | "down" | "up" | "over") {
                     // "sits down", "walks in": a particle.
                     if let Some(c) = cur {
                         actions[c].manner.push(x.lower.clone());
@@ -804,26 +675,18 @@ impl Parser<'_> {
             if !self.diags.iter().any(|d| d.word.is_some()) {
                 self.diag(
                     None,
-                    format!(
-                        "no action for {name}: write a verb (e.g. \"{name} walks to the desk\")"
-                    ),
+                    format!("no action for {name}: write a verb (e.g. \"{name} walks to the desk\")"),
                     vec![],
                 );
             }
             return true;
         }
-        self.ssg.characters.push(CharacterNode {
-            name,
-            actions,
-            sentence: self.sentence,
-        });
+        self.ssg.characters.push(CharacterNode { name, actions, sentence: self.sentence });
         true
     }
 
     fn names_objects(&self, t: &[Tagged]) -> bool {
-        t.iter().any(|x| {
-            x.tag.is_noun()
-                && (self.cat.resolve(&x.lower).is_some() || self.cat.resolve(&x.lemma).is_some())
-        })
+        t.iter()
+            .any(|x| x.tag.is_noun() && (self.cat.resolve(&x.lower).is_some() || self.cat.resolve(&x.lemma).is_some()))
     }
 }

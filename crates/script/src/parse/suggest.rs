@@ -17,9 +17,7 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
     for i in 1..=a.len() {
         for j in 1..=b.len() {
             let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut v = (d[i - 1][j] + 1)
-                .min(d[i][j - 1] + 1)
-                .min(d[i - 1][j - 1] + cost);
+            let mut v = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
                 v = v.min(d[i - 2][j - 2] + 1);
             }
@@ -42,11 +40,7 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .collect();
     scored.sort();
     scored.dedup_by(|a, b| a.1 == b.1);
-    scored
-        .into_iter()
-        .take(3)
-        .map(|(_, c)| c.to_string())
-        .collect()
+    scored.into_iter().take(3).map(|(_, c)| c.to_string()).collect()
 }
 
 /// Closest catalogue words (objects and rooms) and known verbs to an unknown word.
@@ -61,10 +55,7 @@ pub fn noun_suggestions(word: &str, cat: &Catalogue) -> Vec<String> {
     if !s.is_empty() {
         return s;
     }
-    closest(
-        word,
-        super::lexicon::PREPOSITIONS.iter().chain(VERBS).copied(),
-    )
+    closest(word, super::lexicon::PREPOSITIONS.iter().chain(VERBS).copied())
 }
 
 /// Closest known verbs, for an unknown verb.
@@ -76,12 +67,7 @@ pub fn verb_suggestions(word: &str) -> Vec<String> {
             a.push(s);
         }
     }
-    a.sort_by_key(|s| {
-        (
-            edit_distance(&base, s).min(edit_distance(word, s)),
-            s.clone(),
-        )
-    });
+    a.sort_by_key(|s| (edit_distance(&base, s).min(edit_distance(word, s)), s.clone()));
     a.truncate(3);
     a
 }
@@ -95,9 +81,6 @@ mod tests {
         assert_eq!(edit_distance("sofa", "soda"), 1);
         assert_eq!(edit_distance("jumsp", "jumps"), 1);
         assert_eq!(edit_distance("", "abc"), 3);
-        assert_eq!(
-            closest("chiar", ["chair", "desk", "char"]),
-            ["chair", "char"]
-        );
+        assert_eq!(closest("chiar", ["chair", "desk", "char"]), ["chair", "char"]);
     }
 }

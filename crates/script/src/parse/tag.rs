@@ -61,10 +61,7 @@ pub enum Tag {
 
 impl Tag {
     pub fn is_verb(self) -> bool {
-        matches!(
-            self,
-            Tag::VB | Tag::VBZ | Tag::VBP | Tag::VBD | Tag::VBG | Tag::VBN
-        )
+        matches!(self, Tag::VB | Tag::VBZ | Tag::VBP | Tag::VBD | Tag::VBG | Tag::VBN)
     }
 
     pub fn is_noun(self) -> bool {
@@ -139,33 +136,22 @@ pub fn tag(tokens: &[Token], cat: &Catalogue) -> Vec<Tagged> {
             && !contains(ADVERBS, &t.lower)
             && t.text.chars().next().is_some_and(char::is_uppercase)
         {
-            let adverb = tokens.get(1).is_some_and(|n| {
-                n.text == "," || n.text.chars().next().is_some_and(char::is_uppercase)
-            });
+            let adverb =
+                tokens.get(1).is_some_and(|n| n.text == "," || n.text.chars().next().is_some_and(char::is_uppercase));
             if !adverb {
                 (tag, known) = (Tag::NNP, true);
             }
         }
         seen_verb |= tag.is_verb();
         let lemma = match tag {
-            Tag::NN if cat.resolve(&t.lower).is_none() && t.lower.ends_with('s') && !known => {
-                lemmatize_noun(&t.lower)
+            Tag::NN if cat.resolve(&t.lower).is_none() && t.lower.ends_with('s') && !known => lemmatize_noun(&t.lower),
+            _ if AUXILIARIES.iter().any(|(f, _, _)| *f == t.lower) && tag.is_verb() => {
+                AUXILIARIES.iter().find(|(f, _, _)| *f == t.lower).map(|a| a.1.to_string()).unwrap_or_default()
             }
-            _ if AUXILIARIES.iter().any(|(f, _, _)| *f == t.lower) && tag.is_verb() => AUXILIARIES
-                .iter()
-                .find(|(f, _, _)| *f == t.lower)
-                .map(|a| a.1.to_string())
-                .unwrap_or_default(),
             Tag::NNS if contains(PLURALIA_TANTUM, &t.lower) => t.lower.clone(),
             _ => lemmatize(&t.text, tag),
         };
-        out.push(Tagged {
-            text: t.text.clone(),
-            lower: t.lower.clone(),
-            tag,
-            lemma,
-            known,
-        });
+        out.push(Tagged { text: t.text.clone(), lower: t.lower.clone(), tag, lemma, known });
     }
     out
 }
@@ -184,11 +170,7 @@ fn tag_word(
     }
     if w == "'s" {
         return (
-            if prev.is_some_and(Tag::is_noun) && next.is_some_and(|n| !is_verbish(n)) {
-                Tag::POS
-            } else {
-                Tag::VBZ
-            },
+            if prev.is_some_and(Tag::is_noun) && next.is_some_and(|n| !is_verbish(n)) { Tag::POS } else { Tag::VBZ },
             true,
         );
     }
@@ -197,15 +179,9 @@ fn tag_word(
     }
     let capital = t.text.chars().next().is_some_and(char::is_uppercase);
     let after_subject = matches!(prev, Some(Tag::NN | Tag::NNS | Tag::NNP | Tag::PRP));
-    let noun_context = matches!(
-        prev,
-        Some(Tag::DT | Tag::JJ | Tag::CD | Tag::PRPS | Tag::POS)
-    );
+    let noun_context = matches!(prev, Some(Tag::DT | Tag::JJ | Tag::CD | Tag::PRPS | Tag::POS));
     // Closed classes first.
-    if w == "there"
-        && next
-            .is_some_and(|n| matches!(n, "is" | "are" | "was" | "were" | "'s" | "stands" | "hangs"))
-    {
+    if w == "there" && next.is_some_and(|n| matches!(n, "is" | "are" | "was" | "were" | "'s" | "stands" | "hangs")) {
         return (Tag::EX, true);
     }
     if w == "which" || w == "where" || w == "whose" {
@@ -240,10 +216,8 @@ fn tag_word(
         return (penn(tag), true);
     }
     // Direction particles right after a verb ("turns right") before any other reading.
-    if matches!(
-        w,
-        "right" | "left" | "around" | "back" | "away" | "up" | "down" | "forward" | "aside"
-    ) && prev.is_some_and(Tag::is_verb)
+    if matches!(w, "right" | "left" | "around" | "back" | "away" | "up" | "down" | "forward" | "aside")
+        && prev.is_some_and(Tag::is_verb)
         && next.is_none_or(|n| !known_noun(n, cat))
     {
         return (Tag::RB, true);
@@ -254,10 +228,7 @@ fn tag_word(
     // Open classes: capitalised words not at the start are names.
     let verb = known_verb_lemma(w);
     let noun = known_noun(w, cat);
-    if capital
-        && i > 0
-        && !(noun && t.text.chars().skip(1).all(char::is_lowercase) && cat.resolve(w).is_some())
-    {
+    if capital && i > 0 && !(noun && t.text.chars().skip(1).all(char::is_lowercase) && cat.resolve(w).is_some()) {
         return (Tag::NNP, true);
     }
     if capital
@@ -286,8 +257,7 @@ fn tag_word(
             let verb_context = after_subject
                 || matches!(prev, Some(Tag::MD | Tag::TO | Tag::RB))
                 || prev == Some(Tag::CC) && seen_verb
-                || prev.is_none()
-                    && next.is_some_and(|n| contains(DETERMINERS, n) || contains(PREPOSITIONS, n));
+                || prev.is_none() && next.is_some_and(|n| contains(DETERMINERS, n) || contains(PREPOSITIONS, n));
             if verb_context && !noun_context {
                 (verb_form(w), true)
             } else {
@@ -320,36 +290,18 @@ fn tag_word(
             }
             if w.ends_with("ed") && w.len() > 4 {
                 // "an organized office desk": a participle before a noun is an adjective.
-                let before_noun =
-                    next.is_some_and(|n| known_noun(n, cat) || contains(ADJECTIVES, n));
-                return (
-                    if noun_context || before_noun {
-                        Tag::JJ
-                    } else {
-                        Tag::VBD
-                    },
-                    true,
-                );
+                let before_noun = next.is_some_and(|n| known_noun(n, cat) || contains(ADJECTIVES, n));
+                return (if noun_context || before_noun { Tag::JJ } else { Tag::VBD }, true);
             }
             if w.ends_with("ing") && w.len() > 5 {
                 let before_noun = next.is_some_and(|n| known_noun(n, cat));
-                return (
-                    if noun_context && before_noun {
-                        Tag::JJ
-                    } else {
-                        Tag::VBG
-                    },
-                    false,
-                );
+                return (if noun_context && before_noun { Tag::JJ } else { Tag::VBG }, false);
             }
             if w.chars().all(|c| c.is_ascii_digit() || c == '.') {
                 return (Tag::CD, true);
             }
             // Unknown: after a subject it is most likely the verb, otherwise a noun.
-            if (after_subject || prev == Some(Tag::CC) && seen_verb)
-                && !noun_context
-                && !seen_verb_just_before(prev)
-            {
+            if (after_subject || prev == Some(Tag::CC) && seen_verb) && !noun_context && !seen_verb_just_before(prev) {
                 (if w.ends_with('s') { Tag::VBZ } else { Tag::VB }, false)
             } else {
                 (Tag::NN, false)
@@ -409,12 +361,9 @@ fn verb_form(w: &str) -> Tag {
 
 fn has_adjective_suffix(w: &str) -> bool {
     w.len() > 5
-        && [
-            "ous", "ful", "ive", "able", "ible", "ical", "less", "ish", "ern", "ary", "ic", "ant",
-            "ent", "y",
-        ]
-        .iter()
-        .any(|s| w.ends_with(s))
+        && ["ous", "ful", "ive", "able", "ible", "ical", "less", "ish", "ern", "ary", "ic", "ant", "ent", "y"]
+            .iter()
+            .any(|s| w.ends_with(s))
         && !w.ends_with("ly")
 }
 
@@ -424,26 +373,14 @@ mod tests {
     use super::*;
 
     fn tags(s: &str) -> Vec<&'static str> {
-        tag(&tokenize(s), &Catalogue::default())
-            .into_iter()
-            .map(|t| t.tag.name())
-            .collect()
+        tag(&tokenize(s), &Catalogue::default()).into_iter().map(|t| t.tag.name()).collect()
     }
 
     #[test]
     fn direction_tags() {
-        assert_eq!(
-            tags("Tom sits and calls with phone"),
-            ["NNP", "VBZ", "CC", "VBZ", "IN", "NN"]
-        );
-        assert_eq!(
-            tags("The man walks unbelievably to the road"),
-            ["DT", "NN", "VBZ", "RB", "TO", "DT", "NN"]
-        );
+        assert_eq!(tags("Tom sits and calls with phone"), ["NNP", "VBZ", "CC", "VBZ", "IN", "NN"]);
+        assert_eq!(tags("The man walks unbelievably to the road"), ["DT", "NN", "VBZ", "RB", "TO", "DT", "NN"]);
         assert_eq!(tags("Tom turns right"), ["NNP", "VBZ", "RB"]);
-        assert_eq!(
-            tags("Worker is sawing the wood"),
-            ["NN", "VBZ", "VBG", "DT", "NN"]
-        );
+        assert_eq!(tags("Worker is sawing the wood"), ["NN", "VBZ", "VBG", "DT", "NN"]);
     }
 }

@@ -11,10 +11,7 @@ pub struct Token {
 
 impl Token {
     fn new(text: &str) -> Token {
-        Token {
-            text: text.to_string(),
-            lower: text.to_lowercase(),
-        }
+        Token { text: text.to_string(), lower: text.to_lowercase() }
     }
 
     /// Whether this is punctuation rather than a word.
@@ -35,12 +32,7 @@ pub fn tokenize(text: &str) -> Vec<Token> {
         }
         let lower = word.to_lowercase();
         if lower.len() > 2 && (lower.ends_with("'s") || lower.ends_with("\u{2019}s")) {
-            let cut = word.len()
-                - if word.ends_with("'s") || word.ends_with("'S") {
-                    2
-                } else {
-                    "\u{2019}s".len()
-                };
+            let cut = word.len() - if word.ends_with("'s") || word.ends_with("'S") { 2 } else { "\u{2019}s".len() };
             out.push(Token::new(&word[..cut]));
             out.push(Token::new("'s"));
         } else {
@@ -73,13 +65,7 @@ mod tests {
 
     #[test]
     fn words_and_punctuation() {
-        let t: Vec<String> = tokenize("In the room, Eve's 2.5 m-wide desk!")
-            .into_iter()
-            .map(|t| t.text)
-            .collect();
-        assert_eq!(
-            t,
-            ["In", "the", "room", ",", "Eve", "'s", "2.5", "m-wide", "desk", "!"]
-        );
+        let t: Vec<String> = tokenize("In the room, Eve's 2.5 m-wide desk!").into_iter().map(|t| t.text).collect();
+        assert_eq!(t, ["In", "the", "room", ",", "Eve", "'s", "2.5", "m-wide", "desk", "!"]);
     }
 }

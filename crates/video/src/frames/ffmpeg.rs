@@ -66,9 +66,8 @@ pub(crate) fn decode_with(
         cmd.args(["-frames:v", &m.to_string()]);
     }
     cmd.arg("-").stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped());
-    let mut child = cmd
-        .spawn()
-        .map_err(|e| decode_err(path, None, format!("cannot run {}: {e}", program.to_string_lossy())))?;
+    let mut child =
+        cmd.spawn().map_err(|e| decode_err(path, None, format!("cannot run {}: {e}", program.to_string_lossy())))?;
     let mut stderr = child.stderr.take().expect("stderr is piped");
     let errors = std::thread::spawn(move || {
         let mut s = String::new();
@@ -110,7 +109,12 @@ fn finish(
 }
 
 /// Cuts a raw rgb24 byte stream into frames; also returns the bytes of a trailing partial frame.
-fn read_frames(r: &mut impl Read, width: u32, height: u32, max_frames: Option<usize>) -> std::io::Result<(Vec<RgbImage>, usize)> {
+fn read_frames(
+    r: &mut impl Read,
+    width: u32,
+    height: u32,
+    max_frames: Option<usize>,
+) -> std::io::Result<(Vec<RgbImage>, usize)> {
     let size = width as usize * height as usize * 3;
     let mut frames = Vec::new();
     loop {

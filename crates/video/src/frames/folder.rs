@@ -86,14 +86,20 @@ fn check_sizes(files: &[PathBuf], frames: &[RgbImage]) -> Result<(), VideoError>
             Err(decode_err(
                 &files[i],
                 Some(i),
-                format!("is {fw}x{fh} but the first frame ({}) is {w}x{h}; all frames must have one size", files[0].display()),
+                format!(
+                    "is {fw}x{fh} but the first frame ({}) is {w}x{h}; all frames must have one size",
+                    files[0].display()
+                ),
             ))
         }
     }
 }
 
 /// Reads the folder's frames (at most `max_frames`), decoding files in parallel.
-pub(crate) fn read_folder(dir: &Path, max_frames: Option<usize>) -> Result<(Vec<RgbImage>, f64, DecodeReport), VideoError> {
+pub(crate) fn read_folder(
+    dir: &Path,
+    max_frames: Option<usize>,
+) -> Result<(Vec<RgbImage>, f64, DecodeReport), VideoError> {
     let mut files = image_files(dir)?;
     if files.is_empty() {
         return Err(decode_err(dir, None, "the folder holds no .png/.jpg/.jpeg frames"));

@@ -36,7 +36,10 @@ fn fps_from_delays(frames: usize, total_ms: f64) -> f64 {
 }
 
 /// Reads every frame of an animated GIF (at most `max_frames`).
-pub(crate) fn read_gif(path: &Path, max_frames: Option<usize>) -> Result<(Vec<RgbImage>, f64, DecodeReport), VideoError> {
+pub(crate) fn read_gif(
+    path: &Path,
+    max_frames: Option<usize>,
+) -> Result<(Vec<RgbImage>, f64, DecodeReport), VideoError> {
     let file = std::fs::File::open(path).map_err(|e| VideoError::io(path, e))?;
     let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(file))
         .map_err(|e| decode_err(path, None, format!("not a readable GIF: {e}")))?;

@@ -25,8 +25,8 @@ mod procedural;
 mod tests;
 
 pub use ffmpeg::ffmpeg_available;
-pub(crate) use gray::gray_downscaled;
 pub use folder::natural_cmp;
+pub(crate) use gray::gray_downscaled;
 pub use mp4_in::{probe_openh264, OpenH264Probe, SampleOutcome};
 pub use procedural::{procedural_clip, procedural_truth, ProceduralKind, ProceduralTruth};
 

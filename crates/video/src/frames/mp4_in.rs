@@ -89,7 +89,10 @@ fn demux_inner(bytes: &[u8]) -> Result<Demuxed, DemuxError> {
         height: track.height() as u32,
         fps: fps_of(track),
         profile: avcc.avc_profile_indication,
-        reorder: stbl.ctts.as_ref().is_some_and(|c| c.entries.windows(2).any(|w| w[0].sample_offset != w[1].sample_offset)),
+        reorder: stbl
+            .ctts
+            .as_ref()
+            .is_some_and(|c| c.entries.windows(2).any(|w| w[0].sample_offset != w[1].sample_offset)),
         length_size: avcc.length_size_minus_one as usize % 4 + 1,
         params,
         samples: Vec::new(),
@@ -241,7 +244,12 @@ fn to_rgb(yuv: &DecodedYUV<'_>, size: &mut Option<(u32, u32)>) -> Result<RgbImag
 
 /// Feeds the samples to openh264 in decode order. Stops at the first error unless `keep_going`,
 /// and once `max_frames` pictures are out; keeps pictures only when `keep_frames`.
-fn run_openh264(d: &Demuxed, max_frames: Option<usize>, keep_going: bool, keep_frames: bool) -> Result<H264Run, String> {
+fn run_openh264(
+    d: &Demuxed,
+    max_frames: Option<usize>,
+    keep_going: bool,
+    keep_frames: bool,
+) -> Result<H264Run, String> {
     let config = DecoderConfig::new().flush_after_decode(Flush::NoFlush);
     let mut dec = H264Decoder::with_api_config(openh264::OpenH264API::from_source(), config)
         .map_err(|e| format!("openh264 does not start: {e}"))?;
@@ -261,12 +269,10 @@ fn run_openh264(d: &Demuxed, max_frames: Option<usize>, keep_going: bool, keep_f
                 packet.extend_from_slice(p);
             }
         }
-        let outcome = avcc_to_annexb(sample, d.length_size, &mut packet).and_then(|()| {
-            match dec.decode(&packet) {
-                Ok(Some(yuv)) => to_rgb(&yuv, &mut size).map(Some),
-                Ok(None) => Ok(None),
-                Err(e) => Err(format!("openh264: {e}")),
-            }
+        let outcome = avcc_to_annexb(sample, d.length_size, &mut packet).and_then(|()| match dec.decode(&packet) {
+            Ok(Some(yuv)) => to_rgb(&yuv, &mut size).map(Some),
+            Ok(None) => Ok(None),
+            Err(e) => Err(format!("openh264: {e}")),
         });
         match outcome {
             Ok(Some(img)) => {
@@ -416,7 +422,12 @@ fn via_openh264(d: &Demuxed, max_frames: Option<usize>) -> Result<Read, (Option<
 }
 
 /// Decodes with an ffmpeg subprocess; the frame size comes from ffprobe, else from the MP4 header.
-fn via_ffmpeg(path: &Path, d: Option<&Demuxed>, max_frames: Option<usize>, mut notes: Vec<String>) -> Result<Read, VideoError> {
+fn via_ffmpeg(
+    path: &Path,
+    d: Option<&Demuxed>,
+    max_frames: Option<usize>,
+    mut notes: Vec<String>,
+) -> Result<Read, VideoError> {
     if !ffmpeg_available() {
         return Err(VideoError::Unsupported {
             path: path.to_path_buf(),
@@ -427,7 +438,8 @@ fn via_ffmpeg(path: &Path, d: Option<&Demuxed>, max_frames: Option<usize>, mut n
     }
     let probe = ffprobe_video(path);
     let size = probe.map(|p| (p.0, p.1)).or(d.map(|d| (d.width, d.height)));
-    let (w, h) = size.ok_or_else(|| decode_err(path, None, "cannot tell the frame size: no ffprobe and no readable MP4 header"))?;
+    let (w, h) = size
+        .ok_or_else(|| decode_err(path, None, "cannot tell the frame size: no ffprobe and no readable MP4 header"))?;
     let fps = probe.and_then(|p| p.2).or(d.and_then(|d| d.fps)).unwrap_or_else(|| {
         notes.push(format!("no frame rate found: assumed {DEFAULT_FPS} fps"));
         DEFAULT_FPS
@@ -455,7 +467,12 @@ mod tests {
         let p = OpenH264Probe {
             profile: 100,
             has_b_frames: true,
-            samples: vec![SampleOutcome::Frame, SampleOutcome::Frame, SampleOutcome::Error("x".into()), SampleOutcome::NoOutput],
+            samples: vec![
+                SampleOutcome::Frame,
+                SampleOutcome::Frame,
+                SampleOutcome::Error("x".into()),
+                SampleOutcome::NoOutput,
+            ],
             flushed: 1,
         };
         assert_eq!(p.summary(), "0-1 frame, 2-2 error, 3-3 no output (3 frames, 1 errors, 1 flushed)");

@@ -9,7 +9,9 @@
 use super::Clip;
 use crate::VideoError;
 use image::RgbImage;
-use openh264::encoder::{BitRate, Encoder, EncoderConfig, FrameRate, FrameType, IntraFramePeriod, Profile, RateControlMode};
+use openh264::encoder::{
+    BitRate, Encoder, EncoderConfig, FrameRate, FrameType, IntraFramePeriod, Profile, RateControlMode,
+};
 use openh264::formats::{RgbSliceU8, YUVBuffer};
 use openh264::OpenH264API;
 use std::path::Path;
@@ -132,7 +134,8 @@ fn mux(frames: &[EncodedFrame], w: u32, h: u32, fps: f64) -> Result<Vec<u8>, Str
         compatible_brands: ["isom", "iso2", "avc1", "mp41"].iter().map(|b| brand(b)).collect(),
         timescale: 1000,
     };
-    let mut writer = mp4::Mp4Writer::write_start(std::io::Cursor::new(Vec::new()), &config).map_err(|e| e.to_string())?;
+    let mut writer =
+        mp4::Mp4Writer::write_start(std::io::Cursor::new(Vec::new()), &config).map_err(|e| e.to_string())?;
     let avc = mp4::AvcConfig { width: w as u16, height: h as u16, seq_param_set: sps, pic_param_set: pps };
     let track = mp4::TrackConfig {
         track_type: mp4::TrackType::Video,

@@ -107,7 +107,10 @@ impl Scene {
             w: width as f32,
             h: height as f32,
             truth: procedural_truth(kind, frames),
-            backgrounds: [textured_background(width, height, derive(seed, 2)), textured_background(width, height, derive(seed, 3))],
+            backgrounds: [
+                textured_background(width, height, derive(seed, 2)),
+                textured_background(width, height, derive(seed, 3)),
+            ],
             amplitude: r.random_range(0.45..0.75),
             period: r.random_range(22.0..34.0),
             phase: r.random_range(0.0..2.0 * PI),

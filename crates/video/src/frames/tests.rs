@@ -86,7 +86,8 @@ fn mp4_round_trip_decodes_with_openh264_above_30_db() {
     let (auto, report) = read(&path).unwrap();
     assert_eq!(report.decoder, "openh264 (bundled)");
     for (i, b) in auto.frames.iter().enumerate().take(16) {
-        let best = (0..clip.len()).max_by(|&x, &y| psnr(&clip.frames[x], b).total_cmp(&psnr(&clip.frames[y], b))).unwrap();
+        let best =
+            (0..clip.len()).max_by(|&x, &y| psnr(&clip.frames[x], b).total_cmp(&psnr(&clip.frames[y], b))).unwrap();
         assert_eq!(best, i);
     }
 }
@@ -260,7 +261,13 @@ fn real_bigbuckbunny_decodes_132_frames_with_openh264_matching_ffmpegs_frames() 
         let path = video.join("bigbuckbunny.mp4");
         let t = std::time::Instant::now();
         let (clip, report) = read(&path).unwrap();
-        println!("bigbuckbunny: {} frames in {:.2} s via {} {:?}", clip.len(), t.elapsed().as_secs_f64(), report.decoder, report.notes);
+        println!(
+            "bigbuckbunny: {} frames in {:.2} s via {} {:?}",
+            clip.len(),
+            t.elapsed().as_secs_f64(),
+            report.decoder,
+            report.notes
+        );
         assert_eq!((clip.len(), clip.width(), clip.height()), (132, 1280, 720));
         assert_eq!(report.decoder, "openh264 (bundled)");
         assert!((clip.fps - 25.0).abs() < 0.01, "{}", clip.fps);
@@ -329,7 +336,11 @@ fn real_carphone_openh264_measurement_and_auto_path() {
             assert_eq!(report.decoder, "ffmpeg (subprocess)");
         } else {
             assert_eq!(report.decoder, "openh264 (bundled)");
-            assert!(report.notes.iter().any(|n| n.contains("B-frames") && n.contains("no ffmpeg")), "{:?}", report.notes);
+            assert!(
+                report.notes.iter().any(|n| n.contains("B-frames") && n.contains("no ffmpeg")),
+                "{:?}",
+                report.notes
+            );
         }
         // The pictures come out in display order, not decode order: taken in display order they are
         // smoother than if they were still in decode order, and no swap of neighbours helps.
@@ -338,7 +349,8 @@ fn real_carphone_openh264_measurement_and_auto_path() {
         println!("consecutive-frame PSNR: {shown:.2} dB as returned, {as_if_decode_order:.2} dB if in decode order");
         assert!(shown > as_if_decode_order + 1.0);
         let d = |a: usize, b: usize| psnr(&clip.frames[a], &clip.frames[b]);
-        let better_swaps = (1..117).filter(|&i| d(i - 1, i + 1) + d(i, i + 2) > d(i - 1, i) + d(i + 1, i + 2) + 0.5).count();
+        let better_swaps =
+            (1..117).filter(|&i| d(i - 1, i + 1) + d(i, i + 2) > d(i - 1, i) + d(i + 1, i + 2) + 0.5).count();
         assert_eq!(better_swaps, 0);
     });
 }

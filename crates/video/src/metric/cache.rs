@@ -117,7 +117,16 @@ pub fn embeddings_cached(
     let path = cache_path(cache_dir, key);
     let rejected_cache = match read_entry(&path, key, planes.len(), cfg, opts) {
         Ok(Some((embedder, embeddings, summary))) => {
-            return Ok(ClipMetric { embedder, embeddings, summary, key, path, from_cache: true, rejected_cache: None, write_error: None });
+            return Ok(ClipMetric {
+                embedder,
+                embeddings,
+                summary,
+                key,
+                path,
+                from_cache: true,
+                rejected_cache: None,
+                write_error: None,
+            });
         }
         Ok(None) => None,
         Err(reason) => {
@@ -137,7 +146,13 @@ pub fn embeddings_cached(
 type Entry = (Embedder, Vec<Vec<f32>>, TrainSummary);
 
 /// `Ok(None)`: no file. `Err`: a file that cannot be used, and why.
-fn read_entry(path: &Path, key: u64, frames: usize, cfg: &RsfConfig, opts: &TrainOptions) -> Result<Option<Entry>, String> {
+fn read_entry(
+    path: &Path,
+    key: u64,
+    frames: usize,
+    cfg: &RsfConfig,
+    opts: &TrainOptions,
+) -> Result<Option<Entry>, String> {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
@@ -147,16 +162,26 @@ fn read_entry(path: &Path, key: u64, frames: usize, cfg: &RsfConfig, opts: &Trai
         return Err("not an RSFNet cache file".into());
     }
     let json_len = u64::from_le_bytes(bytes[8..16].try_into().expect("8 bytes"));
-    let json_end = usize::try_from(json_len).ok().and_then(|l| l.checked_add(16)).filter(|&e| e <= bytes.len()).ok_or("truncated")?;
+    let json_end = usize::try_from(json_len)
+        .ok()
+        .and_then(|l| l.checked_add(16))
+        .filter(|&e| e <= bytes.len())
+        .ok_or("truncated")?;
     let meta: CacheMeta = serde_json::from_slice(&bytes[16..json_end]).map_err(|e| format!("bad header: {e}"))?;
-    if meta.format != CACHE_FORMAT || meta.key != key || meta.frames != frames || &meta.config != cfg || &meta.options != opts {
+    if meta.format != CACHE_FORMAT
+        || meta.key != key
+        || meta.frames != frames
+        || &meta.config != cfg
+        || &meta.options != opts
+    {
         return Err("written for another clip, config or format".into());
     }
     if meta.embeddings.len() != frames || meta.embeddings.iter().any(|e| e.len() != cfg.latent) {
         return Err("embeddings of the wrong shape".into());
     }
     let device = backend::cpu();
-    let net = checkpoint::load_module_bytes(cfg.init(&device), bytes[json_end..].to_vec(), path).map_err(|e| e.to_string())?;
+    let net = checkpoint::load_module_bytes(cfg.init(&device), bytes[json_end..].to_vec(), path)
+        .map_err(|e| e.to_string())?;
     Ok(Some((Embedder::new(net, cfg.clone()), meta.embeddings, meta.summary)))
 }
 

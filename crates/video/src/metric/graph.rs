@@ -53,7 +53,8 @@ impl Graph {
         if self.n < 2 {
             return 0.0;
         }
-        let hits = (0..self.n).filter(|&i| self.neighbours(i).first().is_some_and(|&j| j.abs_diff(i) <= window)).count();
+        let hits =
+            (0..self.n).filter(|&i| self.neighbours(i).first().is_some_and(|&j| j.abs_diff(i) <= window)).count();
         hits as f64 / self.n as f64
     }
 }

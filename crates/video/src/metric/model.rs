@@ -55,14 +55,28 @@ pub struct RsfConfig {
 
 impl Default for RsfConfig {
     fn default() -> Self {
-        RsfConfig { input_side: 32, channels: [8, 16, 32, 32], convs_per_block: 1, pool_grid: 2, latent: 32, use_rff: true }
+        RsfConfig {
+            input_side: 32,
+            channels: [8, 16, 32, 32],
+            convs_per_block: 1,
+            pool_grid: 2,
+            latent: 32,
+            use_rff: true,
+        }
     }
 }
 
 impl RsfConfig {
     /// A small network for tests and tiny inputs (32×32).
     pub fn tiny() -> RsfConfig {
-        RsfConfig { input_side: 32, channels: [4, 8, 8, 16], convs_per_block: 1, pool_grid: 2, latent: 16, use_rff: true }
+        RsfConfig {
+            input_side: 32,
+            channels: [4, 8, 8, 16],
+            convs_per_block: 1,
+            pool_grid: 2,
+            latent: 16,
+            use_rff: true,
+        }
     }
 
     /// Checks the sizes; the error names the field.
@@ -79,7 +93,10 @@ impl RsfConfig {
         }
         let last_side = self.last_side();
         if self.pool_grid > last_side {
-            return bad(format!("pool_grid {} is larger than the last feature map ({last_side}×{last_side})", self.pool_grid));
+            return bad(format!(
+                "pool_grid {} is larger than the last feature map ({last_side}×{last_side})",
+                self.pool_grid
+            ));
         }
         Ok(())
     }
@@ -87,7 +104,11 @@ impl RsfConfig {
     /// Side of the map that is pooled: `F_4` (side S/16) with RFF, `X_4` (S/8) without.
     pub fn last_side(&self) -> usize {
         let s = self.input_side as usize;
-        if self.use_rff { s / 16 } else { s / 8 }
+        if self.use_rff {
+            s / 16
+        } else {
+            s / 8
+        }
     }
 
     /// Builds the network on `device` (call inside [`inbetween_nn::backend::seeded_module`] for
@@ -105,7 +126,8 @@ impl RsfConfig {
             .collect();
         let (ncm, c1r) = if self.use_rff {
             let ncm = self.channels.iter().map(|&c| Ncm::new(c, device)).collect();
-            let c1r = (1..4).map(|i| C1r::new(self.channels[i - 1] + self.channels[i], self.channels[i], device)).collect();
+            let c1r =
+                (1..4).map(|i| C1r::new(self.channels[i - 1] + self.channels[i], self.channels[i], device)).collect();
             (ncm, c1r)
         } else {
             (Vec::new(), Vec::new())
@@ -230,7 +252,8 @@ impl RsfNet {
     /// Latent vectors `[batch, latent]` of a `[batch, 3, S, S]` input (RGB in [0, 1]).
     pub fn forward(&self, x: Tensor<4>) -> Tensor<2> {
         let xs = self.coarse_features(x);
-        let last = if self.ncm.is_empty() { xs.into_iter().last().expect("four CFE maps") } else { self.fine_features(xs) };
+        let last =
+            if self.ncm.is_empty() { xs.into_iter().last().expect("four CFE maps") } else { self.fine_features(xs) };
         let pooled = adaptive_avg_pool2d(last, [self.pool_grid, self.pool_grid]);
         self.dense.forward(pooled.flatten(1, 3))
     }

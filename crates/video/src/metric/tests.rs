@@ -20,7 +20,8 @@ pub(crate) fn moving_square(n: usize, side: u32) -> Vec<RgbImage> {
             let x0 = 1.0 + u * (s - size - 2.0);
             let y0 = (s - size) / 2.0 * (1.0 + 0.8 * (u * 5.0).sin());
             RgbImage::from_fn(side, side, |x, y| {
-                let overlap = |p: u32, start: f32| ((p as f32 + 1.0).min(start + size) - (p as f32).max(start)).max(0.0);
+                let overlap =
+                    |p: u32, start: f32| ((p as f32 + 1.0).min(start + size) - (p as f32).max(start)).max(0.0);
                 let cover = overlap(x, x0) * overlap(y, y0);
                 let background = [(x * 255 / side) as f32 / 2.0, (y * 255 / side) as f32 / 2.0, 120.0];
                 let square = [230.0, 40.0, 40.0];
@@ -135,7 +136,8 @@ fn early_stopping_keeps_the_best_validated_epoch() {
     assert_eq!(embedder.embed(&frames), again.embed(&frames));
     assert_eq!(summary.val_agreement, s2.val_agreement);
     // Patience 0 trains the whole budget.
-    let (_, full) = train_rsfnet(&frames, &cfg, &TrainOptions { patience: 0, ..quick(20, 4) }, &Progress::hidden()).unwrap();
+    let (_, full) =
+        train_rsfnet(&frames, &cfg, &TrainOptions { patience: 0, ..quick(20, 4) }, &Progress::hidden()).unwrap();
     assert_eq!((full.steps, full.loss_history.len()), (20, 4));
 }
 
@@ -161,7 +163,9 @@ fn training_lowers_the_loss_and_ranks_neighbours_closer() {
     let opts = quick(80, 11);
     let (trained, summary) = train_rsfnet(&frames, &cfg, &opts, &Progress::hidden()).unwrap();
     let secs = started.elapsed().as_secs_f64();
-    let (untrained, none) = train_rsfnet(&frames, &cfg, &TrainOptions { use_distance_loss: false, ..opts.clone() }, &Progress::hidden()).unwrap();
+    let (untrained, none) =
+        train_rsfnet(&frames, &cfg, &TrainOptions { use_distance_loss: false, ..opts.clone() }, &Progress::hidden())
+            .unwrap();
     assert!(!none.trained && none.steps == 0);
 
     // Held-out triplets (a seed the training never drew from).
@@ -174,7 +178,9 @@ fn training_lowers_the_loss_and_ranks_neighbours_closer() {
     let (g_before, g_after) = (graph_from_embeddings(&e_before), graph_from_embeddings(&e_after));
     let (nn_before, nn_after) = (g_before.nearest_within(3), g_after.nearest_within(3));
     // Chance that a random other frame is within ±3: about 6/23.
-    let chance = (1..24).map(|i: usize| (0..24).filter(|&j| j != i && j.abs_diff(i) <= 3).count() as f64 / 23.0).sum::<f64>() / 23.0;
+    let chance =
+        (1..24).map(|i: usize| (0..24).filter(|&j| j != i && j.abs_diff(i) <= 3).count() as f64 / 23.0).sum::<f64>()
+            / 23.0;
     println!(
         "80 steps in {secs:.1}s; epoch losses {:.3} → {:.3}; held-out loss {loss_before:.3} → {loss_after:.3}, \
          agreement {agree_before:.3} → {agree_after:.3} (summary {:.3} → {:.3}); nearest within ±3: {nn_before:.2} → {nn_after:.2} \
@@ -226,7 +232,10 @@ fn cache_round_trip_and_corrupt_file_rebuild() {
         let rebuilt = embeddings_cached(dir.path(), &frames, &cfg, &opts, &progress).unwrap();
         assert!(!rebuilt.from_cache && rebuilt.rejected_cache.is_some());
         assert_eq!(rebuilt.embeddings, first.embeddings, "rebuilding is deterministic");
-        assert!(embeddings_cached(dir.path(), &frames, &cfg, &opts, &progress).unwrap().from_cache, "the bad file was not replaced");
+        assert!(
+            embeddings_cached(dir.path(), &frames, &cfg, &opts, &progress).unwrap().from_cache,
+            "the bad file was not replaced"
+        );
     }
 }
 
@@ -266,7 +275,8 @@ fn timing_132_frames_at_64() {
 #[ignore]
 fn real_frames_bbb_png_seq() {
     inbetween_io::data::with_shared_data("video/bbb_png_seq", |dir| {
-        let mut paths: Vec<_> = std::fs::read_dir(dir.join("video/bbb_png_seq")).unwrap().map(|e| e.unwrap().path()).collect();
+        let mut paths: Vec<_> =
+            std::fs::read_dir(dir.join("video/bbb_png_seq")).unwrap().map(|e| e.unwrap().path()).collect();
         paths.sort();
         let frames: Vec<RgbImage> = paths.iter().map(|p| image::open(p).unwrap().to_rgb8()).collect();
         let cfg = RsfConfig::default();

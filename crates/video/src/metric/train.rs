@@ -95,7 +95,10 @@ impl TrainOptions {
     pub fn validate(&self) -> Result<(), VideoError> {
         let bad = |m: String| Err(VideoError::Invalid(format!("RSFNet training: {m}")));
         if self.batch == 0 || self.steps_per_epoch == 0 {
-            return bad(format!("batch ({}) and steps_per_epoch ({}) must be at least 1", self.batch, self.steps_per_epoch));
+            return bad(format!(
+                "batch ({}) and steps_per_epoch ({}) must be at least 1",
+                self.batch, self.steps_per_epoch
+            ));
         }
         if !(self.lr > 0.0 && self.lr.is_finite()) {
             return bad(format!("lr must be positive, got {}", self.lr));
@@ -167,7 +170,11 @@ impl<'a> TripletSampler<'a> {
         let (lo, hi) = if local { (a.saturating_sub(self.window), (a + self.window).min(n - 1)) } else { (0, n - 1) };
         // Draw from [lo, hi] without a: one fewer slot, shifted past a.
         let k = rng.random_range(lo..hi);
-        if k >= a { k + 1 } else { k }
+        if k >= a {
+            k + 1
+        } else {
+            k
+        }
     }
 
     /// One triplet and its label, or `None` when `MAX_DRAWS` draws all tied.
@@ -226,10 +233,8 @@ struct TripletObjective<'a> {
 impl TripletObjective<'_> {
     fn batch_loss(&self, model: &RsfNet, triplets: &[(Triplet, f32)]) -> Tensor<1> {
         let b = triplets.len();
-        let order: Vec<usize> = [0, 1, 2]
-            .iter()
-            .flat_map(|&k| triplets.iter().map(move |((a, p, n), _)| [*a, *p, *n][k]))
-            .collect();
+        let order: Vec<usize> =
+            [0, 1, 2].iter().flat_map(|&k| triplets.iter().map(move |((a, p, n), _)| [*a, *p, *n][k])).collect();
         let x = batch_tensor(self.sampler.planes, &order, self.side, &self.device);
         let r = model.forward(x);
         let z: Vec<f32> = triplets.iter().map(|(_, z)| *z).collect();
@@ -275,20 +280,31 @@ pub fn clip_planes(frames: &[RgbImage], side: u32) -> Vec<Planes> {
 
 /// Trains RSFNet on the frames of one clip (see the module docs) and returns it ready for
 /// inference, with a summary. Needs at least 3 frames.
-pub fn train_rsfnet(frames: &[RgbImage], cfg: &RsfConfig, opts: &TrainOptions, progress: &Progress) -> Result<(Embedder, TrainSummary), VideoError> {
+pub fn train_rsfnet(
+    frames: &[RgbImage],
+    cfg: &RsfConfig,
+    opts: &TrainOptions,
+    progress: &Progress,
+) -> Result<(Embedder, TrainSummary), VideoError> {
     let planes = clip_planes(frames, cfg.input_side);
     train_on_planes(&planes, cfg, opts, progress)
 }
 
 /// [`train_rsfnet`] on frames already resized by [`clip_planes`].
-pub fn train_on_planes(planes: &[Planes], cfg: &RsfConfig, opts: &TrainOptions, progress: &Progress) -> Result<(Embedder, TrainSummary), VideoError> {
+pub fn train_on_planes(
+    planes: &[Planes],
+    cfg: &RsfConfig,
+    opts: &TrainOptions,
+    progress: &Progress,
+) -> Result<(Embedder, TrainSummary), VideoError> {
     cfg.validate()?;
     opts.validate()?;
     if planes.len() < 3 {
         return Err(VideoError::Invalid(format!("RSFNet training needs at least 3 frames, got {}", planes.len())));
     }
     let sampler = TripletSampler::new(planes, opts);
-    let eval = sampler.draw_many(&mut inbetween_core::seed::rng(inbetween_core::seed::derive(opts.seed, EVAL_STREAM)), EVAL_TRIPLETS);
+    let eval = sampler
+        .draw_many(&mut inbetween_core::seed::rng(inbetween_core::seed::derive(opts.seed, EVAL_STREAM)), EVAL_TRIPLETS);
     let initial = Embedder::new(backend::seeded_module(&backend::cpu(), opts.seed, |d| cfg.init(d)), cfg.clone());
     let agreement_before = agreement(&initial.embed_planes(planes), &eval);
     // A clip whose frames all tie (a still shot) has no triplet to learn from: nothing to train.
@@ -317,7 +333,8 @@ pub fn train_on_planes(planes: &[Planes], cfg: &RsfConfig, opts: &TrainOptions, 
         ..TrainConfig::default()
     };
     progress.phase((loop_config.epochs * loop_config.steps_per_epoch) as u64, "RSFNet");
-    let val = sampler.draw_many(&mut inbetween_core::seed::rng(inbetween_core::seed::derive(opts.seed, VAL_STREAM)), EVAL_TRIPLETS);
+    let val = sampler
+        .draw_many(&mut inbetween_core::seed::rng(inbetween_core::seed::derive(opts.seed, VAL_STREAM)), EVAL_TRIPLETS);
     let mut objective = TripletObjective {
         sampler,
         batch: opts.batch,

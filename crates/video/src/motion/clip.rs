@@ -32,28 +32,17 @@ pub fn analyse_clip(gray: &[GrayImage], p: &FlowParams) -> ClipMotion {
     let (forward, backward) = clip_flows(gray, p);
     let tendency: Vec<Option<f32>> = forward.iter().map(|f| motion_tendency(f, SIGMA)).collect();
     let lms = lms_frames(&tendency, DELTA, LMS_MIN_LEN);
-    ClipMotion {
-        backward,
-        tendency,
-        lms,
-        seconds: start.elapsed().as_secs_f64(),
-    }
+    ClipMotion { backward, tendency, lms, seconds: start.elapsed().as_secs_f64() }
 }
 
 /// Per frame: (forward motion, backward flow FC), both n long.
 fn clip_flows(gray: &[GrayImage], p: &FlowParams) -> (Vec<Flow>, Vec<Flow>) {
     let n = gray.len();
     if n < 2 {
-        let still: Vec<Flow> = gray
-            .iter()
-            .map(|g| Flow::zeros(g.width() as usize, g.height() as usize))
-            .collect();
+        let still: Vec<Flow> = gray.iter().map(|g| Flow::zeros(g.width() as usize, g.height() as usize)).collect();
         return (still.clone(), still);
     }
-    let frames: Vec<Prepared> = gray
-        .par_iter()
-        .map(|g| Prepared::from_image(g, p))
-        .collect();
+    let frames: Vec<Prepared> = gray.par_iter().map(|g| Prepared::from_image(g, p)).collect();
     let pair = |c: usize, d: usize| {
         let (a, b) = (&frames[c], &frames[d]);
         // A pair of different sizes: the public path resamples frame d to frame c's grid.
@@ -66,13 +55,7 @@ fn clip_flows(gray: &[GrayImage], p: &FlowParams) -> (Vec<Flow>, Vec<Flow>) {
     // Jobs 0..n−1: forward c → c+1; jobs n−1..2(n−1): backward c → c−1 for c = 1..n.
     let flows: Vec<Flow> = (0..2 * (n - 1))
         .into_par_iter()
-        .map(|j| {
-            if j < n - 1 {
-                pair(j, j + 1)
-            } else {
-                pair(j + 2 - n, j + 1 - n)
-            }
-        })
+        .map(|j| if j < n - 1 { pair(j, j + 1) } else { pair(j + 2 - n, j + 1 - n) })
         .collect();
     let (fwd, bwd) = flows.split_at(n - 1);
     let mut forward = fwd.to_vec();

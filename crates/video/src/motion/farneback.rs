@@ -67,11 +67,7 @@ pub fn farneback(prev: &GrayImage, next: &GrayImage, p: &FlowParams) -> Flow {
     }
     let mut b = from_gray(next);
     if b.w != w || b.h != h {
-        b = if b.w == 0 || b.h == 0 {
-            Grid::zeros(w, h)
-        } else {
-            resample(&b, w, h)
-        };
+        b = if b.w == 0 || b.h == 0 { Grid::zeros(w, h) } else { resample(&b, w, h) };
     }
     flow_between(&Prepared::new(from_gray(prev), p), &Prepared::new(b, p), p)
 }
@@ -87,10 +83,7 @@ impl Prepared {
     /// Expansions of `img` for the settings `p`.
     pub(crate) fn new(img: Grid<1>, p: &FlowParams) -> Prepared {
         let levels = level_count(img.w, img.h, p);
-        let levels = pyramid(img, levels)
-            .iter()
-            .map(|g| expand(g, p.poly_n, p.poly_sigma))
-            .collect();
+        let levels = pyramid(img, levels).iter().map(|g| expand(g, p.poly_n, p.poly_sigma)).collect();
         Prepared { levels }
     }
 
@@ -117,11 +110,7 @@ pub(crate) fn flow_between(a: &Prepared, b: &Prepared, p: &FlowParams) -> Flow {
         flow = upscale_flow(&flow, ea.w, ea.h);
         flow = refine(ea, eb, flow, p);
     }
-    Flow {
-        width: w,
-        height: h,
-        uv: flow.px,
-    }
+    Flow { width: w, height: h, uv: flow.px }
 }
 
 /// Levels actually used: at most `p.levels` (≥ 1), with the coarsest side ≥ `min_level_side`.
@@ -195,13 +184,7 @@ fn pixel_equations(c1: &[f32; 5], c2: &[f32; 5], d: [f32; 2]) -> [f32; 5] {
     let a12 = 0.5 * (c1[4] + c2[4]);
     let db1 = -0.5 * (c2[0] - c1[0]) + a11 * d[0] + a12 * d[1];
     let db2 = -0.5 * (c2[1] - c1[1]) + a12 * d[0] + a22 * d[1];
-    [
-        a11 * a11 + a12 * a12,
-        a12 * (a11 + a22),
-        a12 * a12 + a22 * a22,
-        a11 * db1 + a12 * db2,
-        a12 * db1 + a22 * db2,
-    ]
+    [a11 * a11 + a12 * a12, a12 * (a11 + a22), a12 * a12 + a22 * a22, a11 * db1 + a12 * db2, a12 * db1 + a22 * db2]
 }
 
 /// d = (G + λI)⁻¹ (h + λ·d̃) per pixel; G + λI is positive definite for λ > 0, so this never
@@ -222,9 +205,5 @@ fn solve(normal: &Grid<5>, prior: &Grid<2>, lambda: f32) -> Grid<2> {
             [(g22 * h1 - g12 * h2) / det, (g11 * h2 - g12 * h1) / det]
         })
         .collect();
-    Grid {
-        w: normal.w,
-        h: normal.h,
-        px,
-    }
+    Grid { w: normal.w, h: normal.h, px }
 }

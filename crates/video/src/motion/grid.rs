@@ -14,11 +14,7 @@ pub(crate) struct Grid<const N: usize> {
 
 impl<const N: usize> Grid<N> {
     pub fn zeros(w: usize, h: usize) -> Self {
-        Grid {
-            w,
-            h,
-            px: vec![[0.0; N]; w * h],
-        }
+        Grid { w, h, px: vec![[0.0; N]; w * h] }
     }
 
     /// A `w`×`h` grid whose rows (starting at zero) are filled in parallel by `fill(y, row)`,
@@ -26,11 +22,7 @@ impl<const N: usize> Grid<N> {
     pub fn par_rows(w: usize, h: usize, fill: impl Fn(usize, &mut [[f32; N]]) + Sync + Send) -> Self {
         let mut out = Grid::zeros(w, h);
         if w > 0 {
-            out.px
-                .par_chunks_mut(w)
-                .with_min_len(ROWS_PER_TASK)
-                .enumerate()
-                .for_each(|(y, row)| fill(y, row));
+            out.px.par_chunks_mut(w).with_min_len(ROWS_PER_TASK).enumerate().for_each(|(y, row)| fill(y, row));
         }
         out
     }
@@ -61,11 +53,7 @@ pub(crate) const ROWS_PER_TASK: usize = 16;
 /// Luma in [0, 1].
 pub(crate) fn from_gray(img: &GrayImage) -> Grid<1> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    Grid {
-        w,
-        h,
-        px: img.as_raw().iter().map(|&v| [v as f32 / 255.0]).collect(),
-    }
+    Grid { w, h, px: img.as_raw().iter().map(|&v| [v as f32 / 255.0]).collect() }
 }
 
 /// Separable correlation along rows: `out(x, y) = Σ_t k[t + r] · src(x + t, y)`, t ∈ [−r, r], with
@@ -160,40 +148,24 @@ mod tests {
 
     #[test]
     fn correlation_uses_the_kernel_orientation_and_replicates_borders() {
-        let g = Grid::<1> {
-            w: 4,
-            h: 1,
-            px: vec![[0.0], [1.0], [2.0], [3.0]],
-        };
+        let g = Grid::<1> { w: 4, h: 1, px: vec![[0.0], [1.0], [2.0], [3.0]] };
         // k = [0, 0, 1]: out(x) = src(x + 1), the last pixel repeats.
         let out = correlate_rows(&g, &[0.0, 0.0, 1.0]);
         assert_eq!(out.px, vec![[1.0], [2.0], [3.0], [3.0]]);
-        let col = Grid::<1> {
-            w: 1,
-            h: 3,
-            px: vec![[5.0], [6.0], [7.0]],
-        };
+        let col = Grid::<1> { w: 1, h: 3, px: vec![[5.0], [6.0], [7.0]] };
         assert_eq!(correlate_cols(&col, &[1.0, 0.0, 0.0]).px, vec![[5.0], [5.0], [6.0]]);
     }
 
     #[test]
     fn bilinear_interpolates_and_clamps() {
-        let g = Grid::<1> {
-            w: 2,
-            h: 2,
-            px: vec![[0.0], [1.0], [2.0], [3.0]],
-        };
+        let g = Grid::<1> { w: 2, h: 2, px: vec![[0.0], [1.0], [2.0], [3.0]] };
         assert!((g.bilinear(0.5, 0.5)[0] - 1.5).abs() < 1e-6);
         assert_eq!(g.bilinear(-3.0, 9.0)[0], 2.0);
     }
 
     #[test]
     fn halving_keeps_a_constant_image_constant() {
-        let g = Grid::<2> {
-            w: 7,
-            h: 5,
-            px: vec![[0.25, -1.0]; 35],
-        };
+        let g = Grid::<2> { w: 7, h: 5, px: vec![[0.25, -1.0]; 35] };
         let h = half(&g);
         assert_eq!((h.w, h.h), (4, 3));
         assert!(h.px.iter().all(|p| (p[0] - 0.25).abs() < 1e-6 && (p[1] + 1.0).abs() < 1e-6));

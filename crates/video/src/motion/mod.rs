@@ -21,8 +21,8 @@ pub use clip::{analyse_clip, ClipMotion};
 pub use farneback::{farneback, FlowParams};
 pub use pseudo::{pseudo_images, rotate_flow, threshold, MU0};
 pub use tendency::{
-    angle_between, lms_frames, motion_tendency, motion_tendency_with_floor, normalized_magnitude,
-    DELTA, LMS_MIN_LEN, SIGMA, STATIC_MAX_PX,
+    angle_between, lms_frames, motion_tendency, motion_tendency_with_floor, normalized_magnitude, DELTA, LMS_MIN_LEN,
+    SIGMA, STATIC_MAX_PX,
 };
 
 /// A dense flow field: `uv[y * width + x]` = (u, v), the displacement in pixels of pixel (x, y)
@@ -42,11 +42,7 @@ impl Flow {
 
     /// The same vector everywhere.
     pub fn uniform(width: usize, height: usize, uv: [f32; 2]) -> Flow {
-        Flow {
-            width,
-            height,
-            uv: vec![uv; width * height],
-        }
+        Flow { width, height, uv: vec![uv; width * height] }
     }
 
     /// The vector at (x, y).
@@ -56,11 +52,7 @@ impl Flow {
 
     /// Every vector reversed (the flow of the opposite frame order, to first order).
     pub fn negated(&self) -> Flow {
-        Flow {
-            width: self.width,
-            height: self.height,
-            uv: self.uv.iter().map(|v| [-v[0], -v[1]]).collect(),
-        }
+        Flow { width: self.width, height: self.height, uv: self.uv.iter().map(|v| [-v[0], -v[1]]).collect() }
     }
 
     /// ‖F_ij‖₂ per pixel; a non-finite vector counts as 0.
@@ -106,12 +98,7 @@ impl Flow {
         }
         let pick = |i: usize, n: usize, src: usize| ((i * 2 + 1) * src / (2 * n)).min(src - 1);
         let uv = (0..width * height)
-            .map(|i| {
-                self.at(
-                    pick(i % width, width, self.width),
-                    pick(i / width, height, self.height),
-                )
-            })
+            .map(|i| self.at(pick(i % width, width, self.width), pick(i / width, height, self.height)))
             .collect();
         Flow { width, height, uv }
     }

@@ -20,10 +20,7 @@ pub(crate) fn expand(img: &Grid<1>, poly_n: usize, sigma: f32) -> Expansion {
     let g = gaussian_weights(sigma, radius);
     let kernel = |p: i32| -> Vec<f32> {
         let r = radius as f64;
-        g.iter()
-            .enumerate()
-            .map(|(i, gv)| (gv * (i as f64 - r).powi(p)) as f32)
-            .collect()
+        g.iter().enumerate().map(|(i, gv)| (gv * (i as f64 - r).powi(p)) as f32).collect()
     };
     let k = [kernel(0), kernel(1), kernel(2)];
     let moments = column_moments(&row_moments(img, &k), &k);
@@ -105,9 +102,7 @@ fn invert6(mut m: [[f64; 6]; 6]) -> [[f64; 6]; 6] {
         row[i] = 1.0;
     }
     for col in 0..6 {
-        let pivot = (col..6)
-            .max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))
-            .unwrap_or(col);
+        let pivot = (col..6).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs())).unwrap_or(col);
         m.swap(col, pivot);
         inv.swap(col, pivot);
         let p = m[col][col];
@@ -146,12 +141,7 @@ mod tests {
         let b2 = -0.01 + 2.0 * 0.001 * y - 0.002 * x;
         let want = [b1, b2, 0.003, 0.001, -0.001];
         for k in 0..5 {
-            assert!(
-                (c[k] as f64 - want[k]).abs() < 1e-5,
-                "coefficient {k}: {} vs {}",
-                c[k],
-                want[k]
-            );
+            assert!((c[k] as f64 - want[k]).abs() < 1e-5, "coefficient {k}: {} vs {}", c[k], want[k]);
         }
     }
 }

@@ -28,21 +28,14 @@ pub fn pseudo_images(fc: &Flow, fk: &Flow, mu0: f32, min_count: usize) -> (Vec<f
     let fk = fk.resampled_nearest(fc.width, fc.height);
     let (nc, nk) = (normalized_magnitude(fc), normalized_magnitude(&fk));
     let m: Vec<f32> = nc.iter().zip(&nk).map(|(a, b)| a.max(*b)).collect();
-    let (mu_c, mu_k) = (
-        threshold(&nc, mu0, min_count),
-        threshold(&nk, mu0, min_count),
-    );
+    let (mu_c, mu_k) = (threshold(&nc, mu0, min_count), threshold(&nk, mu0, min_count));
     (render(fc, &m, mu_c), render(&fk, &m, mu_k))
 }
 
 /// The threshold of Eq. 14: μ, starting at `mu0` and halved while fewer than `min_count`
 /// elements of `norm` exceed it. A non-positive or non-finite `mu0` means [`MU0`].
 pub fn threshold(norm: &[f32], mu0: f32, min_count: usize) -> f32 {
-    let mut mu = if mu0.is_finite() && mu0 > 0.0 {
-        mu0
-    } else {
-        MU0
-    };
+    let mut mu = if mu0.is_finite() && mu0 > 0.0 { mu0 } else { MU0 };
     for _ in 0..MAX_HALVINGS {
         if norm.iter().filter(|&&v| v > mu).count() >= min_count {
             break;
@@ -58,11 +51,7 @@ fn render(flow: &Flow, m: &[f32], mu: f32) -> Vec<f32> {
     for (v, &mv) in flow.uv.iter().zip(m) {
         if mv >= mu {
             let len = (v[0] * v[0] + v[1] * v[1]).sqrt();
-            let (ux, uy) = if len > 0.0 && len.is_finite() {
-                (v[0] / len, v[1] / len)
-            } else {
-                (0.0, 0.0)
-            };
+            let (ux, uy) = if len > 0.0 && len.is_finite() { (v[0] / len, v[1] / len) } else { (0.0, 0.0) };
             out.extend_from_slice(&[0.5 * ux + 0.5, 0.5 * uy + 0.5, 1.0]);
         } else {
             out.extend_from_slice(&[0.5, 0.5, 0.0]);
@@ -77,14 +66,6 @@ fn render(flow: &Flow, m: &[f32], mu: f32) -> Vec<f32> {
 /// coordinates (y down) a positive angle turns clockwise on screen: (1, 0) → (0, 1).
 pub fn rotate_flow(flow: &Flow, angle: f32) -> Flow {
     let (s, c) = angle.sin_cos();
-    let uv = flow
-        .uv
-        .iter()
-        .map(|v| [c * v[0] - s * v[1], s * v[0] + c * v[1]])
-        .collect();
-    Flow {
-        width: flow.width,
-        height: flow.height,
-        uv,
-    }
+    let uv = flow.uv.iter().map(|v| [c * v[0] - s * v[1], s * v[0] + c * v[1]]).collect();
+    Flow { width: flow.width, height: flow.height, uv }
 }

@@ -24,9 +24,7 @@ pub const STATIC_MAX_PX: f32 = 0.2;
 /// one, so all get 1, unless there is no motion at all (all 0). Non-finite vectors count as 0.
 pub fn normalized_magnitude(flow: &Flow) -> Vec<f32> {
     let mags = flow.magnitudes();
-    let (lo, hi) = mags.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &m| {
-        (lo.min(m), hi.max(m))
-    });
+    let (lo, hi) = mags.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &m| (lo.min(m), hi.max(m)));
     if hi <= 1e-12 {
         return vec![0.0; mags.len()];
     }
@@ -34,9 +32,7 @@ pub fn normalized_magnitude(flow: &Flow) -> Vec<f32> {
     if range <= 1e-6 * hi {
         return vec![1.0; mags.len()];
     }
-    mags.iter()
-        .map(|&m| ((m - lo) / range).clamp(0.0, 1.0))
-        .collect()
+    mags.iter().map(|&m| ((m - lo) / range).clamp(0.0, 1.0)).collect()
 }
 
 /// Eq. 10 with the default static floor [`STATIC_MAX_PX`]: the angle of the mean unit flow vector

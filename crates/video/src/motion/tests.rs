@@ -23,22 +23,14 @@ impl Texture {
                 let wavelength = r.random_range(5.0f32..16.0);
                 let theta = r.random_range(0.0f32..2.0 * PI);
                 let k = 2.0 * PI / wavelength;
-                (
-                    k * theta.cos(),
-                    k * theta.sin(),
-                    r.random_range(0.0f32..2.0 * PI),
-                )
+                (k * theta.cos(), k * theta.sin(), r.random_range(0.0f32..2.0 * PI))
             })
             .collect();
         Texture { waves }
     }
 
     fn value(&self, x: f32, y: f32) -> f32 {
-        let s: f32 = self
-            .waves
-            .iter()
-            .map(|(kx, ky, ph)| (kx * x + ky * y + ph).sin())
-            .sum();
+        let s: f32 = self.waves.iter().map(|(kx, ky, ph)| (kx * x + ky * y + ph).sin()).sum();
         (128.0 + 100.0 * s / (self.waves.len() as f32).sqrt() * 0.9).clamp(0.0, 255.0)
     }
 
@@ -76,21 +68,12 @@ fn rotated(w: u32, h: u32, angle: f32, seed: u64) -> (GrayImage, GrayImage, Flow
             [c * dx - s * dy - dx, s * dx + c * dy - dy]
         })
         .collect();
-    (
-        prev,
-        next,
-        Flow {
-            width: w as usize,
-            height: h as usize,
-            uv,
-        },
-    )
+    (prev, next, Flow { width: w as usize, height: h as usize, uv })
 }
 
 fn epe(prev: &GrayImage, next: &GrayImage, truth: &Flow, margin: usize) -> f64 {
     let f = farneback(prev, next, &FlowParams::default());
-    f.mean_endpoint_error(truth, margin)
-        .expect("same size, pixels inside the margin")
+    f.mean_endpoint_error(truth, margin).expect("same size, pixels inside the margin")
 }
 
 // ---------------------------------------------------------------- flow accuracy
@@ -110,13 +93,8 @@ fn large_translation_is_reached_by_the_pyramid() {
     println!("EPE (6, 3) px: {e:.4}");
     assert!(e < 0.3, "mean endpoint error {e}");
     // Without the pyramid the same shift is out of reach: the pyramid is what does it.
-    let single = FlowParams {
-        levels: 1,
-        ..FlowParams::default()
-    };
-    let e1 = farneback(&prev, &next, &single)
-        .mean_endpoint_error(&truth, 12)
-        .unwrap();
+    let single = FlowParams { levels: 1, ..FlowParams::default() };
+    let e1 = farneback(&prev, &next, &single).mean_endpoint_error(&truth, 12).unwrap();
     println!("EPE (6, 3) px, one level: {e1:.4}");
     assert!(e1 > 2.0 * e, "one level {e1} vs pyramid {e}");
 }
@@ -145,17 +123,10 @@ fn degenerate_images_do_not_panic() {
     assert_eq!((f.width, f.height, f.uv.len()), (0, 0, 0));
     let flat = GrayImage::from_pixel(40, 30, image::Luma([90]));
     let f = farneback(&flat, &flat, &p);
-    assert!(
-        f.uv.iter().all(|v| v[0] == 0.0 && v[1] == 0.0),
-        "uniform frames: no motion"
-    );
+    assert!(f.uv.iter().all(|v| v[0] == 0.0 && v[1] == 0.0), "uniform frames: no motion");
     let tiny = GrayImage::from_pixel(1, 1, image::Luma([3]));
     let f = farneback(&tiny, &flat, &p);
-    assert!(
-        f.uv.len() == 1 && f.magnitudes()[0] < 1e-6,
-        "a 1×1 frame has no structure: {:?}",
-        f.uv
-    );
+    assert!(f.uv.len() == 1 && f.magnitudes()[0] < 1e-6, "a 1×1 frame has no structure: {:?}", f.uv);
     // Another size: resampled to prev's grid, and the result is finite.
     let (prev, _, _) = translated(48, 36, [0.0, 0.0], 15);
     let f = farneback(&prev, &flat, &p);
@@ -186,55 +157,29 @@ fn flow_speed_160x90() {
         f = farneback(&prev, &next, &p);
     }
     let ms = t.elapsed().as_secs_f64() * 1000.0 / runs as f64;
-    println!(
-        "160x90 farneback: {ms:.2} ms per flow, EPE {:.4}",
-        f.mean_endpoint_error(&truth, 10).unwrap()
-    );
-    let single = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
+    println!("160x90 farneback: {ms:.2} ms per flow, EPE {:.4}", f.mean_endpoint_error(&truth, 10).unwrap());
+    let single = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let t = std::time::Instant::now();
     single.install(|| (0..runs).for_each(|_| drop(farneback(&prev, &next, &p))));
-    println!(
-        "160x90 farneback, 1 thread: {:.2} ms per flow",
-        t.elapsed().as_secs_f64() * 1000.0 / runs as f64
-    );
+    println!("160x90 farneback, 1 thread: {:.2} ms per flow", t.elapsed().as_secs_f64() * 1000.0 / runs as f64);
     // A clip: each frame expanded once, 2(n − 1) flows.
     let t = Texture::new(18);
-    let gray: Vec<GrayImage> = (0..40)
-        .map(|i| t.render(160, 90, |x, y| (x - 1.5 * i as f32, y)))
-        .collect();
+    let gray: Vec<GrayImage> = (0..40).map(|i| t.render(160, 90, |x, y| (x - 1.5 * i as f32, y))).collect();
     let m = analyse_clip(&gray, &p);
-    println!(
-        "analyse_clip 40 frames 160x90: {:.3} s, {:.2} ms per flow",
-        m.seconds,
-        m.seconds * 1000.0 / (2.0 * 39.0)
-    );
+    println!("analyse_clip 40 frames 160x90: {:.3} s, {:.2} ms per flow", m.seconds, m.seconds * 1000.0 / (2.0 * 39.0));
 }
 
 // ---------------------------------------------------------------- Eq. 9
 
 #[test]
 fn eq9_normalizes_magnitudes_to_the_unit_interval() {
-    let f = Flow {
-        width: 3,
-        height: 1,
-        uv: vec![[1.0, 0.0], [0.0, -3.0], [3.0, 4.0]],
-    };
+    let f = Flow { width: 3, height: 1, uv: vec![[1.0, 0.0], [0.0, -3.0], [3.0, 4.0]] };
     let n = normalized_magnitude(&f);
     assert_eq!(n, vec![0.0, 0.5, 1.0]);
     // Degenerate: equal magnitudes → all 1; no motion → all 0; NaN counts as no motion.
-    assert_eq!(
-        normalized_magnitude(&Flow::uniform(2, 2, [0.0, 2.0])),
-        vec![1.0; 4]
-    );
+    assert_eq!(normalized_magnitude(&Flow::uniform(2, 2, [0.0, 2.0])), vec![1.0; 4]);
     assert_eq!(normalized_magnitude(&Flow::zeros(2, 2)), vec![0.0; 4]);
-    let nan = Flow {
-        width: 2,
-        height: 1,
-        uv: vec![[f32::NAN, 0.0], [2.0, 0.0]],
-    };
+    let nan = Flow { width: 2, height: 1, uv: vec![[f32::NAN, 0.0], [2.0, 0.0]] };
     assert_eq!(normalized_magnitude(&nan), vec![0.0, 1.0]);
     assert!(normalized_magnitude(&Flow::zeros(0, 0)).is_empty());
 }
@@ -268,8 +213,7 @@ fn eq10_tendency_is_the_direction_of_the_dominant_motion() {
         f.uv[3 * 10 + x] = [2.5, 2.5]; // |.| ≈ 3.54 > σ · 4
     }
     let t = motion_tendency(&f, SIGMA).unwrap();
-    let want =
-        (std::f32::consts::FRAC_1_SQRT_2 * 4.0).atan2(12.0 + 4.0 * std::f32::consts::FRAC_1_SQRT_2);
+    let want = (std::f32::consts::FRAC_1_SQRT_2 * 4.0).atan2(12.0 + 4.0 * std::f32::consts::FRAC_1_SQRT_2);
     assert!((t - want).abs() < 1e-5, "{t} vs {want}");
 }
 
@@ -289,10 +233,7 @@ fn eq10_has_no_tendency_without_motion_or_direction() {
     }
     assert_eq!(motion_tendency(&f, SIGMA), None);
     // σ = 1: nothing exceeds the largest normalised magnitude.
-    assert_eq!(
-        motion_tendency(&block_flow([3.0, 0.0], [0.0, 0.0]), 1.0),
-        None
-    );
+    assert_eq!(motion_tendency(&block_flow([3.0, 0.0], [0.0, 0.0]), 1.0), None);
 }
 
 // ---------------------------------------------------------------- Eq. 11
@@ -301,28 +242,13 @@ fn eq10_has_no_tendency_without_motion_or_direction() {
 fn eq11_marks_runs_of_at_least_four_consistent_frames() {
     let r = Some(0.0);
     // Four frames moving right, then a reversal, then three frames moving left (too short).
-    let t = [
-        r,
-        Some(0.3),
-        Some(-0.5),
-        r,
-        Some(PI),
-        Some(PI),
-        Some(3.0),
-        None,
-    ];
+    let t = [r, Some(0.3), Some(-0.5), r, Some(PI), Some(PI), Some(3.0), None];
     let lms = lms_frames(&t, DELTA, LMS_MIN_LEN);
-    assert_eq!(
-        lms,
-        vec![true, true, true, true, false, false, false, false]
-    );
+    assert_eq!(lms, vec![true, true, true, true, false, false, false, false]);
     // Anchored on T_j: 0, 0.7, 1.4 turn gradually but 1.4 is more than π/4 from 0, so the run
     // from 0 stops; the run from 0.7 (0.7, 1.4, 1.2, 1.0) is long enough on its own.
     let t = [Some(0.0), Some(0.7), Some(1.4), Some(1.2), Some(1.0)];
-    assert_eq!(
-        lms_frames(&t, DELTA, 4),
-        vec![false, true, true, true, true]
-    );
+    assert_eq!(lms_frames(&t, DELTA, 4), vec![false, true, true, true, true]);
     // A missing tendency breaks the run.
     let t = [r, r, None, r, r, r];
     assert_eq!(lms_frames(&t, DELTA, 4), vec![false; 6]);
@@ -341,13 +267,7 @@ fn eq11_wraps_angles_across_pi() {
 fn tendency_and_lms_of_hand_made_clip_flows() {
     // Six frames moving right then five moving left: two runs, tendency 0 then π.
     let flows: Vec<Flow> = (0..11)
-        .map(|i| {
-            if i < 6 {
-                block_flow([2.0, 0.0], [0.0, 0.0])
-            } else {
-                block_flow([-2.0, 0.1], [0.0, 0.0])
-            }
-        })
+        .map(|i| if i < 6 { block_flow([2.0, 0.0], [0.0, 0.0]) } else { block_flow([-2.0, 0.1], [0.0, 0.0]) })
         .collect();
     let t: Vec<Option<f32>> = flows.iter().map(|f| motion_tendency(f, SIGMA)).collect();
     assert!(t[..6].iter().all(|a| a.unwrap().abs() < 1e-6));
@@ -422,16 +342,8 @@ fn eq14_halving_widens_the_mask_of_a_flow() {
 #[test]
 fn eq14_zero_and_mismatched_flows_do_not_panic() {
     let (xc, xk) = pseudo_images(&Flow::zeros(4, 3), &Flow::zeros(4, 3), MU0, 224);
-    assert!(xc
-        .chunks(3)
-        .chain(xk.chunks(3))
-        .all(|p| p == [0.5, 0.5, 0.0]));
-    let (xc, xk) = pseudo_images(
-        &Flow::uniform(4, 3, [1.0, 0.0]),
-        &Flow::uniform(2, 2, [0.0, 1.0]),
-        MU0,
-        1,
-    );
+    assert!(xc.chunks(3).chain(xk.chunks(3)).all(|p| p == [0.5, 0.5, 0.0]));
+    let (xc, xk) = pseudo_images(&Flow::uniform(4, 3, [1.0, 0.0]), &Flow::uniform(2, 2, [0.0, 1.0]), MU0, 1);
     assert_eq!((xc.len(), xk.len()), (36, 36));
     assert_eq!(pixel(&xk, 4, 3, 2), [0.5, 1.0, 1.0]);
     let (xc, xk) = pseudo_images(&Flow::zeros(0, 0), &Flow::zeros(0, 0), MU0, 5);
@@ -442,11 +354,7 @@ fn eq14_zero_and_mismatched_flows_do_not_panic() {
 
 #[test]
 fn eq17_rotations_turn_every_vector_by_a_quarter() {
-    let f = Flow {
-        width: 2,
-        height: 1,
-        uv: vec![[1.0, 0.0], [3.0, 4.0]],
-    };
+    let f = Flow { width: 2, height: 1, uv: vec![[1.0, 0.0], [3.0, 4.0]] };
     let a1 = rotate_flow(&f, FRAC_PI_2);
     let a2 = rotate_flow(&f, -FRAC_PI_2);
     let close = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
@@ -454,11 +362,7 @@ fn eq17_rotations_turn_every_vector_by_a_quarter() {
     assert!(close(a1.uv[1], [-4.0, 3.0]) && close(a2.uv[1], [4.0, -3.0]));
     assert_eq!(f.magnitudes(), a1.magnitudes());
     // Tendency turns with it: right → down.
-    let t = motion_tendency(
-        &rotate_flow(&block_flow([2.0, 0.0], [0.0, 0.0]), FRAC_PI_2),
-        SIGMA,
-    )
-    .unwrap();
+    let t = motion_tendency(&rotate_flow(&block_flow([2.0, 0.0], [0.0, 0.0]), FRAC_PI_2), SIGMA).unwrap();
     assert!((t - FRAC_PI_2).abs() < 1e-6);
 }
 
@@ -469,32 +373,21 @@ fn analyse_clip_finds_backward_flows_and_a_reversal() {
     // A texture panned right by 2 px per frame for 5 frames, then back left for 4.
     let t = Texture::new(21);
     let offsets = [0.0f32, 2.0, 4.0, 6.0, 8.0, 10.0, 8.0, 6.0, 4.0, 2.0];
-    let gray: Vec<GrayImage> = offsets
-        .iter()
-        .map(|&o| t.render(64, 48, |x, y| (x - o, y)))
-        .collect();
+    let gray: Vec<GrayImage> = offsets.iter().map(|&o| t.render(64, 48, |x, y| (x - o, y))).collect();
     let m = analyse_clip(&gray, &FlowParams::default());
-    assert_eq!(
-        (m.backward.len(), m.tendency.len(), m.lms.len()),
-        (10, 10, 10)
-    );
+    assert_eq!((m.backward.len(), m.tendency.len(), m.lms.len()), (10, 10, 10));
     // FC of frame c is the motion c → c−1: (−2, 0) while panning right, (+2, 0) after the turn.
     for c in 1..10 {
         let want = Flow::uniform(64, 48, [offsets[c - 1] - offsets[c], 0.0]);
         let e = m.backward[c].mean_endpoint_error(&want, 8).unwrap();
         assert!(e < 0.3, "frame {c}: EPE {e}");
     }
-    let e0 = m.backward[0]
-        .mean_endpoint_error(&Flow::uniform(64, 48, [-2.0, 0.0]), 8)
-        .unwrap();
+    let e0 = m.backward[0].mean_endpoint_error(&Flow::uniform(64, 48, [-2.0, 0.0]), 8).unwrap();
     assert!(e0 < 0.3, "frame 0 (negated forward flow): EPE {e0}");
     // Forward motion: right for frames 0..=4, left for 5..=9.
     for (c, a) in m.tendency.iter().enumerate() {
         let want = if c < 5 { 0.0 } else { PI };
-        assert!(
-            angle_between(a.expect("moving"), want) < 0.3,
-            "frame {c}: {a:?}"
-        );
+        assert!(angle_between(a.expect("moving"), want) < 0.3, "frame {c}: {a:?}");
     }
     assert_eq!(m.lms, vec![true; 10]);
     assert!(m.seconds > 0.0);
@@ -509,10 +402,7 @@ fn analyse_clip_handles_short_clips() {
     assert_eq!(m.backward, vec![Flow::zeros(8, 6)]);
     assert_eq!((m.tendency, m.lms), (vec![None], vec![false]));
     // Mixed sizes: resampled, flows on each frame's own grid, no panic.
-    let (a, b) = (
-        GrayImage::from_pixel(8, 6, image::Luma([50])),
-        GrayImage::from_pixel(5, 4, image::Luma([80])),
-    );
+    let (a, b) = (GrayImage::from_pixel(8, 6, image::Luma([50])), GrayImage::from_pixel(5, 4, image::Luma([80])));
     let m = analyse_clip(&[a.clone(), b, a], &FlowParams::default());
     let sizes: Vec<(usize, usize)> = m.backward.iter().map(|f| (f.width, f.height)).collect();
     assert_eq!(sizes, vec![(8, 6), (5, 4), (8, 6)]);

@@ -75,7 +75,11 @@ impl<'a> Ctx<'a> {
         let dists: Vec<f32> = s2
             .iter()
             .map(|c| {
-                let content = if self.p.content_weight > 0.0 && edge_scale > 0.0 { self.p.content_weight * c.edge / edge_scale } else { 0.0 };
+                let content = if self.p.content_weight > 0.0 && edge_scale > 0.0 {
+                    self.p.content_weight * c.edge / edge_scale
+                } else {
+                    0.0
+                };
                 c.motion / scale + content
             })
             .collect();
@@ -131,8 +135,9 @@ impl<'a> Ctx<'a> {
         if !s1.iter().any(|&k| self.motion.is_lms(k)) {
             return (CdState::NoLmsCandidate, Vec::new());
         }
-        let keeps =
-            |k: usize| self.motion.is_lms(k) && self.motion.tendency_of(k).is_some_and(|tk| angle_between(tc, tk) <= self.p.xi);
+        let keeps = |k: usize| {
+            self.motion.is_lms(k) && self.motion.tendency_of(k).is_some_and(|tk| angle_between(tc, tk) <= self.p.xi)
+        };
         (CdState::Active { tendency: tc, xi: self.p.xi }, s1.iter().copied().filter(|&k| !keeps(k)).collect())
     }
 
@@ -163,7 +168,8 @@ impl<'a> Ctx<'a> {
     /// Motion distances `from → k` for every `k` of `ks`, asking the [`MotionDistance`] (in one
     /// batch) only for the pairs not seen before.
     fn motion_distances(&self, from: usize, ks: &[usize]) -> Vec<f32> {
-        let missing: Vec<usize> = ks.iter().copied().filter(|&k| !self.memo.borrow().contains_key(&(from, k))).collect();
+        let missing: Vec<usize> =
+            ks.iter().copied().filter(|&k| !self.memo.borrow().contains_key(&(from, k))).collect();
         if !missing.is_empty() {
             let got = self.md.distances(from, &missing);
             let mut memo = self.memo.borrow_mut();
@@ -198,8 +204,10 @@ pub fn softmax(distances: &[f32], temperature: f32) -> Vec<f32> {
     if !best.is_finite() {
         return vec![1.0 / distances.len().max(1) as f32; distances.len()];
     }
-    let w: Vec<f64> =
-        distances.iter().map(|&d| if d.is_finite() { (-((d - best) / temperature) as f64).exp() } else { 0.0 }).collect();
+    let w: Vec<f64> = distances
+        .iter()
+        .map(|&d| if d.is_finite() { (-((d - best) / temperature) as f64).exp() } else { 0.0 })
+        .collect();
     let total: f64 = w.iter().sum();
     w.iter().map(|x| (x / total) as f32).collect()
 }

@@ -89,7 +89,9 @@ fn ct_words(t: &Transition) -> String {
     match t.omega {
         Omega::Off if t.s1.is_empty() => "nothing to check".into(),
         Omega::Off => "off".into(),
-        Omega::Mean(w) => format!("keeps motion ≤ ω = {w:.4} (mean over S1); removed {}", none_if_empty_frames(&t.removed_ct)),
+        Omega::Mean(w) => {
+            format!("keeps motion ≤ ω = {w:.4} (mean over S1); removed {}", none_if_empty_frames(&t.removed_ct))
+        }
         Omega::Rotated(w) => {
             format!(
                 "keeps motion ≤ ω = {w:.4} (FC against its ±90° rotations, n1 < 2); removed {}",

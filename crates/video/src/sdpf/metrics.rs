@@ -18,12 +18,16 @@ pub fn stability_md(frames: &[RgbImage], order: &[usize]) -> f64 {
 /// [`stability_md`], with an error naming the frame out of range or the frames whose sizes differ.
 pub fn try_stability_md(frames: &[RgbImage], order: &[usize]) -> Result<f64, VideoError> {
     if let Some(&bad) = order.iter().find(|&&i| i >= frames.len()) {
-        return Err(VideoError::Invalid(format!("M_D: frame {bad} is out of range (the clip has {} frames)", frames.len())));
+        return Err(VideoError::Invalid(format!(
+            "M_D: frame {bad} is out of range (the clip has {} frames)",
+            frames.len()
+        )));
     }
     if order.len() < 2 {
         return Ok(0.0);
     }
-    let diffs = order.windows(2).map(|w| frame_rms(&frames[w[0]], &frames[w[1]], w[0], w[1])).collect::<Result<Vec<_>, _>>()?;
+    let diffs =
+        order.windows(2).map(|w| frame_rms(&frames[w[0]], &frames[w[1]], w[0], w[1])).collect::<Result<Vec<_>, _>>()?;
     Ok(diffs.iter().sum::<f64>() / diffs.len() as f64)
 }
 

@@ -57,11 +57,11 @@ pub use distill::{eta, softmax};
 pub use explain::explain;
 pub use metrics::{frame_rms, overlap, overlap_delta_o, source_md, stability_md, try_stability_md, Overlap};
 pub use search::{sdpf, several};
-pub use sspf::sspf;
 pub use ssim::{ssim, ssim_planes, transition_ssims, Plane, SSIM_SIDE};
+pub use sspf::sspf;
 pub use types::{
-    Candidate, CdState, MatrixMotion, MotionDistance, MotionInfo, NoMotion, Omega, Path, SdpfParams, SdpfPath, StopReason,
-    Transition,
+    Candidate, CdState, MatrixMotion, MotionDistance, MotionInfo, NoMotion, Omega, Path, SdpfParams, SdpfPath,
+    StopReason, Transition,
 };
 
 #[cfg(test)]

@@ -40,7 +40,11 @@ impl Plane {
     /// `data` must hold `width · height` values.
     pub fn new(width: usize, height: usize, data: Vec<f64>) -> Result<Plane, VideoError> {
         if data.len() != width * height {
-            return Err(VideoError::Invalid(format!("SSIM: a {width}x{height} plane needs {} values, got {}", width * height, data.len())));
+            return Err(VideoError::Invalid(format!(
+                "SSIM: a {width}x{height} plane needs {} values, got {}",
+                width * height,
+                data.len()
+            )));
         }
         Ok(Plane { width, height, data })
     }
@@ -96,7 +100,10 @@ fn filter_valid(data: &[f64], w: usize, h: usize, k: &[f64]) -> Vec<f64> {
 /// Mean SSIM of two planes of the same size, in [−1, 1] (1 for identical planes).
 pub fn ssim(a: &Plane, b: &Plane) -> Result<f64, VideoError> {
     if (a.width, a.height) != (b.width, b.height) {
-        return Err(VideoError::Invalid(format!("SSIM: a {}x{} plane against a {}x{} one", a.width, a.height, b.width, b.height)));
+        return Err(VideoError::Invalid(format!(
+            "SSIM: a {}x{} plane against a {}x{} one",
+            a.width, a.height, b.width, b.height
+        )));
     }
     if a.width == 0 || a.height == 0 {
         return Err(VideoError::Invalid("SSIM: empty planes".into()));
@@ -121,7 +128,10 @@ pub fn ssim(a: &Plane, b: &Plane) -> Result<f64, VideoError> {
 /// SSIM of every transition `order[i] → order[i + 1]`, frames given as planes.
 pub fn transition_ssims(planes: &[Plane], order: &[usize]) -> Result<Vec<f64>, VideoError> {
     if let Some(&bad) = order.iter().find(|&&i| i >= planes.len()) {
-        return Err(VideoError::Invalid(format!("SSIM: frame {bad} is out of range (the clip has {} frames)", planes.len())));
+        return Err(VideoError::Invalid(format!(
+            "SSIM: frame {bad} is out of range (the clip has {} frames)",
+            planes.len()
+        )));
     }
     order.windows(2).map(|p| ssim(&planes[p[0]], &planes[p[1]])).collect()
 }
@@ -133,7 +143,9 @@ mod tests {
 
     /// A smooth texture with structure at several scales, in [0.2, 0.8].
     fn texture(w: usize, h: usize) -> Plane {
-        Plane::from_fn(w, h, |x, y| 0.5 + 0.2 * (x as f64 / 3.0).sin() * (y as f64 / 4.0).cos() + 0.1 * ((x + 2 * y) as f64 / 7.0).sin())
+        Plane::from_fn(w, h, |x, y| {
+            0.5 + 0.2 * (x as f64 / 3.0).sin() * (y as f64 / 4.0).cos() + 0.1 * ((x + 2 * y) as f64 / 7.0).sin()
+        })
     }
 
     /// 3×3 box blur with clamped edges.

@@ -217,7 +217,10 @@ fn walks_never_revisit_and_only_take_s2_frames() {
 #[test]
 fn the_seed_alone_decides_the_path() {
     let g = line_graph(20);
-    let run = |seed| sdpf(&g, &MotionInfo::none(), &NoMotion, 10, &SdpfParams { seed, ..SdpfParams::default() }.paper_choice()).unwrap();
+    let run = |seed| {
+        sdpf(&g, &MotionInfo::none(), &NoMotion, 10, &SdpfParams { seed, ..SdpfParams::default() }.paper_choice())
+            .unwrap()
+    };
     assert_eq!(run(3), run(3));
     let mut distinct: Vec<Vec<usize>> = (0..8).map(|s| run(s).frames).collect();
     distinct.sort();
@@ -253,11 +256,13 @@ fn a_target_length_is_met_or_the_longest_attempt_kept() {
     let g = line_graph(12);
     for seed in 0..6 {
         let p =
-            sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(6), seed, ..SdpfParams::default() }).unwrap();
+            sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(6), seed, ..SdpfParams::default() })
+                .unwrap();
         assert_eq!((p.len(), p.stop), (6, StopReason::TargetLength));
         assert_eq!(p.transitions.len(), 5);
     }
-    let one = sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(1), ..SdpfParams::default() }).unwrap();
+    let one =
+        sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(1), ..SdpfParams::default() }).unwrap();
     assert_eq!((one.frames.clone(), one.transitions.len()), (vec![5], 0));
     // Unreachable target: every attempt runs and the longest walk comes back.
     let p = SdpfParams { length: Some(50), attempts: 5, ..SdpfParams::default() };
@@ -279,8 +284,14 @@ fn a_target_length_is_met_or_the_longest_attempt_kept() {
 fn loop_closure_ends_on_a_frame_that_steps_back_to_the_start() {
     let g = line_graph(16);
     for seed in 0..4 {
-        let p =
-            sdpf(&g, &MotionInfo::none(), &NoMotion, 8, &SdpfParams { loop_close: true, seed, ..SdpfParams::default() }).unwrap();
+        let p = sdpf(
+            &g,
+            &MotionInfo::none(),
+            &NoMotion,
+            8,
+            &SdpfParams { loop_close: true, seed, ..SdpfParams::default() },
+        )
+        .unwrap();
         assert!(p.closes_loop && p.len() >= 3, "{:?}", p.frames);
         assert_eq!(p.stop, StopReason::LoopClosed);
         let closing = p.closing.as_ref().unwrap();
@@ -289,9 +300,14 @@ fn loop_closure_ends_on_a_frame_that_steps_back_to_the_start() {
         assert_eq!(p.transitions.len(), p.len() - 1);
     }
     // With a target length: a loop of exactly that many frames.
-    let p =
-        sdpf(&g, &MotionInfo::none(), &NoMotion, 8, &SdpfParams { loop_close: true, length: Some(6), ..SdpfParams::default() })
-            .unwrap();
+    let p = sdpf(
+        &g,
+        &MotionInfo::none(),
+        &NoMotion,
+        8,
+        &SdpfParams { loop_close: true, length: Some(6), ..SdpfParams::default() },
+    )
+    .unwrap();
     assert_eq!((p.len(), p.closes_loop), (6, true));
 }
 
@@ -299,7 +315,8 @@ fn loop_closure_ends_on_a_frame_that_steps_back_to_the_start() {
 fn loop_closure_reports_failure_on_a_chain() {
     // 0 – 1 – 2 – 3: only neighbours are under η = 5.5, so no prefix of ≥ 3 frames can return to 0.
     let g = Graph::from_fn(4, |i, j| if i.abs_diff(j) == 1 { 1.0 } else { 10.0 });
-    let p = sdpf(&g, &MotionInfo::none(), &NoMotion, 0, &SdpfParams { loop_close: true, ..SdpfParams::default() }).unwrap();
+    let p =
+        sdpf(&g, &MotionInfo::none(), &NoMotion, 0, &SdpfParams { loop_close: true, ..SdpfParams::default() }).unwrap();
     assert_eq!(p.frames, vec![0, 1, 2, 3]);
     assert!(!p.closes_loop && p.closing.is_none());
     assert_eq!(p.stop, StopReason::AllVisited);
