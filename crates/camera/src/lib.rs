@@ -7,6 +7,9 @@
 //! [`infer::Rollout`], [`infer::GenerateJob`], the causal mode), exports ([`gltf`], [`preview`]) and
 //! the [`bench`](mod@bench).
 
+/// Toric space lives in core (the script engine frames two-shots in it too); re-exported here.
+pub use inbetween_core::toric;
+
 pub mod bench;
 pub mod dataset;
 pub mod demo;
@@ -15,7 +18,6 @@ pub mod gltf;
 pub mod infer;
 pub mod model;
 pub mod preview;
-pub mod toric;
 pub mod train;
 pub mod weights;
 

@@ -1,6 +1,6 @@
 //! Core types and math every inbetween engine speaks: skeletons, motion clips, rotations, forward
 //! kinematics, resampling and windowing, keyed curves, keyframe sets, interpolation, error metrics, length units,
-//! seeding ([`seed`]) and angle wrapping ([`angle`]).
+//! seeding ([`seed`]), angle wrapping ([`angle`]) and Toric space for two-subject camera framing ([`toric`]).
 
 pub mod angle;
 pub mod curve;
@@ -13,6 +13,7 @@ pub mod procedural;
 pub mod rotation;
 pub mod seed;
 pub mod skeleton;
+pub mod toric;
 pub mod units;
 
 pub use curve::{Animatable, Curve, Interpolation, Key, KeyCorrected, Samples, ScalarTrack, Track};
@@ -23,15 +24,5 @@ pub use motion::{Motion, Pose};
 pub use rotation::{Axis, EulerOrder};
 pub use skeleton::{Channel, Joint, Skeleton};
 
-/// Errors from building core types out of invalid values.
-#[derive(Debug, thiserror::Error, Clone, PartialEq)]
-pub enum CoreError {
-    #[error("invalid skeleton: {0}")]
-    InvalidSkeleton(String),
-    #[error("invalid motion: {0}")]
-    InvalidMotion(String),
-    #[error("invalid curve: {0}")]
-    InvalidCurve(String),
-    #[error("invalid keyframes: {0}")]
-    InvalidKeyframes(String),
-}
+mod error;
+pub use error::CoreError;

@@ -1,11 +1,11 @@
 //! Camera commands ("camera left", "camera front", ...) as shots over the animation, and the
 //! camera placed for a frame. With one character: relative to it and the room, looking at its
 //! chest. With two or more: a two-shot of the first two placed in the camera engine's Toric
-//! space ([`inbetween_camera::toric`]: both heads at fixed screen positions), on the side of the
+//! space ([`inbetween_core::toric`]: both heads at fixed screen positions), on the side of the
 //! pair the command names; "top" and "wide" keep the room-relative placement.
 
 use glam::{DVec2, DVec3};
-use inbetween_camera::toric::{to_pose, Lens, Toric};
+use inbetween_core::toric::{to_pose, Lens, Toric};
 use inbetween_core::fk::forward;
 
 use super::{Animation, CameraShot};
@@ -206,7 +206,7 @@ mod tests {
     use crate::animate::{CameraShot, CharacterTrack};
     use crate::motion::rig::{yaw, FPS};
     use crate::scene::{Room, Scene};
-    use inbetween_camera::toric::CameraPose;
+    use inbetween_core::toric::CameraPose;
     use inbetween_core::Motion;
 
     fn standing_at(rig: &Rig, x: f64, z: f64, heading: f64, frames: usize) -> Motion {

@@ -232,7 +232,7 @@ mod tests {
 
     proptest! {
         // A fixed seed: the same cases on every run (the project's tests are deterministic).
-        #![proptest_config(ProptestConfig { rng_seed: proptest::test_runner::RngSeed::Fixed(inbetween_core::seed::PROPTEST_SEED), ..ProptestConfig::default() })]
+        #![proptest_config(ProptestConfig { rng_seed: proptest::test_runner::RngSeed::Fixed(crate::seed::PROPTEST_SEED), ..ProptestConfig::default() })]
         #[test]
         fn toric_to_pose_to_toric_round_trips(
             (lens, toric) in lens().prop_flat_map(|l| (Just(l), toric_for(l))),
