@@ -78,7 +78,7 @@ impl Interval {
     /// although `3 · (1/3)` may round above 1), and it is clamped onto `end`. Fails on an unbounded
     /// interval or a rate that is not finite and positive.
     pub fn uniform_times(&self, rate: f64) -> Result<impl ExactSizeIterator<Item = f64> + Clone, CoreError> {
-        if !self.is_bounded() || !(rate.is_finite() && rate > 0.0) {
+        if !(self.is_bounded() && rate.is_finite() && rate > 0.0) {
             return Err(CoreError::InvalidCurve(format!(
                 "uniform times need a bounded interval and a positive rate (got [{}, {}] at {rate} per second)",
                 self.start, self.end
