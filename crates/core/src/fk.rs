@@ -21,25 +21,33 @@ impl GlobalPose {
 
 /// Global transforms of one pose: `R_j = R_parent · r_j`, `p_j = p_parent + R_parent · t_j`.
 pub fn forward(skeleton: &Skeleton, pose: &Pose) -> GlobalPose {
-    let n = skeleton.len();
-    let mut positions = Vec::with_capacity(n);
-    let mut rotations = Vec::with_capacity(n);
+    let mut out =
+        GlobalPose { positions: Vec::with_capacity(skeleton.len()), rotations: Vec::with_capacity(skeleton.len()) };
+    forward_into(skeleton, pose, &mut out);
+    out
+}
+
+/// [`forward`] into a global pose the caller owns (no allocation once it has the skeleton's size):
+/// the playback loop's second step after [`crate::clip::Clip::sample_into`].
+pub fn forward_into(skeleton: &Skeleton, pose: &Pose, out: &mut GlobalPose) {
+    out.positions.clear();
+    out.rotations.clear();
     for (j, joint) in skeleton.joints().iter().enumerate() {
         let local_r = pose.rotations[j];
         let local_t = pose.translations[j];
         match joint.parent {
             None => {
-                positions.push(local_t);
-                rotations.push(local_r);
+                out.positions.push(local_t);
+                out.rotations.push(local_r);
             }
             Some(p) => {
-                let pr: DQuat = rotations[p];
-                positions.push(positions[p] + pr * local_t);
-                rotations.push((pr * local_r).normalize());
+                let pr: DQuat = out.rotations[p];
+                let position = out.positions[p] + pr * local_t;
+                out.positions.push(position);
+                out.rotations.push((pr * local_r).normalize());
             }
         }
     }
-    GlobalPose { positions, rotations }
 }
 
 /// Global transforms of every frame of a clip, in parallel over frames.
@@ -83,5 +91,10 @@ mod tests {
         assert!((g.positions[1] - DVec3::new(0.0, 6.0, 0.0)).length() < 1e-12);
         let tip = g.end_site(&s, 1).unwrap();
         assert!((tip - DVec3::new(-1.0, 6.0, 0.0)).length() < 1e-12);
+        // Into a reused global pose: the same transforms.
+        let mut reused = forward(&s, &m.pose(0));
+        reused.positions[1] = DVec3::ZERO;
+        forward_into(&s, &m.pose(0), &mut reused);
+        assert_eq!(reused, g);
     }
 }

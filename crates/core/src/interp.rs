@@ -1,5 +1,5 @@
-//! Interpolation primitives: linear, cubic Hermite (values + derivatives), quaternion slerp and
-//! quaternion Hermite (values + angular velocities).
+//! Interpolation primitives: linear, smoothstep, cubic Hermite (values + derivatives), quaternion
+//! slerp and quaternion Hermite (values + angular velocities).
 //!
 //! Parameters: `u ∈ [0, 1]` is the normalised time inside a segment of duration `h` seconds, and
 //! every derivative is per second, so segments of different lengths share one convention.
@@ -19,6 +19,15 @@ pub fn hermite_basis(u: f64) -> (f64, f64, f64, f64) {
 #[inline]
 pub fn lerp(a: f64, b: f64, u: f64) -> f64 {
     a + (b - a) * u
+}
+
+/// The smoothstep ease `3x² − 2x³` of `x` clamped to `[0, 1]`: 0 at 0, 1 at 1, zero slope at both
+/// ends (the Hermite cubic from 0 to 1 with zero tangents, `h01` of [`hermite_basis`]). The weight
+/// of cross-fades ([`crate::curve::CrossFade`]), blinks and expression onsets.
+#[inline]
+pub fn smoothstep(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
 }
 
 /// The cubic with value `p0`, slope `v0` at the start and `p1`, `v1` at the end of a segment `h` long.
@@ -78,6 +87,22 @@ pub fn hermite_quat(q0: DQuat, w0: DVec3, q1: DQuat, w1: DVec3, h: f64, u: f64) 
 mod tests {
     use super::*;
     use crate::rotation::angle_between;
+
+    #[test]
+    fn smoothstep_eases_from_zero_to_one_with_flat_ends() {
+        assert_eq!(smoothstep(-1.0), 0.0);
+        assert_eq!(smoothstep(0.0), 0.0);
+        assert_eq!(smoothstep(0.5), 0.5);
+        assert_eq!(smoothstep(1.0), 1.0);
+        assert_eq!(smoothstep(7.0), 1.0);
+        // It is the Hermite cubic from 0 to 1 with zero slopes.
+        for i in 0..=10 {
+            let u = i as f64 / 10.0;
+            assert!((smoothstep(u) - hermite(0.0, 0.0, 1.0, 0.0, 1.0, u)).abs() < 1e-15);
+        }
+        let e = 1e-7;
+        assert!(smoothstep(e) < 1e-12 && 1.0 - smoothstep(1.0 - e) < 1e-12, "flat at both ends");
+    }
 
     #[test]
     fn hermite_matches_ends_and_slopes() {

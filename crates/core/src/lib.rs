@@ -1,8 +1,11 @@
-//! Core types and math every inbetween engine speaks: skeletons, motion clips, rotations, forward
-//! kinematics, resampling and windowing, keyed curves, keyframe sets, interpolation, error metrics, length units,
-//! seeding ([`seed`]), angle wrapping ([`angle`]) and Toric space for two-subject camera framing ([`toric`]).
+//! Core types and math every inbetween engine speaks: skeletons, BVH-form motion clips ([`Motion`]),
+//! runtime pose clips ([`clip::Clip`]), rotations, forward kinematics, resampling and windowing,
+//! curves with an [`Interval`] domain and their adapters ([`curve`]), keyframe sets, interpolation,
+//! error metrics, length units, seeding ([`seed`]), angle wrapping ([`angle`]) and Toric space for
+//! two-subject camera framing ([`toric`]).
 
 pub mod angle;
+pub mod clip;
 pub mod curve;
 pub mod fk;
 pub mod interp;
@@ -16,8 +19,9 @@ pub mod skeleton;
 pub mod toric;
 pub mod units;
 
-pub use curve::{Animatable, Curve, Interpolation, Key, KeyCorrected, Samples, ScalarTrack, Track};
-pub use fk::{forward, forward_clip, positions_clip, GlobalPose};
+pub use clip::{Clip, SamplingContext};
+pub use curve::{Animatable, Curve, Interpolation, Interval, Key, KeyCorrected, Samples, ScalarTrack, Track};
+pub use fk::{forward, forward_clip, forward_into, positions_clip, GlobalPose};
 pub use keyframes::KeyframeSet;
 pub use metrics::{position_error, rotation_error, ErrorStats};
 pub use motion::{Motion, Pose};
@@ -26,3 +30,8 @@ pub use skeleton::{Channel, Joint, Skeleton};
 
 mod error;
 pub use error::CoreError;
+
+/// The README's examples, compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

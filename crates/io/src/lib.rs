@@ -8,6 +8,7 @@
 pub mod asf;
 pub mod bvh;
 pub mod data;
+mod error;
 pub mod fsutil;
 pub mod gltf_buffer;
 mod lexer;
@@ -17,39 +18,12 @@ pub mod report;
 pub use asf::{parse_asf_amc, read_asf_amc};
 pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
 pub use data::shared_data_dir;
+pub use error::IoError;
 pub use fsutil::{write_atomic, write_atomic_with};
 pub use progress::Progress;
 
 use inbetween_core::Motion;
-use std::path::{Path, PathBuf};
-
-/// Everything that can go wrong reading or writing a motion file.
-#[derive(Debug, thiserror::Error)]
-pub enum IoError {
-    /// The operating system refused a read or write.
-    #[error("{}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    /// The text does not follow the format: `file:line: expected …, found …`.
-    #[error("{file}:{line}: expected {expected}, found {found}")]
-    Syntax { file: String, line: usize, expected: String, found: String },
-    /// The text parses but describes an invalid skeleton or motion.
-    #[error("{file}:{line}: {message}")]
-    Invalid { file: String, line: usize, message: String },
-    /// `load_motion` cannot tell the format from the file name.
-    #[error("{}: unknown motion format; expected a .bvh or .amc file", path.display())]
-    UnknownFormat { path: PathBuf },
-    /// An `.amc` file whose skeleton `.asf` is not beside it.
-    #[error("{}: no skeleton file found; expected one of {}", amc.display(), list_paths(tried))]
-    MissingAsf { amc: PathBuf, tried: Vec<PathBuf> },
-}
-
-fn list_paths(paths: &[PathBuf]) -> String {
-    paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
-}
+use std::path::Path;
 
 /// Reads a whole file as UTF-8 text; invalid UTF-8 is a syntax error at the line where it occurs.
 pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {

@@ -306,117 +306,6 @@ impl View {
     }
 }
 
-// ---- filled polygons ------------------------------------------------------------------------------
-
-/// Vertical samples per pixel row for polygon coverage (horizontal coverage is exact).
-const SUBROWS: usize = 4;
-
-/// Crossings of the horizontal line at `y` with the polygon's edges, sorted: consecutive pairs are the
-/// inside spans (even-odd rule).
-fn crossings(poly: &[(f32, f32)], y: f32, out: &mut Vec<f32>) {
-    out.clear();
-    let n = poly.len();
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if (a.1 <= y) != (b.1 <= y) {
-            let x = a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1);
-            if x.is_finite() {
-                out.push(x);
-            }
-        }
-    }
-    out.sort_by(f32::total_cmp);
-}
-
-/// Intersection of two sorted span lists (`[x0, x1, x2, x3, …]` = spans x0..x1, x2..x3, …).
-fn intersect_spans(a: &[f32], b: &[f32]) -> Vec<f32> {
-    let mut out = Vec::new();
-    let (mut i, mut j) = (0, 0);
-    while i + 1 < a.len() && j + 1 < b.len() {
-        let (lo, hi) = (a[i].max(b[j]), a[i + 1].min(b[j + 1]));
-        if lo < hi {
-            out.extend([lo, hi]);
-        }
-        if a[i + 1] < b[j + 1] {
-            i += 2;
-        } else {
-            j += 2;
-        }
-    }
-    out
-}
-
-/// Fills the intersection of `polys` (each by the even-odd rule) with `color` at opacity `alpha`,
-/// anti-aliased: exact coverage across each row, [`SUBROWS`] samples down it.
-fn fill(cv: &mut Canvas, polys: &[&[(f32, f32)]], color: [u8; 3], alpha: f32) {
-    if polys.is_empty() || polys.iter().any(|p| p.len() < 3) || alpha <= 0.0 {
-        return;
-    }
-    let (mut x0, mut y0, mut x1, mut y1) = (0.0f32, 0.0f32, cv.width() as f32, cv.height() as f32);
-    for p in polys {
-        let (lo_x, hi_x) = p.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), q| (l.min(q.0), h.max(q.0)));
-        let (lo_y, hi_y) = p.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), q| (l.min(q.1), h.max(q.1)));
-        (x0, y0, x1, y1) = (x0.max(lo_x), y0.max(lo_y), x1.min(hi_x), y1.min(hi_y));
-    }
-    if !(x0 < x1 && y0 < y1) {
-        return;
-    }
-    let (px0, px1) = (x0.floor() as i64, x1.ceil() as i64);
-    let width = (px1 - px0) as usize;
-    // Per row: coverage of the pixels a span edge cuts (`edge`), plus a difference array of the
-    // pixels spans cover fully (`inner`), so a span costs O(1) whatever its length.
-    let mut edge = vec![0.0f32; width + 1];
-    let mut inner = vec![0.0f32; width + 1];
-    let mut xs = Vec::new();
-    let share = 1.0 / SUBROWS as f32;
-    for py in y0.floor() as i64..y1.ceil() as i64 {
-        edge.iter_mut().for_each(|a| *a = 0.0);
-        inner.iter_mut().for_each(|a| *a = 0.0);
-        for k in 0..SUBROWS {
-            let sy = py as f32 + (k as f32 + 0.5) * share;
-            crossings(polys[0], sy, &mut xs);
-            let mut spans = xs.clone();
-            for p in &polys[1..] {
-                crossings(p, sy, &mut xs);
-                spans = intersect_spans(&spans, &xs);
-            }
-            for s in spans.chunks_exact(2) {
-                let (a, b) = (s[0].max(x0) - px0 as f32, s[1].min(x1) - px0 as f32);
-                if a >= b {
-                    continue;
-                }
-                let (ia, ib) = (a.floor() as usize, b.floor() as usize);
-                if ia == ib {
-                    edge[ia] += (b - a) * share;
-                } else {
-                    edge[ia] += (ia as f32 + 1.0 - a) * share;
-                    edge[ib] += (b - ib as f32) * share;
-                    inner[ia + 1] += share;
-                    inner[ib] -= share;
-                }
-            }
-        }
-        // Fully covered opaque pixels are written in runs; the rest are blended.
-        let (mut run, mut solid_from) = (0.0, None);
-        for i in 0..=width {
-            run += inner[i];
-            let a = (edge[i] + run).min(1.0) * alpha;
-            let solid = i < width && a >= 0.999;
-            match (solid, solid_from) {
-                (true, None) => solid_from = Some(i),
-                (false, Some(from)) => {
-                    cv.rect((px0 + from as i64) as f32, py as f32, (i - from) as f32, 1.0, color);
-                    solid_from = None;
-                }
-                _ => {}
-            }
-            if !solid && i < width && a > 1e-4 {
-                cv.blend(px0 + i as i64, py, color, a);
-            }
-        }
-    }
-}
-
 /// Strokes a polyline with round joins.
 fn polyline(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3], width: f32) {
     for w in pts.windows(2) {
@@ -500,7 +389,7 @@ fn draw_head(cv: &mut Canvas, v: &View, p: &FacePose) {
             v.outline(x, y)
         })
         .collect();
-    fill(cv, &[&outline], SKIN, 1.0);
+    cv.fill_polygons(&[&outline], SKIN, 1.0);
     let mut closed = outline.clone();
     closed.push(outline[0]);
     polyline(cv, &closed, OUTLINE, v.width(0.022));
@@ -508,7 +397,7 @@ fn draw_head(cv: &mut Canvas, v: &View, p: &FacePose) {
         for side in [-1.0f32, 1.0] {
             let r = 0.09 + 0.05 * p.cheek_puff;
             let blush = ellipse((side * 0.5, 0.32), (r, r * 0.8), 24, |x, y| v.at(x, y, DEPTH_EYE));
-            fill(cv, &[&blush], CHEEK, 0.45 * p.cheek_puff);
+            cv.fill_polygons(&[&blush], CHEEK, 0.45 * p.cheek_puff);
         }
     }
 }
@@ -545,12 +434,12 @@ fn draw_eye(cv: &mut Canvas, v: &View, p: &FacePose, side: f32) {
     let upper: Vec<(f32, f32)> = params(16).map(|u| map(u, upper_y(u))).collect();
     let lower: Vec<(f32, f32)> = params(16).map(|u| map(u, lower_y(u))).collect();
     let opening: Vec<(f32, f32)> = upper.iter().chain(lower.iter().rev()).copied().collect();
-    fill(cv, &[&opening], EYE_WHITE, 1.0);
+    cv.fill_polygons(&[&opening], EYE_WHITE, 1.0);
     let iris_c = (ex + gaze.0 * 0.08, ey - 0.004 + gaze.1 * 0.045);
     let iris = ellipse(iris_c, (IRIS_R, IRIS_R), 28, |x, y| v.at(x, y, DEPTH_EYE));
-    fill(cv, &[&iris, &opening], IRIS, 1.0);
+    cv.fill_polygons(&[&iris, &opening], IRIS, 1.0);
     let pupil = ellipse(iris_c, (PUPIL_R, PUPIL_R), 20, |x, y| v.at(x, y, DEPTH_EYE));
-    fill(cv, &[&pupil, &opening], PUPIL, 1.0);
+    cv.fill_polygons(&[&pupil, &opening], PUPIL, 1.0);
     polyline(cv, &lower, LOWER_LID, v.width(0.009));
     polyline(cv, &upper, LID, v.width(0.024));
 }
@@ -650,19 +539,19 @@ fn draw_mouth(cv: &mut Canvas, v: &View, p: &FacePose) {
         a.into_iter().chain(b.into_iter().rev()).collect()
     };
     let cavity = join(px(&m.upper_inner), px(&m.lower_inner));
-    fill(cv, &[&cavity], MOUTH_CAVITY, 1.0);
+    cv.fill_polygons(&[&cavity], MOUTH_CAVITY, 1.0);
     let upper_teeth = join(px(&offset(&m.upper_inner, -0.01)), px(&offset(&m.upper_inner, 0.032)));
-    fill(cv, &[&upper_teeth, &cavity], TEETH, 1.0);
+    cv.fill_polygons(&[&upper_teeth, &cavity], TEETH, 1.0);
     let lower_teeth = join(px(&offset(&m.lower_inner, -0.022)), px(&offset(&m.lower_inner, 0.01)));
-    fill(cv, &[&lower_teeth, &cavity], TEETH, 1.0);
-    fill(cv, &[&join(px(&m.upper_outer), px(&m.upper_inner))], LIP, 1.0);
-    fill(cv, &[&join(px(&m.lower_inner), px(&m.lower_outer))], LIP, 1.0);
+    cv.fill_polygons(&[&lower_teeth, &cavity], TEETH, 1.0);
+    cv.fill_polygons(&[&join(px(&m.upper_outer), px(&m.upper_inner))], LIP, 1.0);
+    cv.fill_polygons(&[&join(px(&m.lower_inner), px(&m.lower_outer))], LIP, 1.0);
     polyline(cv, &px(&m.upper_inner), LIP_LINE, v.width(0.012));
     if p.tongue_out > 0.02 {
         let t = p.tongue_out;
         let c = (m.lower_mid.0, m.lower_mid.1 + 0.01 + 0.06 * t);
         let tongue = ellipse(c, (0.085, 0.025 + 0.07 * t), 28, |x, y| v.at(x, y, DEPTH_MOUTH + 0.05));
-        fill(cv, &[&tongue], TONGUE, 1.0);
+        cv.fill_polygons(&[&tongue], TONGUE, 1.0);
         let mid = [v.at(c.0, c.1 - 0.01, DEPTH_MOUTH + 0.05), v.at(c.0, c.1 + 0.04 * t, DEPTH_MOUTH + 0.05)];
         polyline(cv, &mid, mix(TONGUE, LIP_LINE, 0.5), v.width(0.008));
     }
@@ -1001,12 +890,6 @@ mod tests {
         let mut small = Canvas::new(4, 4, BACKGROUND);
         draw_face(&mut small, (0.0, 0.0, 4.0, 4.0), &FacePose::default());
         assert_eq!(small.pixel(2, 2), BACKGROUND);
-    }
-
-    #[test]
-    fn span_intersection() {
-        assert_eq!(intersect_spans(&[0.0, 5.0, 7.0, 9.0], &[3.0, 8.0]), vec![3.0, 5.0, 7.0, 8.0]);
-        assert!(intersect_spans(&[0.0, 1.0], &[2.0, 3.0]).is_empty());
     }
 
     #[test]

@@ -8,35 +8,22 @@
 pub mod bench;
 pub mod canvas;
 pub mod curves;
+mod error;
 pub mod face;
+mod fill;
 mod gif_out;
 pub mod plot;
 pub mod stick;
 
 pub use canvas::{Camera3, Canvas};
 pub use curves::{render_edit_plot, write_edit_plot, EditCurve, EditPlot};
+pub use error::RenderError;
 pub use face::{draw_face, render_face_frames, render_face_panels, write_face_gif, FaceGifOptions, FacePose};
+pub use fill::{subdivide_triangle, UvTriangle};
 pub use stick::{render_motion_frame, render_motion_gif, render_motion_png, render_positions_gif, StickOptions};
 
 use image::RgbImage;
-use std::path::{Path, PathBuf};
-
-/// Errors from rendering or writing a preview.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    #[error("cannot write {path}: {source}")]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error("invalid render input: {0}")]
-    InvalidInput(String),
-    #[error("encoding failed: {0}")]
-    Encode(String),
-    #[error("plot '{title}': {message}")]
-    Plot { title: String, message: String },
-}
+use std::path::Path;
 
 /// Writes `bytes` to `path` atomically, naming the path in the error.
 pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), RenderError> {

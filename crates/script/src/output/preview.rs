@@ -23,36 +23,10 @@ const INK: [u8; 3] = [40, 40, 40];
 /// Polygons are clipped a little in front of the camera's near plane (cameras inside the room).
 const NEAR_CLIP: f64 = NEAR * 20.0;
 
-/// Fills a convex polygon given in pixels (either winding); pixel centres inside are painted.
-pub fn fill_convex(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3]) {
-    if pts.len() < 3 || pts.iter().any(|p| !(p.0.is_finite() && p.1.is_finite())) {
-        return;
-    }
-    let (mut x0, mut y0, mut x1, mut y1) = (f32::MAX, f32::MAX, f32::MIN, f32::MIN);
-    for p in pts {
-        x0 = x0.min(p.0);
-        y0 = y0.min(p.1);
-        x1 = x1.max(p.0);
-        y1 = y1.max(p.1);
-    }
-    let (w, h) = (cv.width() as f32, cv.height() as f32);
-    let (x0, y0) = (x0.max(0.0).floor() as i64, y0.max(0.0).floor() as i64);
-    let (x1, y1) = (x1.min(w).ceil() as i64, y1.min(h).ceil() as i64);
-    let n = pts.len();
-    let area: f32 = (0..n).map(|i| pts[i].0 * pts[(i + 1) % n].1 - pts[(i + 1) % n].0 * pts[i].1).sum();
-    let sign = if area >= 0.0 { 1.0 } else { -1.0 };
-    for py in y0..y1 {
-        for px in x0..x1 {
-            let (qx, qy) = (px as f32 + 0.5, py as f32 + 0.5);
-            let inside = (0..n).all(|i| {
-                let (a, b) = (pts[i], pts[(i + 1) % n]);
-                sign * ((b.0 - a.0) * (qy - a.1) - (b.1 - a.1) * (qx - a.0)) >= 0.0
-            });
-            if inside {
-                cv.blend(px, py, color, 1.0);
-            }
-        }
-    }
+/// [`Canvas::fill_convex`] as a free function, for `skinned.rs` until it calls the canvas (and
+/// [`Canvas::fill_textured_triangle`]) itself; drawing lives in `inbetween_render`.
+pub(crate) fn fill_convex(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3]) {
+    cv.fill_convex(pts, color);
 }
 
 pub(crate) fn scale_color(c: [u8; 3], k: f32) -> [u8; 3] {
@@ -107,7 +81,7 @@ pub(crate) fn draw_object(cv: &mut Canvas, cam: &Camera3, o: &PlacedObject, colo
         }
         let Some(pts) = project_polygon(cam, &f) else { continue };
         let shade = 0.55 + 0.45 * nn.dot(light).max(0.0) as f32;
-        fill_convex(cv, &pts, scale_color(color, shade));
+        cv.fill_convex(&pts, scale_color(color, shade));
         for k in 0..pts.len() {
             cv.line(pts[k], pts[(k + 1) % pts.len()], scale_color(color, 0.45), 1.0);
         }
@@ -120,7 +94,7 @@ pub(crate) fn draw_room(cv: &mut Canvas, cam: &Camera3, scene: &Scene) {
     let (w, d, h) = (r.width as f64, r.depth as f64, r.height as f64);
     let floor = [DVec3::ZERO, DVec3::new(w, 0.0, 0.0), DVec3::new(w, 0.0, d), DVec3::new(0.0, 0.0, d)];
     if let Some(f) = project_polygon(cam, &floor) {
-        fill_convex(cv, &f, FLOOR);
+        cv.fill_convex(&f, FLOOR);
     }
     let seg = |cv: &mut Canvas, a: DVec3, b: DVec3, color: [u8; 3], width: f32| {
         if let Some((p, q)) = cam.project_segment(a, b) {
@@ -208,7 +182,7 @@ pub fn top_down(scene: &Scene, cat: &Catalogue) -> RgbImage {
     for o in &objs {
         let color = category_color(cat, &o.category);
         let pts: Vec<(f32, f32)> = geom::corners(o).iter().map(|&c| px(c)).collect();
-        fill_convex(&mut cv, &pts, color);
+        cv.fill_convex(&pts, color);
         for k in 0..4 {
             cv.line(pts[k], pts[(k + 1) % 4], scale_color(color, 0.55), 1.5);
         }
