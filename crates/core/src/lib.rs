@@ -1,8 +1,9 @@
 //! Core types and math every inbetween engine speaks: skeletons, motion clips, rotations, forward
 //! kinematics, resampling and windowing, keyed curves, keyframe sets, interpolation, error metrics, length units,
-//! seeding ([`seed`]), angle wrapping ([`angle`]) and Toric space for two-subject camera framing ([`toric`]).
+//! seeding ([`seed`]), cooperative cancellation and time limits ([`cancel`]), angle wrapping ([`angle`]) and Toric space for two-subject camera framing ([`toric`]).
 
 pub mod angle;
+pub mod cancel;
 pub mod curve;
 pub mod fk;
 pub mod interp;
