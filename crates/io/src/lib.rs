@@ -1,4 +1,5 @@
-//! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), locating
+//! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), whole-or-none
+//! output sets ([`OutputSet`]), locating
 //! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]) and the
 //! bench/report harness ([`report`]: tables, reports, timings).
 //!
@@ -11,6 +12,7 @@ pub mod data;
 pub mod fsutil;
 pub mod gltf_buffer;
 mod lexer;
+pub mod output_set;
 pub mod progress;
 pub mod report;
 
@@ -18,6 +20,7 @@ pub use asf::{parse_asf_amc, read_asf_amc};
 pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
 pub use data::shared_data_dir;
 pub use fsutil::{write_atomic, write_atomic_with};
+pub use output_set::OutputSet;
 pub use progress::Progress;
 
 use inbetween_core::Motion;
