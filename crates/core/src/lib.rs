@@ -1,10 +1,11 @@
 //! Core types and math every inbetween engine speaks: skeletons, BVH-form motion clips ([`Motion`]),
 //! runtime pose clips ([`clip::Clip`]), rotations, forward kinematics, resampling and windowing,
 //! curves with an [`Interval`] domain and their adapters ([`curve`]), keyframe sets, interpolation,
-//! error metrics, length units, seeding ([`seed`]), angle wrapping ([`angle`]) and Toric space for
-//! two-subject camera framing ([`toric`]).
+//! error metrics, length units, seeding ([`seed`]), cooperative cancellation and time limits
+//! ([`cancel`]), angle wrapping ([`angle`]) and Toric space for two-subject camera framing ([`toric`]).
 
 pub mod angle;
+pub mod cancel;
 pub mod clip;
 pub mod curve;
 pub mod fk;

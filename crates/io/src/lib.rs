@@ -1,4 +1,5 @@
-//! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), locating
+//! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), whole-or-none
+//! output sets ([`OutputSet`]), locating
 //! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]) and the
 //! bench/report harness ([`report`]: tables, reports, timings).
 //!
@@ -12,6 +13,7 @@ mod error;
 pub mod fsutil;
 pub mod gltf_buffer;
 mod lexer;
+pub mod output_set;
 pub mod progress;
 pub mod report;
 
@@ -20,6 +22,7 @@ pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
 pub use data::shared_data_dir;
 pub use error::IoError;
 pub use fsutil::{write_atomic, write_atomic_with};
+pub use output_set::OutputSet;
 pub use progress::Progress;
 
 use inbetween_core::Motion;
