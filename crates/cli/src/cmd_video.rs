@@ -4,11 +4,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
-use inbetween_io::Progress;
+use inbetween_core::cancel::Cancel;
+use inbetween_io::{OutputSet, Progress};
 use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, Decoder, ProceduralKind, ReadOptions};
-use inbetween_video::pipeline::{analyse, reorder, resequence, MetricChoice, ResequenceConfig};
+use inbetween_video::pipeline::{analyse, reorder, resequence, MetricChoice, ResequenceConfig, VideoLimits};
 use inbetween_video::preview::{write_contact_sheet, SheetOptions};
-use inbetween_video::sdpf::{explain, overlap_delta_o, stability_md, SdpfParams};
+use inbetween_video::sdpf::{backward_steps, direction_words, explain, overlap_delta_o, stability_md, SdpfParams};
+use inbetween_video::VideoError;
 
 #[derive(Subcommand)]
 pub enum VideoCommand {
@@ -30,6 +32,9 @@ pub struct BenchArgs {
     /// Folder of the real clips (default: ../shared/data/video or $INBETWEEN_DATA/video).
     #[arg(long)]
     pub clips: Option<PathBuf>,
+    /// Start frames per clip (from frame 0, evenly spread; default 4, or 2 with --quick).
+    #[arg(long)]
+    pub starts: Option<usize>,
     #[arg(short, long, default_value = "out/video-bench")]
     pub out: PathBuf,
 }
@@ -59,14 +64,41 @@ pub struct ResequenceArgs {
     /// Start frame (0-based source index).
     #[arg(long, default_value_t = 0)]
     pub start: usize,
-    /// Target length in frames (default: until no candidate is left).
+    /// Target length in frames, at least 1 (default: the source's frame count; with --stop-early,
+    /// until no candidate is left).
     #[arg(long)]
     pub length: Option<usize>,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Distinct sequences to write.
+    /// Distinct sequences to write (at least 1).
     #[arg(long, default_value_t = 1)]
     pub count: usize,
+    /// The paper's early stop: end where no candidate is left, instead of cutting to the shot that
+    /// best matches or looping back.
+    #[arg(long)]
+    pub stop_early: bool,
+    /// Let steps that play the motion backwards through in shots judged undirected (water, fire,
+    /// flicker); shots judged directed keep them out. --explain says how each shot was judged.
+    #[arg(long)]
+    pub allow_reverse: bool,
+    /// Drop the reverse distillation C_r (ablation: steps back to the previous frames allowed).
+    #[arg(long)]
+    pub no_cr: bool,
+    /// Give up after this many seconds (decoding excepted), writing nothing.
+    #[arg(long)]
+    pub time_limit: Option<f64>,
+    /// Refuse clips of more frames than this (checked while decoding).
+    #[arg(long, default_value_t = VideoLimits::default().max_frames)]
+    pub limit_frames: usize,
+    /// Refuse frames larger than this, WIDTHxHEIGHT (compared as a pixel count).
+    #[arg(long, default_value = "3840x2160", value_parser = parse_resolution)]
+    pub limit_resolution: u64,
+    /// Refuse target lengths above this many frames.
+    #[arg(long, default_value_t = VideoLimits::default().max_length)]
+    pub limit_length: usize,
+    /// Refuse --count above this.
+    #[arg(long, default_value_t = VideoLimits::default().max_count)]
+    pub limit_count: usize,
     /// End on a frame that can transition back to the start (a loop).
     #[arg(long = "loop")]
     pub loop_close: bool,
@@ -109,6 +141,8 @@ pub enum KindArg {
     Pendulum,
     Walker,
     Slider,
+    /// A block moving right at constant speed over the whole clip.
+    Drift,
     Mixed,
 }
 
@@ -143,11 +177,42 @@ pub fn run(c: VideoCommand) -> anyhow::Result<()> {
     }
 }
 
+/// `1280x720` → 921 600 pixels.
+fn parse_resolution(s: &str) -> Result<u64, String> {
+    let (w, h) =
+        s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT such as 3840x2160, got {s:?}"))?;
+    let w: u64 = w.trim().parse().map_err(|_| format!("width {w:?} is not a whole number (in {s:?})"))?;
+    let h: u64 = h.trim().parse().map_err(|_| format!("height {h:?} is not a whole number (in {s:?})"))?;
+    if w == 0 || h == 0 {
+        return Err(format!("a resolution limit of {s} allows no frame"));
+    }
+    Ok(w * h)
+}
+
+/// The command-line flag that raises each limit of [`VideoLimits`].
+fn limit_flag(field: &str) -> &'static str {
+    match field {
+        "max_frames" => "--limit-frames",
+        "max_pixels" => "--limit-resolution",
+        "max_length" => "--limit-length",
+        _ => "--limit-count",
+    }
+}
+
+/// A library error, with the flag that raises the limit when it is one.
+fn with_flag(e: VideoError) -> anyhow::Error {
+    match &e {
+        VideoError::Limit { field, .. } => anyhow::anyhow!("{e}; raise it with {}", limit_flag(field)),
+        _ => e.into(),
+    }
+}
+
 fn kind(k: KindArg) -> ProceduralKind {
     match k {
         KindArg::Pendulum => ProceduralKind::Pendulum,
         KindArg::Walker => ProceduralKind::Walker,
         KindArg::Slider => ProceduralKind::Slider,
+        KindArg::Drift => ProceduralKind::Drift,
         KindArg::Mixed => ProceduralKind::Mixed,
     }
 }
@@ -189,13 +254,23 @@ fn sheet_path(out: &Path) -> PathBuf {
     out.with_extension("sheet.png")
 }
 
-fn read_input(a: &ResequenceArgs) -> anyhow::Result<Clip> {
+fn read_input(a: &ResequenceArgs, limits: &VideoLimits) -> anyhow::Result<Clip> {
     let decoder = match a.decoder {
         DecoderArg::Auto => Decoder::Auto,
         DecoderArg::Openh264 => Decoder::OpenH264,
         DecoderArg::Ffmpeg => Decoder::Ffmpeg,
     };
-    let (clip, report) = read_clip(&a.input, &ReadOptions { decoder, max_frames: a.max_frames })?;
+    // One frame past the limit is enough to know the clip is too long: decoding stops there.
+    let past_limit = limits.max_frames.saturating_add(1);
+    let max_frames = Some(a.max_frames.map_or(past_limit, |m| m.min(past_limit)));
+    let (clip, report) = read_clip(&a.input, &ReadOptions { decoder, max_frames })?;
+    if clip.len() > limits.max_frames {
+        anyhow::bail!(
+            "{}: more than {} frames, the limit; raise it with --limit-frames, or read only the first frames with --max-frames",
+            a.input.display(),
+            limits.max_frames
+        );
+    }
     println!(
         "{}: {} frames {}x{} at {:.3} fps, decoded by {}",
         a.input.display(),
@@ -214,7 +289,23 @@ fn read_input(a: &ResequenceArgs) -> anyhow::Result<Clip> {
 fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
     let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     anyhow::ensure!(ext == "mp4" || ext == "gif", "{}: the output must end in .mp4 or .gif", a.out.display());
-    let clip = read_input(&a)?;
+    if a.length == Some(0) {
+        anyhow::bail!(
+            "--length 0 asks for no frame: give at least 1 (the start frame), or leave it out for the source's length"
+        );
+    }
+    if a.count == 0 {
+        anyhow::bail!("--count 0 asks for no sequence: give at least 1");
+    }
+    let limits = VideoLimits {
+        max_frames: a.limit_frames,
+        max_pixels: a.limit_resolution,
+        max_length: a.limit_length,
+        max_count: a.limit_count,
+    };
+    // What the request alone decides, before decoding anything.
+    limits.check_request(a.length, 0, a.count).map_err(with_flag)?;
+    let clip = read_input(&a, &limits)?;
     anyhow::ensure!(
         a.start < clip.len(),
         "--start {} is outside the clip (frames 0..{})",
@@ -226,6 +317,8 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
             MetricArg::Rsfnet => MetricChoice::RsfNet,
             MetricArg::Pixels => MetricChoice::Pixels,
         },
+        limits: limits.clone(),
+        cancel: Cancel::with_optional_limit_s(a.time_limit).map_err(|e| anyhow::anyhow!("--time-limit: {e}"))?,
         ..ResequenceConfig::default()
     };
     if let Some(s) = a.steps {
@@ -235,12 +328,15 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         cfg.cache_dir = d.clone();
     }
     let progress = Progress::new(cfg.train.steps as u64, "RSFNet");
-    let analysis = analyse(&clip, &cfg, &progress)?;
+    let analysis = analyse(&clip, &cfg, &progress).map_err(with_flag)?;
     progress.finish();
     println!("{}", analysis.metric_note);
     let params = SdpfParams {
         use_cd: !a.no_cd,
         use_ct: !a.no_ct,
+        use_cr: !a.no_cr,
+        allow_reverse: a.allow_reverse,
+        stop_early: a.stop_early,
         length: a.length,
         loop_close: a.loop_close,
         allow_cuts: a.allow_cuts,
@@ -248,18 +344,32 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         ..SdpfParams::default()
     };
     let params = if a.paper_choice { params.paper_choice() } else { params };
-    let (paths, walk_s) = resequence(&analysis, a.start, &params, a.count)?;
+    let (paths, walk_s) = resequence(&analysis, a.start, &params, a.count, &limits).map_err(with_flag)?;
+    if a.explain {
+        print!("{}", direction_words(&analysis.info, &analysis.direction, params.allow_reverse, params.use_cr));
+    }
     let source: Vec<usize> = (0..clip.len()).collect();
     let md_source = stability_md(&clip.frames, &source);
+    // Every clip and sheet of the run, or none: staged, then moved into place together.
+    let mut set = OutputSet::new();
     for (i, path) in paths.iter().enumerate() {
         let out = numbered(&a.out, i, a.count);
-        write_clip(&out, &reorder(&clip, &path.frames)).with_context(|| format!("writing {}", out.display()))?;
+        let staged = set.file(&out).with_context(|| format!("staging {}", out.display()))?;
+        write_clip(&staged, &reorder(&clip, &path.frames)).with_context(|| format!("writing {}", out.display()))?;
         let sheet = a.sheet.as_ref().map(|s| numbered(s, i, a.count)).unwrap_or_else(|| sheet_path(&out));
-        let title =
-            format!("{} from frame {} (seed {}): {} frames", a.input.display(), a.start, path.seed, path.frames.len());
-        write_contact_sheet(&sheet, &clip.frames, &path.frames, &SheetOptions { title, ..SheetOptions::default() })?;
+        let staged_sheet = set.file(&sheet).with_context(|| format!("staging {}", sheet.display()))?;
+        let title = format!(
+            "{} from frame {} (seed {}): {} frames (red BACK: backward step, blue CUT, purple LOOP)",
+            a.input.display(),
+            a.start,
+            path.seed,
+            path.frames.len()
+        );
+        let (cuts, loops) = (path.cut_positions(), path.loop_positions());
+        let opts = SheetOptions { title, cuts: cuts.clone(), loops: loops.clone(), ..SheetOptions::default() };
+        write_contact_sheet(&staged_sheet, &clip.frames, &path.frames, &opts)?;
         println!(
-            "{}: {} frames ({:?}{}), M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
+            "{}: {} frames ({:?}{}), {} backward steps, {} cuts, {} loop backs, M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
             out.display(),
             path.frames.len(),
             path.stop,
@@ -272,6 +382,9 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
             } else {
                 ""
             },
+            backward_steps(&path.frames, 3),
+            cuts.len(),
+            loops.len(),
             stability_md(&clip.frames, &path.frames),
             md_source,
             overlap_delta_o(&path.frames, clip.len()),
@@ -281,6 +394,7 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
             print!("{}", explain(path));
         }
     }
+    set.commit().with_context(|| format!("moving the outputs into place beside {}", a.out.display()))?;
     if paths.len() < a.count {
         println!("only {} distinct sequences exist from frame {} under these constraints", paths.len(), a.start);
     }
@@ -310,6 +424,11 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
             ),
         }
         VideoBenchConfig::full(dir.as_deref().filter(|d| d.exists()), cache.clone())
+    };
+    let cfg = match a.starts {
+        Some(0) => anyhow::bail!("--starts 0 runs nothing: give at least 1"),
+        Some(k) => VideoBenchConfig { starts: k, ..cfg },
+        None => cfg,
     };
     let t = std::time::Instant::now();
     let progress = Progress::new(1, "video bench");

@@ -67,6 +67,10 @@ fn synth_then_resequence_writes_clips_sheets_and_explains() {
     ];
     let text = ok(&inbetween(&args));
     assert!(text.contains("S1 (content, Eq. 8)"), "{text}");
+    assert!(text.contains("C_r (reverse, beyond the paper)"), "{text}");
+    assert!(text.contains("shot 0 (24 frames): motion judged"), "{text}");
+    // The default length is the source's: 24 frames.
+    assert!(text.contains("new-1.gif: 24 frames"), "{text}");
     assert!(text.contains("SDPF walks"), "{text}");
     for f in ["new-1.gif", "new-1.sheet.png"] {
         assert!(d.join(f).exists(), "{f} missing: {text}");
@@ -91,6 +95,32 @@ fn bad_inputs_name_the_problem() {
         &inbetween(&["video", "resequence", s(&clip), "--start", "99", "-o", s(&d.join("o.gif"))]),
         "--start 99",
     );
+    let o = d.join("o.gif");
+    fails_with(&inbetween(&["video", "resequence", s(&clip), "--length", "0", "-o", s(&o)]), "--length 0");
+    fails_with(&inbetween(&["video", "resequence", s(&clip), "--count", "0", "-o", s(&o)]), "--count 0");
+    fails_with(&inbetween(&["video", "resequence", s(&clip), "--limit-frames", "5", "-o", s(&o)]), "--limit-frames");
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--limit-resolution", "16x16", "-o", s(&o)]),
+        "raise it with --limit-resolution",
+    );
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--length", "50000", "-o", s(&o)]),
+        "raise it with --limit-length",
+    );
+    fails_with(&inbetween(&["video", "resequence", s(&clip), "--count", "99", "-o", s(&o)]), "--limit-count");
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--limit-resolution", "wide", "-o", s(&o)]),
+        "WIDTHxHEIGHT",
+    );
+    fails_with(&inbetween(&["video", "resequence", s(&clip), "--time-limit", "-1", "-o", s(&o)]), "--time-limit");
+    // A time limit too short for the work: a clear error and no output at all (no clip, no sheet).
+    let cache = d.join("cache-limit");
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--time-limit", "0.001", "--cache-dir", s(&cache), "-o", s(&o)]),
+        "time limit of 0.001 s reached",
+    );
+    assert!(!o.exists(), "no output for a refused request");
+    assert!(!d.join("o.sheet.png").exists());
     let junk = d.join("junk.gif");
     std::fs::write(&junk, b"GIF89a not really").unwrap();
     fails_with(&inbetween(&["video", "resequence", s(&junk), "-o", s(&d.join("o.gif"))]), "junk.gif");

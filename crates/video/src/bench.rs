@@ -1,6 +1,8 @@
 //! `inbetween video bench`: the paper's measures (§6.3: M_D of Eq. 21, Δ_o of Eq. 23) on procedural
-//! and real clips, the ablations of Table 3 (w/o C_t, w/o C_d, w/o RSFNet, w/o L_d), and the wall
-//! time of each stage of the pipeline.
+//! and real clips, with the length each run reached and its share of backward steps (steps to one
+//! of the three previous source frames), per clip and start; the ablations of Table 3 (w/o C_t,
+//! w/o C_d, w/o RSFNet, w/o L_d) plus ours (w/o C_r, the paper's walk with its early stop); contact
+//! sheets that mark cuts and backward steps; and the wall time of each stage of the pipeline.
 //!
 //! Beyond the paper, a perceptual proxy that needs no download: SSIM (Wang et al. 2004, see
 //! [`crate::sdpf::ssim`]) of every transition of the new orders against that of the source's own
@@ -14,8 +16,12 @@ use inbetween_io::Progress;
 
 use crate::frames::{procedural_clip, read_clip, Clip, ProceduralKind, ReadOptions};
 use crate::metric::{embeddings_cached, graph_from_embeddings, pixel_graph, RsfConfig, TrainOptions};
-use crate::pipeline::{analyse, resequence, Analysis, ResequenceConfig};
-use crate::sdpf::{overlap_delta_o, ssim_planes, stability_md, transition_ssims, SdpfParams, SSIM_SIDE};
+use crate::pipeline::{analyse, resequence, Analysis, ResequenceConfig, VideoLimits};
+use crate::preview::{contact_sheet, SheetOptions};
+use crate::sdpf::{
+    backward_steps, direction_flips, overlap_delta_o, ssim_planes, stability_md, transition_ssims, SdpfParams,
+    SSIM_SIDE,
+};
 use crate::VideoError;
 
 /// A clip of the bench.
@@ -29,10 +35,10 @@ pub enum BenchClip {
 #[derive(Clone, Debug)]
 pub struct VideoBenchConfig {
     pub clips: Vec<BenchClip>,
-    /// Start frames per clip (evenly spread).
+    /// Start frames per clip (evenly spread, the first at frame 0).
     pub starts: usize,
-    /// Target length of each new order.
-    pub length: usize,
+    /// Target length of each new order; `None`: the clip's frame count (the default of `resequence`).
+    pub length: Option<usize>,
     pub rsf: RsfConfig,
     pub train: TrainOptions,
     pub flow_side: u32,
@@ -46,7 +52,7 @@ impl VideoBenchConfig {
         VideoBenchConfig {
             clips: vec![BenchClip::Procedural { kind: ProceduralKind::Pendulum, frames: 24, width: 64, height: 48 }],
             starts: 2,
-            length: 10,
+            length: None,
             rsf: RsfConfig::tiny(),
             train: TrainOptions { steps: 10, ..TrainOptions::default() },
             flow_side: 48,
@@ -57,10 +63,12 @@ impl VideoBenchConfig {
 
     /// Procedural clips plus the real clips found in `video_dir` (`../shared/data/video`).
     pub fn full(video_dir: Option<&Path>, cache_dir: PathBuf) -> VideoBenchConfig {
-        let mut clips =
-            vec![BenchClip::Procedural { kind: ProceduralKind::Mixed, frames: 72, width: 320, height: 180 }];
+        let mut clips = vec![
+            BenchClip::Procedural { kind: ProceduralKind::Mixed, frames: 72, width: 320, height: 180 },
+            BenchClip::Procedural { kind: ProceduralKind::Drift, frames: 48, width: 320, height: 180 },
+        ];
         if let Some(dir) = video_dir {
-            for f in ["bigbuckbunny.mp4", "bbb_png_seq"] {
+            for f in ["bigbuckbunny.mp4", "bbb_png_seq", "carphone_pristine.mp4"] {
                 if dir.join(f).exists() {
                     clips.push(BenchClip::File(dir.join(f)));
                 }
@@ -69,7 +77,7 @@ impl VideoBenchConfig {
         VideoBenchConfig {
             clips,
             starts: 4,
-            length: 30,
+            length: None,
             rsf: RsfConfig::default(),
             train: TrainOptions::default(),
             flow_side: 160,
@@ -79,32 +87,53 @@ impl VideoBenchConfig {
     }
 }
 
-/// The configurations of Table 3, and the full method with Eq. 20 as printed (no content term,
-/// τ = 1 on latent units).
-/// The last two are the issue's baselines: the shortest-path walk of Fig. 3(a) on our graph, and
-/// the same walk on plain pixel distances.
-const CONFIGS: [&str; 8] = [
+/// The configurations: the full method, the ablations of Table 3, ours (w/o C_r, the paper's walk
+/// with its early stop), the full method with Eq. 20 as printed (no content term, τ = 1 on latent
+/// units), and the issue's baselines: the shortest-path walk of Fig. 3(a) on our graph and on plain
+/// pixel distances.
+const CONFIGS: [&str; 10] = [
     "full",
-    "w/o C_t",
+    "w/o C_r",
     "w/o C_d",
+    "w/o C_t",
     "w/o RSFNet",
     "w/o L_d",
+    "paper walk (no C_r, early stop)",
     "Eq. 20 as printed",
     "SSPF (shortest path)",
     "SSPF on pixel distance",
 ];
 /// The paper's Table 3 (M_D, Δ_o), same order, and its ground truth.
-const PAPER_TABLE3: [Option<(f64, f64)>; 8] = [
+const PAPER_TABLE3: [Option<(f64, f64)>; 10] = [
     Some((0.0648, 0.706)),
-    Some((0.118, 0.783)),
+    None,
     Some((0.079, 0.827)),
+    Some((0.118, 0.783)),
     Some((0.082, 0.731)),
     Some((0.281, 0.816)),
     None,
     None,
     None,
+    None,
 ];
+/// Backward steps: to one of this many previous source frames (the issue's i → i−1, i−2, i−3).
+const BACKWARD_WINDOW: usize = 3;
 const PAPER_GT_MD: f64 = 0.0535;
+
+/// One new order: where it started, how long it got, its steps backwards, cuts and loops.
+#[derive(Clone, Debug)]
+struct Run {
+    start: usize,
+    length: usize,
+    steps: usize,
+    backward: usize,
+    /// Steps between LMS frames whose tendencies differ by more than ξ (what C_d prevents).
+    flips: usize,
+    cuts: usize,
+    loops: usize,
+    md: f64,
+    delta_o: f64,
+}
 
 struct ClipResult {
     name: String,
@@ -117,6 +146,14 @@ struct ClipResult {
     md_source: f64,
     /// Per configuration: (mean M_D, mean Δ_o, mean length).
     configs: Vec<(f64, f64, f64)>,
+    /// Per configuration, per start: one run.
+    runs: Vec<Vec<Run>>,
+    /// The target length of every run.
+    target: usize,
+    /// Per shot: directed, share of LMS frames.
+    direction: Vec<(bool, f32)>,
+    /// Contact sheets (file name, PNG bytes) of the first start: full method and w/o C_r.
+    sheets: Vec<(String, Vec<u8>)>,
     /// SSIM of the source's adjacent pairs `f → f + 1`.
     ssim_source: Vec<f64>,
     /// Per configuration: SSIM of every transition of its new orders (all starts pooled).
@@ -189,19 +226,42 @@ fn ablated(
     Ok(a)
 }
 
-fn params_for(which: &str, length: usize, seed: u64) -> SdpfParams {
+fn params_for(which: &str, length: Option<usize>, seed: u64) -> SdpfParams {
+    let base = if which.starts_with("paper walk") { SdpfParams::paper_walk() } else { SdpfParams::default() };
     let p = SdpfParams {
         use_ct: which != "w/o C_t",
         use_cd: which != "w/o C_d",
-        length: Some(length),
+        use_cr: base.use_cr && which != "w/o C_r",
+        length,
         seed,
-        ..SdpfParams::default()
+        ..base
     };
     if which == "Eq. 20 as printed" {
         p.paper_choice()
     } else {
         p
     }
+}
+
+/// A contact sheet as PNG bytes, small thumbnails, cuts/loops/backward steps marked.
+fn sheet_png(
+    clip: &Clip,
+    order: &[usize],
+    cuts: Vec<usize>,
+    loops: Vec<usize>,
+    title: String,
+) -> Result<Vec<u8>, VideoError> {
+    let opts = SheetOptions { columns: 16, thumb_width: 72, title, cuts, loops, backward_window: BACKWARD_WINDOW };
+    let img = contact_sheet(&clip.frames, order, &opts)?;
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| VideoError::Invalid(format!("contact sheet PNG: {e}")))?;
+    Ok(bytes)
+}
+
+/// A file-name-safe version of a clip name.
+fn slug(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' }).collect()
 }
 
 fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> Result<ClipResult, VideoError> {
@@ -215,13 +275,11 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
     };
     let full = analyse(&clip, &rcfg, progress)?;
     let n = clip.len();
-    let starts: Vec<usize> = (0..cfg.starts.max(1))
-        .map(|i| (i * n) / cfg.starts.max(1) + n / (2 * cfg.starts.max(1)))
-        .map(|s| s.min(n - 1))
-        .collect();
+    let k = cfg.starts.max(1);
+    let starts: Vec<usize> = (0..k).map(|i| ((i * n) / k).min(n - 1)).collect();
+    let target = cfg.length.unwrap_or(n);
     let planes = ssim_planes(&clip.frames, SSIM_SIDE);
-    let mut configs = Vec::new();
-    let mut ssim_configs = Vec::new();
+    let (mut configs, mut ssim_configs, mut runs, mut sheets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut walk_s = 0.0;
     let mut walks = 0usize;
     for which in CONFIGS {
@@ -231,33 +289,50 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
             full.clone()
         };
         let shots: Vec<usize> = (0..n).map(|i| a.info.shot_of(i)).collect();
-        let (mut md, mut dq, mut len) = (0.0, 0.0, 0.0);
         let mut ssims = Vec::new();
+        let mut these = Vec::new();
         for (i, &s) in starts.iter().enumerate() {
-            let order = if which.starts_with("SSPF") {
-                crate::sdpf::sspf(&a.graph, s, cfg.length, Some(&shots))
+            let (order, cuts, loops) = if which.starts_with("SSPF") {
+                (crate::sdpf::sspf(&a.graph, s, target, Some(&shots)), Vec::new(), Vec::new())
             } else {
-                let (paths, secs) = resequence(
-                    &a,
-                    s,
-                    &params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64)),
-                    1,
-                )?;
+                let params = params_for(which, cfg.length, inbetween_core::seed::derive(cfg.seed, i as u64));
+                let (paths, secs) = resequence(&a, s, &params, 1, &VideoLimits::default())?;
                 if which == "full" {
                     walk_s += secs;
                     walks += 1;
                 }
-                paths[0].frames.clone()
+                let p = &paths[0];
+                (p.frames.clone(), p.cut_positions(), p.loop_positions())
             };
-            let order = &order;
-            md += stability_md(&clip.frames, order);
-            dq += overlap_delta_o(order, n);
-            len += order.len() as f64;
-            ssims.extend(transition_ssims(&planes, order)?);
+            if i == 0 && matches!(which, "full" | "w/o C_r") {
+                let title = format!(
+                    "{name}, {which}, from frame {s}: {} frames (red BACK: backward step, blue CUT, purple LOOP)",
+                    order.len()
+                );
+                let file = format!("sheet-{}-{}.png", slug(&name), if which == "full" { "full" } else { "no-cr" });
+                sheets.push((file, sheet_png(&clip, &order, cuts.clone(), loops.clone(), title)?));
+            }
+            these.push(Run {
+                start: s,
+                length: order.len(),
+                steps: order.len().saturating_sub(1),
+                backward: backward_steps(&order, BACKWARD_WINDOW),
+                flips: direction_flips(&order, &full.info, SdpfParams::default().xi),
+                cuts: cuts.len(),
+                loops: loops.len(),
+                md: stability_md(&clip.frames, &order),
+                delta_o: overlap_delta_o(&order, n),
+            });
+            ssims.extend(transition_ssims(&planes, &order)?);
         }
         ssim_configs.push(ssims);
-        let k = starts.len() as f64;
-        configs.push((md / k, dq / k, len / k));
+        let kf = these.len() as f64;
+        configs.push((
+            these.iter().map(|r| r.md).sum::<f64>() / kf,
+            these.iter().map(|r| r.delta_o).sum::<f64>() / kf,
+            these.iter().map(|r| r.length as f64).sum::<f64>() / kf,
+        ));
+        runs.push(these);
     }
     let source: Vec<usize> = (0..n).collect();
     let ssim_source = transition_ssims(&planes, &source)?;
@@ -272,6 +347,10 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
         metric_note,
         md_source: stability_md(&clip.frames, &source),
         configs,
+        runs,
+        target,
+        direction: full.direction.clone(),
+        sheets,
         ssim_source,
         ssim_configs,
     })
@@ -283,10 +362,88 @@ pub fn run(cfg: &VideoBenchConfig, progress: &Progress) -> Result<Report, VideoE
     let mut report = Report::new("video-bench", "Video engine benchmark (resequencing with SDPF, Le et al.)");
     report.table(table2(&results, cfg));
     report.table(table3(&results));
+    report.table(runs_table(&results));
     report.table(ssim_table(&results));
     report.table(stage_table(&results));
     report.file("ssim.png", ssim_png(&results)?);
+    for r in &results {
+        for (file, bytes) in &r.sheets {
+            report.file(file, bytes.clone());
+        }
+    }
     Ok(report)
+}
+
+/// Backward steps over all steps of `runs`, percent.
+fn backward_pct(runs: &[Run]) -> f64 {
+    let steps: usize = runs.iter().map(|r| r.steps).sum();
+    let back: usize = runs.iter().map(|r| r.backward).sum();
+    if steps == 0 {
+        0.0
+    } else {
+        100.0 * back as f64 / steps as f64
+    }
+}
+
+/// Direction flips (Eq. 12 broken) over all steps of `runs`, percent.
+fn flip_pct(runs: &[Run]) -> f64 {
+    let steps: usize = runs.iter().map(|r| r.steps).sum();
+    if steps == 0 {
+        0.0
+    } else {
+        100.0 * runs.iter().map(|r| r.flips).sum::<usize>() as f64 / steps as f64
+    }
+}
+
+/// Mean share of the target length the runs reached.
+fn reached(runs: &[Run], target: usize) -> f64 {
+    mean(&runs.iter().map(|r| r.length as f64 / target.max(1) as f64).collect::<Vec<_>>())
+}
+
+/// Every run: clip, start, method, length reached, backward steps, M_D ratio, Δo, cuts, loops.
+fn runs_table(results: &[ClipResult]) -> Table {
+    let mut t = Table::new(
+        "runs",
+        "Every run: per clip, start and method",
+        &[
+            "clip",
+            "start",
+            "method",
+            "length",
+            "target",
+            "backward_steps",
+            "backward_pct",
+            "flips",
+            "md_ratio",
+            "delta_o",
+            "cuts",
+            "loops",
+        ],
+    );
+    for r in results {
+        for (i, name) in CONFIGS.iter().enumerate() {
+            for run in &r.runs[i] {
+                t.row([
+                    r.name.clone(),
+                    run.start.to_string(),
+                    name.to_string(),
+                    run.length.to_string(),
+                    r.target.to_string(),
+                    run.backward.to_string(),
+                    num(backward_pct(std::slice::from_ref(run)), 1),
+                    run.flips.to_string(),
+                    num(run.md / r.md_source.max(1e-12), 2),
+                    num(run.delta_o, 3),
+                    run.cuts.to_string(),
+                    run.loops.to_string(),
+                ]);
+            }
+        }
+    }
+    t.note("backward step: a step to one of the 3 previous source frames (i -> i-1, i-2, i-3), which plays the source backwards; backward_pct = backward steps / steps");
+    t.note("flips: steps between two LMS frames whose motion tendencies differ by more than 60 degrees (what C_d, Eq. 12, prevents)");
+    t.note("length: frames reached; target: the clip's frame count (the default length); cuts: steps that cut to another shot where no candidate was left; loops: loop backs (then the loop repeats)");
+    t
 }
 
 fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
@@ -296,11 +453,16 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
         &[
             "clip",
             "frames",
+            "directed_shots",
+            "length_reached",
+            "backward_pct",
+            "backward_pct_no_cr",
             "md_source",
             "md_ours",
             "md_ratio",
             "delta_o",
-            "mean_length",
+            "cuts",
+            "loops",
             "ssim_source",
             "ssim_ours",
             "ssim_ratio",
@@ -308,16 +470,22 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
         ],
     );
     for r in results {
-        let (md, dq, len) = r.configs[0];
+        let (md, dq, _) = r.configs[0];
         let (ss, sr, sp) = r.ssim(0);
+        let directed = r.direction.iter().filter(|d| d.0).count();
         t.row([
             r.name.clone(),
             r.frames.to_string(),
+            format!("{directed}/{}", r.direction.len()),
+            num(reached(&r.runs[0], r.target), 2),
+            num(backward_pct(&r.runs[0]), 1),
+            num(backward_pct(&r.runs[1]), 1),
             num(r.md_source, 4),
             num(md, 4),
             num(md / r.md_source.max(1e-12), 2),
             num(dq, 3),
-            num(len, 1),
+            r.runs[0].iter().map(|x| x.cuts).sum::<usize>().to_string(),
+            r.runs[0].iter().map(|x| x.loops).sum::<usize>().to_string(),
             num(mean(&r.ssim_source), 3),
             num(ss, 3),
             num(sr, 3),
@@ -325,9 +493,11 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
         ]);
     }
     t.note(format!(
-        "{} start frames per clip, target length {}; M_D = mean RMS step of pixels in [0, 1]",
-        cfg.starts, cfg.length
+        "{} start frames per clip (from frame 0, evenly spread), target length {}; M_D = mean RMS step of pixels in [0, 1]",
+        cfg.starts,
+        cfg.length.map_or_else(|| "= the clip's frame count".to_string(), |l| l.to_string())
     ));
+    t.note("directed_shots: shots whose motion is judged directed (at least half LMS frames); length_reached: mean share of the target length; backward_pct: steps to one of the 3 previous source frames, over all steps of the 4 starts (full method; _no_cr: without C_r); cuts, loops: summed over the starts");
     t.note("paper (12 clips, their own): ground truth M_D 0.050, ours 0.055 (ratio 1.10), Δo 0.73; Morace et al. 0.069, Δo 0.74");
     t.note(SSIM_NOTE);
     t
@@ -341,6 +511,9 @@ fn table3(results: &[ClipResult]) -> Table {
         "Table 3 analogue: ablations, mean over clips",
         &[
             "method",
+            "length_reached",
+            "backward_pct",
+            "flip_pct",
             "md",
             "md_ratio",
             "delta_o",
@@ -358,6 +531,9 @@ fn table3(results: &[ClipResult]) -> Table {
     let gt_p10 = results.iter().map(|r| quantile(&r.ssim_source, 0.1)).sum::<f64>() / k;
     t.row([
         "ground truth".to_string(),
+        "1.00".into(),
+        "0.0".into(),
+        "-".into(),
         num(gt, 4),
         "1.00".into(),
         "1".into(),
@@ -368,7 +544,7 @@ fn table3(results: &[ClipResult]) -> Table {
         "1.00".into(),
         "1".into(),
     ]);
-    for (i, name) in CONFIGS.iter().enumerate().rev() {
+    for (i, name) in CONFIGS.iter().enumerate() {
         let md = results.iter().map(|r| r.configs[i].0).sum::<f64>() / k;
         let ratio = results.iter().map(|r| r.configs[i].0 / r.md_source.max(1e-12)).sum::<f64>() / k;
         let dq = results.iter().map(|r| r.configs[i].1).sum::<f64>() / k;
@@ -379,8 +555,14 @@ fn table3(results: &[ClipResult]) -> Table {
         let [pm, pr, pd] = paper;
         let ssim = |f: fn((f64, f64, f64)) -> f64| results.iter().map(|r| f(r.ssim(i))).sum::<f64>() / k;
         let (ss, sr, sp) = (ssim(|s| s.0), ssim(|s| s.1), ssim(|s| s.2));
+        let len = results.iter().map(|r| reached(&r.runs[i], r.target)).sum::<f64>() / k;
+        let back = results.iter().map(|r| backward_pct(&r.runs[i])).sum::<f64>() / k;
+        let flips = results.iter().map(|r| flip_pct(&r.runs[i])).sum::<f64>() / k;
         t.row([
             name.to_string(),
+            num(len, 2),
+            num(back, 1),
+            num(flips, 1),
             num(md, 4),
             num(ratio, 2),
             num(dq, 3),
@@ -393,6 +575,9 @@ fn table3(results: &[ClipResult]) -> Table {
         ]);
     }
     t.note("md_ratio: M_D of the new orders over the clip's own (lower is smoother); the paper's clips differ from ours, so compare ratios");
+    t.note("length_reached: mean share of the clip's frame count reached; backward_pct: mean over the clips of the share of steps to one of the 3 previous source frames");
+    t.note("flip_pct: mean over the clips of the share of steps between LMS frames whose tendencies differ by more than 60 degrees (Eq. 12 broken)");
+    t.note("w/o C_r: without our reverse distillation; paper walk: also without C_r, and the paper's early stop where S2 is empty (no cut, no loop back)");
     t.note("w/o RSFNet: Euclidean distance of 32-pixel thumbnails; w/o L_d: the same network untrained (our backbone is not pretrained)");
     t.note("Eq. 20 as printed: the full method choosing by exp(-motion distance) in latent units, without our content term and relative temperature");
     t.note("SSPF: the baseline of Fig. 3(a), always the nearest unvisited frame (RSFNet graph); SSPF on pixel distance: the same on 32-pixel thumbnails; the paper gives no numbers for them");
@@ -510,7 +695,7 @@ mod tests {
         ] {
             assert!(text.contains(needle), "{needle} missing:\n{text}");
         }
-        assert_eq!(report.tables().count(), 4);
+        assert_eq!(report.tables().count(), 5);
         let ssim = report.tables().find(|t| t.name == "ssim").unwrap().to_csv();
         // Header, the source's own pairs, then one row per configuration.
         assert_eq!(ssim.lines().count(), 2 + CONFIGS.len(), "{ssim}");

@@ -38,7 +38,7 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<VideoDemo, Vide
         ..ResequenceConfig::default()
     };
     let analysis = analyse(&clip, &cfg, progress)?;
-    let (paths, _) = resequence(&analysis, START, &SdpfParams { seed, ..SdpfParams::default() }, 1)?;
+    let (paths, _) = resequence(&analysis, START, &SdpfParams { seed, ..SdpfParams::default() }, 1, &cfg.limits)?;
     let order = paths[0].frames.clone();
     std::fs::create_dir_all(dir).map_err(|e| VideoError::io(dir, e))?;
     let source_gif = dir.join("video-demo-source.gif");
@@ -47,7 +47,15 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<VideoDemo, Vide
     write_clip(&gif, &reorder(&clip, &order))?;
     let sheet = dir.join("video-demo.sheet.png");
     let title = format!("procedural clip resequenced from frame {START} (seed {seed}): {} frames", order.len());
-    write_contact_sheet(&sheet, &clip.frames, &order, &SheetOptions { title, columns: 8, thumb_width: 120 })?;
+    let opts = SheetOptions {
+        title,
+        columns: 8,
+        thumb_width: 120,
+        cuts: paths[0].cut_positions(),
+        loops: paths[0].loop_positions(),
+        ..SheetOptions::default()
+    };
+    write_contact_sheet(&sheet, &clip.frames, &order, &opts)?;
     let source: Vec<usize> = (0..clip.len()).collect();
     let md = (stability_md(&clip.frames, &order), stability_md(&clip.frames, &source));
     let delta_o = overlap_delta_o(&order, clip.len());

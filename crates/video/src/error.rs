@@ -19,8 +19,16 @@ pub enum VideoError {
     /// Bad arguments or inconsistent inputs.
     #[error("{0}")]
     Invalid(String),
+    /// An input or request beyond one of the limits of
+    /// [`VideoLimits`](crate::pipeline::VideoLimits), refused before the heavy work. `field` names
+    /// the limit (a field of `VideoLimits`), so that a front end can name its own way to raise it.
+    #[error("{subject}: {value} {what} is more than the limit of {limit} (VideoLimits::{field})")]
+    Limit { subject: String, what: &'static str, value: u64, limit: u64, field: &'static str },
     #[error(transparent)]
     Nn(#[from] inbetween_nn::NnError),
+    /// The job's [`Cancel`](inbetween_core::cancel::Cancel) token was cancelled or its time limit passed.
+    #[error(transparent)]
+    Cancelled(#[from] inbetween_core::cancel::Cancelled),
 }
 
 impl VideoError {

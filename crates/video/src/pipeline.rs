@@ -6,13 +6,16 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use inbetween_core::cancel::Cancel;
 use inbetween_io::Progress;
 use rayon::prelude::*;
 
 use crate::frames::Clip;
-use crate::metric::{embeddings_cached, graph_from_embeddings, pixel_graph, Embedder, Graph, RsfConfig, TrainOptions};
+use crate::metric::{
+    embeddings_cached_with, graph_from_embeddings, pixel_graph, Embedder, Graph, RsfConfig, TrainOptions,
+};
 use crate::motion::{analyse_clip, pseudo_images, rotate_flow, ClipMotion, Flow, FlowParams, MU0};
-use crate::sdpf::{detect_shots, several, MotionDistance, MotionInfo, SdpfParams, SdpfPath};
+use crate::sdpf::{detect_shots, judge_directed, several_with, MotionDistance, MotionInfo, SdpfParams, SdpfPath};
 use crate::VideoError;
 
 /// Which frame metric builds the graph (Table 3's ablations).
@@ -37,6 +40,100 @@ pub struct ResequenceConfig {
     pub cache_dir: PathBuf,
     /// Detect scene cuts (off: the whole clip is one shot).
     pub detect_cuts: bool,
+    /// What a clip and a request may ask for, checked before the heavy work.
+    pub limits: VideoLimits,
+    /// Checked between the stages, before every RSFNet training step and before every step of a
+    /// walk; a time limit (`--time-limit`) is a token with a deadline. The [`Analysis`] keeps a
+    /// clone, so that the walks on it obey the same token.
+    pub cancel: Cancel,
+}
+
+/// The limits of a resequencing, checked before the heavy work (flows, training, walks) so that no
+/// input occupies the machine for long or fills its memory. Each error names the field it broke
+/// ([`VideoError::Limit`]).
+///
+/// Cost grows with them: flows and embeddings with frames × pixels (the flows run on frames
+/// downscaled to 160 px, but decoding and the cut detector see every pixel); the graph with
+/// frames²; a walk with its length × the candidates per step (about half the clip, each needing
+/// two network passes for C_t).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct VideoLimits {
+    /// Most frames a clip may have.
+    pub max_frames: usize,
+    /// Most pixels per frame (width × height).
+    pub max_pixels: u64,
+    /// Longest new order, frames.
+    pub max_length: usize,
+    /// Most distinct sequences asked for at once.
+    pub max_count: usize,
+}
+
+impl Default for VideoLimits {
+    /// 3 000 frames (2 minutes at 25 fps), 3840×2160 pixels (UHD), orders of 10 000 frames, 16
+    /// sequences per call.
+    fn default() -> Self {
+        VideoLimits { max_frames: 3000, max_pixels: 3840 * 2160, max_length: 10_000, max_count: 16 }
+    }
+}
+
+impl VideoLimits {
+    /// The clip's frame count and frame size.
+    pub fn check_clip(&self, clip: &Clip) -> Result<(), VideoError> {
+        let subject = clip.source.clone();
+        if clip.len() > self.max_frames {
+            return Err(VideoError::Limit {
+                subject,
+                what: "frames",
+                value: clip.len() as u64,
+                limit: self.max_frames as u64,
+                field: "max_frames",
+            });
+        }
+        let pixels = clip.frames.iter().map(|f| u64::from(f.width()) * u64::from(f.height())).max().unwrap_or(0);
+        if pixels > self.max_pixels {
+            return Err(VideoError::Limit {
+                subject: format!("{subject} ({}x{})", clip.width(), clip.height()),
+                what: "pixels per frame",
+                value: pixels,
+                limit: self.max_pixels,
+                field: "max_pixels",
+            });
+        }
+        Ok(())
+    }
+
+    /// A request: the target length (`None`: the source's `frames`) and the number of sequences.
+    /// Zero of either is refused: it asks for nothing.
+    pub fn check_request(&self, length: Option<usize>, frames: usize, count: usize) -> Result<(), VideoError> {
+        if length == Some(0) {
+            return Err(VideoError::Invalid(
+                "a length of 0 frames asks for nothing: give at least 1 (the start frame), or none for the source's length".into(),
+            ));
+        }
+        if count == 0 {
+            return Err(VideoError::Invalid("a count of 0 sequences asks for nothing: give at least 1".into()));
+        }
+        let length = length.unwrap_or(frames);
+        if length > self.max_length {
+            return Err(VideoError::Limit {
+                subject: "the requested length".into(),
+                what: "frames",
+                value: length as u64,
+                limit: self.max_length as u64,
+                field: "max_length",
+            });
+        }
+        if count > self.max_count {
+            return Err(VideoError::Limit {
+                subject: "the requested count".into(),
+                what: "sequences",
+                value: count as u64,
+                limit: self.max_count as u64,
+                field: "max_count",
+            });
+        }
+        Ok(())
+    }
 }
 
 impl Default for ResequenceConfig {
@@ -49,6 +146,8 @@ impl Default for ResequenceConfig {
             metric: MetricChoice::RsfNet,
             cache_dir: default_cache_dir(),
             detect_cuts: true,
+            limits: VideoLimits::default(),
+            cancel: Cancel::new(),
         }
     }
 }
@@ -70,14 +169,20 @@ pub struct Analysis {
     pub graph: Graph,
     /// The network that embeds frames and pseudo-images (trained, or untrained for "w/o L_d").
     pub embedder: Embedder,
+    /// Per shot: whether its motion is judged directed, and its share of LMS frames
+    /// ([`judge_directed`]).
+    pub direction: Vec<(bool, f32)>,
     /// (stage, seconds) in order.
     pub stages: Vec<(String, f64)>,
     /// What happened to the metric (trained, from cache, …).
     pub metric_note: String,
+    /// The token of the [`ResequenceConfig`] that made this analysis; [`resequence`] checks it.
+    pub cancel: Cancel,
 }
 
-/// Flows, metric, graph and shots of `clip`.
+/// Flows, metric, graph and shots of `clip`, after checking it against `cfg.limits`.
 pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Result<Analysis, VideoError> {
+    cfg.limits.check_clip(clip)?;
     if clip.len() < 2 {
         return Err(VideoError::Invalid(format!(
             "{}: a clip needs at least 2 frames to resequence, it has {}",
@@ -86,13 +191,16 @@ pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Resu
         )));
     }
     let mut stages = Vec::new();
+    let cancel = &cfg.cancel;
+    cancel.check()?;
     let t = Instant::now();
     let gray = clip.gray_downscaled(cfg.flow_side);
     let motion = analyse_clip(&gray, &cfg.flow);
+    cancel.check()?;
     stages.push(("optical flow, tendency, LMS (Eq. 9-11)".to_string(), t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
-    let metric = embeddings_cached(&cfg.cache_dir, &clip.frames, &cfg.rsf, &cfg.train, progress)?;
+    let metric = embeddings_cached_with(&cfg.cache_dir, &clip.frames, &cfg.rsf, &cfg.train, progress, cancel)?;
     let metric_note = if metric.from_cache {
         format!("RSFNet read from the cache {}", metric.path.display())
     } else if metric.summary.trained {
@@ -117,8 +225,20 @@ pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Resu
     };
     let shot = if cfg.detect_cuts { detect_shots(&clip.frames) } else { vec![0; clip.len()] };
     stages.push(("complete graph, scene cuts".to_string(), t.elapsed().as_secs_f64()));
-    let info = MotionInfo { tendency: motion.tendency.clone(), lms: motion.lms.clone(), shot };
-    Ok(Analysis { motion, info, graph, embedder: metric.embedder, stages, metric_note })
+    let direction = judge_directed(&motion.lms, &shot);
+    let directed = direction.iter().map(|d| d.0).collect();
+    let info = MotionInfo { tendency: motion.tendency.clone(), lms: motion.lms.clone(), shot, directed };
+    cancel.check()?;
+    Ok(Analysis {
+        motion,
+        info,
+        graph,
+        embedder: metric.embedder,
+        direction,
+        stages,
+        metric_note,
+        cancel: cancel.clone(),
+    })
 }
 
 /// PMSM (Eq. 13–15): the motion distance of c → k is the latent distance of their pseudo-images.
@@ -174,15 +294,18 @@ impl MotionDistance for Pmsm<'_> {
 }
 
 /// `count` distinct new orders from `start` (SDPF on the analysed clip), and the walk's wall time.
+/// The request is checked against `limits` first (a zero length or count is refused).
 pub fn resequence(
     analysis: &Analysis,
     start: usize,
     params: &SdpfParams,
     count: usize,
+    limits: &VideoLimits,
 ) -> Result<(Vec<SdpfPath>, f64), VideoError> {
+    limits.check_request(params.length, analysis.graph.n, count)?;
     let t = Instant::now();
     let pmsm = Pmsm { backward: &analysis.motion.backward, embedder: &analysis.embedder };
-    let paths = several(&analysis.graph, &analysis.info, &pmsm, start, params, count.max(1))?;
+    let paths = several_with(&analysis.graph, &analysis.info, &pmsm, start, params, count, &analysis.cancel)?;
     Ok((paths, t.elapsed().as_secs_f64()))
 }
 
@@ -200,6 +323,7 @@ mod tests {
     use super::*;
     use crate::frames::{procedural_clip, ProceduralKind};
     use crate::sdpf::{overlap_delta_o, stability_md};
+    use crate::VideoError;
 
     fn quick_config(dir: &std::path::Path) -> ResequenceConfig {
         ResequenceConfig {
@@ -220,7 +344,7 @@ mod tests {
         assert_eq!(a.graph.n, 24);
         assert_eq!(a.stages.len(), 3);
         let params = SdpfParams { seed: 5, ..SdpfParams::default() };
-        let (paths, _) = resequence(&a, 4, &params, 2).unwrap();
+        let (paths, _) = resequence(&a, 4, &params, 2, &VideoLimits::default()).unwrap();
         assert!(!paths.is_empty());
         let order = &paths[0].frames;
         assert_eq!(order[0], 4);
@@ -235,9 +359,112 @@ mod tests {
         // Second run: the metric comes from the cache and the same seed gives the same order.
         let b = analyse(&clip, &cfg, &Progress::hidden()).unwrap();
         assert!(b.metric_note.contains("cache"), "{}", b.metric_note);
-        assert_eq!(resequence(&b, 4, &params, 2).unwrap().0[0].frames, *order);
+        assert_eq!(resequence(&b, 4, &params, 2, &VideoLimits::default()).unwrap().0[0].frames, *order);
         let r = reorder(&clip, order);
         assert_eq!(r.frames[1], clip.frames[order[1]]);
+    }
+
+    /// Every step of `order` but loop backs, as (from, to).
+    fn steps_but_loops(path: &SdpfPath) -> Vec<(usize, usize)> {
+        let loops = path.loop_positions();
+        (1..path.len()).filter(|i| !loops.contains(i)).map(|i| (path.frames[i - 1], path.frames[i])).collect()
+    }
+
+    #[test]
+    fn a_block_moving_right_is_never_played_leftwards() {
+        // The block moves right at constant speed: frame k shows it left of frame c exactly when k < c.
+        let dir = tempfile::tempdir().unwrap();
+        let clip = procedural_clip(ProceduralKind::Drift, 24, 64, 48, 3);
+        let a = analyse(&clip, &quick_config(dir.path()), &Progress::hidden()).unwrap();
+        assert_eq!(a.direction.len(), 1);
+        assert!(a.direction[0].0, "a steady drift is directed motion: {:?}", a.direction);
+        let limits = VideoLimits::default();
+        let mut left_without_cr = 0;
+        for start in [0, 5, 11] {
+            for seed in 0..3 {
+                let p = SdpfParams { seed, ..SdpfParams::default() };
+                let path = &resequence(&a, start, &p, 1, &limits).unwrap().0[0];
+                assert_eq!(path.len(), 24, "the source's length: {:?}", path.frames);
+                for (c, k) in steps_but_loops(path) {
+                    assert!(k > c, "step {c} → {k} goes left: {:?}", path.frames);
+                }
+                assert_eq!(crate::sdpf::backward_steps(&path.frames, 3), 0);
+                let off = SdpfParams { use_cr: false, ..p };
+                let path = &resequence(&a, start, &off, 1, &limits).unwrap().0[0];
+                left_without_cr += steps_but_loops(path).iter().filter(|(c, k)| k < c).count();
+            }
+        }
+        assert!(left_without_cr > 0, "without C_r some steps go left (what the test guards against)");
+    }
+
+    #[test]
+    fn a_run_of_the_source_length_crosses_the_cut() {
+        // Two shots of the drifting block, on two different backgrounds: a hard cut at frame 12.
+        let dir = tempfile::tempdir().unwrap();
+        let (one, two) = (
+            procedural_clip(ProceduralKind::Drift, 12, 64, 48, 3),
+            procedural_clip(ProceduralKind::Drift, 12, 64, 48, 9),
+        );
+        let clip = Clip { frames: [one.frames, two.frames].concat(), fps: one.fps, source: "two shots".into() };
+        let a = analyse(&clip, &quick_config(dir.path()), &Progress::hidden()).unwrap();
+        assert_eq!(a.info.shot_of(11), 0);
+        assert_eq!(a.info.shot_of(12), 1, "the cut is detected");
+        for seed in 0..3 {
+            let path = &resequence(&a, 2, &SdpfParams { seed, ..SdpfParams::default() }, 1, &VideoLimits::default())
+                .unwrap()
+                .0[0];
+            assert_eq!(path.len(), 24, "{:?}", path.frames);
+            assert!(path.frames.iter().any(|&f| f >= 12), "never left the first shot: {:?}", path.frames);
+            let cuts = path.cut_positions();
+            assert!(!cuts.is_empty(), "{:?}", path.frames);
+            assert!(cuts.iter().all(|&c| a.info.shot_of(path.frames[c]) != a.info.shot_of(path.frames[c - 1])));
+        }
+        // The paper's early stop stays in the first shot.
+        let early = SdpfParams { stop_early: true, ..SdpfParams::default() };
+        let path = &resequence(&a, 2, &early, 1, &VideoLimits::default()).unwrap().0[0];
+        assert!(path.frames.iter().all(|&f| f < 12), "{:?}", path.frames);
+    }
+
+    #[test]
+    fn limits_are_checked_before_the_work_and_name_their_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let clip = procedural_clip(ProceduralKind::Drift, 12, 64, 48, 3);
+        let mut cfg = quick_config(dir.path());
+        cfg.limits.max_frames = 10;
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("too many frames");
+        assert!(matches!(e, VideoError::Limit { field: "max_frames", value: 12, limit: 10, .. }), "{e}");
+        assert!(e.to_string().contains("12 frames is more than the limit of 10"), "{e}");
+        cfg.limits = VideoLimits { max_pixels: 64 * 47, ..VideoLimits::default() };
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("too many pixels");
+        assert!(e.to_string().contains("64x48") && e.to_string().contains("max_pixels"), "{e}");
+        let l = VideoLimits { max_length: 100, max_count: 3, ..VideoLimits::default() };
+        assert!(l.check_request(Some(0), 12, 1).unwrap_err().to_string().contains("0 frames"));
+        assert!(l.check_request(None, 12, 0).unwrap_err().to_string().contains("0 sequences"));
+        assert!(l.check_request(Some(101), 12, 1).unwrap_err().to_string().contains("max_length"));
+        assert!(l.check_request(None, 101, 1).unwrap_err().to_string().contains("101 frames"));
+        assert!(l.check_request(None, 12, 4).unwrap_err().to_string().contains("max_count"));
+        assert!(l.check_request(Some(100), 12, 3).is_ok());
+    }
+
+    #[test]
+    fn a_cancelled_token_stops_the_analysis_and_the_walks() {
+        let dir = tempfile::tempdir().unwrap();
+        let clip = procedural_clip(ProceduralKind::Drift, 12, 64, 48, 3);
+        let mut cfg = quick_config(dir.path());
+        cfg.cancel = Cancel::new();
+        cfg.cancel.cancel();
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("cancelled");
+        assert!(matches!(e, VideoError::Cancelled(_)), "{e}");
+        // A deadline already past: the same, reported as the time limit.
+        cfg.cancel = Cancel::with_time_limit(std::time::Duration::ZERO);
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("time limit");
+        assert!(e.to_string().contains("time limit"), "{e}");
+        // Cancelled after the analysis: the walk stops before its first step.
+        cfg.cancel = Cancel::new();
+        let a = analyse(&clip, &cfg, &Progress::hidden()).unwrap();
+        cfg.cancel.cancel();
+        let e = resequence(&a, 0, &SdpfParams::default(), 1, &VideoLimits::default()).err().expect("cancelled walk");
+        assert!(matches!(e, VideoError::Cancelled(_)), "{e}");
     }
 
     #[test]

@@ -19,11 +19,26 @@ pub struct SheetOptions {
     pub thumb_width: u32,
     /// Title drawn above the grid.
     pub title: String,
+    /// Positions entered by a cut to another shot ([`SdpfPath::cut_positions`](crate::sdpf::SdpfPath::cut_positions)):
+    /// framed in blue, labelled "CUT".
+    pub cuts: Vec<usize>,
+    /// Positions entered by a loop back: framed in purple, labelled "LOOP".
+    pub loops: Vec<usize>,
+    /// Mark backward steps (to one of this many previous source frames, see
+    /// [`is_backward_step`](crate::sdpf::is_backward_step)) in red, labelled "BACK"; 0: none.
+    pub backward_window: usize,
 }
 
 impl Default for SheetOptions {
     fn default() -> Self {
-        SheetOptions { columns: 8, thumb_width: 160, title: String::new() }
+        SheetOptions {
+            columns: 8,
+            thumb_width: 160,
+            title: String::new(),
+            cuts: Vec::new(),
+            loops: Vec::new(),
+            backward_window: 3,
+        }
     }
 }
 
@@ -33,6 +48,12 @@ const INK: [u8; 3] = [30, 30, 30];
 const SOURCE_STEP: [u8; 3] = [120, 170, 120];
 /// A transition to a frame the source does not follow with: a new transition.
 const JUMP: [u8; 3] = [214, 96, 40];
+/// A cut to another shot.
+const CUT: [u8; 3] = [40, 90, 210];
+/// A loop back to an earlier frame of the path.
+const LOOP: [u8; 3] = [150, 60, 170];
+/// A step back to one of the previous source frames: motion played backwards.
+const BACKWARD: [u8; 3] = [220, 20, 30];
 const LABEL_SIZE: f32 = 13.0;
 const TITLE_SIZE: f32 = 16.0;
 
@@ -42,8 +63,9 @@ pub fn is_jump(order: &[usize], i: usize) -> bool {
 }
 
 /// The contact sheet of `order` (source frame indices into `frames`): row-major thumbnails, each
-/// labelled `position: source`, framed in orange where the order jumps and in green where it
-/// follows the source.
+/// labelled `position: source`, framed in green where the order follows the source, orange where
+/// it jumps, and, with a word in the label, red for a backward step ("BACK"), blue for a cut
+/// ("CUT") and purple for a loop back ("LOOP").
 pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) -> Result<RgbImage, VideoError> {
     if let Some(&bad) = order.iter().find(|&&f| f >= frames.len()) {
         return Err(VideoError::Invalid(format!("the order names frame {bad} of a {}-frame clip", frames.len())));
@@ -68,9 +90,22 @@ pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) 
         let x = pad + col * cell_w;
         let y = title_h + pad + row * cell_h;
         canvas.blit_scaled(&frames[src], i64::from(x), i64::from(y), tw, th);
-        let border = if is_jump(order, i) { JUMP } else { SOURCE_STEP };
+        let backward =
+            i > 0 && opts.backward_window > 0 && crate::sdpf::is_backward_step(order[i - 1], src, opts.backward_window);
+        let (border, word) = if opts.cuts.contains(&i) {
+            (CUT, " CUT")
+        } else if opts.loops.contains(&i) {
+            (LOOP, " LOOP")
+        } else if backward {
+            (BACKWARD, " BACK")
+        } else if is_jump(order, i) {
+            (JUMP, "")
+        } else {
+            (SOURCE_STEP, "")
+        };
+        let thick = if word.is_empty() { 2 } else { 3 };
         if i > 0 {
-            for inset in 0..2 {
+            for inset in 0..thick {
                 let k = inset as f32;
                 canvas.rect_outline(
                     x as f32 - 1.0 - k,
@@ -81,7 +116,7 @@ pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) 
                 );
             }
         }
-        let label = format!("{i}: frame {src}");
+        let label = format!("{i}: frame {src}{word}");
         let lx = x as f32 + (tw as f32 - text_width(&label, LABEL_SIZE)).max(0.0) / 2.0;
         canvas.text((lx, (y + th + 2) as f32), &label, LABEL_SIZE, INK);
     }
@@ -145,7 +180,7 @@ mod tests {
         assert!(!is_jump(&order, 0));
         assert!(!is_jump(&order, 1));
         assert!(is_jump(&order, 3));
-        let opts = SheetOptions { columns: 3, thumb_width: 64, title: "t".into() };
+        let opts = SheetOptions { columns: 3, thumb_width: 64, title: "t".into(), ..SheetOptions::default() };
         let img = contact_sheet(&frames, &order, &opts).unwrap();
         assert_eq!(img.width(), 6 + 3 * 70);
         // The thumbnail of position 4 (row 1, column 1) shows source frame 1.

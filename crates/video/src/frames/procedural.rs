@@ -26,6 +26,9 @@ pub enum ProceduralKind {
     Walker,
     /// A striped block at rest, then moving in a straight line at constant speed, then at rest.
     Slider,
+    /// The striped block moving to the right at constant speed over the whole clip: motion with a
+    /// known direction, so that a step to the left is a step backwards.
+    Drift,
     /// Pendulum plus a ball moving linearly over part of the clip, and a scene cut (another
     /// background) for the last ~15 % of frames.
     Mixed,
@@ -46,6 +49,7 @@ pub fn procedural_truth(kind: ProceduralKind, frames: usize) -> ProceduralTruth 
     match kind {
         ProceduralKind::Pendulum | ProceduralKind::Walker => ProceduralTruth { cut: None, linear: None },
         ProceduralKind::Slider => ProceduralTruth { cut: None, linear: Some(at(0.25)..at(0.75)) },
+        ProceduralKind::Drift => ProceduralTruth { cut: None, linear: Some(0..frames) },
         ProceduralKind::Mixed => {
             let cut = frames - at(0.15);
             ProceduralTruth { cut: (cut > 0 && cut < frames).then_some(cut), linear: Some(at(0.2)..at(0.6)) }
@@ -130,7 +134,7 @@ impl Scene {
         match self.kind {
             ProceduralKind::Pendulum => self.pendulum(&mut c, t),
             ProceduralKind::Walker => self.walker(&mut c, t),
-            ProceduralKind::Slider => self.slider(&mut c, t),
+            ProceduralKind::Slider | ProceduralKind::Drift => self.slider(&mut c, t),
             ProceduralKind::Mixed => {
                 self.pendulum(&mut c, t);
                 self.ball(&mut c, t);
@@ -231,7 +235,13 @@ mod tests {
 
     #[test]
     fn same_seed_same_pixels_other_seed_other_pixels() {
-        for kind in [ProceduralKind::Pendulum, ProceduralKind::Walker, ProceduralKind::Slider, ProceduralKind::Mixed] {
+        for kind in [
+            ProceduralKind::Pendulum,
+            ProceduralKind::Walker,
+            ProceduralKind::Slider,
+            ProceduralKind::Drift,
+            ProceduralKind::Mixed,
+        ] {
             let a = procedural_clip(kind, 6, 48, 32, 7);
             let b = procedural_clip(kind, 6, 48, 32, 7);
             let c = procedural_clip(kind, 6, 48, 32, 8);

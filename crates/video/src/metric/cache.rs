@@ -17,6 +17,7 @@
 use std::path::{Path, PathBuf};
 
 use image::RgbImage;
+use inbetween_core::cancel::Cancel;
 use inbetween_io::{write_atomic, Progress};
 use inbetween_nn::{backend, checkpoint};
 use serde::{Deserialize, Serialize};
@@ -24,7 +25,7 @@ use serde::{Deserialize, Serialize};
 use super::embed::Embedder;
 use super::input::Planes;
 use super::model::RsfConfig;
-use super::train::{clip_planes, train_on_planes, TrainOptions, TrainSummary};
+use super::train::{clip_planes, TrainOptions, TrainSummary};
 use crate::VideoError;
 
 const MAGIC: &[u8; 8] = b"INBRSF01";
@@ -110,6 +111,19 @@ pub fn embeddings_cached(
     opts: &TrainOptions,
     progress: &Progress,
 ) -> Result<ClipMetric, VideoError> {
+    embeddings_cached_with(cache_dir, frames, cfg, opts, progress, &Cancel::new())
+}
+
+/// [`embeddings_cached`] whose training stops with [`VideoError::Cancelled`] once `cancel` is
+/// cancelled (nothing is written to the cache then).
+pub fn embeddings_cached_with(
+    cache_dir: &Path,
+    frames: &[RgbImage],
+    cfg: &RsfConfig,
+    opts: &TrainOptions,
+    progress: &Progress,
+    cancel: &Cancel,
+) -> Result<ClipMetric, VideoError> {
     cfg.validate()?;
     opts.validate()?;
     let planes = clip_planes(frames, cfg.input_side);
@@ -134,8 +148,9 @@ pub fn embeddings_cached(
             Some(reason)
         }
     };
-    let (embedder, summary) = train_on_planes(&planes, cfg, opts, progress)?;
+    let (embedder, summary) = super::train::train_on_planes_with(&planes, cfg, opts, progress, cancel)?;
     let embeddings = embedder.embed_planes(&planes);
+    cancel.check()?;
     let write_error = write_entry(&path, key, cfg, opts, &summary, &embeddings, &embedder).err();
     if let Some(e) = &write_error {
         progress.println(format!("{}: could not write the RSFNet cache: {e}", path.display()));

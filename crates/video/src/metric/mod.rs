@@ -30,12 +30,15 @@ pub mod loss;
 pub mod model;
 pub mod train;
 
-pub use cache::{cache_key, cache_path, embeddings_cached, ClipMetric};
+pub use cache::{cache_key, cache_path, embeddings_cached, embeddings_cached_with, ClipMetric};
 pub use embed::Embedder;
 pub use graph::{graph_from_embeddings, pixel_graph, Graph};
 pub use loss::{distance_loss, distance_loss_value, triplet_label, triplet_labels, Triplet};
 pub use model::{RsfConfig, RsfNet};
-pub use train::{agreement, clip_planes, train_on_planes, train_rsfnet, TrainOptions, TrainSummary, TripletSampler};
+pub use train::{
+    agreement, clip_planes, train_on_planes, train_on_planes_with, train_rsfnet, TrainOptions, TrainSummary,
+    TripletSampler,
+};
 
 #[cfg(test)]
 mod tests;

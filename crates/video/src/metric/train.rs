@@ -33,6 +33,7 @@ use std::time::Instant;
 
 use burn::tensor::{Device, Tensor, TensorData};
 use image::RgbImage;
+use inbetween_core::cancel::Cancel;
 use inbetween_io::Progress;
 use inbetween_nn::backend;
 use inbetween_nn::train::{fit_with, Control, EpochEnd, Objective, Step, TrainConfig};
@@ -228,6 +229,8 @@ struct TripletObjective<'a> {
     val_history: Vec<f64>,
     /// Best validation agreement so far, its epoch and network.
     best: Option<(f64, usize, Embedder)>,
+    /// Once cancelled, the remaining steps are skipped and the epoch ends the loop.
+    cancel: &'a Cancel,
 }
 
 impl TripletObjective<'_> {
@@ -245,6 +248,9 @@ impl TripletObjective<'_> {
 
 impl Objective<RsfNet> for TripletObjective<'_> {
     fn loss(&mut self, model: &RsfNet, step: &Step) -> Option<Tensor<1>> {
+        if self.cancel.is_cancelled() {
+            return None;
+        }
         let mut rng = inbetween_core::seed::rng(step.seed);
         let triplets = self.sampler.draw_many(&mut rng, self.batch);
         (!triplets.is_empty()).then(|| self.batch_loss(model, &triplets))
@@ -258,6 +264,9 @@ impl Objective<RsfNet> for TripletObjective<'_> {
     }
 
     fn after_epoch(&mut self, model: &RsfNet, end: &EpochEnd) -> Control {
+        if self.cancel.is_cancelled() {
+            return Control::Stop;
+        }
         let embedder = Embedder::new(model.clone(), self.cfg.clone());
         let a = agreement(&embedder.embed_planes(self.sampler.planes), &self.val);
         self.val_history.push(a);
@@ -297,8 +306,21 @@ pub fn train_on_planes(
     opts: &TrainOptions,
     progress: &Progress,
 ) -> Result<(Embedder, TrainSummary), VideoError> {
+    train_on_planes_with(planes, cfg, opts, progress, &Cancel::new())
+}
+
+/// [`train_on_planes`] that stops with [`VideoError::Cancelled`] once `cancel` is cancelled
+/// (checked before every training step and after every epoch).
+pub fn train_on_planes_with(
+    planes: &[Planes],
+    cfg: &RsfConfig,
+    opts: &TrainOptions,
+    progress: &Progress,
+    cancel: &Cancel,
+) -> Result<(Embedder, TrainSummary), VideoError> {
     cfg.validate()?;
     opts.validate()?;
+    cancel.check()?;
     if planes.len() < 3 {
         return Err(VideoError::Invalid(format!("RSFNet training needs at least 3 frames, got {}", planes.len())));
     }
@@ -346,8 +368,10 @@ pub fn train_on_planes(
         patience: opts.patience,
         val_history: Vec::new(),
         best: None,
+        cancel,
     };
     let run = fit_with(&loop_config, &device, |d| cfg.init(d), &mut objective)?;
+    cancel.check()?;
     let last_epoch = run.loss_history.len().saturating_sub(1);
     let (best_epoch, embedder) = match objective.best.take() {
         Some((_, epoch, e)) => (epoch, e),

@@ -4,9 +4,10 @@
 use std::cell::RefCell;
 use std::collections::HashMap;
 
+use inbetween_core::cancel::Cancel;
 use rand::Rng;
 
-use super::types::{Candidate, CdState, MotionDistance, MotionInfo, Omega, SdpfParams, Transition};
+use super::types::{Candidate, CdState, CrState, MotionDistance, MotionInfo, Omega, SdpfParams, StepKind, Transition};
 use crate::metric::Graph;
 use crate::motion::angle_between;
 
@@ -42,36 +43,55 @@ pub(crate) struct Ctx<'a> {
     pub md: &'a dyn MotionDistance,
     pub p: &'a SdpfParams,
     pub eta: f32,
+    /// Checked before every step of a walk.
+    pub cancel: Cancel,
     memo: RefCell<HashMap<(usize, usize), f32>>,
     floors: RefCell<HashMap<usize, f32>>,
 }
 
 impl<'a> Ctx<'a> {
     pub fn new(graph: &'a Graph, motion: &'a MotionInfo, md: &'a dyn MotionDistance, p: &'a SdpfParams) -> Self {
-        Ctx { graph, motion, md, p, eta: eta(graph), memo: RefCell::default(), floors: RefCell::default() }
+        Ctx {
+            graph,
+            motion,
+            md,
+            p,
+            eta: eta(graph),
+            cancel: Cancel::new(),
+            memo: RefCell::default(),
+            floors: RefCell::default(),
+        }
     }
 
     /// Lines 7–21 of Algorithm 1 from frame `from`; `chosen` is left `None` for the caller's draw.
+    ///
+    /// Order of the layers: S1 (Eq. 8, minus other shots), then C_r (beyond the paper) and C_d
+    /// (Eq. 12), which need no motion distance, then C_t (Eq. 16–17) on what those two left. So
+    /// PMSM (two network passes per candidate) runs only for frames that can still be chosen, and
+    /// ω is their mean motion distance (the paper's Eq. 17 averages over all of S1). The candidates
+    /// C_r or C_d removed keep a NaN motion distance.
     pub fn step(&self, from: usize, visited: &[bool]) -> Transition {
         let (s1, removed_cut) = self.content(from, visited);
+        let (cr, removed_cr) = self.reverse(from, &s1);
         let (cd, removed_cd) = self.directional(from, &s1);
-        let motions = self.motion_distances(from, &s1);
+        let live: Vec<usize> =
+            s1.iter().copied().filter(|k| !removed_cr.contains(k) && !removed_cd.contains(k)).collect();
+        let live_motion = self.motion_distances(from, &live);
         let candidates: Vec<Candidate> = s1
             .iter()
-            .zip(&motions)
-            .map(|(&k, &m)| Candidate {
+            .map(|&k| Candidate {
                 frame: k,
                 edge: self.edge(from, k),
-                motion: m,
+                motion: live.iter().position(|&l| l == k).map_or(f32::NAN, |i| live_motion[i]),
                 tendency: self.motion.tendency_of(k),
                 lms: self.motion.is_lms(k),
             })
             .collect();
-        let (omega, removed_ct) = self.coherent(from, &candidates);
-        let s2: Vec<&Candidate> =
-            candidates.iter().filter(|c| !removed_cd.contains(&c.frame) && !removed_ct.contains(&c.frame)).collect();
-        let scale = self.softmax_scale(&candidates);
-        let edge_scale = finite_mean(candidates.iter().map(|c| c.edge));
+        let judged: Vec<Candidate> = candidates.iter().copied().filter(|c| live.contains(&c.frame)).collect();
+        let (omega, removed_ct) = self.coherent(from, &judged);
+        let s2: Vec<&Candidate> = judged.iter().filter(|c| !removed_ct.contains(&c.frame)).collect();
+        let scale = self.softmax_scale(&judged);
+        let edge_scale = finite_mean(judged.iter().map(|c| c.edge));
         let dists: Vec<f32> = s2
             .iter()
             .map(|c| {
@@ -84,7 +104,90 @@ impl<'a> Ctx<'a> {
             })
             .collect();
         let probs = s2.iter().map(|c| c.frame).zip(softmax(&dists, self.p.temperature)).collect();
-        Transition { from, chosen: None, s1, candidates, removed_cut, cd, removed_cd, omega, removed_ct, probs }
+        Transition {
+            from,
+            chosen: None,
+            s1,
+            candidates,
+            removed_cut,
+            cr,
+            removed_cr,
+            cd,
+            removed_cd,
+            omega,
+            removed_ct,
+            probs,
+            kind: StepKind::Distilled,
+        }
+    }
+
+    /// C_r (beyond the paper): the S1 frames a step to which plays the motion backwards. C_d
+    /// (Eq. 12) compares the tendency of frame k's *own* motion with T_c, so it cannot see the
+    /// direction of the step c → k: the source's previous frame c − 1 moves just like c and
+    /// passes, and its motion (C_t) and content distances are as small as those of c + 1. Measured
+    /// on `bigbuckbunny.mp4` from frame 100, Eq. 20 gave 99 and 101 probabilities 0.49 and 0.39,
+    /// and 53 of 69 steps went to one of the three previous frames (36 to c − 1). A step c → k plays backwards
+    /// when ([`Ctx::plays_backwards`]):
+    /// - it replays the source's previous frames: k = c − j with 1 ≤ j ≤ `reverse_window`; or
+    /// - k lies in c's shot and is closer in content (edge weight) to c's past, c − 1, than to
+    ///   its future, c + 1: whatever k shows, it shows what came before c.
+    ///
+    /// Skipped in shots judged undirected when `allow_reverse` is on.
+    fn reverse(&self, from: usize, s1: &[usize]) -> (CrState, Vec<usize>) {
+        if !self.p.use_cr {
+            return (CrState::Disabled, Vec::new());
+        }
+        if self.p.allow_reverse && !self.motion.directed_at(from) {
+            return (CrState::AllowedUndirected, Vec::new());
+        }
+        (CrState::Active, s1.iter().copied().filter(|&k| self.plays_backwards(from, k)).collect())
+    }
+
+    /// The test of [`Ctx::reverse`] for one step `c → k` (regardless of `use_cr`).
+    pub fn plays_backwards(&self, c: usize, k: usize) -> bool {
+        if k < c && c - k <= self.p.reverse_window {
+            return true;
+        }
+        let shot = self.motion.shot_of(c);
+        let n = self.graph.n;
+        let in_shot = |f: usize| self.motion.shot_of(f) == shot;
+        if !in_shot(k) || c == 0 || c + 1 >= n || !in_shot(c - 1) || !in_shot(c + 1) {
+            return false;
+        }
+        self.edge(k, c - 1) < self.edge(k, c + 1)
+    }
+
+    /// Whether C_r (as configured) forbids the step `c → k`.
+    pub fn forbids(&self, c: usize, k: usize) -> bool {
+        self.p.use_cr && !(self.p.allow_reverse && !self.motion.directed_at(c)) && self.plays_backwards(c, k)
+    }
+
+    /// S2 was empty: the cut an editor would make, to the unvisited frame of another shot closest
+    /// in content to `from` (C_r's replay test still applies); `None` when no other shot has
+    /// unvisited frames.
+    pub fn cut(&self, from: usize, visited: &[bool]) -> Option<(usize, f32)> {
+        let shot = self.motion.shot_of(from);
+        (0..self.graph.n)
+            .filter(|&k| !visited[k] && self.motion.shot_of(k) != shot && !self.forbids(from, k))
+            .map(|k| (k, self.edge(from, k)))
+            .filter(|(_, e)| !e.is_nan())
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// S2 was empty and no cut is left: the position in `path` to loop back to, the one whose
+    /// frame is closest in content to `from` among those C_r's replay test allows, leaving a loop
+    /// of at least [`MIN_LOOP`] frames.
+    pub fn loop_back(&self, path: &[usize]) -> Option<(usize, f32)> {
+        let from = *path.last()?;
+        let last = path.len().checked_sub(MIN_LOOP)?;
+        (0..=last)
+            .filter(|&j| {
+                let k = path[j];
+                k != from && !(self.p.use_cr && k < from && from - k <= self.p.reverse_window)
+            })
+            .map(|j| (j, self.edge(from, path[j])))
+            .filter(|(_, e)| !e.is_nan())
+            .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
     /// What the motion distances are divided by before Eq. 20: their mean over S1 with
@@ -102,7 +205,7 @@ impl<'a> Ctx<'a> {
     /// motion distance, so that hopeless loop closures cost nothing.
     pub fn passes_cheap_checks(&self, from: usize, to: usize, visited: &[bool]) -> bool {
         let (s1, _) = self.content(from, visited);
-        s1.contains(&to) && !self.directional(from, &s1).1.contains(&to)
+        s1.contains(&to) && !self.reverse(from, &s1).1.contains(&to) && !self.directional(from, &s1).1.contains(&to)
     }
 
     fn edge(&self, c: usize, k: usize) -> f32 {
@@ -185,6 +288,9 @@ impl<'a> Ctx<'a> {
         *self.floors.borrow_mut().entry(from).or_insert_with(|| self.md.rotated_floor(from))
     }
 }
+
+/// The shortest loop [`Ctx::loop_back`] makes, in frames (a shorter one flickers).
+pub const MIN_LOOP: usize = 4;
 
 /// Mean of the finite values (NaN when there is none).
 fn finite_mean(values: impl Iterator<Item = f32>) -> f32 {

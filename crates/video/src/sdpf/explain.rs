@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::types::{Candidate, CdState, Omega, SdpfPath, StopReason, Transition};
+use super::types::{Candidate, CdState, CrState, Omega, SdpfPath, StepKind, StopReason, Transition};
 
 /// A readable account of `path`, one block per transition (plus the loop-closing step).
 pub fn explain(path: &SdpfPath) -> String {
@@ -23,6 +23,10 @@ pub fn explain(path: &SdpfPath) -> String {
         let _ = writeln!(s, "step {}: {}", i + 1, head(t));
         body(&mut s, t);
     }
+    if let Some(StepKind::LoopBack { to, .. }) = path.transitions.last().map(|t| t.kind) {
+        let body = path.transitions.len() - to;
+        let _ = writeln!(s, "then the loop of {body} frames (positions {to}..) repeats up to {} frames", path.len());
+    }
     if let Some(t) = &path.closing {
         let _ = writeln!(s, "loop closure: {}", head(t));
         body(&mut s, t);
@@ -36,12 +40,20 @@ fn stop_words(stop: StopReason) -> &'static str {
         StopReason::EarlyStop => "early stop, no candidate left (S2 empty, §5.2.3)",
         StopReason::AllVisited => "every frame used",
         StopReason::LoopClosed => "cut where the last frame returns to the start (loop closure)",
+        StopReason::DeadEnd => "dead end: no candidate left, no other shot to cut to and no loop back possible",
     }
 }
 
 fn head(t: &Transition) -> String {
+    let how = match t.kind {
+        StepKind::Distilled => String::new(),
+        StepKind::Cut { edge } => format!(" CUT to another shot (S2 empty; its closest unvisited frame, e {edge:.3})"),
+        StepKind::LoopBack { to, edge } => {
+            format!(" LOOP back to position {to} (S2 empty, no other shot left; the closest frame of the path, e {edge:.3})")
+        }
+    };
     match t.chosen {
-        Some(k) => format!("frame {} → {k}", t.from),
+        Some(k) => format!("frame {} → {k}{how}", t.from),
         None => format!("frame {} → (none)", t.from),
     }
 }
@@ -52,23 +64,43 @@ fn body(s: &mut String, t: &Transition) {
     if !t.removed_cut.is_empty() {
         let _ = writeln!(s, "  left out, another shot (scene cut): {}", frames(&t.removed_cut));
     }
+    let _ = writeln!(s, "  C_r (reverse, beyond the paper): {}", cr_words(t));
     let _ = writeln!(s, "  C_d (Eq. 12): {}", cd_words(t));
     let _ = writeln!(s, "  C_t (Eq. 16-17): {}", ct_words(t));
     let s2: Vec<String> = t.probs.iter().map(|(f, p)| format!("{f} p={p:.3}")).collect();
     let _ = writeln!(s, "  S2 with softmax probabilities (Eq. 20): {}", none_if_empty(&s2));
-    match t.chosen {
-        Some(k) => {
+    match (t.chosen, t.kind) {
+        (Some(k), StepKind::Distilled) => {
             let _ = writeln!(s, "  chose {k}");
         }
-        None => {
-            let _ = writeln!(s, "  no candidate left: early stop");
+        (Some(k), StepKind::Cut { .. }) => {
+            let _ = writeln!(s, "  no candidate left: cut to {k}");
+        }
+        (Some(k), StepKind::LoopBack { .. }) => {
+            let _ = writeln!(s, "  no candidate left and no other shot: loop back to {k}");
+        }
+        (None, _) => {
+            let _ = writeln!(s, "  no candidate left: stop");
         }
     }
 }
 
 fn candidate(c: &Candidate) -> String {
     let t = c.tendency.map_or_else(|| "-".to_string(), |t| format!("{:.0}°", t.to_degrees()));
-    format!("{} (e {:.3}, motion {:.3}, T {t}{})", c.frame, c.edge, c.motion, if c.lms { ", LMS" } else { "" })
+    let m = if c.motion.is_nan() { "-".to_string() } else { format!("{:.3}", c.motion) };
+    format!("{} (e {:.3}, motion {m}, T {t}{})", c.frame, c.edge, if c.lms { ", LMS" } else { "" })
+}
+
+fn cr_words(t: &Transition) -> String {
+    match t.cr {
+        CrState::Disabled => "off".into(),
+        CrState::AllowedUndirected => "skipped, the shot's motion is judged undirected (--allow-reverse)".into(),
+        CrState::Active => format!(
+            "removes steps that play the motion backwards (replays of the previous source frames, or frames closer to frame {}'s past than to its future); removed {}",
+            t.from,
+            none_if_empty_frames(&t.removed_cr)
+        ),
+    }
 }
 
 fn cd_words(t: &Transition) -> String {
@@ -90,7 +122,10 @@ fn ct_words(t: &Transition) -> String {
         Omega::Off if t.s1.is_empty() => "nothing to check".into(),
         Omega::Off => "off".into(),
         Omega::Mean(w) => {
-            format!("keeps motion ≤ ω = {w:.4} (mean over S1); removed {}", none_if_empty_frames(&t.removed_ct))
+            format!(
+                "keeps motion ≤ ω = {w:.4} (mean over what C_r and C_d left); removed {}",
+                none_if_empty_frames(&t.removed_ct)
+            )
         }
         Omega::Rotated(w) => {
             format!(

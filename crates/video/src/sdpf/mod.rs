@@ -7,6 +7,7 @@
 //! - [`distill`]: one step (Eq. 8, 12, 16–20);
 //! - [`search`]: the walk, target length, loop closure, several distinct sequences;
 //! - [`cuts`]: scene-cut detection, so that walks stay inside a shot;
+//! - [`reverse`]: whether a shot's motion is directed, and the count of backward steps;
 //! - [`metrics`]: M_D (Eq. 21) and Δo (Eq. 22–23);
 //! - [`ssim`](mod@ssim): SSIM of transitions (Wang et al. 2004; not in the paper), the bench's perceptual proxy;
 //! - [`explain`](mod@explain): `--explain` text;
@@ -37,8 +38,14 @@
 //!   gives Eq. 20 as printed.
 //!
 //! Beyond the paper:
+//! - **reverse distillation C_r**: no step that plays the motion backwards (a step to one of the
+//!   three previous source frames, or to a frame of the shot closer in content to the current
+//!   frame's past than to its future). C_d cannot do this: it compares the tendencies of the two
+//!   frames' own motions, and the previous frame moves just like the current one. In shots judged
+//!   undirected (water, fire, flicker; [`judge_directed`]) `allow_reverse` lets such steps through;
 //! - shots: no jump across a scene cut unless `allow_cuts`;
-//! - a target length;
+//! - a target length, by default the source's frame count; where S2 is empty, a cut to the shot
+//!   that best matches or a loop back instead of the paper's early stop (`stop_early` keeps it);
 //! - loop closure back to the start frame;
 //! - several distinct sequences from one graph;
 //! - a record of every transition for `--explain`.
@@ -47,6 +54,7 @@ pub mod cuts;
 pub mod distill;
 pub mod explain;
 pub mod metrics;
+pub mod reverse;
 pub mod search;
 pub mod ssim;
 pub mod sspf;
@@ -56,12 +64,16 @@ pub use cuts::{cut_scores, detect_cuts, detect_cuts_with, detect_shots, shots_fr
 pub use distill::{eta, softmax};
 pub use explain::explain;
 pub use metrics::{frame_rms, overlap, overlap_delta_o, source_md, stability_md, try_stability_md, Overlap};
-pub use search::{sdpf, several};
+pub use reverse::{
+    backward_positions, backward_steps, direction_flips, direction_words, is_backward_step, judge_directed,
+    DIRECTED_LMS_SHARE,
+};
+pub use search::{sdpf, several, several_with};
 pub use ssim::{ssim, ssim_planes, transition_ssims, Plane, SSIM_SIDE};
 pub use sspf::sspf;
 pub use types::{
-    Candidate, CdState, MatrixMotion, MotionDistance, MotionInfo, NoMotion, Omega, Path, SdpfParams, SdpfPath,
-    StopReason, Transition,
+    Candidate, CdState, CrState, MatrixMotion, MotionDistance, MotionInfo, NoMotion, Omega, Path, SdpfParams, SdpfPath,
+    StepKind, StopReason, Transition,
 };
 
 #[cfg(test)]

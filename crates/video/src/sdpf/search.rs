@@ -1,10 +1,11 @@
 //! Algorithm 1 as a walk, plus what the paper lacks: a target length, loop closure back to the
 //! start frame, several distinct paths from one graph.
 
+use inbetween_core::cancel::Cancel;
 use inbetween_core::seed::{derive, rng};
 
 use super::distill::{draw, Ctx};
-use super::types::{MotionDistance, MotionInfo, SdpfParams, SdpfPath, StopReason};
+use super::types::{MotionDistance, MotionInfo, SdpfParams, SdpfPath, StepKind, StopReason};
 use crate::metric::Graph;
 use crate::VideoError;
 
@@ -12,9 +13,11 @@ use crate::VideoError;
 ///
 /// Each step builds S1 (Eq. 8, η = mean off-diagonal edge weight; frames of another shot left
 /// out unless `allow_cuts`), distils it with C_d (Eq. 12) and C_t (Eq. 16–17) into S2 (Eq. 18–19)
-/// and draws the next frame with the softmax of Eq. 20 from a seeded stream. No frame is visited
-/// twice. The walk ends when S2 is empty (the paper's early stop), every frame is used, or the
-/// target `length` is reached.
+/// and draws the next frame with the softmax of Eq. 20 from a seeded stream; C_r (beyond the paper)
+/// first removes the steps that would play the motion backwards. No frame is visited twice before
+/// a loop back. The walk ends at the target length (default: the source's frame count). Where S2
+/// is empty it ends only with `stop_early` (the paper's early stop); otherwise it cuts to the shot
+/// that best matches, or loops back (see [`SdpfParams::stop_early`]).
 ///
 /// Goals beyond the paper are met by seeded retries: attempt 0 uses `seed` itself, attempt `a`
 /// uses `derive(seed, a)`, up to `attempts` walks, stopping at the first that meets the goal.
@@ -38,7 +41,7 @@ pub fn sdpf(
     p: &SdpfParams,
 ) -> Result<SdpfPath, VideoError> {
     validate(graph, motion, start, p)?;
-    Ok(best_walk(&Ctx::new(graph, motion, md, p), start, p.seed))
+    best_walk(&Ctx::new(graph, motion, md, p), start, p.seed)
 }
 
 /// Several distinct paths from `start` (beyond the paper): path `i` is [`sdpf`] with a seed derived
@@ -53,8 +56,23 @@ pub fn several(
     p: &SdpfParams,
     count: usize,
 ) -> Result<Vec<SdpfPath>, VideoError> {
+    several_with(graph, motion, md, start, p, count, &Cancel::new())
+}
+
+/// [`several`], stopping with [`VideoError::Cancelled`] once `cancel` is cancelled (checked before
+/// every step of every walk).
+pub fn several_with(
+    graph: &Graph,
+    motion: &MotionInfo,
+    md: &dyn MotionDistance,
+    start: usize,
+    p: &SdpfParams,
+    count: usize,
+    cancel: &Cancel,
+) -> Result<Vec<SdpfPath>, VideoError> {
     validate(graph, motion, start, p)?;
-    let ctx = Ctx::new(graph, motion, md, p);
+    let mut ctx = Ctx::new(graph, motion, md, p);
+    ctx.cancel = cancel.clone();
     let count = count.max(1);
     let mut kept: Vec<SdpfPath> = Vec::new();
     for i in 0..(4 * count + 8) {
@@ -62,7 +80,7 @@ pub fn several(
             break;
         }
         let seed = if i == 0 { p.seed } else { derive(derive(p.seed, u64::MAX), i as u64) };
-        let path = best_walk(&ctx, start, seed);
+        let path = best_walk(&ctx, start, seed)?;
         if kept.iter().all(|k| k.frames != path.frames) {
             kept.push(path);
         }
@@ -94,16 +112,16 @@ fn validate(graph: &Graph, motion: &MotionInfo, start: usize, p: &SdpfParams) ->
 }
 
 /// The seeded attempts of [`sdpf`], keeping the first that meets the goal, else the best.
-fn best_walk(ctx: &Ctx, start: usize, seed: u64) -> SdpfPath {
+fn best_walk(ctx: &Ctx, start: usize, seed: u64) -> Result<SdpfPath, VideoError> {
     let p = ctx.p;
     let mut best: Option<SdpfPath> = None;
     for attempt in 0..p.attempts.max(1) {
         let s = if attempt == 0 { seed } else { derive(seed, attempt as u64) };
-        let mut path = walk(ctx, start, s, attempt);
+        let mut path = walk(ctx, start, s, attempt)?;
         if p.loop_close {
             close_loop(ctx, &mut path);
         }
-        let done = goal_met(p, &path);
+        let done = goal_met(p, ctx.graph.n, &path);
         if best.as_ref().is_none_or(|b| rank(&path) > rank(b)) {
             best = Some(path);
         }
@@ -111,41 +129,76 @@ fn best_walk(ctx: &Ctx, start: usize, seed: u64) -> SdpfPath {
             break;
         }
     }
-    best.unwrap_or_else(|| walk(ctx, start, seed, 0))
+    match best {
+        Some(b) => Ok(b),
+        None => walk(ctx, start, seed, 0),
+    }
 }
 
-/// One seeded walk of Algorithm 1 (lines 3–24, repeated until a stop).
-fn walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> SdpfPath {
+/// One seeded walk of Algorithm 1 (lines 3–24, repeated until a stop). When S2 is empty the walk
+/// stops only with `stop_early` (the paper); otherwise it cuts to the shot that best matches the
+/// current frame ([`Ctx::cut`]) or, with no other shot left, loops back ([`Ctx::loop_back`]) and
+/// repeats the loop up to the target length.
+fn walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<SdpfPath, VideoError> {
     let n = ctx.graph.n;
+    let target = ctx.p.target_length(n);
     let mut rng = rng(seed);
     let mut visited = vec![false; n];
     visited[start] = true;
     let (mut frames, mut transitions) = (vec![start], Vec::new());
     let mut current = start;
     let stop = loop {
-        if ctx.p.length.is_some_and(|l| frames.len() >= l) {
+        if frames.len() >= target {
             break StopReason::TargetLength;
         }
-        if frames.len() == n {
+        if ctx.p.stop_early && frames.len() == n {
             break StopReason::AllVisited;
         }
+        ctx.cancel.check()?;
         let mut t = ctx.step(current, &visited);
         t.chosen = draw(&t.probs, &mut rng);
+        if t.chosen.is_none() && !ctx.p.stop_early {
+            if let Some((k, edge)) = ctx.cut(current, &visited) {
+                t.chosen = Some(k);
+                t.kind = StepKind::Cut { edge };
+            } else if let Some((to, edge)) = ctx.loop_back(&frames) {
+                t.chosen = Some(frames[to]);
+                t.kind = StepKind::LoopBack { to, edge };
+                transitions.push(t);
+                let body = frames[to..].to_vec();
+                while frames.len() < target {
+                    let take = (target - frames.len()).min(body.len());
+                    frames.extend_from_slice(&body[..take]);
+                }
+                break StopReason::TargetLength;
+            }
+        }
         let chosen = t.chosen;
         transitions.push(t);
-        let Some(next) = chosen else { break StopReason::EarlyStop };
+        let Some(next) = chosen else {
+            break if ctx.p.stop_early {
+                StopReason::EarlyStop
+            } else if frames.len() == n {
+                StopReason::AllVisited
+            } else {
+                StopReason::DeadEnd
+            };
+        };
         visited[next] = true;
         frames.push(next);
         current = next;
     };
-    SdpfPath { frames, transitions, stop, closes_loop: false, closing: None, eta: ctx.eta, seed, attempt }
+    Ok(SdpfPath { frames, transitions, stop, closes_loop: false, closing: None, eta: ctx.eta, seed, attempt })
 }
 
 /// Cuts `path` at its longest prefix (≥ 3 frames, at most `length`) whose last frame can step
 /// back to the start under the same constraints, recording that step.
 fn close_loop(ctx: &Ctx, path: &mut SdpfPath) {
     let start = path.frames[0];
-    let longest = path.frames.len().min(ctx.p.length.unwrap_or(usize::MAX));
+    // Only the part before any loop back, where no frame repeats.
+    let mut seen = vec![false; ctx.graph.n];
+    let fresh = path.frames.iter().take_while(|&&f| !std::mem::replace(&mut seen[f], true)).count();
+    let longest = fresh.min(ctx.p.target_length(ctx.graph.n));
     let mut visited = vec![false; ctx.graph.n];
     path.frames[1..longest].iter().for_each(|&f| visited[f] = true);
     for last in (2..longest).rev() {
@@ -166,8 +219,13 @@ fn close_loop(ctx: &Ctx, path: &mut SdpfPath) {
     }
 }
 
-fn goal_met(p: &SdpfParams, path: &SdpfPath) -> bool {
-    let long_enough = p.length.is_none_or(|l| path.len() >= l);
+fn goal_met(p: &SdpfParams, n: usize, path: &SdpfPath) -> bool {
+    let long_enough = match p.length {
+        Some(l) => path.len() >= l,
+        // The paper's walk ends where it ends; a loop is as long as it closes; otherwise the
+        // source's length (missed only at a dead end).
+        None => p.stop_early || p.loop_close || path.len() >= n,
+    };
     if p.loop_close {
         path.closes_loop && long_enough
     } else {

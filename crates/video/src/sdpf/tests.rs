@@ -61,7 +61,7 @@ fn eta_is_the_mean_of_the_off_diagonal_edges() {
 #[test]
 fn s1_holds_the_unvisited_frames_strictly_below_eta() {
     let g = line_graph(9); // η = mean |i − j| over i ≠ j = 10/3
-    let t = step_from(&g, &MotionInfo::none(), &NoMotion, &SdpfParams::default().paper_choice(), 4, &[3]);
+    let t = step_from(&g, &MotionInfo::none(), &NoMotion, &SdpfParams::paper_walk().paper_choice(), 4, &[3]);
     assert_eq!(t.s1, vec![1, 2, 5, 6, 7], "|4 − k| < 10/3, frames 3 and 4 visited");
     // Without motion differences every S1 frame survives, with equal probabilities (§5.1).
     assert_eq!(t.s2(), t.s1);
@@ -77,6 +77,7 @@ fn cd_scene() -> (Graph, MotionInfo) {
         tendency: vec![Some(0.0), Some(0.2), Some(3.0), Some(0.0), Some(-0.5), Some(TAU - 0.3)],
         lms: vec![true, true, true, false, true, true],
         shot: vec![],
+        directed: vec![],
     };
     (star_graph(6), motion)
 }
@@ -84,7 +85,7 @@ fn cd_scene() -> (Graph, MotionInfo) {
 #[test]
 fn cd_keeps_only_lms_candidates_heading_within_xi() {
     let (g, m) = cd_scene();
-    let t = step_from(&g, &m, &NoMotion, &SdpfParams::default(), 0, &[]);
+    let t = step_from(&g, &m, &NoMotion, &SdpfParams::paper_walk(), 0, &[]);
     assert_eq!(t.s1, vec![1, 2, 3, 4, 5]);
     assert_eq!(t.cd, CdState::Active { tendency: 0.0, xi: FRAC_PI_3 });
     assert_eq!(t.removed_cd, vec![2, 3]);
@@ -93,7 +94,7 @@ fn cd_keeps_only_lms_candidates_heading_within_xi() {
     let mut m2 = m.clone();
     m2.tendency[4] = Some(f32::NAN);
     m2.tendency[5] = None;
-    assert_eq!(step_from(&g, &m2, &NoMotion, &SdpfParams::default(), 0, &[]).removed_cd, vec![2, 3, 4, 5]);
+    assert_eq!(step_from(&g, &m2, &NoMotion, &SdpfParams::paper_walk(), 0, &[]).removed_cd, vec![2, 3, 4, 5]);
 }
 
 #[test]
@@ -101,31 +102,31 @@ fn cd_is_skipped_unless_both_sides_are_lms() {
     let (g, m) = cd_scene();
     let mut not_lms = m.clone();
     not_lms.lms[0] = false;
-    let t = step_from(&g, &not_lms, &NoMotion, &SdpfParams::default(), 0, &[]);
+    let t = step_from(&g, &not_lms, &NoMotion, &SdpfParams::paper_walk(), 0, &[]);
     assert_eq!((t.cd, t.removed_cd.len(), t.s2().len()), (CdState::NotLms, 0, 5));
     let mut lone = m.clone();
     lone.lms = vec![true, false, false, false, false, false];
-    let t = step_from(&g, &lone, &NoMotion, &SdpfParams::default(), 0, &[]);
+    let t = step_from(&g, &lone, &NoMotion, &SdpfParams::paper_walk(), 0, &[]);
     assert_eq!((t.cd, t.s2().len()), (CdState::NoLmsCandidate, 5));
-    let off = SdpfParams { use_cd: false, ..SdpfParams::default() };
+    let off = SdpfParams { use_cd: false, ..SdpfParams::paper_walk() };
     let t = step_from(&g, &m, &NoMotion, &off, 0, &[]);
     assert_eq!((t.cd, t.s2().len()), (CdState::Disabled, 5));
     // NaN tendency on the current frame: no direction to compare, C_d skipped (no panic).
     let mut nan = m;
     nan.tendency[0] = Some(f32::NAN);
-    assert_eq!(step_from(&g, &nan, &NoMotion, &SdpfParams::default(), 0, &[]).cd, CdState::NotLms);
+    assert_eq!(step_from(&g, &nan, &NoMotion, &SdpfParams::paper_walk(), 0, &[]).cd, CdState::NotLms);
 }
 
 #[test]
 fn ct_keeps_the_candidates_at_most_the_mean_motion_distance_of_s1() {
     let g = star_graph(4);
     let md = motion_from_zero(&[0.0, 1.0, 2.0, 6.0], 100.0);
-    let t = step_from(&g, &MotionInfo::none(), &md, &SdpfParams::default().paper_choice(), 0, &[]);
+    let t = step_from(&g, &MotionInfo::none(), &md, &SdpfParams::paper_walk().paper_choice(), 0, &[]);
     assert_eq!(t.omega, Omega::Mean(3.0), "n1 = 3 ≥ 2: ω is the mean of 1, 2, 6");
     assert_eq!(t.removed_ct, vec![3], "the least smooth candidate goes (the floor is not used)");
     // Eq. 20: Ω ∝ exp(−distance), so frame 1 is e times as likely as frame 2.
     assert!((t.prob_of(1) / t.prob_of(2) - std::f32::consts::E).abs() < 1e-4);
-    let off = SdpfParams { use_ct: false, ..SdpfParams::default() };
+    let off = SdpfParams { use_ct: false, ..SdpfParams::paper_walk() };
     let t = step_from(&g, &MotionInfo::none(), &md, &off, 0, &[]);
     assert_eq!((t.omega, t.s2()), (Omega::Off, vec![1, 2, 3]));
 }
@@ -136,7 +137,7 @@ fn the_default_choice_is_relative_to_omega_and_weighs_content() {
     // and 2 (ω = 3).
     let g = line_graph(6);
     let md = motion_from_zero(&[0.0, 4.0, 2.0, 0.0, 0.0, 0.0], 100.0);
-    let p = SdpfParams { use_ct: false, ..SdpfParams::default() };
+    let p = SdpfParams { use_ct: false, ..SdpfParams::paper_walk() };
     let t = step_from(&g, &MotionInfo::none(), &md, &p, 0, &[]);
     assert_eq!(t.s2(), vec![1, 2]);
     // Ω_1/Ω_2 = exp(−((4 − 2)/ω + λ(1 − 2)/ē)/τ) with ω = 3, ē = 1.5, λ = 2, τ = 0.1.
@@ -157,14 +158,14 @@ fn ct_uses_the_rotated_flow_floor_when_s1_has_one_frame_and_stops_early_on_an_em
     // From 0 only frame 1 is under η = (1 + 10 + 10) / 3 = 7.
     let g = Graph::from_fn(3, |i, j| if i.min(j) == 0 && i.max(j) == 1 { 1.0 } else { 10.0 });
     let rough = motion_from_zero(&[0.0, 2.0, 0.0], 1.5);
-    let p = sdpf(&g, &MotionInfo::none(), &rough, 0, &SdpfParams::default()).unwrap();
+    let p = sdpf(&g, &MotionInfo::none(), &rough, 0, &SdpfParams::paper_walk()).unwrap();
     assert_eq!(p.frames, vec![0]);
     assert_eq!(p.stop, StopReason::EarlyStop);
     let t = &p.transitions[0];
     assert_eq!((t.s1.clone(), t.omega, t.removed_ct.clone(), t.chosen), (vec![1], Omega::Rotated(1.5), vec![1], None));
     // A candidate no farther than the floor passes; the next step has nothing under η and stops.
     let smooth = motion_from_zero(&[0.0, 1.0, 0.0], 1.5);
-    let p = sdpf(&g, &MotionInfo::none(), &smooth, 0, &SdpfParams::default()).unwrap();
+    let p = sdpf(&g, &MotionInfo::none(), &smooth, 0, &SdpfParams::paper_walk()).unwrap();
     assert_eq!((p.frames.clone(), p.stop), (vec![0, 1], StopReason::EarlyStop));
     assert!(p.transitions[1].s1.is_empty());
 }
@@ -172,9 +173,9 @@ fn ct_uses_the_rotated_flow_floor_when_s1_has_one_frame_and_stops_early_on_an_em
 #[test]
 fn s2_is_what_passes_both_constraints_and_each_verdict_is_recorded() {
     let (g, m) = cd_scene();
-    // Distances from 0: mean over S1 (1..5) = (1 + 1 + 1 + 9 + 3) / 5 = 3.
+    // C_d removes 2 and 3 first; C_t judges 1, 4, 5: ω = (1 + 9 + 3) / 3 = 4.33.
     let md = motion_from_zero(&[0.0, 1.0, 1.0, 1.0, 9.0, 3.0], 0.0);
-    let t = step_from(&g, &m, &md, &SdpfParams::default(), 0, &[]);
+    let t = step_from(&g, &m, &md, &SdpfParams::paper_walk(), 0, &[]);
     assert_eq!(t.removed_cd, vec![2, 3]);
     assert_eq!(t.removed_ct, vec![4]);
     assert_eq!(t.s2(), vec![1, 5]);
@@ -183,19 +184,20 @@ fn s2_is_what_passes_both_constraints_and_each_verdict_is_recorded() {
 
 #[test]
 fn degenerate_graphs_stop_without_panicking() {
-    let one = sdpf(&line_graph(1), &MotionInfo::none(), &NoMotion, 0, &SdpfParams::default()).unwrap();
+    let one = sdpf(&line_graph(1), &MotionInfo::none(), &NoMotion, 0, &SdpfParams::paper_walk()).unwrap();
     assert_eq!((one.frames.clone(), one.stop), (vec![0], StopReason::AllVisited));
     // All distances equal: nothing is strictly under the mean, S1 is empty.
     let flat = Graph::from_fn(5, |_, _| 1.0);
-    let p = sdpf(&flat, &MotionInfo::none(), &NoMotion, 2, &SdpfParams::default()).unwrap();
+    let p = sdpf(&flat, &MotionInfo::none(), &NoMotion, 2, &SdpfParams::paper_walk()).unwrap();
     assert_eq!((p.frames.clone(), p.stop), (vec![2], StopReason::EarlyStop));
     // NaN motion distances and tendencies everywhere: C_t cannot vouch for anyone, early stop.
     let nan_md = MatrixMotion { n: 6, dist: vec![f32::NAN; 36], floor: vec![f32::NAN; 6] };
-    let nan_m = MotionInfo { tendency: vec![Some(f32::NAN); 6], lms: vec![true; 6], shot: vec![] };
-    let p = sdpf(&line_graph(6), &nan_m, &nan_md, 0, &SdpfParams::default()).unwrap();
+    let nan_m = MotionInfo { tendency: vec![Some(f32::NAN); 6], lms: vec![true; 6], shot: vec![], directed: vec![] };
+    let p = sdpf(&line_graph(6), &nan_m, &nan_md, 0, &SdpfParams::paper_walk()).unwrap();
     assert_eq!(p.stop, StopReason::EarlyStop);
     // Without C_t the softmax over NaN distances is uniform and the walk goes on.
-    let p = sdpf(&line_graph(6), &nan_m, &nan_md, 0, &SdpfParams { use_ct: false, ..SdpfParams::default() }).unwrap();
+    let p =
+        sdpf(&line_graph(6), &nan_m, &nan_md, 0, &SdpfParams { use_ct: false, ..SdpfParams::paper_walk() }).unwrap();
     assert!(p.len() > 1 && no_repeats(&p.frames));
 }
 
@@ -203,7 +205,7 @@ fn degenerate_graphs_stop_without_panicking() {
 fn walks_never_revisit_and_only_take_s2_frames() {
     let g = line_graph(20);
     for seed in 0..10 {
-        let p = sdpf(&g, &MotionInfo::none(), &NoMotion, 7, &SdpfParams { seed, ..SdpfParams::default() }).unwrap();
+        let p = sdpf(&g, &MotionInfo::none(), &NoMotion, 7, &SdpfParams { seed, ..SdpfParams::paper_walk() }).unwrap();
         assert_eq!(p.frames[0], 7);
         assert!(no_repeats(&p.frames), "{:?}", p.frames);
         for (t, w) in p.transitions.iter().zip(p.frames.windows(2)) {
@@ -218,7 +220,7 @@ fn walks_never_revisit_and_only_take_s2_frames() {
 fn the_seed_alone_decides_the_path() {
     let g = line_graph(20);
     let run = |seed| {
-        sdpf(&g, &MotionInfo::none(), &NoMotion, 10, &SdpfParams { seed, ..SdpfParams::default() }.paper_choice())
+        sdpf(&g, &MotionInfo::none(), &NoMotion, 10, &SdpfParams { seed, ..SdpfParams::paper_walk() }.paper_choice())
             .unwrap()
     };
     assert_eq!(run(3), run(3));
@@ -240,13 +242,13 @@ fn walks_stay_in_their_shot_unless_cuts_are_allowed() {
     let (g, m) = two_shots();
     assert_eq!(m.shot, [vec![0; 6], vec![1; 6]].concat());
     for seed in 0..6 {
-        let p = sdpf(&g, &m, &NoMotion, 2, &SdpfParams { seed, ..SdpfParams::default() }).unwrap();
+        let p = sdpf(&g, &m, &NoMotion, 2, &SdpfParams { seed, ..SdpfParams::paper_walk() }).unwrap();
         assert!(p.frames.iter().all(|&f| f < 6), "{:?}", p.frames);
         assert!(p.transitions.iter().all(|t| t.removed_cut.iter().all(|&f| f >= 6)));
     }
-    let first = sdpf(&g, &m, &NoMotion, 2, &SdpfParams::default()).unwrap();
+    let first = sdpf(&g, &m, &NoMotion, 2, &SdpfParams::paper_walk()).unwrap();
     assert!(!first.transitions[0].removed_cut.is_empty(), "frames of the other shot were under η");
-    let across = sdpf(&g, &m, &NoMotion, 2, &SdpfParams { allow_cuts: true, ..SdpfParams::default() }).unwrap();
+    let across = sdpf(&g, &m, &NoMotion, 2, &SdpfParams { allow_cuts: true, ..SdpfParams::paper_walk() }).unwrap();
     assert!(across.transitions[0].s1.iter().any(|&f| f >= 6));
     assert!(across.transitions[0].removed_cut.is_empty());
 }
@@ -255,17 +257,22 @@ fn walks_stay_in_their_shot_unless_cuts_are_allowed() {
 fn a_target_length_is_met_or_the_longest_attempt_kept() {
     let g = line_graph(12);
     for seed in 0..6 {
-        let p =
-            sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(6), seed, ..SdpfParams::default() })
-                .unwrap();
+        let p = sdpf(
+            &g,
+            &MotionInfo::none(),
+            &NoMotion,
+            5,
+            &SdpfParams { length: Some(6), seed, ..SdpfParams::paper_walk() },
+        )
+        .unwrap();
         assert_eq!((p.len(), p.stop), (6, StopReason::TargetLength));
         assert_eq!(p.transitions.len(), 5);
     }
-    let one =
-        sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(1), ..SdpfParams::default() }).unwrap();
+    let one = sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &SdpfParams { length: Some(1), ..SdpfParams::paper_walk() })
+        .unwrap();
     assert_eq!((one.frames.clone(), one.transitions.len()), (vec![5], 0));
     // Unreachable target: every attempt runs and the longest walk comes back.
-    let p = SdpfParams { length: Some(50), attempts: 5, ..SdpfParams::default() };
+    let p = SdpfParams { length: Some(50), attempts: 5, ..SdpfParams::paper_walk() };
     let long = sdpf(&g, &MotionInfo::none(), &NoMotion, 5, &p).unwrap();
     let longest = (0..5)
         .map(|a| {
@@ -289,7 +296,7 @@ fn loop_closure_ends_on_a_frame_that_steps_back_to_the_start() {
             &MotionInfo::none(),
             &NoMotion,
             8,
-            &SdpfParams { loop_close: true, seed, ..SdpfParams::default() },
+            &SdpfParams { loop_close: true, seed, ..SdpfParams::paper_walk() },
         )
         .unwrap();
         assert!(p.closes_loop && p.len() >= 3, "{:?}", p.frames);
@@ -305,7 +312,7 @@ fn loop_closure_ends_on_a_frame_that_steps_back_to_the_start() {
         &MotionInfo::none(),
         &NoMotion,
         8,
-        &SdpfParams { loop_close: true, length: Some(6), ..SdpfParams::default() },
+        &SdpfParams { loop_close: true, length: Some(6), ..SdpfParams::paper_walk() },
     )
     .unwrap();
     assert_eq!((p.len(), p.closes_loop), (6, true));
@@ -315,8 +322,8 @@ fn loop_closure_ends_on_a_frame_that_steps_back_to_the_start() {
 fn loop_closure_reports_failure_on_a_chain() {
     // 0 – 1 – 2 – 3: only neighbours are under η = 5.5, so no prefix of ≥ 3 frames can return to 0.
     let g = Graph::from_fn(4, |i, j| if i.abs_diff(j) == 1 { 1.0 } else { 10.0 });
-    let p =
-        sdpf(&g, &MotionInfo::none(), &NoMotion, 0, &SdpfParams { loop_close: true, ..SdpfParams::default() }).unwrap();
+    let p = sdpf(&g, &MotionInfo::none(), &NoMotion, 0, &SdpfParams { loop_close: true, ..SdpfParams::paper_walk() })
+        .unwrap();
     assert_eq!(p.frames, vec![0, 1, 2, 3]);
     assert!(!p.closes_loop && p.closing.is_none());
     assert_eq!(p.stop, StopReason::AllVisited);
@@ -325,7 +332,7 @@ fn loop_closure_reports_failure_on_a_chain() {
 #[test]
 fn several_sequences_are_distinct_and_the_first_is_sdpf() {
     let g = line_graph(14);
-    let p = SdpfParams { seed: 9, ..SdpfParams::default() }.paper_choice();
+    let p = SdpfParams { seed: 9, ..SdpfParams::paper_walk() }.paper_choice();
     let paths = several(&g, &MotionInfo::none(), &NoMotion, 7, &p, 4).unwrap();
     assert_eq!(paths.len(), 4);
     for i in 0..paths.len() {
@@ -359,7 +366,7 @@ impl MotionDistance for Counting {
 fn motion_distances_are_asked_once_per_pair() {
     let g = line_graph(16);
     let md = Counting { calls: Cell::new(0) };
-    let p = SdpfParams { loop_close: true, length: Some(10), attempts: 8, ..SdpfParams::default() };
+    let p = SdpfParams { loop_close: true, length: Some(10), attempts: 8, ..SdpfParams::paper_walk() };
     let paths = several(&g, &MotionInfo::none(), &md, 8, &p, 3).unwrap();
     assert!(!paths.is_empty());
     assert!(md.calls.get() <= 16 * 15, "{} calls for 240 pairs", md.calls.get());
@@ -368,14 +375,14 @@ fn motion_distances_are_asked_once_per_pair() {
 #[test]
 fn bad_inputs_are_clear_errors() {
     let g = line_graph(12);
-    let p = SdpfParams::default();
+    let p = SdpfParams::paper_walk();
     let e = sdpf(&g, &MotionInfo::none(), &NoMotion, 12, &p).unwrap_err().to_string();
     assert!(e.contains("start frame 12") && e.contains("12 frames"), "{e}");
     let short = MotionInfo { lms: vec![false; 3], ..MotionInfo::none() };
     assert!(sdpf(&g, &short, &NoMotion, 0, &p).unwrap_err().to_string().contains("lms has 3 entries"));
     assert!(sdpf(&Graph { n: 3, dist: vec![0.0; 4] }, &MotionInfo::none(), &NoMotion, 0, &p).is_err());
     assert!(sdpf(&Graph { n: 0, dist: vec![] }, &MotionInfo::none(), &NoMotion, 0, &p).is_err());
-    let hot = SdpfParams { temperature: 0.0, ..SdpfParams::default() };
+    let hot = SdpfParams { temperature: 0.0, ..SdpfParams::paper_walk() };
     assert!(several(&g, &MotionInfo::none(), &NoMotion, 0, &hot, 2).is_err());
 }
 
@@ -395,14 +402,109 @@ fn softmax_is_eq_20_and_survives_non_finite_distances() {
 fn explain_names_the_candidates_the_removals_and_the_choice() {
     let (g, m) = cd_scene();
     let md = motion_from_zero(&[0.0, 1.0, 1.0, 1.0, 9.0, 3.0], 0.0);
-    let p = sdpf(&g, &m, &md, 0, &SdpfParams::default()).unwrap();
+    let p = sdpf(&g, &m, &md, 0, &SdpfParams::paper_walk()).unwrap();
     let text = explain(&p);
     assert!(text.contains("from frame 0"), "{text}");
     assert!(text.contains("S1 (content, Eq. 8) = frames with e < η, n1 = 5"), "{text}");
     assert!(text.contains("T_c = 0°, keeps LMS frames within ξ = 60°; removed 2 3"), "{text}");
-    assert!(text.contains("ω = 3.0000 (mean over S1); removed 4"), "{text}");
+    assert!(text.contains("ω = 4.3333 (mean over what C_r and C_d left); removed 4"), "{text}");
     assert!(text.contains(&format!("chose {}", p.frames[1])), "{text}");
     assert!(text.contains("no candidate left"), "the star's leaves are far apart: {text}");
+}
+
+// --- reverse distillation C_r, lengths, cuts and loop backs (beyond the paper) ------------------
+
+#[test]
+fn cr_removes_steps_back_to_the_previous_frames_and_to_the_past() {
+    // From 6 on a line of 12: η = 13/3, S1 = 2..=10 without 6.
+    let g = line_graph(12);
+    let t = step_from(&g, &MotionInfo::none(), &NoMotion, &SdpfParams::default(), 6, &[]);
+    assert_eq!(t.s1, vec![2, 3, 4, 5, 7, 8, 9, 10]);
+    assert_eq!(t.cr, CrState::Active);
+    // 3, 4, 5 replay the source backwards; 2 is closer to 5 (the past) than to 7 (the future).
+    assert_eq!(t.removed_cr, vec![2, 3, 4, 5]);
+    assert!(t.s2().iter().all(|&k| k > 6), "{:?}", t.s2());
+    // Removed frames need no motion distance (NaN), the others have one.
+    assert!(t.candidates.iter().all(|c| c.motion.is_nan() == (c.frame < 6)));
+    // Ablation: off. --allow-reverse acts on undirected shots only.
+    let off = SdpfParams { use_cr: false, ..SdpfParams::default() };
+    let t = step_from(&g, &MotionInfo::none(), &NoMotion, &off, 6, &[]);
+    assert_eq!((t.cr, t.removed_cr.len()), (CrState::Disabled, 0));
+    let allow = SdpfParams { allow_reverse: true, ..SdpfParams::default() };
+    let undirected = MotionInfo { directed: vec![false], ..MotionInfo::none() };
+    let t = step_from(&g, &undirected, &NoMotion, &allow, 6, &[]);
+    assert_eq!((t.cr, t.removed_cr.len()), (CrState::AllowedUndirected, 0));
+    let directed = MotionInfo { directed: vec![true], ..MotionInfo::none() };
+    assert_eq!(step_from(&g, &directed, &NoMotion, &allow, 6, &[]).removed_cr, vec![2, 3, 4, 5]);
+    // Without --allow-reverse an undirected shot keeps C_r too.
+    assert_eq!(step_from(&g, &undirected, &NoMotion, &SdpfParams::default(), 6, &[]).removed_cr, vec![2, 3, 4, 5]);
+}
+
+#[test]
+fn the_default_length_is_the_source_s_and_a_dead_end_loops_back_without_a_backward_step() {
+    let g = line_graph(10);
+    for seed in 0..8 {
+        let p = sdpf(&g, &MotionInfo::none(), &NoMotion, 0, &SdpfParams { seed, ..SdpfParams::default() }).unwrap();
+        assert_eq!((p.len(), p.stop), (10, StopReason::TargetLength), "{:?}", p.frames);
+        assert_eq!(backward_steps(&p.frames, 3), 0, "{:?}", p.frames);
+        let loops = p.loop_positions();
+        if no_repeats(&p.frames) {
+            assert!(loops.is_empty());
+            assert!(p.frames.windows(2).all(|w| w[1] > w[0]), "{:?}", p.frames);
+        } else {
+            // A loop back, then the loop's frames repeat: every step except the loop back goes forward.
+            assert_eq!(loops.len(), 1, "{:?}", p.frames);
+            let StepKind::LoopBack { to, .. } = p.transitions.last().unwrap().kind else { panic!("no loop back") };
+            assert_eq!(p.frames[loops[0]], p.frames[to]);
+            assert!(p.transitions.len() - to >= super::distill::MIN_LOOP, "the loop has at least 4 frames");
+        }
+        let text = explain(&p);
+        assert!(loops.is_empty() || text.contains("LOOP back to position"), "{text}");
+    }
+    // The paper's early stop ends at the first dead end, short of the source's length.
+    let p =
+        sdpf(&g, &MotionInfo::none(), &NoMotion, 0, &SdpfParams { stop_early: true, ..SdpfParams::default() }).unwrap();
+    assert!(p.stop == StopReason::EarlyStop || p.len() == 10);
+    assert!(p.frames.windows(2).all(|w| w[1] > w[0]));
+}
+
+#[test]
+fn a_run_of_the_source_length_cuts_to_the_other_shot_at_a_dead_end() {
+    // Two shots of six frames on one line: 0..6 and 6..12, the second a scene cut away.
+    let g = line_graph(12);
+    let m = MotionInfo::with_cuts(vec![], vec![], &(0..12).map(|i| i == 6).collect::<Vec<_>>());
+    for seed in 0..6 {
+        let p = sdpf(&g, &m, &NoMotion, 1, &SdpfParams { seed, ..SdpfParams::default() }).unwrap();
+        assert_eq!(p.len(), 12, "{:?}", p.frames);
+        let cuts = p.cut_positions();
+        assert!(!cuts.is_empty(), "{:?}", p.frames);
+        for &c in &cuts {
+            assert_ne!(m.shot_of(p.frames[c - 1]), m.shot_of(p.frames[c]), "{:?} at {c}", p.frames);
+        }
+        assert!(p.frames.iter().any(|&f| f >= 6) && p.frames.iter().any(|&f| f < 6));
+        assert_eq!(backward_steps(&p.frames, 3), 0, "{:?}", p.frames);
+        assert!(explain(&p).contains("CUT to another shot"));
+    }
+}
+
+#[test]
+fn zero_lengths_are_refused_and_shots_are_judged_by_their_lms_share() {
+    let e = sdpf(
+        &line_graph(5),
+        &MotionInfo::none(),
+        &NoMotion,
+        0,
+        &SdpfParams { length: Some(0), ..SdpfParams::default() },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("length of 0 frames"), "{e}");
+    // Shot 0: 3 of 4 frames LMS (directed); shot 1: 1 of 4 (undirected).
+    let lms = [true, true, true, false, false, true, false, false];
+    let judged = judge_directed(&lms, &[0, 0, 0, 0, 1, 1, 1, 1]);
+    assert_eq!(judged, vec![(true, 0.75), (false, 0.25)]);
+    assert_eq!(judge_directed(&[], &[]), vec![(false, 0.0)]);
+    assert_eq!(backward_positions(&[5, 4, 8, 5, 9, 1], 3), vec![1, 3]);
 }
 
 // --- scene cuts -------------------------------------------------------------------------------

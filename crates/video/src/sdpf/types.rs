@@ -15,8 +15,22 @@ pub struct SdpfParams {
     pub use_cd: bool,
     /// Coherent distillation C_t (Eq. 16–17); `false` is the "w/o C_t" ablation of Table 3.
     pub use_ct: bool,
-    /// Target length in frames (the start frame included); `None`: walk until the early stop.
+    /// Reverse distillation C_r (beyond the paper, see [`Ctx::reverse`](super::distill)): no step
+    /// that plays the source's motion backwards. `false` is the "w/o C_r" ablation.
+    pub use_cr: bool,
+    /// Let C_r through in shots whose motion is judged undirected ([`MotionInfo::directed`]: water,
+    /// fire, flicker), where playing backwards looks no different. Shots judged directed keep C_r.
+    pub allow_reverse: bool,
+    /// How many previous source frames a step may not go back to (C_r's replay test): a step
+    /// c → c − j, 1 ≤ j ≤ `reverse_window`, replays the source backwards.
+    pub reverse_window: usize,
+    /// Target length in frames (the start frame included); `None`: the source's frame count, or
+    /// with `stop_early`, until the early stop.
     pub length: Option<usize>,
+    /// The paper's early stop (§5.2.3): end the walk when S2 is empty. Off (the default), the walk
+    /// goes on as an editor would: a cut to the shot that best matches the current frame, or,
+    /// when no other shot has frames left, a loop back to the path's best-matching frame.
+    pub stop_early: bool,
     /// Loop closure: end on a frame that can transition back to the start frame under the same
     /// constraints (beyond the paper; see [`sdpf`](super::sdpf) for the method).
     pub loop_close: bool,
@@ -46,6 +60,22 @@ impl SdpfParams {
     pub fn paper_choice(self) -> SdpfParams {
         SdpfParams { temperature: 1.0, relative_temperature: false, content_weight: 0.0, ..self }
     }
+
+    /// Algorithm 1's walk as the paper describes it: no reverse distillation C_r, the early stop
+    /// when S2 is empty and, without a target length, no other end (the choice stays ours; add
+    /// [`SdpfParams::paper_choice`] for Eq. 20 as printed).
+    pub fn paper_walk() -> SdpfParams {
+        SdpfParams { use_cr: false, stop_early: true, ..SdpfParams::default() }
+    }
+
+    /// The target length for a source of `n` frames: `length`, else `n` (unbounded with `stop_early`).
+    pub fn target_length(&self, n: usize) -> usize {
+        match self.length {
+            Some(l) => l,
+            None if self.stop_early => usize::MAX,
+            None => n,
+        }
+    }
 }
 
 impl Default for SdpfParams {
@@ -54,7 +84,11 @@ impl Default for SdpfParams {
             xi: std::f32::consts::FRAC_PI_3,
             use_cd: true,
             use_ct: true,
+            use_cr: true,
+            allow_reverse: false,
+            reverse_window: 3,
             length: None,
+            stop_early: false,
             loop_close: false,
             allow_cuts: false,
             seed: 0,
@@ -75,6 +109,11 @@ impl SdpfParams {
         if !(self.temperature.is_finite() && self.temperature > 0.0) {
             return Err(VideoError::Invalid(format!("SDPF: temperature must be > 0, got {}", self.temperature)));
         }
+        if self.length == Some(0) {
+            return Err(VideoError::Invalid(
+                "SDPF: a target length of 0 frames asks for nothing; give at least 1 (the start frame), or none for the source's length".into(),
+            ));
+        }
         Ok(())
     }
 }
@@ -90,6 +129,10 @@ pub struct MotionInfo {
     /// Shot (scene) index of each frame: scene cuts split shots (see
     /// [`detect_shots`](super::detect_shots)); empty or all equal for one shot.
     pub shot: Vec<usize>,
+    /// Per shot (indexed by shot, not frame): whether its motion is directed (people, vehicles,
+    /// camera moves), so that playing it backwards shows; see
+    /// [`judge_directed`](super::judge_directed). Empty, or a shot past its end: directed.
+    pub directed: Vec<bool>,
 }
 
 impl MotionInfo {
@@ -101,7 +144,7 @@ impl MotionInfo {
     /// Tendencies and LMS flags with the shots that the cut flags of
     /// [`detect_cuts`](super::detect_cuts) delimit (`cuts[i]`: a cut between frames `i − 1` and `i`).
     pub fn with_cuts(tendency: Vec<Option<f32>>, lms: Vec<bool>, cuts: &[bool]) -> MotionInfo {
-        MotionInfo { tendency, lms, shot: super::cuts::shots_from_cuts(cuts) }
+        MotionInfo { tendency, lms, shot: super::cuts::shots_from_cuts(cuts), directed: Vec::new() }
     }
 
     /// Checks that every non-empty vector has one entry per frame.
@@ -127,6 +170,16 @@ impl MotionInfo {
     /// The shot of frame `i` (0 when no shots are given).
     pub fn shot_of(&self, i: usize) -> usize {
         self.shot.get(i).copied().unwrap_or(0)
+    }
+
+    /// Whether the shot of frame `i` is judged directed (true when unknown).
+    pub fn directed_at(&self, i: usize) -> bool {
+        self.directed.get(self.shot_of(i)).copied().unwrap_or(true)
+    }
+
+    /// The number of shots (1 when no shots are given).
+    pub fn shots(&self) -> usize {
+        self.shot.iter().max().map_or(1, |m| m + 1)
     }
 }
 
@@ -230,12 +283,41 @@ pub struct Transition {
     pub candidates: Vec<Candidate>,
     /// Frames under η that lie in another shot (beyond the paper; empty with `allow_cuts`).
     pub removed_cut: Vec<usize>,
+    /// C_r (beyond the paper): the S1 frames a step to which would play the motion backwards.
+    pub cr: CrState,
+    pub removed_cr: Vec<usize>,
     pub cd: CdState,
     pub removed_cd: Vec<usize>,
     pub omega: Omega,
     pub removed_ct: Vec<usize>,
     /// S2 with the probabilities of Eq. 20.
     pub probs: Vec<(usize, f32)>,
+    /// How the step was taken: drawn from S2, or, S2 being empty, a cut or a loop back.
+    pub kind: StepKind,
+}
+
+/// What C_r did at one step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CrState {
+    /// `use_cr` is off (ablation).
+    Disabled,
+    /// The shot is judged undirected and `allow_reverse` is on: reverse steps allowed.
+    AllowedUndirected,
+    /// Applied.
+    Active,
+}
+
+/// How a step was taken.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepKind {
+    /// Drawn from S2 by Eq. 20 (Algorithm 1, line 22).
+    Distilled,
+    /// S2 was empty: a cut to the unvisited frame of another shot closest in content (beyond the
+    /// paper; what an editor does at a dead end). `edge` is its edge weight e_ck.
+    Cut { edge: f32 },
+    /// S2 was empty and no other shot had frames left: back to the frame at position `to` of the
+    /// path, closest in content among those C_r allows; from there the path's frames repeat (a loop).
+    LoopBack { to: usize, edge: f32 },
 }
 
 impl Transition {
@@ -261,6 +343,8 @@ pub enum StopReason {
     AllVisited,
     /// The path was cut where its last frame can transition back to the start (loop closure).
     LoopClosed,
+    /// S2 was empty, no other shot had frames left and no loop back was possible.
+    DeadEnd,
 }
 
 /// The plan's name for [`SdpfPath`].
@@ -269,9 +353,11 @@ pub type Path = SdpfPath;
 /// A path found by SDPF: the new frame order and how each step was taken.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SdpfPath {
-    /// Source frame indices in the new order, starting with the start frame; no repeats.
+    /// Source frame indices in the new order, starting with the start frame. No repeats, except
+    /// after a loop back ([`StepKind::LoopBack`]), from which the loop's frames repeat.
     pub frames: Vec<usize>,
-    /// One entry per step (`frames.len() − 1`), plus the failed step of an early stop.
+    /// One entry per step up to and including a loop back (then the loop repeats without new
+    /// steps), plus the failed step of an early stop.
     pub transitions: Vec<Transition>,
     pub stop: StopReason,
     /// Whether the last frame can transition back to the start (loop closure succeeded); the same
@@ -300,5 +386,24 @@ impl SdpfPath {
     /// Whether the last frame transitions back to the start (loop closure succeeded).
     pub fn closed(&self) -> bool {
         self.closes_loop
+    }
+
+    /// Positions `i` (in `frames`) entered by a cut (frames[i − 1] → frames[i]).
+    pub fn cut_positions(&self) -> Vec<usize> {
+        self.kind_positions(|k| matches!(k, StepKind::Cut { .. }))
+    }
+
+    /// Positions `i` entered by a loop back.
+    pub fn loop_positions(&self) -> Vec<usize> {
+        self.kind_positions(|k| matches!(k, StepKind::LoopBack { .. }))
+    }
+
+    fn kind_positions(&self, want: impl Fn(&StepKind) -> bool) -> Vec<usize> {
+        self.transitions
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.chosen.is_some() && want(&t.kind))
+            .map(|(i, _)| i + 1)
+            .collect()
     }
 }
