@@ -305,6 +305,7 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
     };
     // What the request alone decides, before decoding anything.
     limits.check_request(a.length, 0, a.count).map_err(with_flag)?;
+    Cancel::with_optional_limit_s(a.time_limit).map_err(|e| anyhow::anyhow!("--time-limit: {e}"))?;
     let clip = read_input(&a, &limits)?;
     anyhow::ensure!(
         a.start < clip.len(),

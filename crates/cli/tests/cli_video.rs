@@ -112,7 +112,7 @@ fn bad_inputs_name_the_problem() {
         &inbetween(&["video", "resequence", s(&clip), "--limit-resolution", "wide", "-o", s(&o)]),
         "WIDTHxHEIGHT",
     );
-    fails_with(&inbetween(&["video", "resequence", s(&clip), "--time-limit", "-1", "-o", s(&o)]), "--time-limit");
+    fails_with(&inbetween(&["video", "resequence", s(&clip), "--time-limit=-1", "-o", s(&o)]), "--time-limit");
     // A time limit too short for the work: a clear error and no output at all (no clip, no sheet).
     let cache = d.join("cache-limit");
     fails_with(
