@@ -11,6 +11,7 @@
 //! - [`report`]: the tables (the paper's figures beside ours), the chart and the report folder.
 
 pub mod acl;
+pub mod acl_race;
 pub mod measure;
 pub mod report;
 pub mod run;
@@ -19,7 +20,7 @@ pub use crate::corpus::Clip;
 pub use report::BenchResults;
 pub use run::{run, BenchConfig, BenchOutput, PolicyChoice};
 
-use crate::error::{Objective, SegmentModel};
+use crate::metrics::{ErrorMeasure, SegmentModel};
 use crate::representation::{JointFilter, SphericalMotion};
 use crate::select;
 use crate::{MocapError, Result};
@@ -193,8 +194,8 @@ pub fn select_keys(
     match method {
         Method::Rc => select::random(n, k, &mut ChaCha8Rng::seed_from_u64(seed)),
         Method::Uc => select::uniform(n, k),
-        Method::Greedy => select::greedy(rep, k, Objective::Angle),
-        Method::Optimal => select::optimal_spherical(rep, k, Objective::Angle),
+        Method::Greedy => select::greedy(rep, k, ErrorMeasure::Angle),
+        Method::Optimal => select::optimal_spherical(rep, k, ErrorMeasure::Angle),
         Method::Sidql => match policy {
             Some(p) => p(rep, k),
             None => Err(MocapError::Invalid("SIDQL needs a trained model".into())),

@@ -4,7 +4,7 @@
 
 use crate::codec::{self, Budget};
 use crate::dqn::SidqlPolicy;
-use crate::error::{Objective, SegmentModel, SegmentTable};
+use crate::metrics::{ErrorMeasure, SegmentModel, SegmentTable};
 use crate::representation::{JointFilter, SphericalMotion};
 use crate::rotations::RotationMotion;
 use crate::{MocapError, Result};
@@ -57,7 +57,7 @@ pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>> {
     progress.inc(1);
     // The rotation model is the one the codec uses; say how it compares to the spherical one.
     let rm = RotationMotion::from_motion(&paper)?;
-    let k10 = crate::select::optimal(&table, 10, Objective::Angle)?;
+    let k10 = crate::select::optimal(&table, 10, ErrorMeasure::Angle)?;
     lines.push(format!(
         "  K=10 on {} joints: rotation reconstruction mean {:.2} cm vs spherical {:.2} cm",
         rep.num_joints,
@@ -77,7 +77,7 @@ pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>> {
 
 /// One line: the optimal, uniform and SIDQL keys for `k` and their errors.
 fn compare_selectors(rep: &SphericalMotion, table: &SegmentTable, sidql: &SidqlPolicy, k: usize) -> Result<String> {
-    let opt = crate::select::optimal(table, k, Objective::Angle)?;
+    let opt = crate::select::optimal(table, k, ErrorMeasure::Angle)?;
     let uc = crate::select::uniform(rep.num_frames, k)?;
     let sq = sidql.select(rep, k)?;
     let (eo, eu, es) = (rep.error(&opt), rep.error(&uc), rep.error(&sq));

@@ -3,7 +3,7 @@
 //! velocity at both keys) and every translation with a cubic Hermite (the root's path, Eq. 12–13).
 //! In-betweens again depend only on the two keys around them, so the same selectors apply.
 
-use crate::error::{Scratch, SegmentCost, SegmentModel};
+use crate::metrics::{Scratch, SegmentCost, SegmentModel};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::interp::{angular_velocity, hermite_quat, hermite_vec3};

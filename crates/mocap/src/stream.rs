@@ -20,7 +20,7 @@
 //! carries its frame index, so [`Received::start_frame`] says where its frames belong in the clip.
 
 use crate::codec::{quantised_model, read_scaled_key, read_skeleton, write_scaled_key, write_skeleton, Reader};
-use crate::error::SegmentModel;
+use crate::metrics::SegmentModel;
 use crate::rotations::{interpolate_pose_into, KeyPose, RotationMotion};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
@@ -58,7 +58,7 @@ pub fn online_keys(model: &dyn SegmentModel, max_cm: f64, lookahead: usize) -> V
         if newest <= a {
             continue;
         }
-        let fits = |b: usize, s: &mut crate::error::Scratch| model.segment_cost_within(a, b, max_cm, s).is_some();
+        let fits = |b: usize, s: &mut crate::metrics::Scratch| model.segment_cost_within(a, b, max_cm, s).is_some();
         if newest - a < lookahead && fits(newest, &mut scratch) {
             continue;
         }
@@ -439,6 +439,30 @@ pub fn recv(listener: &TcpListener, opts: &RecvOptions) -> Result<Received> {
     })
 }
 
+impl Received {
+    /// Frames of the sender's clip that did not arrive: those before the first key (a receiver
+    /// that joined late) are not counted, those after the last frame rebuilt are.
+    pub fn frames_lost(&self) -> usize {
+        self.clip_frames.saturating_sub(self.start_frame + self.motion.num_frames())
+    }
+
+    /// An error saying what was lost and why when the sender's End never arrived.
+    pub fn check_complete(&self) -> Result<()> {
+        if self.complete {
+            return Ok(());
+        }
+        Err(MocapError::Stream(format!(
+            "the stream ended without the sender's End: {} of the clip's {} frames were rebuilt (frames {}..{}), {} lost after them; {}",
+            self.motion.num_frames(),
+            self.clip_frames,
+            self.start_frame,
+            self.start_frame + self.motion.num_frames(),
+            self.frames_lost(),
+            if self.warnings.is_empty() { "no reason given".to_string() } else { self.warnings.join("; ") }
+        )))
+    }
+}
+
 /// Position error of received frames against the sender's clip, at the right offset.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StreamError {
@@ -579,6 +603,44 @@ mod tests {
         assert!(got.complete && got.sessions == 2, "{:?}", got.warnings);
         assert!(!got.warnings.is_empty());
         assert_eq!(got.motion.num_frames(), 90);
+    }
+
+    /// A sender that says hello, sends two keys and is cut off inside the third (or sends
+    /// garbage after hello): the receiver keeps the frames it rebuilt and says what it lost.
+    #[test]
+    fn a_sender_cut_mid_message_leaves_an_incomplete_stream_that_says_what_was_lost() {
+        let m = walk();
+        let model = RotationMotion::from_motion(&m).unwrap();
+        for garbage in [false, true] {
+            let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+            let addr = listener.local_addr().unwrap().to_string();
+            let opts = RecvOptions { max_sessions: 3, accept_timeout: Duration::from_millis(500) };
+            let rx = std::thread::spawn(move || recv(&listener, &opts));
+            {
+                let mut c = TcpStream::connect(&addr).unwrap();
+                c.write_all(&frame_message(HELLO, &hello_payload(&model.skeleton, model.frame_time, 90))).unwrap();
+                if garbage {
+                    c.write_all(&[0x5a; 64]).unwrap();
+                } else {
+                    for f in [0, 10] {
+                        c.write_all(&frame_message(KEY, &key_payload(&model.skeleton, f, &model.frames[f]))).unwrap();
+                    }
+                    let key = frame_message(KEY, &key_payload(&model.skeleton, 20, &model.frames[20]));
+                    c.write_all(&key[..key.len() / 2]).unwrap();
+                }
+            }
+            let got = rx.join().unwrap().unwrap();
+            assert!(!got.complete);
+            let e = got.check_complete().unwrap_err().to_string();
+            if garbage {
+                assert_eq!(got.motion.num_frames(), 0);
+                assert!(e.contains("0 of the clip's 90 frames") && e.contains("90 lost"), "{e}");
+            } else {
+                assert_eq!(got.motion.num_frames(), 11, "frames 0..=10 rebuilt");
+                assert_eq!(got.frames_lost(), 79);
+                assert!(e.contains("11 of the clip's 90 frames") && e.contains("inside a"), "{e}");
+            }
+        }
     }
 
     /// A receiver dies after a few keys and a new one takes its place: the sender reconnects, the

@@ -38,7 +38,7 @@ fn every_cmu_take_filters_to_the_major_joints_and_optimal_never_loses() {
 fn fast_optimum_equals_the_full_table_programme_on_every_cmu_window() {
     use inbetween_mocap::select::optimal;
     use inbetween_mocap::select::optimal::optimal_spherical_with_total;
-    use inbetween_mocap::{Objective, SegmentTable};
+    use inbetween_mocap::{ErrorMeasure, SegmentTable};
     with_shared_data("mocap fast-optimum real-data test", |dir| {
         let corpus = inbetween_mocap::corpus::load(&dir, None).unwrap();
         let mut windows = 0;
@@ -46,8 +46,8 @@ fn fast_optimum_equals_the_full_table_programme_on_every_cmu_window() {
             for w in clip_windows(clip, &Protocol::paper()).unwrap() {
                 let table = SegmentTable::full_serial(&w.rep);
                 for k in [5, 10, 15] {
-                    let want = optimal(&table, k, Objective::Angle).unwrap();
-                    let (got, total) = optimal_spherical_with_total(&w.rep, k, Objective::Angle).unwrap();
+                    let want = optimal(&table, k, ErrorMeasure::Angle).unwrap();
+                    let (got, total) = optimal_spherical_with_total(&w.rep, k, ErrorMeasure::Angle).unwrap();
                     assert_eq!(got, want, "{} window at {}, K={k}", w.clip, w.start);
                     assert_eq!(total.to_bits(), table.total(&want).unwrap().angle_sum.to_bits(), "{} K={k}", w.clip);
                 }

@@ -6,8 +6,8 @@
 //! on the BVH text and on the raw floats, and the rate–error curve as a PNG.
 
 use super::Clip;
-use crate::codec::alloc::{self, Options};
-use crate::codec::v3;
+use crate::codec::alloc::{self, Format, Options};
+use crate::codec::{v3, v4};
 use crate::{MocapError, Result};
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::Motion;
@@ -42,6 +42,10 @@ pub struct AclConfig {
     /// Random poses timed per clip for the seek benchmark.
     pub seek_poses: usize,
     pub seed: u64,
+    /// Bounds (cm) of the race against the real ACL on the CMU takes (empty: no race).
+    pub race_bounds: Vec<f64>,
+    /// Where ACL is built for the race (None: `$CARGO_TARGET_DIR/acl-race` or `target/acl-race`).
+    pub acl_build_dir: Option<PathBuf>,
 }
 
 impl Default for AclConfig {
@@ -55,6 +59,8 @@ impl Default for AclConfig {
             segment_len: v3::DEFAULT_SEGMENT_LEN,
             seek_poses: 2000,
             seed: 0,
+            race_bounds: vec![0.01, 0.05],
+            acl_build_dir: None,
         }
     }
 }
@@ -142,6 +148,10 @@ pub struct AclResults {
     pub rows: Vec<CodecRow>,
     pub baselines: Vec<BaselineRow>,
     pub unit_notes: Vec<String>,
+    /// The race against the real ACL: its group, rows and whether/where ACL was built.
+    pub race_group: String,
+    pub race: Vec<super::acl_race::RaceRow>,
+    pub race_note: String,
 }
 
 /// The groups of takes: the CMU skeletons (cgspeed, ASF/AMC, or a plain folder) and the
@@ -222,6 +232,72 @@ fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<Tak
     })
 }
 
+/// One take compressed in `format` at `bound_cm` (the format's default segment length), with
+/// its timings on this thread: what the race against ACL ([`super::acl_race`]) runs.
+pub struct FormatResult {
+    pub bytes: usize,
+    pub errors: Vec<f64>,
+    pub compress_s: f64,
+    /// Seconds per pose at a random time and per playback pose (best of 5 rounds).
+    pub pose_s: f64,
+    pub playback_s: f64,
+}
+
+/// Best of `rounds` timings of `f`, seconds.
+fn best_of(rounds: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    (0..rounds)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+pub fn run_format(t: &Take, bound_cm: f64, format: Format, seek_poses: usize, seed: u64) -> Result<FormatResult> {
+    let opts = Options::with_format(bound_cm, format);
+    let start = Instant::now();
+    let c = alloc::compress_in(&t.motion, t.unit.clone(), &opts)?;
+    let compress_s = start.elapsed().as_secs_f64();
+    let mut rng =
+        rand_chacha::ChaCha8Rng::seed_from_u64(inbetween_core::seed::derive(seed, t.motion.num_frames() as u64));
+    let duration = (t.motion.num_frames() - 1) as f64 * t.motion.frame_time;
+    let times: Vec<f64> = (0..seek_poses.max(1)).map(|_| rng.random::<f64>() * duration).collect();
+    let ticks: Vec<f64> = (0..).map(|k| k as f64 / 60.0).take_while(|&t| t <= duration).collect();
+    let (pose_s, playback_s) = match format {
+        Format::V3 => {
+            let file = v3::File::open(&c.bytes)?;
+            let (mut pose, mut sc) = (inbetween_core::Pose::rest(&t.motion.skeleton), v3::Scratch::default());
+            let mut timed = |ts: &[f64]| {
+                best_of(5, || {
+                    for &time in ts {
+                        file.pose_at(time, &mut pose, &mut sc).expect("a valid file seeks");
+                    }
+                    std::hint::black_box(&pose);
+                }) / ts.len() as f64
+            };
+            (timed(&times), timed(&ticks))
+        }
+        Format::V4 => {
+            let clip = v4::Clip::open(&c.bytes).map_err(|e| MocapError::Codec(e.to_string()))?;
+            let mut ctx = v4::Context::new(&clip);
+            let n = clip.num_joints();
+            let (mut rot, mut tr) = (vec![[0f32; 4]; n], vec![[0f32; 3]; n]);
+            let mut timed = |ts: &[f64]| {
+                best_of(5, || {
+                    for &time in ts {
+                        clip.sample(&mut ctx, time, &mut rot, &mut tr).expect("buffers fit");
+                    }
+                    std::hint::black_box((&rot, &tr));
+                }) / ts.len() as f64
+            };
+            (timed(&times), timed(&ticks))
+        }
+    };
+    Ok(FormatResult { bytes: c.bytes.len(), errors: c.errors_cm, compress_s, pose_s, playback_s })
+}
+
 /// Runs the protocol: every group at every bound (timings single-threaded, so MB/s is per core).
 pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
     let dir = super::run::data_dir(cfg.data.as_deref())?;
@@ -280,7 +356,35 @@ pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
         }
     }
     let baselines = baselines(&takes)?;
-    Ok(AclResults { fps: cfg.fps, headline_cm: cfg.headline_cm, rows, baselines, unit_notes: corpus.unit_notes() })
+    let (race_group, race, race_note) = match groups(&takes).into_iter().next() {
+        Some((group, members)) if !cfg.race_bounds.is_empty() => {
+            let out = cfg.acl_build_dir.clone().unwrap_or_else(super::acl_race::default_build_dir);
+            progress.set_message("building ACL for the race".to_string());
+            let built = super::acl_race::build_acl(super::acl_race::acl_sources(&dir).as_deref(), &out);
+            let note = match &built {
+                Ok(p) => {
+                    format!("ACL v2.1.0 built from ../shared/peers/acl-race into {} (g++ -O3 -msse4.1)", p.display())
+                }
+                Err(why) => format!("skipped: ACL not built ({why}); our rows only"),
+            };
+            progress.set_message(format!("race on {group}"));
+            let rows = pool.install(|| {
+                super::acl_race::race(&members, &cfg.race_bounds, built.as_deref().ok(), cfg.seek_poses, cfg.seed)
+            })?;
+            (group, rows, note)
+        }
+        _ => (String::new(), Vec::new(), String::new()),
+    };
+    Ok(AclResults {
+        fps: cfg.fps,
+        headline_cm: cfg.headline_cm,
+        rows,
+        baselines,
+        unit_notes: corpus.unit_notes(),
+        race_group,
+        race,
+        race_note,
+    })
 }
 
 /// The raw 40-byte buffer of a take: per sample, per bone, quaternion xyzw, translation, scale.
@@ -460,6 +564,9 @@ impl AclResults {
     /// The report: both tables and the unit notes.
     pub fn report(&self) -> Report {
         let mut r = Report::new("acl_codec", "The codec on ACL's protocol (CMU takes at 24 fps)");
+        if !self.race.is_empty() {
+            r.table(super::acl_race::table(&self.race_group, &self.race, &self.race_note));
+        }
         r.table(self.codec_table());
         r.table(self.baseline_table());
         r.text(format!("units: {}", self.unit_notes.join("; ")));
@@ -520,8 +627,24 @@ mod tests {
             written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
         assert_eq!(
             names,
-            ["acl_codec.txt", "acl_codec.md", "acl_codec.csv", "acl_baselines.csv", "acl_rate_error.png"]
+            [
+                "acl_codec.txt",
+                "acl_codec.md",
+                "acl_race.csv",
+                "acl_codec.csv",
+                "acl_baselines.csv",
+                "acl_rate_error.png"
+            ]
         );
+        // The race: without ACL's sources beside this folder, our rows only (versions 3 and 4 at
+        // each race bound), and the report says why.
+        assert!(r.race_note.starts_with("skipped: ACL not built"), "{}", r.race_note);
+        assert_eq!(r.race.len(), 2 * cfg.race_bounds.len());
+        for row in &r.race {
+            assert!(row.max_cm <= row.bound_cm && row.ratio() > 5.0, "{row:?}");
+            assert!(row.pose_us > 0.0 && row.playback_us > 0.0, "{row:?}");
+        }
+        assert!(report.to_text().contains("skipped: ACL not built"));
         let text = report.to_text();
         assert!(text.contains("ACL 2.1, published") && text.contains("21.77"), "{text}");
         let csv = std::fs::read_to_string(out.join("acl_codec.csv")).unwrap();

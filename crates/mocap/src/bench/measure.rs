@@ -5,7 +5,7 @@
 
 use super::{Clip, Window};
 use crate::codec::{self, Budget};
-use crate::error::{Objective, SegmentModel};
+use crate::metrics::{ErrorMeasure, SegmentModel};
 use crate::representation::SphericalMotion;
 use crate::rotations::RotationMotion;
 use crate::Result;
@@ -23,7 +23,7 @@ use std::time::Instant;
 /// interpolated by the same cubic with the same velocities, its error |φ̂ − φ| with no wrap, and
 /// the sum divided by frames × joints (our Eq. 24 divides by frames × joints × 2, one term each
 /// for θ and φ, and takes φ unwrapped over time with wrapped differences; see
-/// [`crate::error`]). A bone whose azimuth crosses ±π between two keys is interpolated the long
+/// [`crate::metrics`]). A bone whose azimuth crosses ±π between two keys is interpolated the long
 /// way round, which is what inflates this figure.
 pub fn paper_units_error(rep: &SphericalMotion, keys: &KeyframeSet) -> f64 {
     let n = rep.num_frames;
@@ -107,7 +107,7 @@ pub fn both_reconstructions(windows: &[Window], ks: &[usize], progress: &Progres
         let mut rm = RotationMotion::from_motion(&w.motion)?;
         rm.cm_per_unit = w.rep.cm_per_unit;
         for row in out.iter_mut() {
-            let keys = crate::select::optimal_spherical(&w.rep, row.k, Objective::Angle)?;
+            let keys = crate::select::optimal_spherical(&w.rep, row.k, ErrorMeasure::Angle)?;
             let (es, er) = (w.rep.error(&keys), rm.error(&keys));
             row.spherical_mean_cm += es.mean_cm;
             row.rotation_mean_cm += er.mean_cm;

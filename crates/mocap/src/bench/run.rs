@@ -128,58 +128,7 @@ pub fn data_dir(data: Option<&Path>) -> Result<PathBuf> {
     }
 }
 
-/// Which windows SIDQL trains on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TrainingData {
-    /// 24 procedural gaits (our own data).
-    Procedural,
-    /// The CMU training split of the bench protocol (its test split held out).
-    CmuSplit,
-    /// Every CMU take of the corpus (the committed policy; the bench's k-fold is its held-out score).
-    CmuAll,
-}
-
-/// SIDQL's training windows and their description in words (written in the policy's card).
-pub fn training_set(
-    data_choice: TrainingData,
-    data: Option<&Path>,
-    unit: Option<LengthUnit>,
-    seed: u64,
-    stride: usize,
-) -> Result<(Vec<SphericalMotion>, String)> {
-    let protocol = Protocol { seed, ..Protocol::paper() };
-    if data_choice == TrainingData::Procedural {
-        let clips = super::procedural_clips(seed, 24);
-        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-        let p = Protocol { skip_first_frame: false, ..protocol };
-        let windows = super::training_windows(&clips, &names, &p, stride)?;
-        let data = format!(
-            "{} procedural gaits (seed {seed}), {} windows of 60 frames at stride {stride}",
-            clips.len(),
-            windows.len()
-        );
-        return Ok((windows, data));
-    }
-    let dir = data_dir(data)?;
-    let clips = crate::corpus::load(&dir, unit)?.clips;
-    let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-    if data_choice == TrainingData::CmuAll {
-        let windows = super::training_windows(&clips, &names, &protocol, stride)?;
-        let data = format!(
-            "every CMU take of the corpus ({} takes), {} windows of 60 frames at stride {stride}",
-            clips.len(),
-            windows.len()
-        );
-        return Ok((windows, data));
-    }
-    let (train, test) = super::split_clips(&names, &protocol);
-    let windows = super::training_windows(&clips, &train, &protocol, stride)?;
-    let data = format!(
-        "CMU training split (seed {seed}) {train:?}, {} windows of 60 frames at stride {stride}; test split {test:?} held out",
-        windows.len()
-    );
-    Ok((windows, data))
-}
+pub use crate::corpus::{training_set, TrainingData};
 
 /// Deals the takes that have windows into `folds` groups: sorted, shuffled with `seed`, dealt in
 /// turn.

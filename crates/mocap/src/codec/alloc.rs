@@ -17,6 +17,7 @@
 //! Every check quantises exactly as the decoder dequantises, so the bound holds for the file.
 
 use super::v3::{self, step, Header, Quantised, Track, TrackKind, MAX_Q, STEP_BIAS};
+use super::v4;
 use crate::{MocapError, Result};
 use glam::{DMat3, DQuat, DVec3};
 use inbetween_core::rotation::{quat_to_rotvec, rotvec_to_quat};
@@ -35,12 +36,46 @@ pub struct Options {
     /// Distance of the virtual vertices from each joint, cm.
     pub shell_cm: f64,
     pub segment_len: usize,
+    /// The file version written (and whose decoded values the search checks).
+    pub format: Format,
+}
+
+/// Which sampled version [`compress_in`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Version 3: f64 values, Rice-coded prediction residuals (smallest files).
+    V3,
+    /// Version 4: f32 values at fixed widths per segment (fast sampling, [`v4`]).
+    V4,
+}
+
+impl Format {
+    /// The version number it writes.
+    pub fn version(self) -> u16 {
+        match self {
+            Format::V3 => v3::VERSION,
+            Format::V4 => v4::VERSION,
+        }
+    }
+
+    /// Frames per segment written by default.
+    pub fn default_segment_len(self) -> usize {
+        match self {
+            Format::V3 => v3::DEFAULT_SEGMENT_LEN,
+            Format::V4 => v4::DEFAULT_SEGMENT_LEN,
+        }
+    }
 }
 
 impl Options {
-    /// ACL's protocol at `bound_cm`: vertices 3 cm away, 32-frame segments.
+    /// ACL's protocol at `bound_cm`: vertices 3 cm away, version 3 with 32-frame segments.
     pub fn bound(bound_cm: f64) -> Options {
-        Options { bound_cm, shell_cm: SHELL_CM, segment_len: v3::DEFAULT_SEGMENT_LEN }
+        Options { bound_cm, shell_cm: SHELL_CM, segment_len: v3::DEFAULT_SEGMENT_LEN, format: Format::V3 }
+    }
+
+    /// ACL's protocol at `bound_cm` in `format`, with its default segment length.
+    pub fn with_format(bound_cm: f64, format: Format) -> Options {
+        Options { segment_len: format.default_segment_len(), format, ..Options::bound(bound_cm) }
     }
 }
 
@@ -83,7 +118,7 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, opts: &Options) -> Result<
     if motion.num_frames() == 0 {
         return Err(MocapError::Invalid("a clip of 0 frames has nothing to compress".into()));
     }
-    let ctx = Context::new(motion, opts.shell_cm / cm, opts.bound_cm / cm);
+    let ctx = Context::new(motion, opts.shell_cm / cm, opts.bound_cm / cm, opts.format);
     let n = motion.num_frames();
     let nt = ctx.tracks.len();
     let segments = n.div_ceil(opts.segment_len);
@@ -101,10 +136,21 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, opts: &Options) -> Result<
         codes.extend(c.codes);
     }
     let quantised = Quantised { header: ctx.header(motion, opts.segment_len, cm, opts.bound_cm), codes, q };
-    let bytes = v3::encode(&quantised);
     // Measure the file, not the encoder's state.
-    let decoded = v3::decode(&bytes)?;
-    let mut errors = ctx.errors(&decoded);
+    let (bytes, decoded, mut errors) = match opts.format {
+        Format::V3 => {
+            let bytes = v3::encode(&quantised);
+            let decoded = v3::decode(&bytes)?;
+            let errors = ctx.errors(|f| decoded.pose(f));
+            (bytes, decoded, errors)
+        }
+        Format::V4 => {
+            let bytes = v4::encode(&quantised);
+            let d = v4::decode(&bytes)?;
+            let errors = ctx.errors(|f| d.poses[f].clone());
+            (bytes, quantised, errors)
+        }
+    };
     for e in &mut errors {
         *e *= cm;
     }
@@ -131,7 +177,7 @@ pub fn percentile(v: &mut [f64], p: f64) -> f64 {
 /// Virtual-vertex errors (file units) of `decoded` against `source`, one per joint and frame:
 /// the largest of each joint's three vertices `shell_cm` away (ACL's metric).
 pub fn vertex_errors(source: &Motion, decoded: &Motion, cm_per_unit: f64, shell_cm: f64) -> Vec<f64> {
-    let ctx = Context::new(source, shell_cm / cm_per_unit, f64::INFINITY);
+    let ctx = Context::new(source, shell_cm / cm_per_unit, f64::INFINITY, Format::V3);
     let nj = source.skeleton.len();
     let mut out = Vec::with_capacity(source.num_frames() * nj);
     for f in 0..source.num_frames().min(decoded.num_frames()) {
@@ -161,6 +207,7 @@ struct Context {
     start_codes: Vec<u8>,
     shell: f64,
     bound: f64,
+    format: Format,
     /// What the search compares squared errors with: the bound less a little, squared.
     bound_sq: f64,
 }
@@ -172,7 +219,7 @@ struct SegmentChoice {
 }
 
 impl Context {
-    fn new(motion: &Motion, shell: f64, bound: f64) -> Context {
+    fn new(motion: &Motion, shell: f64, bound: f64, format: Format) -> Context {
         let sk = &motion.skeleton;
         let (n, nj) = (motion.num_frames(), sk.len());
         let tracks = v3::tracks(sk);
@@ -224,6 +271,7 @@ impl Context {
             start_codes: Vec::new(),
             shell,
             bound,
+            format,
             bound_sq: (bound * (1.0 - 1e-9)).powi(2),
         };
         ctx.start_codes = ctx.safe_codes();
@@ -308,13 +356,14 @@ impl Context {
         }
     }
 
-    /// Errors of every joint of every frame of a decoded clip.
-    fn errors(&self, qz: &Quantised) -> Vec<f64> {
+    /// Errors of every joint of every frame of a decoded clip (`pose(f)`: its frame `f`).
+    fn errors(&self, pose: impl Fn(usize) -> inbetween_core::Pose) -> Vec<f64> {
         let nj = self.skeleton.len();
-        let mut out = Vec::with_capacity(qz.header.num_frames * nj);
+        let n = self.raw.len() / nj.max(1);
+        let mut out = Vec::with_capacity(n * nj);
         let (mut pos, mut rot) = (vec![DVec3::ZERO; nj], vec![DQuat::IDENTITY; nj]);
-        for f in 0..qz.header.num_frames {
-            let p = qz.pose(f);
+        for f in 0..n {
+            let p = pose(f);
             crate::rotations::forward_into(&self.skeleton, &p.rotations, &p.translations, &mut pos, &mut rot);
             out.extend((0..nj).map(|j| self.vertex_error(f, j, pos[j], rot[j])));
         }
@@ -411,7 +460,15 @@ impl<'a> Segment<'a> {
             codes: ctx.start_codes.clone(),
             q: vec![[0; 3]; len * nt],
             lrot: vec![DQuat::IDENTITY; len * nj],
-            ltr: (0..len).flat_map(|_| ctx.skeleton.joints().iter().map(|j| j.offset)).collect(),
+            // Version 4 decodes rest offsets as f32.
+            ltr: (0..len)
+                .flat_map(|_| {
+                    ctx.skeleton.joints().iter().map(|j| match ctx.format {
+                        Format::V3 => j.offset,
+                        Format::V4 => j.offset.as_vec3().as_dvec3(),
+                    })
+                })
+                .collect(),
             orot: vec![DQuat::IDENTITY; len * nj],
             opos: vec![DVec3::ZERO; len * nj],
             hot: 0,
@@ -432,12 +489,34 @@ impl<'a> Segment<'a> {
             q.fill([0; 3]);
             return;
         }
-        let st = step(code);
+        let st = match self.ctx.format {
+            Format::V3 => step(code),
+            Format::V4 => v4::step(code) as f64,
+        };
         for i in 0..self.len {
             let x = self.ctx.values[(self.start + i) * nt + t];
             let qi = [x.x, x.y, x.z].map(|c| ((c / st).round() as i64).clamp(-MAX_Q, MAX_Q));
             q[i] = qi;
             v[i] = DVec3::new(qi[0] as f64 * st, qi[1] as f64 * st, qi[2] as f64 * st);
+        }
+        if self.ctx.format == Format::V4 {
+            // The runtime's f32 values: (q_min × scale) + (q − q_min) × scale per component.
+            let (mut comp, mut out) = (vec![0i64; self.len], vec![0f32; self.len]);
+            for c in 0..3 {
+                comp.iter_mut().zip(q.iter()).for_each(|(x, qi)| *x = qi[c]);
+                v4::dequantise(&comp, code, &mut out);
+                for (vi, &o) in v.iter_mut().zip(&out) {
+                    vi[c] = o as f64;
+                }
+            }
+        }
+    }
+
+    /// The local rotation the decoder gives for a decoded rotation vector.
+    fn rotation(&self, v: DVec3) -> DQuat {
+        match self.ctx.format {
+            Format::V3 => rotvec_to_quat(v),
+            Format::V4 => v4::rotation([v.x as f32, v.y as f32, v.z as f32]),
         }
     }
 
@@ -447,7 +526,7 @@ impl<'a> Segment<'a> {
         for i in 0..self.len {
             self.q[i * nt + t] = q[i];
             match tr.kind {
-                TrackKind::Rotation => self.lrot[i * nj + tr.joint] = rotvec_to_quat(v[i]),
+                TrackKind::Rotation => self.lrot[i * nj + tr.joint] = self.rotation(v[i]),
                 TrackKind::Translation => self.ltr[i * nj + tr.joint] = v[i],
             }
         }
@@ -536,7 +615,7 @@ impl<'a> Segment<'a> {
         let (mut pos, mut rot) = (vec![DVec3::ZERO; self.len * m], vec![DQuat::IDENTITY; self.len * m]);
         // The frame that failed last is checked first: most tries that fail, fail there.
         for i in (self.hot..self.len).chain(0..self.hot) {
-            let over = (tr.kind == TrackKind::Rotation).then(|| (tr.joint, rotvec_to_quat(v[i])));
+            let over = (tr.kind == TrackKind::Rotation).then(|| (tr.joint, self.rotation(v[i])));
             let (p, r) = (&mut pos[i * m..(i + 1) * m], &mut rot[i * m..(i + 1) * m]);
             if !self.fk_check(i, joints, over, p, r) {
                 for (i, x) in saved_tr.iter().enumerate() {
@@ -630,13 +709,13 @@ mod tests {
     #[test]
     fn the_safe_starting_steps_keep_the_bound_without_search() {
         for m in clips() {
-            let ctx = Context::new(&m, SHELL_CM / CM_PER_CMU_UNIT, 0.05 / CM_PER_CMU_UNIT);
+            let ctx = Context::new(&m, SHELL_CM / CM_PER_CMU_UNIT, 0.05 / CM_PER_CMU_UNIT, Format::V3);
             let (n, nt) = (m.num_frames(), ctx.tracks.len());
             let seg = Segment::new(&ctx, 0, n);
             let header = ctx.header(&m, n, CM_PER_CMU_UNIT, 0.05);
             let qz = Quantised { header, codes: ctx.start_codes.clone(), q: seg.q.clone() };
             assert_eq!(qz.codes.len(), nt);
-            let max = ctx.errors(&qz).into_iter().fold(0.0, f64::max) * CM_PER_CMU_UNIT;
+            let max = ctx.errors(|f| qz.pose(f)).into_iter().fold(0.0, f64::max) * CM_PER_CMU_UNIT;
             assert!(max <= 0.05, "{max}");
             // ... and are far from tight: the search has room to coarsen.
             assert!(max < 0.025, "{max}");

@@ -26,7 +26,9 @@
 
 pub mod alloc;
 mod bits;
+pub mod job;
 pub mod v3;
+pub mod v4;
 
 use crate::rotations::{reconstruct_from_keys, KeyPose, RotationMotion};
 use crate::{MocapError, Result};
@@ -499,11 +501,12 @@ pub(crate) fn check_envelope(bytes: &[u8], oldest: u16, newest: u16) -> Result<(
     Ok((version, body))
 }
 
-/// Any `.ibk` file: keys (versions 1 and 2) or samples (version 3).
+/// Any `.ibk` file: keys (versions 1 and 2) or samples (versions 3 and 4).
 #[derive(Clone, Debug)]
 pub enum IbkFile {
     Keys(Decoded),
     Samples(v3::Quantised),
+    Runtime(v4::Decoded),
 }
 
 impl IbkFile {
@@ -512,6 +515,7 @@ impl IbkFile {
         match self {
             IbkFile::Keys(d) => d.reconstruct(),
             IbkFile::Samples(q) => q.motion(),
+            IbkFile::Runtime(d) => d.motion(),
         }
     }
 
@@ -519,6 +523,7 @@ impl IbkFile {
         match self {
             IbkFile::Keys(d) => &d.skeleton,
             IbkFile::Samples(q) => &q.header.skeleton,
+            IbkFile::Runtime(d) => &d.header.skeleton,
         }
     }
 
@@ -526,6 +531,7 @@ impl IbkFile {
         match self {
             IbkFile::Keys(d) => d.num_frames,
             IbkFile::Samples(q) => q.header.num_frames,
+            IbkFile::Runtime(d) => d.header.num_frames,
         }
     }
 
@@ -537,14 +543,20 @@ impl IbkFile {
                 "version 3: {} frames in segments of {}, compressed to {} cm (virtual vertices 3 cm from each bone)",
                 q.header.num_frames, q.header.segment_len, q.header.bound_cm
             ),
+            IbkFile::Runtime(d) => format!(
+                "version 4: {} frames in segments of {} at fixed widths (runtime layout), compressed to {} cm (virtual vertices 3 cm from each bone)",
+                d.header.num_frames, d.header.segment_len, d.header.bound_cm
+            ),
         }
     }
 }
 
-/// Reads any `.ibk` file this build knows (versions 1 to 3).
+/// Reads any `.ibk` file this build knows (versions 1 to 4).
 pub fn read(bytes: &[u8]) -> Result<IbkFile> {
-    let (version, _) = check_envelope(bytes, OLDEST_VERSION, v3::VERSION)?;
-    if version == v3::VERSION {
+    let (version, _) = check_envelope(bytes, OLDEST_VERSION, v4::VERSION)?;
+    if version == v4::VERSION {
+        Ok(IbkFile::Runtime(v4::decode(bytes)?))
+    } else if version == v3::VERSION {
         Ok(IbkFile::Samples(v3::decode(bytes)?))
     } else {
         Ok(IbkFile::Keys(decode(bytes)?))
@@ -635,7 +647,7 @@ pub fn raw_bytes(motion: &Motion) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::error::SegmentModel;
+    use crate::metrics::SegmentModel;
     use inbetween_core::positions_clip;
     use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
     use rand::{Rng, SeedableRng};
@@ -887,7 +899,7 @@ pub fn compress(motion: &Motion, budget: Budget, max_gap: usize) -> Result<Compr
 /// should a frame still exceed it (rounding), the keys are chosen again with a tighter bound, and a
 /// bound below what the format stores (a key frame's own quantisation error) is an error.
 pub fn compress_in(motion: &Motion, unit: UnitChoice, budget: Budget, max_gap: usize) -> Result<Compressed> {
-    use crate::error::{Objective, SegmentTable};
+    use crate::metrics::{ErrorMeasure, SegmentTable};
     let exact = RotationMotion::from_motion_in(motion, unit.cm_per_unit())?;
     let model = quantised_model(&exact);
     let n = model.num_frames();
@@ -895,7 +907,7 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, budget: Budget, max_gap: u
         Budget::Keys(k) => {
             crate::select::check_k(n, k)?;
             let gap = max_gap.max((2 * (n - 1)).div_ceil(k - 1));
-            let keys = crate::select::optimal(&SegmentTable::banded(&model, gap), k, Objective::Position)?;
+            let keys = crate::select::optimal(&SegmentTable::banded(&model, gap), k, ErrorMeasure::Position)?;
             return finish(&exact, &model, keys, unit, None);
         }
         Budget::MaxErrorCm(cm) => cm,
@@ -906,7 +918,7 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, budget: Budget, max_gap: u
     let mut select_at = bound;
     for _ in 0..6 {
         let table = SegmentTable::bounded(&model, max_gap, select_at);
-        let keys = crate::select::error_bounded(&table, select_at, Objective::Position)?;
+        let keys = crate::select::error_bounded(&table, select_at, ErrorMeasure::Position)?;
         let c = finish(&exact, &model, keys, unit.clone(), Some(select_at))?;
         if c.decoded_max_cm <= bound {
             return Ok(c);
@@ -931,7 +943,7 @@ fn finish(
     unit: UnitChoice,
     selection_bound_cm: Option<f64>,
 ) -> Result<Compressed> {
-    use crate::error::SegmentModel;
+    use crate::metrics::SegmentModel;
     let bytes = encode(exact, &keys);
     let decoded = decode(&bytes)?.reconstruct()?;
     let nj = model.skeleton.len();
@@ -958,7 +970,8 @@ fn finish(
     })
 }
 
-/// Parses an error bound such as `1cm`, `0.5 cm`, `10mm` or `0.01m` (a bare number is cm).
+/// Parses an error bound such as `1cm`, `0.5 cm`, `10mm` or `0.01m`; a bare number is refused
+/// (its unit would be a guess), with a message showing it with each unit.
 pub fn parse_length_cm(s: &str) -> Result<f64> {
     let t = s.trim().to_ascii_lowercase();
     let (num, scale) = if let Some(v) = t.strip_suffix("mm") {
@@ -967,8 +980,15 @@ pub fn parse_length_cm(s: &str) -> Result<f64> {
         (v, 1.0)
     } else if let Some(v) = t.strip_suffix('m') {
         (v, 100.0)
-    } else {
+    } else if t.parse::<f64>().is_err() {
         (t.as_str(), 1.0)
+    } else {
+        return Err(MocapError::Invalid(format!(
+            "'{s}' has no length unit; write it with one, e.g. {}cm, {}mm or {}m",
+            s.trim(),
+            s.trim(),
+            s.trim()
+        )));
     };
     let v: f64 = num
         .trim()
@@ -1066,5 +1086,8 @@ mod compress_tests {
         assert_eq!(parse_length_cm("0.01m").unwrap(), 1.0);
         assert!(parse_length_cm("fast").is_err());
         assert!(parse_length_cm("-1cm").is_err());
+        // A number without a unit is refused, naming the units it could have meant.
+        let e = parse_length_cm("1e9").unwrap_err().to_string();
+        assert!(e.contains("'1e9' has no length unit") && e.contains("1e9cm"), "{e}");
     }
 }

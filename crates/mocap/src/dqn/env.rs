@@ -13,7 +13,7 @@
 //! key) when a policy selects. The last input of every row is E(s)/E(s₀), the scale of the rewards
 //! still to come.
 
-use crate::error::SegmentModel;
+use crate::metrics::SegmentModel;
 use crate::representation::{direction, SphericalMotion};
 use crate::select::angle_segment_costs;
 use crate::select::optimal::AngleFrames;
@@ -329,7 +329,7 @@ mod tests {
         let (full, lazy) = (EnvWindow::new(&r).unwrap(), EnvWindow::lazy(&r).unwrap());
         let mask = full.initial_mask() | 1 << 9 | 1 << 20;
         let mut ms = r.scratch();
-        let c = |a: usize, b: usize, ms: &mut crate::error::Scratch| r.segment_cost(a, b, ms).angle_sum;
+        let c = |a: usize, b: usize, ms: &mut crate::metrics::Scratch| r.segment_cost(a, b, ms).angle_sum;
         for w in [&full, &lazy] {
             let mut s = w.scratch();
             let mut out = Vec::new();

@@ -4,10 +4,12 @@
 
 pub mod env;
 pub mod model;
+pub mod options;
 pub mod policy;
 pub mod replay;
 pub mod train;
 
 pub use model::{DqnConfig, QNet, QRuntime};
+pub use options::TrainOptions;
 pub use policy::{Finish, PolicyInfo, SidqlPolicy};
-pub use train::{train, TrainOptions, TrainReport, Trained};
+pub use train::{train, TrainReport, Trained};

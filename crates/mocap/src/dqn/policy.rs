@@ -4,7 +4,7 @@
 
 use super::env::{EnvWindow, StateScratch, INPUTS};
 use super::model::{DqnConfig, QBuffers, QNet, QRuntime};
-use super::train::TrainOptions;
+use super::options::TrainOptions;
 use crate::representation::SphericalMotion;
 use crate::select::refine_keys;
 use crate::{MocapError, Result};
@@ -210,7 +210,7 @@ pub(crate) fn q_values(net: &QNet, states: &[f32], batch: usize, frames: usize, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::error::SegmentModel;
+    use crate::metrics::SegmentModel;
     use inbetween_core::procedural::{gait, GaitParams};
 
     #[test]

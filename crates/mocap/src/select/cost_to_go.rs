@@ -17,7 +17,7 @@ use crate::representation::SphericalMotion;
 
 const INF: f64 = f64::INFINITY;
 
-/// Every segment's mean-angle cost (the `angle_sum` of [`crate::error::SegmentModel::segment_cost`],
+/// Every segment's mean-angle cost (the `angle_sum` of [`crate::metrics::SegmentModel::segment_cost`],
 /// the same numbers) of a window of at most 64 frames, as an `n × n` table (0 below the diagonal).
 pub fn angle_segment_costs(rep: &SphericalMotion) -> Vec<f64> {
     let n = rep.num_frames;
@@ -123,7 +123,7 @@ pub fn completion_values(costs: &[f64], n: usize, mask: u64, extra: usize, out: 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::error::{Objective, SegmentModel};
+    use crate::metrics::{ErrorMeasure, SegmentModel};
     use crate::representation::JointFilter;
     use inbetween_core::procedural::gait_library;
     use inbetween_core::KeyframeSet;
@@ -218,7 +218,7 @@ mod tests {
             let costs = angle_segment_costs(&rep);
             for k in [3, 5, 10, 15] {
                 let (_, total) =
-                    super::super::optimal::optimal_spherical_with_total(&rep, k, Objective::Angle).unwrap();
+                    super::super::optimal::optimal_spherical_with_total(&rep, k, ErrorMeasure::Angle).unwrap();
                 let ctg = cost_to_go(&costs, 40, 1 | 1 << 39, k - 2);
                 assert!(close(ctg, total), "K={k}: {ctg} vs {total}");
                 let uniform = KeyframeSet::uniform(40, k).unwrap();

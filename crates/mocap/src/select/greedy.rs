@@ -3,12 +3,12 @@
 //! changes that segment's error, so each candidate costs two segment evaluations, memoised.
 
 use super::check_k;
-use crate::error::{Objective, SegmentCost, SegmentModel};
+use crate::metrics::{ErrorMeasure, SegmentCost, SegmentModel};
 use crate::Result;
 use inbetween_core::KeyframeSet;
 use std::collections::HashMap;
 
-pub fn greedy(model: &dyn SegmentModel, k: usize, objective: Objective) -> Result<KeyframeSet> {
+pub fn greedy(model: &dyn SegmentModel, k: usize, objective: ErrorMeasure) -> Result<KeyframeSet> {
     let n = model.num_frames();
     check_k(n, k)?;
     let mut keys = KeyframeSet::new(vec![], n)?;

@@ -25,7 +25,7 @@
 //! over [`SegmentTable::full_serial`], bit for bit (tested on procedural and noisy windows).
 
 use super::check_k;
-use crate::error::{Objective, SegmentModel, SegmentTable};
+use crate::metrics::{ErrorMeasure, SegmentModel, SegmentTable};
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
 use inbetween_core::interp::hermite_basis;
@@ -33,7 +33,7 @@ use inbetween_core::KeyframeSet;
 use std::f64::consts::TAU;
 
 /// The keyframe set of exactly `k` keys with the lowest total `objective` error.
-pub fn optimal(table: &SegmentTable, k: usize, objective: Objective) -> Result<KeyframeSet> {
+pub fn optimal(table: &SegmentTable, k: usize, objective: ErrorMeasure) -> Result<KeyframeSet> {
     let n = table.num_frames;
     check_k(n, k)?;
     let cost = |i: usize, j: usize| table.get(i, j).map_or(f64::INFINITY, |s| objective.of(s));
@@ -42,9 +42,9 @@ pub fn optimal(table: &SegmentTable, k: usize, objective: Objective) -> Result<K
 
 /// The same keys as [`optimal`] over [`SegmentTable::full_serial`]`(rep)`, much faster: only the
 /// objective is tabulated, and segments that cannot be on an optimal path are dropped early (module
-/// docs). For [`Objective::Angle`] no position is rebuilt; [`Objective::Position`] rebuilds them
+/// docs). For [`ErrorMeasure::Angle`] no position is rebuilt; [`ErrorMeasure::Position`] rebuilds them
 /// through [`SegmentModel::frame_cost`] and gains only from the dropped segments.
-pub fn optimal_spherical(rep: &SphericalMotion, k: usize, objective: Objective) -> Result<KeyframeSet> {
+pub fn optimal_spherical(rep: &SphericalMotion, k: usize, objective: ErrorMeasure) -> Result<KeyframeSet> {
     Ok(optimal_spherical_with_total(rep, k, objective)?.0)
 }
 
@@ -52,13 +52,13 @@ pub fn optimal_spherical(rep: &SphericalMotion, k: usize, objective: Objective) 
 pub fn optimal_spherical_with_total(
     rep: &SphericalMotion,
     k: usize,
-    objective: Objective,
+    objective: ErrorMeasure,
 ) -> Result<(KeyframeSet, f64)> {
     let n = rep.num_frames;
     check_k(n, k)?;
     match objective {
-        Objective::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep)).solution(),
-        Objective::Position => {
+        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep)).solution(),
+        ErrorMeasure::Position => {
             let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
             PrunedCosts::build(n, k, &mut frames).solution()
         }
@@ -121,8 +121,8 @@ trait FrameObjective {
 /// Any model's frame cost through [`SegmentModel::frame_cost`] (the position objective).
 struct ModelFrames<'m> {
     model: &'m dyn SegmentModel,
-    objective: Objective,
-    scratch: crate::error::Scratch,
+    objective: ErrorMeasure,
+    scratch: crate::metrics::Scratch,
 }
 
 impl FrameObjective for ModelFrames<'_> {
@@ -411,7 +411,7 @@ fn segment_within(frames: &mut impl FrameObjective, a: usize, b: usize, room: f6
 
 /// The fewest keys such that no frame's position error exceeds `max_cm` (ties: lowest total
 /// `objective` error). Always feasible: neighbouring keys leave no frame in between.
-pub fn error_bounded(table: &SegmentTable, max_cm: f64, objective: Objective) -> Result<KeyframeSet> {
+pub fn error_bounded(table: &SegmentTable, max_cm: f64, objective: ErrorMeasure) -> Result<KeyframeSet> {
     let n = table.num_frames;
     if n < 2 {
         return Err(MocapError::Invalid(format!("a clip of {n} frames has no segments")));
@@ -445,7 +445,7 @@ pub fn error_bounded(table: &SegmentTable, max_cm: f64, objective: Objective) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::error::{spherical_error, SegmentModel};
+    use crate::metrics::{spherical_error, SegmentModel};
     use crate::reconstruct::reconstruct_spherical;
     use crate::representation::{JointFilter, SphericalMotion};
     use crate::select::greedy;
@@ -476,10 +476,10 @@ mod tests {
         for rep in short_clips() {
             let table = SegmentTable::full(&rep);
             for k in [3, 4, 5] {
-                for objective in [Objective::Angle, Objective::Position] {
+                for objective in [ErrorMeasure::Angle, ErrorMeasure::Position] {
                     let score = |e: crate::ReconstructionError| match objective {
-                        Objective::Angle => e.mean_angle,
-                        Objective::Position => e.mean_cm,
+                        ErrorMeasure::Angle => e.mean_angle,
+                        ErrorMeasure::Position => e.mean_cm,
                     };
                     let brute = subsets(12, k - 2)
                         .iter()
@@ -503,7 +503,7 @@ mod tests {
         for rep in short_clips() {
             let table = SegmentTable::full(&rep);
             for bound in [0.5, 2.0, 8.0] {
-                let keys = error_bounded(&table, bound, Objective::Position).unwrap();
+                let keys = error_bounded(&table, bound, ErrorMeasure::Position).unwrap();
                 let e = spherical_error(&rep, &reconstruct_spherical(&rep, &keys));
                 assert!(e.max_cm <= bound + 1e-9);
                 // No smaller set meets the bound.
@@ -521,7 +521,7 @@ mod tests {
 
     /// The selector as it was before `optimal_spherical` (a verbatim copy of the old `optimal`,
     /// returning its total too): the reference the fast path must match bit for bit.
-    fn reference_optimal(table: &SegmentTable, k: usize, objective: Objective) -> Result<(KeyframeSet, f64)> {
+    fn reference_optimal(table: &SegmentTable, k: usize, objective: ErrorMeasure) -> Result<(KeyframeSet, f64)> {
         let n = table.num_frames;
         check_k(n, k)?;
         let inf = f64::INFINITY;
@@ -595,9 +595,9 @@ mod tests {
             let table = SegmentTable::full_serial(rep);
             let mut ks: Vec<usize> = (2..=16).chain([20, 30, n / 2, n - 2, n - 1, n]).filter(|&k| k <= n).collect();
             ks.dedup();
-            for objective in [Objective::Angle, Objective::Position] {
+            for objective in [ErrorMeasure::Angle, ErrorMeasure::Position] {
                 // Position is the slow objective to tabulate: every other window.
-                if objective == Objective::Position && w % 2 == 1 {
+                if objective == ErrorMeasure::Position && w % 2 == 1 {
                     continue;
                 }
                 for &k in &ks {
@@ -622,7 +622,7 @@ mod tests {
             let cost = |a: usize, b: usize| table.get(a, b).unwrap().angle_sum;
             for k in [3, 5, 10, 15].into_iter().filter(|&k| k <= n) {
                 let kept = PrunedCosts::build(n, k, &mut AngleFrames::new(rep));
-                let (_, best) = reference_optimal(&table, k, Objective::Angle).unwrap();
+                let (_, best) = reference_optimal(&table, k, ErrorMeasure::Angle).unwrap();
                 // The least total of any k-key path through each segment, from the full table.
                 let inf = f64::INFINITY;
                 let (mut before, mut after) = (vec![inf; k * n], vec![inf; k * n]);
@@ -707,8 +707,8 @@ mod tests {
     fn banded_optimum_reports_infeasible_k() {
         let rep = &short_clips()[0];
         let table = SegmentTable::banded(rep, 3);
-        assert!(optimal(&table, 3, Objective::Angle).is_err());
-        let keys = optimal(&table, 5, Objective::Angle).unwrap();
+        assert!(optimal(&table, 3, ErrorMeasure::Angle).is_err());
+        let keys = optimal(&table, 5, ErrorMeasure::Angle).unwrap();
         assert!(keys.segments().all(|(a, b)| b - a <= 3));
     }
 }

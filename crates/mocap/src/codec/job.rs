@@ -1,0 +1,150 @@
+//! `CompressJob`: compress one clip into an `.ibk` file (ozz's job shape: inputs, `validate`, then
+//! `run`), choosing the file version from the budget and returning a report that prints itself.
+//! The command line only parses flags into the job.
+
+use super::alloc::{self, Format};
+use super::{Budget, Compressed};
+use crate::bench::acl::RAW_BYTES_PER_BONE;
+use crate::{MocapError, Result};
+use inbetween_core::units::UnitChoice;
+use inbetween_core::Motion;
+use std::fmt;
+
+/// Which file version a job writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Version {
+    /// Keyframes (version 2): a key count or a bound on each joint's position.
+    V2,
+    /// Every frame (version 3 or 4): a bound on the virtual vertices 3 cm from each joint.
+    Sampled(Format),
+}
+
+impl Version {
+    /// `v2`, `v3` or `v4`.
+    pub fn parse(s: &str) -> Result<Version> {
+        match s {
+            "v2" => Ok(Version::V2),
+            "v3" => Ok(Version::Sampled(Format::V3)),
+            "v4" => Ok(Version::Sampled(Format::V4)),
+            other => Err(MocapError::Invalid(format!("unknown format '{other}'; expected v2, v3 or v4"))),
+        }
+    }
+}
+
+/// Compress one clip.
+#[derive(Clone, Debug)]
+pub struct CompressJob {
+    pub budget: Budget,
+    /// None: version 4 with an error bound, version 2 with a key count.
+    pub version: Option<Version>,
+    /// Frames per segment of a sampled file; None: the version's default.
+    pub segment_len: Option<usize>,
+    /// Longest gap between keys (frames) of a keyframe file.
+    pub max_gap: usize,
+    pub unit: UnitChoice,
+}
+
+/// What a job wrote and how well.
+#[derive(Clone, Debug)]
+pub enum CompressReport {
+    Keys { frames: usize, joints: usize, raw_bytes: usize, bytes_per_key: usize, compressed: Compressed },
+    Sampled { frames: usize, joints: usize, raw_bytes: usize, version: u16, compressed: alloc::Compressed },
+}
+
+impl CompressReport {
+    /// The file's bytes.
+    pub fn bytes(&self) -> &[u8] {
+        match self {
+            CompressReport::Keys { compressed, .. } => &compressed.bytes,
+            CompressReport::Sampled { compressed, .. } => &compressed.bytes,
+        }
+    }
+}
+
+impl CompressJob {
+    /// The version the job writes.
+    pub fn version(&self) -> Version {
+        match (self.version, &self.budget) {
+            (Some(v), _) => v,
+            (None, Budget::Keys(_)) => Version::V2,
+            (None, Budget::MaxErrorCm(_)) => Version::Sampled(Format::V4),
+        }
+    }
+
+    /// Checks the inputs before any work.
+    pub fn validate(&self) -> Result<()> {
+        match (self.version(), &self.budget) {
+            (Version::Sampled(f), Budget::Keys(_)) => Err(MocapError::Invalid(format!(
+                "a key count picks keyframes, which version {} does not store (it keeps every frame): use version 2 or an error bound",
+                f.version()
+            ))),
+            (Version::Sampled(_), Budget::MaxErrorCm(cm)) if !(cm.is_finite() && *cm > 0.0) => {
+                Err(MocapError::Invalid(format!("error bound {cm} cm: expected a positive length")))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Compresses `motion`.
+    pub fn run(&self, motion: &Motion) -> Result<CompressReport> {
+        self.validate()?;
+        let (frames, joints) = (motion.num_frames(), motion.skeleton.len());
+        let raw_bytes = super::raw_bytes(motion);
+        match (self.version(), &self.budget) {
+            (Version::Sampled(format), Budget::MaxErrorCm(cm)) => {
+                let opts = alloc::Options {
+                    segment_len: self.segment_len.unwrap_or(format.default_segment_len()),
+                    ..alloc::Options::with_format(*cm, format)
+                };
+                let compressed = alloc::compress_in(motion, self.unit.clone(), &opts)?;
+                Ok(CompressReport::Sampled { frames, joints, raw_bytes, version: format.version(), compressed })
+            }
+            (_, budget) => {
+                let compressed = super::compress_in(motion, self.unit.clone(), budget.clone(), self.max_gap)?;
+                let bytes_per_key = super::bytes_per_key(&motion.skeleton);
+                Ok(CompressReport::Keys { frames, joints, raw_bytes, bytes_per_key, compressed })
+            }
+        }
+    }
+}
+
+impl fmt::Display for CompressReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CompressReport::Sampled { frames, joints, raw_bytes, version, compressed: c } => {
+                let n = c.bytes.len() as f64;
+                let raw40 = RAW_BYTES_PER_BONE * joints * frames;
+                writeln!(f, "{}", c.unit)?;
+                writeln!(
+                    f,
+                    "{frames} frames, {joints} joints; version {version}: {} bytes vs {raw_bytes} raw f32 channel bytes ({:.1}x) or {raw40} bytes at {RAW_BYTES_PER_BONE} per joint and frame ({:.1}x)",
+                    c.bytes.len(),
+                    *raw_bytes as f64 / n,
+                    raw40 as f64 / n
+                )?;
+                write!(
+                    f,
+                    "virtual-vertex error (3 cm from each joint, decoded file): max {:.4} cm, 99th percentile {:.4} cm",
+                    c.max_error_cm, c.p99_error_cm
+                )
+            }
+            CompressReport::Keys { frames, joints, raw_bytes, bytes_per_key, compressed: c } => {
+                writeln!(f, "{}", c.unit)?;
+                writeln!(
+                    f,
+                    "{frames} frames, {joints} joints, {} keys; {} bytes ({bytes_per_key} bytes per key) vs {raw_bytes} raw f32 bytes: ratio {:.1}x",
+                    c.keys.len(),
+                    c.bytes.len(),
+                    *raw_bytes as f64 / c.bytes.len() as f64
+                )?;
+                write!(
+                    f,
+                    "error: mean {:.3} cm, max {:.3} cm (decoded file); mean local rotation error {:.3} deg",
+                    c.decoded_mean_cm,
+                    c.decoded_max_cm,
+                    c.planned.mean_angle.to_degrees()
+                )
+            }
+        }
+    }
+}
