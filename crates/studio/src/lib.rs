@@ -12,6 +12,9 @@
 //! - [`assets`]: the embedded front-end (our files and three.js installed by `build.rs`);
 //! - [`browser`], [`bench`]: headless Chromium for the browser tests and `inbetween studio bench`.
 
+// serde_json's json! macro recurses once per token; the job results are large objects.
+#![recursion_limit = "256"]
+
 pub mod assets;
 pub mod bench;
 pub mod browser;

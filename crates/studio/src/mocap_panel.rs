@@ -5,7 +5,7 @@
 //! (`inbetween_io::parse_bvh`, `parse_asf_amc`), so a bad file's message names file and line.
 
 use std::path::Path;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use axum::body::Bytes;
@@ -249,8 +249,6 @@ pub struct KeysRequest {
     pub bound_cm: Option<f64>,
 }
 
-static POLICY: OnceLock<std::result::Result<SidqlPolicy, String>> = OnceLock::new();
-
 /// `POST /api/mocap/keys`: keys by the chosen method, the reconstruction from them (quaternion
 /// Hermite rotations, the engine's BVH output), its per-frame error in cm.
 pub async fn keys(State(st): State<Arc<AppState>>, Json(req): Json<KeysRequest>) -> Result<Json<Value>> {
@@ -289,9 +287,9 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
         }
         "sidql" => {
             let k = need_k()?;
-            let policy = POLICY.get_or_init(|| SidqlPolicy::committed().map_err(|e| e.to_string()));
-            let policy = policy.as_ref().map_err(|e| StudioError::Engine(e.clone()))?;
-            (select::sidql::sidql(policy, &rep, k)?, format!("SIDQL K={k}"))
+            // The committed policy (weights compiled into the binary), loaded per job.
+            let policy = SidqlPolicy::committed()?;
+            (select::sidql::sidql(&policy, &rep, k)?, format!("SIDQL K={k}"))
         }
         "bound" => {
             let b = req

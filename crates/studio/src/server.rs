@@ -2,6 +2,7 @@
 
 use std::collections::HashMap;
 use std::convert::Infallible;
+use std::future::IntoFuture;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -250,7 +251,7 @@ impl Studio {
             // Not a graceful shutdown: an open event stream or keep-alive connection would hold it.
             rt.block_on(async move {
                 tokio::select! {
-                    _ = axum::serve(listener, app) => {}
+                    _ = axum::serve(listener, app).into_future() => {}
                     _ = rx => {}
                 }
             });
@@ -314,7 +315,7 @@ pub fn serve_until_ctrl_c(config: StudioConfig, on_ready: impl FnOnce(&str)) -> 
     let app = router(state(config, addr));
     let served = rt.block_on(async move {
         tokio::select! {
-            r = axum::serve(listener, app) => r.map_err(|e| StudioError::Runtime(e.to_string())),
+            r = axum::serve(listener, app).into_future() => r.map_err(|e| StudioError::Runtime(e.to_string())),
             _ = tokio::signal::ctrl_c() => Ok(()),
         }
     });
