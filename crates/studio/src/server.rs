@@ -342,7 +342,7 @@ pub fn parse_size(s: &str) -> Result<u64> {
         _ => return Err(bad()),
     };
     let v = n * mult;
-    if !(v.is_finite() && v >= 1.0 && v < 1e15) {
+    if !(v.is_finite() && (1.0..1e15).contains(&v)) {
         return Err(bad());
     }
     Ok(v.round() as u64)

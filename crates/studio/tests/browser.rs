@@ -56,7 +56,7 @@ fn viewport_coverage(b: &Browser) -> f64 {
         for x in r[0]..(r[0] + r[2]).min(img.width()) {
             let p = img.get_pixel(x, y).0;
             total += 1;
-            if p.iter().zip(bg).any(|(a, b)| (*a as i32 - b as i32).abs() > 12) {
+            if p.iter().zip(bg).any(|(a, b)| (*a as i32 - b).abs() > 12) {
                 differ += 1;
             }
         }
