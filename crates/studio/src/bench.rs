@@ -1,0 +1,189 @@
+//! `inbetween studio bench`: drives headless Chromium through both panels and measures what a user
+//! waits for (issue 23): first paint, script edit to redraw (goal < 100 ms), K change to redraw on
+//! a 1000-frame take (goal < 50 ms), and memory. Each timed action is repeated; the table gives
+//! the median and the range. Times are measured in the page, from the click (or the input's
+//! change event) to the frame drawn with the job's result, so they include the request, the
+//! engine call, the transfer and the drawing. Screenshots of both panels go beside the table.
+
+use std::path::Path;
+
+use inbetween_io::report::{num, Report, Table};
+use serde_json::Value;
+
+use crate::browser::{available, tree_rss_bytes, Browser};
+use crate::error::{Result, StudioError};
+use crate::{Studio, StudioConfig};
+
+/// Page size of the screenshots.
+pub const VIEW: (u32, u32) = (1280, 760);
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
+
+/// One row: median, min, max of `v` (ms), the job's own server time median, and the goal.
+fn row(t: &mut Table, what: &str, v: &mut [f64], server: &mut [f64], goal: &str) {
+    let (lo, hi) = (v.iter().cloned().fold(f64::INFINITY, f64::min), v.iter().cloned().fold(0.0, f64::max));
+    let server = if server.is_empty() { "—".to_string() } else { num(median(server), 1) };
+    t.row([
+        what.to_string(),
+        num(median(v), 1),
+        format!("{}–{}", num(lo, 1), num(hi, 1)),
+        server,
+        v.len().to_string(),
+        goal.to_string(),
+    ]);
+}
+
+fn job_times(b: &Browser, action: &str) -> Result<(f64, f64, Value)> {
+    b.eval(action)?;
+    let st = b.eval("window.inbetweenStudio.state()")?;
+    let job = &st["lastJob"];
+    if job["ok"] != true {
+        return Err(StudioError::Browser(format!("{action}: the job failed: {}", job["message"])));
+    }
+    Ok((job["redraw_ms"].as_f64().unwrap_or(f64::NAN), job["ms"].as_f64().unwrap_or(f64::NAN), st))
+}
+
+fn set_text(find: &str, replace: &str) -> String {
+    format!(
+        "(t => {{ t.value = t.value.replace({find:?}, {replace:?}); t.dispatchEvent(new Event('input')); \
+         document.querySelector('[data-testid=script-run]').click(); return window.inbetweenStudio.ready(); }})\
+         (document.querySelector('[data-testid=script-text]'))"
+    )
+}
+
+fn set_k(k: usize) -> String {
+    format!(
+        "(i => {{ i.value = {k}; i.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); }})\
+         (document.querySelector('[data-testid=mocap-k]'))"
+    )
+}
+
+fn set_method(m: &str) -> String {
+    format!("(s => {{ s.value = {m:?}; return true; }})(document.querySelector('[data-testid=mocap-method]'))")
+}
+
+/// Runs the bench, writes `studio-bench.{txt,md}`, the CSV and the screenshots into `out`, and
+/// returns the text table.
+pub fn run(out: &Path, repeats: usize) -> Result<String> {
+    let repeats = repeats.max(1);
+    let (chromium, driver) = available().map_err(|why| {
+        StudioError::Browser(format!("{why}: install the Debian packages chromium and chromium-driver"))
+    })?;
+    if let Some(why) = crate::assets::missing() {
+        return Err(StudioError::Browser(format!("the studio was built without three.js: {why}")));
+    }
+    let studio = Studio::start(StudioConfig { port: 0, ..StudioConfig::default() })?;
+    let b = Browser::launch(&chromium, &driver, VIEW.0, VIEW.1)?;
+    let mut t = Table::new(
+        "studio-bench",
+        "inbetween studio: what a user waits for (ms, measured in headless Chromium)",
+        &["action", "median ms", "range ms", "server job ms (median)", "runs", "goal"],
+    );
+
+    // First paint: navigation start to the first frame drawn with the page's data loaded.
+    let mut paint = Vec::new();
+    for _ in 0..repeats {
+        b.goto(&studio.url())?;
+        b.eval("window.inbetweenStudio.ready()")?;
+        paint.push(b.eval("window.inbetweenStudio.firstPaintMs")?.as_f64().unwrap_or(f64::NAN));
+    }
+    row(&mut t, "first paint (page load to first frame)", &mut paint, &mut [], "—");
+
+    // Script: the demo story, then one-sentence edits back and forth.
+    let (full_ms, full_server, _) =
+        job_times(&b, "(document.querySelector('[data-testid=script-run]').click(), window.inbetweenStudio.ready())")?;
+    row(&mut t, "script: demo story, first run (full solve)", &mut [full_ms], &mut [full_server], "—");
+    let (mut scene_edit, mut scene_server) = (Vec::new(), Vec::new());
+    for i in 0..repeats {
+        let (a, z) = if i % 2 == 0 { ("a lamp are", "a plant are") } else { ("a plant are", "a lamp are") };
+        let (ms, server, _) = job_times(&b, &set_text(a, z))?;
+        scene_edit.push(ms);
+        scene_server.push(server);
+    }
+    if repeats % 2 == 1 {
+        job_times(&b, &set_text("a plant are", "a lamp are"))?;
+    }
+    row(&mut t, "script edit to redraw: scene sentence (lamp ↔ plant)", &mut scene_edit, &mut scene_server, "< 100");
+    let (mut char_edit, mut char_server) = (Vec::new(), Vec::new());
+    for i in 0..repeats {
+        let (a, z) = if i % 2 == 0 {
+            ("Tom walks slowly", "Tom walks quickly")
+        } else {
+            ("Tom walks quickly", "Tom walks slowly")
+        };
+        let (ms, server, _) = job_times(&b, &set_text(a, z))?;
+        char_edit.push(ms);
+        char_server.push(server);
+    }
+    if repeats % 2 == 1 {
+        job_times(&b, &set_text("Tom walks quickly", "Tom walks slowly"))?;
+    }
+    row(
+        &mut t,
+        "script edit to redraw: character sentence (Tom slowly ↔ quickly)",
+        &mut char_edit,
+        &mut char_server,
+        "< 100",
+    );
+    b.eval("window.inbetweenStudio.seek(200)")?;
+    let script_png = b.screenshot()?;
+
+    // Mocap: the built-in 1000-frame walk, K changes with two selectors.
+    b.eval("(document.querySelector('[data-testid=nav-mocap]').click(), true)")?;
+    job_times(
+        &b,
+        "(s => { s.value = 'builtin:walk-1000'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('mocap-corpus'))",
+    )?;
+    for method in ["optimal", "uniform"] {
+        b.eval(&set_method(method))?;
+        let (mut k_ms, mut k_server) = (Vec::new(), Vec::new());
+        for i in 0..repeats {
+            let (ms, server, _) = job_times(&b, &set_k(if i % 2 == 0 { 16 } else { 15 }))?;
+            k_ms.push(ms);
+            k_server.push(server);
+        }
+        row(&mut t, &format!("K change to redraw, 1000 frames, {method}"), &mut k_ms, &mut k_server, "< 50");
+    }
+    b.eval(&set_method("optimal"))?;
+    job_times(&b, &set_k(16))?;
+    let (c_ms, c_server, _) = job_times(
+        &b,
+        "(document.querySelector('[data-testid=mocap-compress]').click(), window.inbetweenStudio.ready())",
+    )?;
+    row(&mut t, "compress 1000 frames to .ibk (1 cm)", &mut [c_ms], &mut [c_server], "—");
+    b.eval("window.inbetweenStudio.seek(420)")?;
+    let mocap_png = b.screenshot()?;
+
+    let server_mb = tree_rss_bytes(std::process::id()).map(|v| v as f64 / 1e6);
+    let browser_mb = tree_rss_bytes(b.pid()).map(|v| v as f64 / 1e6);
+    let mut mem = Table::new("studio-memory", "Memory after the run (resident set, MB)", &["process", "MB"]);
+    mem.row([
+        "studio server (this process: server + bench driver)".to_string(),
+        server_mb.map_or("—".into(), |v| num(v, 1)),
+    ]);
+    mem.row([
+        "headless Chromium (all its processes, with chromedriver)".to_string(),
+        browser_mb.map_or("—".into(), |v| num(v, 1)),
+    ]);
+    let mut report = Report::new("studio-bench", "inbetween studio bench");
+    report.table(t).table(mem).text(format!(
+        "{repeats} runs per timed action; page {}×{} px, WebGL through SwiftShader (software), debug-profile server \
+         unless built with --release. Screenshots: script.png (demo story, frame 200), mocap.png (1000-frame walk, \
+         optimal K = 16, frame 420).",
+        VIEW.0, VIEW.1
+    ));
+    report.file("script.png", script_png).file("mocap.png", mocap_png);
+    report.write(out)?;
+    Ok(report.to_text())
+}

@@ -1,0 +1,154 @@
+//! Jobs: each panel action (run a story, choose keys, compress) becomes a job that runs an engine
+//! call on a blocking thread. The page follows it over server-sent events
+//! (`GET /api/jobs/{id}/events`): `progress` events (the stage and its share of the job), then one
+//! `result` or `failed` event, or `cancelled` as soon as `POST /api/jobs/{id}/cancel` arrives.
+//! The engines' library calls take no cancel flag, so a cancelled job's engine call runs to its
+//! end in the background and its result is dropped; stages after the cancel are skipped.
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use tokio::sync::Notify;
+
+use crate::error::StudioError;
+
+/// One job's event log (replayed to every subscriber) and its state.
+pub struct Job {
+    pub id: u64,
+    pub kind: String,
+    cancelled: AtomicBool,
+    log: Mutex<(Vec<(String, Value)>, bool)>,
+    notify: Notify,
+    started: Instant,
+}
+
+impl Job {
+    /// Appends an event; `last` closes the log.
+    fn push(&self, event: &str, data: Value, last: bool) {
+        let mut log = self.log.lock().unwrap_or_else(|p| p.into_inner());
+        if log.1 {
+            return;
+        }
+        log.0.push((event.to_string(), data));
+        log.1 = last;
+        drop(log);
+        self.notify.notify_waiters();
+    }
+
+    /// Reports a stage: `fraction` of the job done when it starts.
+    pub fn progress(&self, stage: &str, fraction: f64) {
+        self.push("progress", json!({"job": self.id, "stage": stage, "fraction": fraction}), false);
+    }
+
+    pub fn is_cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::SeqCst)
+    }
+
+    /// Milliseconds since the job started.
+    pub fn elapsed_ms(&self) -> f64 {
+        self.started.elapsed().as_secs_f64() * 1000.0
+    }
+
+    pub fn cancel(&self) {
+        self.cancelled.store(true, Ordering::SeqCst);
+        self.push("cancelled", json!({"job": self.id, "kind": self.kind, "ms": self.elapsed_ms()}), true);
+    }
+
+    /// Events from index `from` on, and whether the log is closed.
+    pub fn events_from(&self, from: usize) -> (Vec<(String, Value)>, bool) {
+        let log = self.log.lock().unwrap_or_else(|p| p.into_inner());
+        (log.0[from.min(log.0.len())..].to_vec(), log.1)
+    }
+
+    /// Waits until the next event (or returns at once when one arrived after `seen`).
+    pub async fn wait_past(&self, seen: usize) {
+        loop {
+            let notified = self.notify.notified();
+            tokio::pin!(notified);
+            notified.as_mut().enable();
+            {
+                let log = self.log.lock().unwrap_or_else(|p| p.into_inner());
+                if log.0.len() > seen || log.1 {
+                    return;
+                }
+            }
+            notified.await;
+        }
+    }
+}
+
+/// The registry of jobs (the last [`KEEP`] are kept).
+#[derive(Default)]
+pub struct Jobs {
+    next: AtomicU64,
+    jobs: Mutex<HashMap<u64, Arc<Job>>>,
+}
+
+/// Jobs kept for late subscribers.
+pub const KEEP: u64 = 64;
+
+impl Jobs {
+    pub fn get(&self, id: u64) -> Option<Arc<Job>> {
+        self.jobs.lock().unwrap_or_else(|p| p.into_inner()).get(&id).cloned()
+    }
+
+    /// Starts `work` on a blocking thread as a job of `kind`; returns its id at once. `work`'s
+    /// value becomes the `result` event (with `ms` added: the job's wall time), its error the
+    /// `failed` event; a panic inside it is caught and reported as `failed`.
+    pub fn spawn<F>(&self, kind: &str, work: F) -> u64
+    where
+        F: FnOnce(&Job) -> Result<Value, StudioError> + Send + 'static,
+    {
+        let id = self.next.fetch_add(1, Ordering::SeqCst) + 1;
+        let job = Arc::new(Job {
+            id,
+            kind: kind.to_string(),
+            cancelled: AtomicBool::new(false),
+            log: Mutex::new((Vec::new(), false)),
+            notify: Notify::new(),
+            started: Instant::now(),
+        });
+        {
+            let mut jobs = self.jobs.lock().unwrap_or_else(|p| p.into_inner());
+            jobs.retain(|&k, _| k + KEEP > id);
+            jobs.insert(id, job.clone());
+        }
+        job.progress("queued", 0.0);
+        tokio::task::spawn_blocking(move || {
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&job)));
+            let ms = job.elapsed_ms();
+            match outcome {
+                Ok(Ok(mut v)) => {
+                    if let Some(o) = v.as_object_mut() {
+                        o.insert("ms".into(), json!(ms));
+                        o.insert("job".into(), json!(job.id));
+                        o.insert("kind".into(), json!(job.kind));
+                    }
+                    job.push("result", v, true);
+                }
+                Ok(Err(e)) => job.push(
+                    "failed",
+                    json!({"job": job.id, "kind": job.kind, "ms": ms, "error": e.to_string(), "status": e.status()}),
+                    true,
+                ),
+                Err(p) => {
+                    let what = p
+                        .downcast_ref::<&str>()
+                        .map(|s| s.to_string())
+                        .or_else(|| p.downcast_ref::<String>().cloned())
+                        .unwrap_or_else(|| "unknown panic".into());
+                    job.push(
+                        "failed",
+                        json!({"job": job.id, "kind": job.kind, "ms": ms,
+                               "error": format!("internal error in the {} job: {what} (the studio keeps serving)", job.kind)}),
+                        true,
+                    )
+                }
+            }
+        });
+        id
+    }
+}

@@ -1,0 +1,29 @@
+//! `inbetween studio`: a local web studio where a story or a mocap take is run, seen in 3D and
+//! edited (issue 23). The server is axum on tokio; every job calls an engine's public library
+//! API (the script engine's [`inbetween_script::animate::incremental::StorySession`], the mocap
+//! engine's key selectors and `.ibk` codec) on a blocking thread; results reach the page as JSON,
+//! glTF and BVH (forms three.js reads), progress as server-sent events.
+//!
+//! - [`server`]: configuration, start/stop, routes;
+//! - [`safety`]: Host (DNS rebinding) and Origin (cross-site writes) checks, the upload cap, paths
+//!   only under `--root`;
+//! - [`jobs`]: job registry with progress events and cancellation;
+//! - [`script_panel`], [`mocap_panel`]: the two panels' jobs;
+//! - [`assets`]: the embedded front-end (our files and three.js installed by `build.rs`);
+//! - [`browser`], [`bench`]: headless Chromium for the browser tests and `inbetween studio bench`.
+
+// serde_json's json! macro recurses once per token; the job results are large objects.
+#![recursion_limit = "256"]
+
+pub mod assets;
+pub mod bench;
+pub mod browser;
+pub mod error;
+pub mod jobs;
+pub mod mocap_panel;
+pub mod safety;
+pub mod script_panel;
+pub mod server;
+
+pub use error::{Result, StudioError};
+pub use server::{serve_until_ctrl_c, Studio, StudioConfig};

@@ -1,0 +1,435 @@
+//! The mocap panel: open a take (BVH, or an ASF + AMC pair; uploaded, or named under `--root`, or
+//! the built-in procedural walk), choose keys with one of the mocap engine's selectors (uniform,
+//! greedy, SIDQL, optimal, or the fewest keys under an error bound), see the reconstruction and
+//! its per-frame error, and compress to `.ibk`. Uploads go through the same parsers as the CLI
+//! (`inbetween_io::parse_bvh`, `parse_asf_amc`), so a bad file's message names file and line.
+
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use axum::body::Bytes;
+use axum::extract::{Query, State};
+use axum::Json;
+use inbetween_core::procedural::{gait, GaitParams};
+use inbetween_core::units::UnitChoice;
+use inbetween_core::{positions_clip, KeyframeSet, Motion};
+use inbetween_mocap::codec;
+use inbetween_mocap::error::SegmentModel;
+use inbetween_mocap::rotations::reconstruct_from_keys;
+use inbetween_mocap::select::{self, sidql::SidqlPolicy};
+use inbetween_mocap::{Objective, RotationMotion, SegmentTable, SphericalMotion};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use crate::error::{Result, StudioError};
+use crate::jobs::Job;
+use crate::safety::resolve_under_root;
+use crate::server::AppState;
+
+/// The open take.
+struct Take {
+    name: String,
+    motion: Motion,
+    unit: UnitChoice,
+}
+
+/// The panel's take and an ASF waiting for its AMC.
+#[derive(Default)]
+pub struct MocapState {
+    take: Mutex<Option<Arc<Take>>>,
+    pending_asf: Mutex<Option<(String, String)>>,
+    version: std::sync::atomic::AtomicU64,
+}
+
+impl MocapState {
+    fn next_version(&self) -> u64 {
+        self.version.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1
+    }
+}
+
+/// Built-in takes (no files needed): procedural walks of the core crate.
+pub const BUILTIN: &[(&str, usize)] = &[("builtin:walk", 240), ("builtin:walk-1000", 1000)];
+
+/// `GET /api/mocap/corpus`: BVH and AMC files under `--root` (relative paths) and the built-ins.
+pub async fn corpus(State(st): State<Arc<AppState>>) -> Json<Value> {
+    let mut files = Vec::new();
+    if let Some(root) = &st.config.root {
+        list(root, root, 0, &mut files);
+    }
+    files.sort();
+    Json(json!({
+        "root": st.config.root.as_ref().map(|p| p.display().to_string()),
+        "files": files,
+        "builtin": BUILTIN.iter().map(|b| b.0).collect::<Vec<_>>(),
+    }))
+}
+
+/// Motion files under `dir`, at most 6 folders deep and 5000 files.
+fn list(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        if out.len() >= 5000 {
+            return;
+        }
+        let p = e.path();
+        let Ok(kind) = e.file_type() else { continue };
+        if kind.is_dir() && depth < 6 {
+            list(root, &p, depth + 1, out);
+        } else if kind.is_file() {
+            let ext = p.extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+            if matches!(ext.as_deref(), Some("bvh" | "amc")) {
+                if let Ok(rel) = p.strip_prefix(root) {
+                    out.push(rel.to_string_lossy().replace('\\', "/"));
+                }
+            }
+        }
+    }
+}
+
+#[derive(Deserialize)]
+pub struct OpenRequest {
+    /// `builtin:walk`, or a path relative to `--root`.
+    pub path: String,
+}
+
+/// `POST /api/mocap/open`: a built-in take or a file under `--root`.
+pub async fn open_path(State(st): State<Arc<AppState>>, Json(req): Json<OpenRequest>) -> Result<Json<Value>> {
+    let source = match BUILTIN.iter().find(|b| b.0 == req.path) {
+        Some(&(name, frames)) => Source::Builtin(name.to_string(), frames),
+        None => Source::File(resolve_under_root(st.config.root.as_deref(), &req.path)?, req.path.clone()),
+    };
+    let state = st.clone();
+    let id = st.jobs.spawn("open", move |job| {
+        job.progress("reading the take", 0.1);
+        let (name, motion) = match source {
+            Source::Builtin(name, frames) => (name, gait(&GaitParams { frames, ..GaitParams::walk() })),
+            Source::File(path, shown) => (shown, inbetween_io::load_motion(&path).map_err(|e| named(e, &path))?),
+        };
+        opened(&state, job, name, motion)
+    });
+    Ok(Json(json!({"job": id})))
+}
+
+enum Source {
+    Builtin(String, usize),
+    File(std::path::PathBuf, String),
+}
+
+/// An I/O error's message with the absolute path shortened to its file name (the page shows it).
+fn named(e: inbetween_io::IoError, path: &Path) -> StudioError {
+    let full = path.display().to_string();
+    let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    StudioError::Engine(e.to_string().replace(&full, &name))
+}
+
+#[derive(Deserialize)]
+pub struct UploadQuery {
+    /// The file's name as the user picked it (its extension picks the parser).
+    pub name: String,
+}
+
+/// `POST /api/mocap/upload?name=…`: the file's bytes as the body. A `.bvh` opens at once; an
+/// `.asf` waits for the `.amc` uploaded next.
+pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
+    let name: String = q.name.chars().filter(|c| !c.is_control() && *c != '/' && *c != '\\').take(200).collect();
+    let ext = Path::new(&name).extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("asf") => {
+            let t = utf8(&name, &body);
+            let t = match t {
+                Ok(t) => t,
+                Err(e) => return Ok(Json(failed_now(&st, e))),
+            };
+            *st.mocap.pending_asf.lock().unwrap_or_else(|p| p.into_inner()) = Some((name.clone(), t));
+            Ok(Json(json!({"pending": name, "need": "the .amc file of this skeleton"})))
+        }
+        Some("bvh") | Some("amc") => {
+            let state = st.clone();
+            let asf = if ext.as_deref() == Some("amc") {
+                let a = st.mocap.pending_asf.lock().unwrap_or_else(|p| p.into_inner()).take();
+                match a {
+                    Some(a) => Some(a),
+                    None => {
+                        return Ok(Json(failed_now(
+                            &st,
+                            StudioError::BadRequest(format!(
+                                "{name}: an .amc file needs its .asf skeleton: pick both files together"
+                            )),
+                        )))
+                    }
+                }
+            } else {
+                None
+            };
+            let id = st.jobs.spawn("open", move |job| {
+                job.progress("parsing", 0.1);
+                let body_text = utf8(&name, &body)?;
+                let motion = match &asf {
+                    Some((asf_name, asf_text)) => inbetween_io::parse_asf_amc(asf_text, &body_text, asf_name, &name)?,
+                    None => inbetween_io::parse_bvh(&body_text, &name)?,
+                };
+                opened(&state, job, name.clone(), motion)
+            });
+            Ok(Json(json!({"job": id})))
+        }
+        _ => Ok(Json(failed_now(
+            &st,
+            StudioError::BadRequest(format!("{name}: expected a .bvh file, or an .asf and .amc pair")),
+        ))),
+    }
+}
+
+/// The upload as text, or an error naming the file, the line and the first byte that is not UTF-8.
+fn utf8(name: &str, bytes: &[u8]) -> Result<String> {
+    String::from_utf8(bytes.to_vec()).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        StudioError::Engine(format!(
+            "{name}:{}: expected UTF-8 text, found byte 0x{:02x}",
+            1 + bytes[..at].iter().filter(|&&b| b == b'\n').count(),
+            bytes[at]
+        ))
+    })
+}
+
+/// A job that fails at once (so the page's `ready()` sees the error like any other job's).
+fn failed_now(st: &AppState, e: StudioError) -> Value {
+    let id = st.jobs.spawn("open", move |_| Err(e));
+    json!({"job": id})
+}
+
+fn opened(st: &AppState, job: &Job, name: String, motion: Motion) -> Result<Value> {
+    if motion.num_frames() < 2 {
+        return Err(StudioError::Engine(format!("{name}: {} frame(s); a take needs at least 2", motion.num_frames())));
+    }
+    job.progress("converting to BVH for the viewer", 0.6);
+    let unit = UnitChoice::resolve(None, &motion.skeleton);
+    let v = st.mocap.next_version();
+    let bvh = st.put_file(
+        "mocap/original.bvh",
+        "text/plain; charset=utf-8",
+        inbetween_io::to_bvh_string(&motion).into_bytes(),
+        v,
+    );
+    let msg = format!(
+        "opened {name}: {} frames at {:.1} fps, {} joints; {unit}",
+        motion.num_frames(),
+        motion.fps(),
+        motion.skeleton.len()
+    );
+    let out = json!({
+        "ok": true,
+        "message": msg,
+        "name": name,
+        "frames": motion.num_frames(),
+        "fps": motion.fps(),
+        "joints": motion.skeleton.len(),
+        "unit": unit.unit.describe(),
+        "unit_reason": unit.reason,
+        "cm_per_unit": unit.cm_per_unit(),
+        "files": {"original": bvh},
+    });
+    *st.mocap.take.lock().unwrap_or_else(|p| p.into_inner()) = Some(Arc::new(Take { name, motion, unit }));
+    Ok(out)
+}
+
+fn current(st: &AppState) -> Result<Arc<Take>> {
+    st.mocap.take.lock().unwrap_or_else(|p| p.into_inner()).clone().ok_or_else(|| {
+        StudioError::BadRequest("open a take first (file picker, drag and drop, or the corpus list)".into())
+    })
+}
+
+#[derive(Deserialize)]
+pub struct KeysRequest {
+    /// uniform, greedy, sidql, optimal, or bound (the fewest keys under `bound_cm`).
+    pub method: String,
+    /// Keys, counting the first and last frames.
+    pub k: Option<usize>,
+    /// Error bound in cm (method `bound`).
+    pub bound_cm: Option<f64>,
+}
+
+/// `POST /api/mocap/keys`: keys by the chosen method, the reconstruction from them (quaternion
+/// Hermite rotations, the engine's BVH output), its per-frame error in cm.
+pub async fn keys(State(st): State<Arc<AppState>>, Json(req): Json<KeysRequest>) -> Result<Json<Value>> {
+    let take = current(&st)?;
+    let state = st.clone();
+    let id = st.jobs.spawn("keys", move |job| keys_job(&state, job, &take, &req));
+    Ok(Json(json!({"job": id})))
+}
+
+fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<Value> {
+    let m = &take.motion;
+    let n = m.num_frames();
+    let cm = take.unit.cm_per_unit();
+    job.progress("spherical representation", 0.05);
+    let mut rep = SphericalMotion::from_motion(m)?;
+    rep.cm_per_unit = cm;
+    let need_k = || -> Result<usize> {
+        let k = req.k.ok_or_else(|| StudioError::BadRequest(format!("method '{}' needs K", req.method)))?;
+        select::check_k(n, k)?;
+        Ok(k)
+    };
+    job.progress("choosing keys", 0.1);
+    let t = Instant::now();
+    let (keys, label) = match req.method.as_str() {
+        "uniform" => {
+            let k = need_k()?;
+            (select::uniform(n, k)?, format!("uniform K={k}"))
+        }
+        "greedy" => {
+            let k = need_k()?;
+            (select::greedy(&rep, k, Objective::Angle)?, format!("greedy K={k}"))
+        }
+        "optimal" => {
+            let k = need_k()?;
+            (select::optimal_spherical(&rep, k, Objective::Angle)?, format!("optimal K={k}"))
+        }
+        "sidql" => {
+            let k = need_k()?;
+            // The committed policy (weights compiled into the binary), loaded per job.
+            let policy = SidqlPolicy::committed()?;
+            (select::sidql::sidql(&policy, &rep, k)?, format!("SIDQL K={k}"))
+        }
+        "bound" => {
+            let b = req
+                .bound_cm
+                .ok_or_else(|| StudioError::BadRequest("method 'bound' needs an error bound in cm".into()))?;
+            if !(b.is_finite() && b > 0.0) {
+                return Err(StudioError::BadRequest(format!("error bound {b} cm: expected a positive number of cm")));
+            }
+            // The CLI's default longest gap between keys (`--max-gap-s 0.5`).
+            let max_gap = ((0.5 / m.frame_time).round() as usize).clamp(1, n - 1);
+            let table = SegmentTable::bounded(&rep, max_gap, b);
+            let keys = select::error_bounded(&table, b, Objective::Angle)?;
+            let k = keys.frames().len();
+            (keys, format!("fewest keys under {b} cm: K={k}"))
+        }
+        other => {
+            return Err(StudioError::BadRequest(format!(
+                "method '{other}': expected uniform, greedy, sidql, optimal or bound"
+            )))
+        }
+    };
+    let select_ms = t.elapsed().as_secs_f64() * 1000.0;
+    if job.is_cancelled() {
+        return Err(StudioError::Engine("cancelled".into()));
+    }
+    job.progress("reconstructing", 0.6);
+    let planned = rep.error(&keys);
+    let rec = reconstruct(m, cm, &keys)?;
+    let (per_frame, mean, max) = per_frame_error(m, &rec, cm);
+    let v = st.mocap.next_version();
+    let url = st.put_file(
+        "mocap/reconstructed.bvh",
+        "text/plain; charset=utf-8",
+        inbetween_io::to_bvh_string(&rec).into_bytes(),
+        v,
+    );
+    let ms = job.elapsed_ms();
+    Ok(json!({
+        "ok": true,
+        "message": format!("{label}: {ms:.2} ms (selection {select_ms:.2} ms), mean {mean:.2} cm, max {max:.2} cm"),
+        "method": req.method,
+        "k": keys.frames().len(),
+        "keys": keys.frames(),
+        "select_ms": select_ms,
+        "error_cm": mean,
+        "max_cm": max,
+        "per_frame_cm": per_frame,
+        "spherical_mean_cm": planned.mean_cm,
+        "spherical_max_cm": planned.max_cm,
+        "mean_angle_deg": planned.mean_angle.to_degrees(),
+        "files": {"reconstructed": url},
+    }))
+}
+
+/// The clip rebuilt from its key poses (the engine's rotation reconstruction).
+fn reconstruct(m: &Motion, cm: f64, keys: &KeyframeSet) -> Result<Motion> {
+    let model = RotationMotion::from_motion_in(m, cm)?;
+    let frames = keys.frames();
+    let poses: Vec<_> = frames.iter().map(|&f| model.frames[f].clone()).collect();
+    Ok(reconstruct_from_keys(&m.skeleton, m.frame_time, frames, &poses)?)
+}
+
+/// Per frame, the mean distance (cm) between original and rebuilt joints; the mean over frames
+/// and the largest joint distance.
+fn per_frame_error(a: &Motion, b: &Motion, cm: f64) -> (Vec<f64>, f64, f64) {
+    let (pa, pb) = (positions_clip(a), positions_clip(b));
+    let mut max = 0.0f64;
+    let per: Vec<f64> = pa
+        .iter()
+        .zip(&pb)
+        .map(|(fa, fb)| {
+            let d: Vec<f64> = fa.iter().zip(fb).map(|(x, y)| x.distance(*y) * cm).collect();
+            max = d.iter().fold(max, |m, &v| m.max(v));
+            d.iter().sum::<f64>() / d.len().max(1) as f64
+        })
+        .collect();
+    let mean = per.iter().sum::<f64>() / per.len().max(1) as f64;
+    (per, mean, max)
+}
+
+#[derive(Deserialize)]
+pub struct CompressRequest {
+    /// Largest error of the decoded file, cm.
+    pub bound_cm: f64,
+}
+
+/// `POST /api/mocap/compress`: the `.ibk` file (version 3, the CLI's default with
+/// `--max-error`), its ratio to the raw float channels and the decoded file's error.
+pub async fn compress(State(st): State<Arc<AppState>>, Json(req): Json<CompressRequest>) -> Result<Json<Value>> {
+    let take = current(&st)?;
+    if !(req.bound_cm.is_finite() && req.bound_cm > 0.0) {
+        return Err(StudioError::BadRequest(format!(
+            "error bound {} cm: expected a positive number of cm",
+            req.bound_cm
+        )));
+    }
+    let state = st.clone();
+    let id = st.jobs.spawn("compress", move |job| {
+        let m = &take.motion;
+        job.progress("compressing", 0.05);
+        let c = codec::alloc::compress_in(m, take.unit.clone(), &codec::alloc::Options::bound(req.bound_cm))?;
+        if job.is_cancelled() {
+            return Err(StudioError::Engine("cancelled".into()));
+        }
+        job.progress("decoding", 0.7);
+        let decoded = codec::read(&c.bytes)?.motion()?;
+        let raw = codec::raw_bytes(m);
+        let ratio = raw as f64 / c.bytes.len() as f64;
+        let v = state.mocap.next_version();
+        let stem = take
+            .name
+            .rsplit(['/', ':'])
+            .next()
+            .unwrap_or("take")
+            .trim_end_matches(".bvh")
+            .trim_end_matches(".amc")
+            .to_string();
+        let bytes = c.bytes.len();
+        let ibk = state.put_file(&format!("mocap/{stem}.ibk"), "application/octet-stream", c.bytes, v);
+        let dec = state.put_file(
+            &format!("mocap/{stem}-decoded.bvh"),
+            "text/plain; charset=utf-8",
+            inbetween_io::to_bvh_string(&decoded).into_bytes(),
+            v,
+        );
+        let ms = job.elapsed_ms();
+        Ok(json!({
+            "ok": true,
+            "message": format!(
+                "compress ≤ {} cm: {ms:.1} ms, {bytes} bytes, ratio {ratio:.1}:1, decoded max {:.3} cm (p99 {:.3} cm)",
+                req.bound_cm, c.max_error_cm, c.p99_error_cm
+            ),
+            "bytes": bytes,
+            "raw_bytes": raw,
+            "ratio": ratio,
+            "error_cm": c.max_error_cm,
+            "p99_cm": c.p99_error_cm,
+            "unit": take.unit.unit.describe(),
+            "files": {"ibk": ibk, "decoded": dec},
+        }))
+    });
+    Ok(Json(json!({"job": id})))
+}

@@ -1,0 +1,226 @@
+//! The script panel (the paper's Fig. 1: a text box, an execution button, a live 3D view). A run
+//! goes through the script engine's [`StorySession`]: the first version is solved in full, a
+//! later one re-solves only the characters and objects its edit touches, so unchanged objects keep
+//! their places. The page gets the animated scene as a GLB (the engine's own story writer: boxes
+//! or Kenney meshes, a joint hierarchy per character, the shot camera, one "story" animation),
+//! each character's BVH, the scene JSON, and a JSON summary (objects, action segments, camera per
+//! frame, parse diagnostics).
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use axum::extract::State;
+use axum::Json;
+use inbetween_script::animate::incremental::StorySession;
+use inbetween_script::animate::{camera_pose, Animation};
+use inbetween_script::compose::ComposeConfig;
+use inbetween_script::job::{story_session, RunJob, SceneJob};
+use inbetween_script::output;
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use crate::error::{Result, StudioError};
+use crate::jobs::Job;
+use crate::server::AppState;
+
+/// The options a session was made with; a run with other options starts a new session.
+#[derive(Debug, Clone, PartialEq)]
+struct Options {
+    seed: u64,
+    optimize: bool,
+    models: Option<PathBuf>,
+}
+
+struct Live {
+    options: Options,
+    session: StorySession,
+    version: u64,
+}
+
+/// The panel's editing session (one per studio: it is a local, single-user tool).
+#[derive(Default)]
+pub struct ScriptState {
+    live: Mutex<Option<Live>>,
+}
+
+/// `GET /api/script/stories`: the built-in texts by name.
+pub async fn stories() -> Json<Value> {
+    let list: Vec<Value> =
+        inbetween_script::stories::all().into_iter().map(|(name, text)| json!({"name": name, "text": text})).collect();
+    Json(json!({"stories": list, "default": "demo"}))
+}
+
+/// `POST /api/script/run` body.
+#[derive(Deserialize)]
+pub struct RunRequest {
+    pub text: String,
+    /// Run the joint scene/motion optimisation (§4.3, Algorithm 2): slower, seconds per edit.
+    #[serde(default)]
+    pub optimize: bool,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+}
+
+fn default_seed() -> u64 {
+    ComposeConfig::default().seed
+}
+
+/// The Kenney furniture folder of the shared data, when present.
+fn kenney_furniture() -> Option<PathBuf> {
+    let dir = inbetween_io::shared_data_dir().ok()?.join("assets/kenney_furniture");
+    dir.is_dir().then_some(dir)
+}
+
+/// `POST /api/script/run`: starts a story job.
+pub async fn run(State(st): State<Arc<AppState>>, Json(req): Json<RunRequest>) -> Result<Json<Value>> {
+    if inbetween_script::script::split(&req.text).is_empty() {
+        return Err(StudioError::BadRequest(
+            "the script is empty: write sentences such as \"In the room, a desk is near a bed$\"".into(),
+        ));
+    }
+    let state = st.clone();
+    let id = st.jobs.spawn("script", move |job| run_job(&state, job, req));
+    Ok(Json(json!({"job": id})))
+}
+
+fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
+    let options = Options { seed: req.seed, optimize: req.optimize, models: kenney_furniture() };
+    let mut live = st.script.live.lock().unwrap_or_else(|p| p.into_inner());
+    let mut notes = Vec::new();
+    if live.as_ref().is_none_or(|l| l.options != options) {
+        job.progress("loading the catalogue and scene database", 0.05);
+        let run = RunJob {
+            scene: SceneJob {
+                out_dir: PathBuf::new(),
+                seed: options.seed,
+                view: None,
+                models: options.models.clone(),
+                config: ComposeConfig { seed: options.seed, ..ComposeConfig::default() },
+                semantic: None,
+            },
+            optimize: options.optimize,
+            shared_motions: false,
+            gif_width: 0,
+        };
+        let (session, n) = story_session(&req.text, &run)?;
+        notes = n;
+        *live = Some(Live { options, session, version: 0 });
+    }
+    let live = live.as_mut().expect("a session was just made");
+    job.progress("composing the scene and animating the characters", 0.15);
+    let up = live.session.update(&req.text);
+    live.version += 1;
+    if job.is_cancelled() {
+        return Err(StudioError::Engine("cancelled".into()));
+    }
+    job.progress("writing the animated glTF and the BVH files", 0.8);
+    let anim = &up.animation;
+    let cat = live.session.catalogue();
+    let v = live.version;
+    let dir = tempfile::tempdir().map_err(|e| StudioError::io(std::env::temp_dir(), e))?;
+    let cam = |f: usize| camera_pose(anim, f);
+    let glb_path = dir.path().join("story.glb");
+    output::write_story_gltf(&glb_path, anim, cat, &cam)?;
+    let glb = st.put_file("script/story.glb", "model/gltf-binary", read(&glb_path)?, v);
+    let gltf_path = dir.path().join("story.gltf");
+    output::write_story_gltf(&gltf_path, anim, cat, &cam)?;
+    let gltf = st.put_file("script/story.gltf", "model/gltf+json", read(&gltf_path)?, v);
+    let scene_json = serde_json::to_vec_pretty(&anim.scene).map_err(|e| StudioError::Engine(e.to_string()))?;
+    let scene_url = st.put_file("script/scene.json", "application/json", scene_json, v);
+    let mut characters = Vec::new();
+    for c in &anim.characters {
+        let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
+        let p = dir.path().join(format!("{safe}.bvh"));
+        output::write_character_bvh(&p, &c.motion)?;
+        let url = st.put_file(&format!("script/{safe}.bvh"), "text/plain; charset=utf-8", read(&p)?, v);
+        characters.push(json!({
+            "name": c.name,
+            "joints": c.motion.skeleton.len(),
+            "frames": c.motion.num_frames(),
+            "bvh": url,
+            "segments": c.segments.iter().map(|s| json!({
+                "verb": s.verb, "start": s.start, "end": s.end, "target": s.target,
+            })).collect::<Vec<_>>(),
+        }));
+    }
+    let comp = &up.scene.composition;
+    let diagnostics: Vec<Value> = notes
+        .iter()
+        .chain(comp.diagnostics.iter())
+        .map(|d| {
+            json!({
+                "line": d.at.line, "sentence": d.at.sentence, "text": d.at.text, "word": d.word,
+                "message": d.message, "suggestions": d.suggestions, "display": d.to_string(),
+            })
+        })
+        .collect();
+    let frames = anim.frames();
+    let camera: Vec<[f32; 7]> = (0..frames)
+        .map(|f| {
+            let (e, t, fov) = camera_pose(anim, f);
+            [e[0], e[1], e[2], t[0], t[1], t[2], fov]
+        })
+        .collect();
+    let summary = format!(
+        "{}; engine {:.1} ms, contact distance {:.3} m, collision cost {:.3}",
+        summary_line(anim, &up.resolved_characters, up.scene.kept, up.full),
+        up.seconds * 1000.0,
+        up.after.contact,
+        up.after.collision
+    );
+    Ok(json!({
+        "ok": true,
+        "message": summary,
+        "fps": anim.fps,
+        "frames": frames,
+        "objects": objects(anim),
+        "characters": characters,
+        "camera": camera,
+        "shots": anim.camera.iter().map(|s| json!({"view": s.view, "start": s.start, "end": s.end})).collect::<Vec<_>>(),
+        "diagnostics": diagnostics,
+        "notes": anim.notes,
+        "full": up.full,
+        "kept_objects": up.scene.kept,
+        "placed_objects": up.scene.placed,
+        "changed_sentences": up.scene.changed_sentences,
+        "resolved_characters": up.resolved_characters,
+        "kept_characters": up.kept_characters,
+        "engine_ms": up.seconds * 1000.0,
+        "cost_before": up.before.total,
+        "cost_after": up.after.total,
+        "files": {"glb": glb, "gltf": gltf, "scene": scene_url},
+    }))
+}
+
+fn read(p: &Path) -> Result<Vec<u8>> {
+    std::fs::read(p).map_err(|e| StudioError::io(p, e))
+}
+
+/// Objects as the page's `state()` reports them: metres, Y up, yaw in radians.
+fn objects(anim: &Animation) -> Vec<Value> {
+    anim.scene
+        .objects
+        .iter()
+        .map(
+            |o| json!({"label": o.label, "category": o.category, "position": o.position, "size": o.size, "yaw": o.yaw}),
+        )
+        .collect()
+}
+
+fn summary_line(anim: &Animation, resolved: &[String], kept_objects: usize, full: bool) -> String {
+    let secs = anim.frames() as f64 / anim.fps;
+    let what = if full {
+        "solved in full".to_string()
+    } else if resolved.is_empty() {
+        format!("{kept_objects} objects kept, no character re-solved")
+    } else {
+        format!("{kept_objects} objects kept, re-solved {}", resolved.join(", "))
+    };
+    format!(
+        "story: {} objects, {} characters, {} frames ({secs:.1} s at {} fps); {what}",
+        anim.scene.objects.len(),
+        anim.characters.len(),
+        anim.frames(),
+        anim.fps
+    )
+}

@@ -1,0 +1,159 @@
+//! The studio's safety rules and job API over plain HTTP against a server on port 0 (issue 23).
+
+mod common;
+
+use common::*;
+use inbetween_studio::{Studio, StudioConfig};
+use serde_json::json;
+
+fn studio(max_upload: u64, root: Option<&std::path::Path>) -> Studio {
+    Studio::start(StudioConfig {
+        port: 0,
+        max_upload,
+        root: root.map(|p| p.to_path_buf()),
+        test_routes: true,
+        ..StudioConfig::default()
+    })
+    .expect("start the studio")
+}
+
+#[test]
+fn binds_loopback_by_default_and_serves_the_page() {
+    let s = studio(1_000_000, None);
+    assert!(s.addr().ip().is_loopback(), "{}", s.addr());
+    assert_ne!(s.addr().port(), 0);
+    let r = get(s.addr(), "/");
+    assert_eq!(r.status, 200);
+    assert!(r.text().contains("inbetween studio"), "{}", r.text());
+    let info = get(s.addr(), "/api/info").json();
+    assert_eq!(info["max_upload"], 1_000_000);
+}
+
+#[test]
+fn refuses_other_hosts() {
+    let s = studio(1_000_000, None);
+    let port = s.addr().port();
+    let evil = format!("rebind.example:{port}");
+    let r = request(s.addr(), "GET", "/api/info", &[("Host", &evil)], b"");
+    assert_eq!(r.status, 403, "{}", r.text());
+    assert!(r.text().contains("rebind.example"), "{}", r.text());
+    let local = format!("localhost:{port}");
+    assert_eq!(request(s.addr(), "GET", "/api/info", &[("Host", &local)], b"").status, 200);
+    let wrong_port = format!("127.0.0.1:{}", port.wrapping_add(1));
+    assert_eq!(request(s.addr(), "GET", "/api/info", &[("Host", &wrong_port)], b"").status, 403);
+}
+
+#[test]
+fn refuses_cross_origin_writes() {
+    let s = studio(1_000_000, None);
+    let body = json!({"path": "builtin:walk"}).to_string();
+    let ct = ("Content-Type", "application/json");
+    let r = request(s.addr(), "POST", "/api/mocap/open", &[ct, ("Origin", "http://evil.example")], body.as_bytes());
+    assert_eq!(r.status, 403, "{}", r.text());
+    let r = request(s.addr(), "POST", "/api/mocap/open", &[ct, ("Sec-Fetch-Site", "cross-site")], body.as_bytes());
+    assert_eq!(r.status, 403, "{}", r.text());
+    // A cross-origin read is a plain GET: allowed (the browser's same-origin policy hides it).
+    assert_eq!(request(s.addr(), "GET", "/api/info", &[("Origin", "http://evil.example")], b"").status, 200);
+    let own = format!("http://{}", s.addr());
+    let r = request(s.addr(), "POST", "/api/mocap/open", &[ct, ("Origin", &own)], body.as_bytes());
+    assert_eq!(r.status, 200, "{}", r.text());
+}
+
+#[test]
+fn caps_uploads() {
+    let s = studio(1000, None);
+    let big = vec![b'x'; 5000];
+    let r = request(s.addr(), "POST", "/api/mocap/upload?name=big.bvh", &[], &big);
+    assert_eq!(r.status, 413, "{}", r.text());
+    // Still serving.
+    assert_eq!(get(s.addr(), "/api/info").status, 200);
+}
+
+#[test]
+fn reads_client_named_paths_only_under_root() {
+    let dir = tempfile::tempdir().unwrap();
+    let inside = dir.path().join("takes");
+    std::fs::create_dir_all(&inside).unwrap();
+    std::fs::write(dir.path().join("secret.bvh"), "HIERARCHY").unwrap();
+    let s = studio(1_000_000, Some(&inside));
+    for bad in ["../secret.bvh", "/etc/passwd", "a/../../secret.bvh"] {
+        let r = post_json(s.addr(), "/api/mocap/open", &json!({"path": bad}));
+        assert_eq!(r.status, 403, "{bad}: {}", r.text());
+    }
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.path().join("secret.bvh"), inside.join("link.bvh")).unwrap();
+        let r = post_json(s.addr(), "/api/mocap/open", &json!({"path": "link.bvh"}));
+        assert_eq!(r.status, 403, "a link out of the root: {}", r.text());
+    }
+    let none = studio(1_000_000, None);
+    let r = post_json(none.addr(), "/api/mocap/open", &json!({"path": "secret.bvh"}));
+    assert_eq!(r.status, 403, "{}", r.text());
+    assert!(r.text().contains("--root"), "{}", r.text());
+}
+
+#[test]
+fn a_panicking_handler_does_not_stop_the_server() {
+    let s = studio(1_000_000, None);
+    let r = request(s.addr(), "POST", "/api/test/panic", &[], b"");
+    assert_eq!(r.status, 500);
+    assert!(r.text().contains("keeps serving"), "{}", r.text());
+    assert_eq!(get(s.addr(), "/api/info").status, 200);
+}
+
+#[test]
+fn garbage_upload_names_file_and_line_and_server_keeps_serving() {
+    let s = studio(1_000_000, None);
+    let (event, data) =
+        run_job(s.addr(), "/api/mocap/upload?name=garbage.bvh", &[], b"HIERARCHY\nROOT Hips\n{\n  OFFSET 1 2\n");
+    assert_eq!(event, "failed", "{data}");
+    let msg = data["error"].as_str().unwrap();
+    assert!(msg.contains("garbage.bvh:"), "{msg}");
+    let (event, data) = run_job(s.addr(), "/api/mocap/upload?name=noise.bvh", &[], &[0xff, 0xfe, 0x00, 0x12]);
+    assert_eq!(event, "failed", "{data}");
+    assert!(data["error"].as_str().unwrap().contains("noise.bvh:1"), "{data}");
+    let (event, data) = run_job(s.addr(), "/api/mocap/upload?name=take.fbx", &[], b"x");
+    assert_eq!(event, "failed", "{data}");
+    assert!(data["error"].as_str().unwrap().contains("expected a .bvh file"), "{data}");
+    assert_eq!(get(s.addr(), "/api/info").status, 200);
+}
+
+#[test]
+fn mocap_jobs_on_the_builtin_walk() {
+    let s = studio(1_000_000, None);
+    let (event, take) =
+        run_job(s.addr(), "/api/mocap/open", &[("Content-Type", "application/json")], br#"{"path":"builtin:walk"}"#);
+    assert_eq!(event, "result", "{take}");
+    assert_eq!(take["frames"], 240);
+    let original = get(s.addr(), take["files"]["original"].as_str().unwrap());
+    assert!(original.text().starts_with("HIERARCHY"), "{}", original.text());
+    for method in ["uniform", "greedy", "optimal"] {
+        let body = json!({"method": method, "k": 10}).to_string();
+        let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
+        assert_eq!(event, "result", "{method}: {r}");
+        let keys: Vec<u64> = r["keys"].as_array().unwrap().iter().map(|k| k.as_u64().unwrap()).collect();
+        assert_eq!(keys.len(), 10, "{method}");
+        assert_eq!((keys[0], keys[9]), (0, 239), "{method}: first and last frames are keys");
+        assert_eq!(r["per_frame_cm"].as_array().unwrap().len(), 240);
+        let max = r["max_cm"].as_f64().unwrap();
+        assert!(max > 0.0 && max.is_finite(), "{method}: {r}");
+        assert!(r["message"].as_str().unwrap().contains("cm"), "{r}");
+    }
+    // SIDQL takes windows of at most 64 frames: a 240-frame take is refused with the engine's words.
+    let body = json!({"method": "sidql", "k": 10}).to_string();
+    let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
+    assert_eq!(event, "failed", "{r}");
+    assert!(r["error"].as_str().unwrap().contains("64"), "{r}");
+    // The error bound: every frame under it.
+    let body = json!({"method": "bound", "bound_cm": 2.0}).to_string();
+    let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
+    assert_eq!(event, "result", "{r}");
+    assert!(r["spherical_max_cm"].as_f64().unwrap() <= 2.0 + 1e-9, "{r}");
+    let body = json!({"bound_cm": 1.0}).to_string();
+    let (event, r) = run_job(s.addr(), "/api/mocap/compress", &[("Content-Type", "application/json")], body.as_bytes());
+    assert_eq!(event, "result", "{r}");
+    assert!(r["ratio"].as_f64().unwrap() > 1.0, "{r}");
+    assert!(r["error_cm"].as_f64().unwrap() <= 1.0 + 1e-9, "{r}");
+    let ibk = get(s.addr(), r["files"]["ibk"].as_str().unwrap());
+    assert_eq!(ibk.body.len() as u64, r["bytes"].as_u64().unwrap());
+}
