@@ -100,7 +100,7 @@ impl CompressJob {
                 Ok(CompressReport::Sampled { frames, joints, raw_bytes, version: format.version(), compressed })
             }
             (_, budget) => {
-                let compressed = super::compress_in(motion, self.unit.clone(), budget.clone(), self.max_gap)?;
+                let compressed = super::compress_in(motion, self.unit.clone(), *budget, self.max_gap)?;
                 let bytes_per_key = super::bytes_per_key(&motion.skeleton);
                 Ok(CompressReport::Keys { frames, joints, raw_bytes, bytes_per_key, compressed })
             }
