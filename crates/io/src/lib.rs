@@ -1,7 +1,8 @@
 //! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), whole-or-none
-//! output sets ([`OutputSet`]), locating
-//! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]) and the
-//! bench/report harness ([`report`]: tables, reports, timings).
+//! output sets ([`OutputSet`]), the error for inputs over a job's stated limits ([`LimitExceeded`]), locating
+//! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]), the
+//! bench/report harness ([`report`]: tables, reports, timings) and scaling runs ([`scale`]: a child's time
+//! and peak memory).
 //!
 //! Every reader returns [`IoError`] on bad input (never panics); its message names the file, the
 //! 1-based line and what was expected there.
@@ -13,15 +14,18 @@ mod error;
 pub mod fsutil;
 pub mod gltf_buffer;
 mod lexer;
+pub mod limits;
 pub mod output_set;
 pub mod progress;
 pub mod report;
+pub mod scale;
 
 pub use asf::{parse_asf_amc, read_asf_amc};
 pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
 pub use data::shared_data_dir;
 pub use error::IoError;
 pub use fsutil::{write_atomic, write_atomic_with};
+pub use limits::LimitExceeded;
 pub use output_set::OutputSet;
 pub use progress::Progress;
 

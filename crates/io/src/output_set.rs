@@ -224,6 +224,32 @@ mod tests {
         assert_eq!(names(dir.path()), ["out"]);
     }
 
+    /// A job that writes its set file by file and is cancelled half-way leaves none of it.
+    #[test]
+    fn run_cancelled_mid_way_leaves_no_partial_set() {
+        use inbetween_core::cancel::{Cancel, Cancelled};
+        fn job(dir: &Path, cancel: &Cancel, cancel_after: usize) -> Result<(), Cancelled> {
+            let mut set = OutputSet::new();
+            for (i, name) in ["track.json", "track.gltf", "preview.gif"].iter().enumerate() {
+                cancel.check()?;
+                crate::write_atomic(&set.file(&dir.join(name)).unwrap(), name.as_bytes()).unwrap();
+                if i + 1 == cancel_after {
+                    cancel.cancel(); // the studio's cancel button, pressed while the job runs
+                }
+            }
+            cancel.check()?;
+            set.commit().unwrap();
+            Ok(())
+        }
+        let dir = tempfile::tempdir().unwrap();
+        for after in 1..=3 {
+            assert_eq!(job(dir.path(), &Cancel::new(), after), Err(Cancelled::Requested));
+            assert!(names(dir.path()).is_empty(), "cancelled after {after} file(s): nothing left");
+        }
+        assert_eq!(job(dir.path(), &Cancel::new(), 0), Ok(()));
+        assert_eq!(names(dir.path()), ["preview.gif", "track.gltf", "track.json"]);
+    }
+
     #[test]
     fn unwritten_entry_fails_the_commit_before_anything_moves() {
         let dir = tempfile::tempdir().unwrap();
