@@ -18,6 +18,7 @@ pub mod corpus;
 pub mod data;
 pub mod demo;
 pub mod edit;
+mod error;
 pub mod infer;
 pub mod model;
 pub mod preview;

@@ -14,17 +14,16 @@
 
 mod clip;
 pub mod curves;
-mod error;
 pub mod livelink;
 mod names;
 mod resample;
 pub(crate) mod text;
 
+pub use crate::error::{Column, FaceError};
 pub use clip::BlendshapeClip;
 pub use curves::{
     parse_curve_csv, parse_curve_json, read_curves, to_curve_csv_string, to_curve_json_string, write_curves,
 };
-pub use error::{Column, FaceError};
 pub use livelink::{parse_live_link, read_live_link, to_live_link_string, write_live_link};
 pub use names::{
     arkit_index, head_eye_index, is_emotion, ARKIT_NAMES, EMOTION_NAMES, HEAD_EYE_NAMES, NUM_ARKIT, NUM_HEAD_EYE,
