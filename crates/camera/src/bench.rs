@@ -19,7 +19,7 @@
 //!   spaced ground-truth keys: the smallest n whose spline error is at most ours.
 
 use crate::dataset::{Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE};
-use crate::infer::{cam_distance as err, key_vector, Cam, Chr, FastModel, Rollout, Scratch, StepIn};
+use crate::infer::{cam_distance, key_vector, Cam, Chr, FastModel, Rollout, Scratch, StepIn};
 use crate::model::{MAP_FRAMES, STYLE_STEPS};
 use crate::toric::Lens;
 use crate::CameraError;
@@ -136,7 +136,7 @@ struct EvalSeq {
 }
 
 fn mean_err(a: &[Cam], b: &[Cam]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| err(x, y)).sum::<f64>() / a.len().max(1) as f64
+    a.iter().zip(b).map(|(x, y)| cam_distance(x, y)).sum::<f64>() / a.len().max(1) as f64
 }
 
 /// Generates from the last of the five `context` steps (H's input) through `keys` (step indices
@@ -157,7 +157,7 @@ fn bend(track: &mut [Cam], keys: &[(usize, Cam)]) {
     let k64: Vec<(f64, [f64; 6])> = keys.iter().map(|(i, c)| (*i as f64, c.map(|v| v as f64))).collect();
     let bent = samples.corrected_to_keys(&k64);
     for (i, d) in track.iter_mut().enumerate() {
-        *d = bent.sample(i as f64).map(|v| v as f32);
+        *d = bent.sample_clamped(i as f64).map(|v| v as f32);
     }
 }
 
@@ -297,7 +297,7 @@ fn table2(
             let regenerate = |zr: &[f32]| roll(model, zr, ctx, chars, &true_keys);
             // Ours.
             let mut x1 = roll(model, z, ctx, chars, &[(len, key_d)]);
-            kd += err(&x1[len], &key_d);
+            kd += cam_distance(&x1[len], &key_d);
             bend(&mut x1, &disp_keys);
             let zr = style_of(model, &chars[1..], &x1[1..]);
             td[0] += mean_err(&regenerate(&zr)[1..], &truth[1..]);
@@ -356,7 +356,7 @@ fn rails(
             let times: Vec<f64> = idx.iter().map(|&i| i as f64).collect();
             let values: Vec<[f64; 6]> = idx.iter().map(|&i| truth[i].map(|v| v as f64)).collect();
             let Ok(curve) = Track::catmull_rom(&times, &values) else { continue };
-            let spline: Vec<Cam> = (0..=len).map(|t| curve.sample(t as f64).map(|v| v as f32)).collect();
+            let spline: Vec<Cam> = (0..=len).map(|t| curve.sample_clamped(t as f64).map(|v| v as f32)).collect();
             if mean_err(&spline, truth) <= e_ours {
                 needed = n;
                 capped = 0;
@@ -559,7 +559,7 @@ pub const PAPER_TABLE2: [(f64, f64, f64, f64); 10] = [
 
 /// A chart's PNG bytes (see [`inbetween_render::rendered_bytes`]), so that [`Report::write`]
 /// writes it atomically with the rest.
-fn png_bytes(
+fn chart_bytes(
     name: &str,
     draw: impl FnOnce(&Path) -> Result<(), inbetween_render::RenderError>,
 ) -> Result<Vec<u8>, CameraError> {
@@ -718,7 +718,7 @@ impl BenchReport {
             ("Toric lerp".into(), col(|r| r.lerp)),
             ("paper mapped".into(), PAPER_TABLE1.iter().map(|p| p.4).collect()),
         ];
-        png_bytes("table1.png", |p| {
+        chart_bytes("table1.png", |p| {
             grouped_bar_chart(
                 p,
                 "Table 1: trajectory error by hidden-state initialisation",
@@ -745,8 +745,12 @@ impl BenchReport {
             series("Toric lerp", |r| r.sd_interpolation),
         ];
         Ok((
-            png_bytes("table2_td.png", |p| line_plot(p, "Table 2: TD vs keyframe displacement", "δ (rad)", "TD", &td))?,
-            png_bytes("table2_sd.png", |p| line_plot(p, "Table 2: SD vs keyframe displacement", "δ (rad)", "SD", &sd))?,
+            chart_bytes("table2_td.png", |p| {
+                line_plot(p, "Table 2: TD vs keyframe displacement", "δ (rad)", "TD", &td)
+            })?,
+            chart_bytes("table2_sd.png", |p| {
+                line_plot(p, "Table 2: SD vs keyframe displacement", "δ (rad)", "SD", &sd)
+            })?,
         ))
     }
 
@@ -771,7 +775,7 @@ impl BenchReport {
                 series.push(s);
             }
         }
-        png_bytes("style_pca.png", |p| scatter_plot(p, "Style codes z, PCA (Fig. 4)", "PC 1", "PC 2", &series))
+        chart_bytes("style_pca.png", |p| scatter_plot(p, "Style codes z, PCA (Fig. 4)", "PC 1", "PC 2", &series))
     }
 }
 

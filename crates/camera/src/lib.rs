@@ -13,6 +13,7 @@ pub use inbetween_core::toric;
 pub mod bench;
 pub mod dataset;
 pub mod demo;
+mod error;
 pub mod features;
 pub mod gltf;
 pub mod infer;
@@ -21,30 +22,9 @@ pub mod preview;
 pub mod train;
 pub mod weights;
 
-use std::path::{Path, PathBuf};
+pub use error::CameraError;
 
-/// Errors of the camera engine; every one names the file (and line, frame or key) at fault.
-#[derive(Debug, thiserror::Error)]
-pub enum CameraError {
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("{path}:{line}:{column}: {message}")]
-    Parse { path: PathBuf, line: usize, column: usize, message: String },
-    #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
-    #[error("{0}")]
-    Toric(#[from] toric::ToricError),
-    #[error("model: {0}")]
-    Model(String),
-    #[error("{0}")]
-    Weights(#[from] inbetween_nn::NnError),
-}
-
-impl CameraError {
-    pub fn invalid(path: &Path, message: impl Into<String>) -> CameraError {
-        CameraError::Invalid { path: path.to_path_buf(), message: message.into() }
-    }
-}
+use std::path::Path;
 
 /// Reads a JSON file; syntax and shape errors give file:line:column.
 pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CameraError> {

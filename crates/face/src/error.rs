@@ -1,5 +1,6 @@
-//! [`FaceError`]: every failure of the face data layer. Parse errors name the file, the 1-based line,
-//! the 1-based column with its header name where there is one, and what was expected.
+//! [`FaceError`]: the face engine's error (re-exported as `data::FaceError`, where the readers
+//! produce most of them). Parse errors name the file, the 1-based line, the 1-based column with its
+//! header name where there is one, and what was expected.
 
 use std::fmt;
 
@@ -48,7 +49,7 @@ pub enum FaceError {
     /// A problem with the file as a whole (JSON structure, UTF-8).
     #[error("{file}: {message}")]
     File { file: String, message: String },
-    /// A clip that breaks the rules of [`super::BlendshapeClip`], or an argument out of range.
+    /// A clip that breaks the rules of [`crate::data::BlendshapeClip`], or an argument out of range.
     #[error("invalid clip: {0}")]
     Invalid(String),
     /// Weights could not be loaded or saved.

@@ -1,6 +1,6 @@
 use std::path::PathBuf;
 
-/// Errors from the nn crate: checkpoint I/O, bad configuration, backend setup.
+/// Errors from the nn crate: checkpoint I/O, bad configuration, a diverged loss, backend setup.
 #[derive(Debug, thiserror::Error)]
 pub enum NnError {
     /// A file could not be read or written.
@@ -22,6 +22,9 @@ pub enum NnError {
     /// A configuration value is out of range.
     #[error("invalid configuration: {0}")]
     Config(String),
+    /// Training diverged: the objective returned a NaN or infinite loss at this step.
+    #[error("loss became {loss} at epoch {epoch}, step {step}: lower lr or clip gradients")]
+    NonFiniteLoss { epoch: usize, step: usize, loss: f64 },
     /// The backend could not be set up (e.g. the global thread pool was already built).
     #[error("backend: {0}")]
     Backend(String),

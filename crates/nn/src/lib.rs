@@ -23,14 +23,6 @@
 //! - [`runtime`]: plain-Rust Dense/LSTM inference layers built from trained modules, no allocation
 //!   per step.
 //! - [`bench`](mod@bench): throughput rows for the `bench` commands.
-//!
-//! # Note for a future WGAN-GP critic (face engine)
-//! burn has no double backward (`backward()` consumes the graph), so the gradient penalty
-//! `(‖∇ₓD(x̂)‖₂ − 1)²` cannot be differentiated through autodiff's own gradient. For a
-//! conv1d + LeakyReLU critic, compute `∇ₓD` by hand (transpose convolutions through the saved
-//! LeakyReLU masks) as a differentiable expression of the weights; the penalty then needs only one
-//! ordinary backward. This was checked against autodiff and finite differences
-//! (see /work/shared/notes/ml-stack.md).
 
 pub mod backend;
 pub mod bench;

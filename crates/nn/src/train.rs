@@ -368,10 +368,7 @@ where
                 let v = f64::from(value.clone().into_scalar::<f32>());
                 if !v.is_finite() {
                     bar.abandon();
-                    return Err(NnError::Config(format!(
-                        "loss became {v} at epoch {epoch}, step {}: lower lr or clip gradients",
-                        step.step
-                    )));
+                    return Err(NnError::NonFiniteLoss { epoch, step: step.step, loss: v });
                 }
                 let grads = GradientsParams::from_grads(value.backward(), &model);
                 model = optim.step(lr, model, grads);
@@ -768,5 +765,25 @@ mod tests {
         let missing = dir.path().join("missing.bpk");
         let err = checkpoint::load_module(build(&device), &missing).unwrap_err().to_string();
         assert!(err.contains("missing.bpk"), "{err}");
+    }
+
+    #[test]
+    fn a_nan_loss_is_named_with_its_epoch_and_step_not_as_a_configuration_error() {
+        let device = backend::cpu_autodiff();
+        let mut loss = sine_loss(&device);
+        let diverging = move |model: &SinePredictor, step: &Step| {
+            let l = loss(model, step);
+            if step.epoch == 1 && step.step == 3 {
+                l.mul_scalar(f32::NAN)
+            } else {
+                l
+            }
+        };
+        let err = fit(&config(2), &device, build, diverging).unwrap_err();
+        match &err {
+            NnError::NonFiniteLoss { epoch: 1, step: 3, loss } => assert!(loss.is_nan()),
+            other => panic!("expected NonFiniteLoss at epoch 1, step 3, got {other:?}"),
+        }
+        assert!(err.to_string().contains("loss became NaN at epoch 1, step 3"), "{err}");
     }
 }

@@ -4,12 +4,13 @@
 //! nothing waits for the future. Keys (placed ahead by the user) can be announced at any time; a
 //! live camera cannot go back, so it corrects nothing and reports its misses.
 
-use super::generate::{camera_frame, GenerateJob, KeyResidual};
 use super::keys::ResolvedKeys;
-use super::{key_vector, toric_distance, velocity_frames, Cam, CameraTrack, FastModel, KeyVec, Rollout};
+use super::track::{camera_frame, CameraTrack, KeyResidual};
+use super::{key_vector, toric_distance, velocity_frames, Cam, FastModel, KeyVec, Rollout, Style};
+use crate::dataset::Scene;
 use crate::dataset::DOWNSAMPLE;
 use crate::features::{decode_camera, encode_camera, encode_character, CharacterFeatures, CAM_DIM};
-use crate::toric::Toric;
+use crate::toric::{Lens, Toric};
 use crate::CameraError;
 use inbetween_nn::runtime::LstmState;
 
@@ -79,10 +80,17 @@ impl<'a> CausalCamera<'a> {
     }
 }
 
-/// A whole track through [`CausalCamera`]: frame by frame, each key announced once the previous one
-/// has passed, no correction. Key residuals report the misses.
-pub(super) fn run_causal(job: &GenerateJob, keys: &ResolvedKeys) -> Result<CameraTrack, CameraError> {
-    let (scene, k) = (job.scene, &keys.keys);
+/// A whole track through [`CausalCamera`] (what [`super::GenerateJob::run`] calls in causal
+/// mode): frame by frame, each key announced once the previous one has passed, no correction.
+/// Key residuals report the misses.
+pub(super) fn run_causal(
+    model: &FastModel,
+    style: &Style,
+    scene: &Scene,
+    lens: &Lens,
+    keys: &ResolvedKeys,
+) -> Result<CameraTrack, CameraError> {
+    let k = &keys.keys;
     let (first, last) = (keys.first_frame(), keys.last_frame(scene));
     let feats = |f: usize, pair: (usize, usize)| {
         CharacterFeatures::compute(
@@ -91,7 +99,7 @@ pub(super) fn run_causal(job: &GenerateJob, keys: &ResolvedKeys) -> Result<Camer
             keys.main_is_a(pair),
         )
     };
-    let mut live = CausalCamera::new(job.model, &job.style.code, &k[0].camera, k[0].velocity, scene.fps);
+    let mut live = CausalCamera::new(model, &style.code, &k[0].camera, k[0].velocity, scene.fps);
     let mut next = 1;
     let mut announced = 0;
     let mut frames = Vec::with_capacity(last - first + 1);
@@ -112,23 +120,18 @@ pub(super) fn run_causal(job: &GenerateJob, keys: &ResolvedKeys) -> Result<Camer
             residuals.push(KeyResidual { frame, residual: toric_distance(&toric.to_array(), &key.camera.to_array()) });
             next += 1;
         }
-        frames.push(camera_frame(scene, frame, target.pair, toric, &job.options.lens)?);
+        frames.push(camera_frame(scene, frame, target.pair, toric, lens)?);
     }
     let max_corrected_residual = residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
     Ok(CameraTrack {
         fps: scene.fps,
-        style: job.style.name.clone(),
-        style_code: job.style.code.clone(),
-        lens: job.options.lens,
+        style: style.name.clone(),
+        style_code: style.code.clone(),
+        lens: *lens,
         frames,
         key_residuals: residuals,
         max_corrected_residual,
     })
-}
-
-/// [`GenerateJob::run`] in causal mode (kept for callers that hold the pieces).
-pub fn generate_causal(job: &GenerateJob) -> Result<CameraTrack, CameraError> {
-    GenerateJob { options: super::GenerateOptions { causal: true, ..job.options }, ..*job }.run()
 }
 
 #[cfg(test)]

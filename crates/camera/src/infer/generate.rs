@@ -5,13 +5,13 @@
 //! [`GenerateJob::run`].
 
 use super::keys::{ResolvedKey, ResolvedKeys};
+use super::track::{camera_frame, CameraFrame, CameraTrack, KeyResidual};
 use super::{key_vector, toric_distance, velocity_frames, Chr, FastModel, Keys, Rollout, Style};
 use crate::dataset::{Scene, DOWNSAMPLE};
 use crate::features::{decode_camera, encode_camera, encode_character, CharacterFeatures};
-use crate::toric::{to_pose, CameraPose, Lens, Toric};
+use crate::toric::{Lens, Toric};
 use crate::CameraError;
 use inbetween_core::curve::{Curve, Track};
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// Options of a [`GenerateJob`].
@@ -31,47 +31,6 @@ pub struct GenerateOptions {
 impl Default for GenerateOptions {
     fn default() -> Self {
         GenerateOptions { exact_keys: true, lens: Lens::default(), remap_at_keys: true, causal: false }
-    }
-}
-
-/// One generated frame.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CameraFrame {
-    pub frame: usize,
-    pub toric: Toric,
-    pub targets: [usize; 2],
-    pub pose: CameraPose,
-}
-
-/// How far the network's own output missed a keyframe (before correction).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct KeyResidual {
-    pub frame: usize,
-    /// ‖x̂^c − x^c_K‖₂ in Toric units.
-    pub residual: f64,
-}
-
-/// A generated camera track.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CameraTrack {
-    pub fps: f64,
-    pub style: String,
-    pub style_code: Vec<f32>,
-    pub lens: Lens,
-    pub frames: Vec<CameraFrame>,
-    pub key_residuals: Vec<KeyResidual>,
-    /// Largest residual left after correction (0 up to rounding when `exact_keys`).
-    pub max_corrected_residual: f64,
-}
-
-impl CameraTrack {
-    pub fn toric(&self) -> Vec<Toric> {
-        self.frames.iter().map(|f| f.toric).collect()
-    }
-
-    /// The largest network miss at a key (before correction).
-    pub fn worst_key_miss(&self) -> f64 {
-        self.key_residuals.iter().map(|r| r.residual).fold(0.0, f64::max)
     }
 }
 
@@ -111,7 +70,7 @@ impl<'a> GenerateJob<'a> {
     pub fn run(&self) -> Result<CameraTrack, CameraError> {
         let keys = self.validate()?;
         if self.options.causal {
-            return super::causal::run_causal(self, &keys);
+            return super::causal::run_causal(self.model, self.style, self.scene, &self.options.lens, &keys);
         }
         let network = self.network_samples(&keys);
         let (track, max_corrected_residual) = self.fill_and_correct(&keys, &network.samples)?;
@@ -183,7 +142,8 @@ impl<'a> GenerateJob<'a> {
 
     /// Catmull-Rom fill of the network samples to every frame (§4.5 "filled with cubic
     /// interpolation"), bent onto the keys when `exact_keys`; returns the per-frame values from the
-    /// first key on and the largest miss left at a key.
+    /// first key on and the largest miss left at a key. With a single key the samples stop at the
+    /// last whole 5-frame step, so the frames after it hold the last sample (clamped on purpose).
     fn fill_and_correct(
         &self,
         keys: &ResolvedKeys,
@@ -198,9 +158,9 @@ impl<'a> GenerateJob<'a> {
         let frames = keys.first_frame()..=last;
         let track: Vec<[f64; 6]> = if self.options.exact_keys {
             let bent = (&spline).corrected_to_keys(&key_values);
-            frames.map(|f| bent.sample(f as f64)).collect()
+            frames.map(|f| bent.sample_clamped(f as f64)).collect()
         } else {
-            frames.map(|f| spline.sample(f as f64)).collect()
+            frames.map(|f| spline.sample_clamped(f as f64)).collect()
         };
         let first = keys.first_frame();
         let worst = key_values.iter().map(|(t, k)| toric_distance(&track[*t as usize - first], k)).fold(0.0, f64::max);
@@ -228,6 +188,11 @@ impl<'a> GenerateJob<'a> {
     }
 }
 
+/// [`GenerateJob::run`] in causal mode (kept for callers that hold the pieces).
+pub fn generate_causal(job: &GenerateJob) -> Result<CameraTrack, CameraError> {
+    GenerateJob { options: GenerateOptions { causal: true, ..job.options }, ..*job }.run()
+}
+
 /// The network's samples, which pair each segment frames, and the misses at keys.
 struct NetworkSamples {
     samples: Vec<(usize, [f64; 6])>,
@@ -235,25 +200,12 @@ struct NetworkSamples {
     residuals: Vec<KeyResidual>,
 }
 
-/// One output frame: `toric` clamped to the lens, posed in the world on `pair`'s targets.
-pub(super) fn camera_frame(
-    scene: &Scene,
-    frame: usize,
-    pair: (usize, usize),
-    toric: Toric,
-    lens: &Lens,
-) -> Result<CameraFrame, CameraError> {
-    let (a, b) = (scene.characters[pair.0].frame(frame).target(), scene.characters[pair.1].frame(frame).target());
-    let toric = toric.clamped(lens, 0.02);
-    let pose = to_pose(&toric, a, b, lens).map_err(|e| CameraError::Model(format!("frame {frame}: {e}")))?;
-    Ok(CameraFrame { frame, toric, targets: [pair.0, pair.1], pose })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::dataset::{film_sequence, Behaviour};
     use crate::infer::example_keys;
+    use crate::toric::CameraPose;
     use glam::DVec3;
     use rand::SeedableRng;
 

@@ -7,8 +7,9 @@
 //! | [`rollout`] | [`Rollout`]: one trajectory stepped every 5th frame, restarts through H; shared by generation, the causal mode, the bench and the examples |
 //! | [`keys`] | the keyframes file ([`Keys`]) and its validation against a scene |
 //! | [`style`] | per-behaviour style codes ([`NamedStyle`]) and reference clips ([`ReferenceClip`]) |
-//! | [`generate`] | [`GenerateJob`]: validate, run the network, Catmull-Rom fill, key correction, world poses |
-//! | [`causal`] | [`CausalCamera`]: one frame at a time, no look-ahead |
+//! | [`track`] | what both modes return: [`CameraTrack`], its frames and key misses |
+//! | [`generate`] | [`GenerateJob`]: validate, run the network (offline, or the causal mode), Catmull-Rom fill, key correction, world poses |
+//! | [`causal`] | [`CausalCamera`]: one frame at a time, no look-ahead (uses [`track`], not [`generate`]) |
 //!
 //! The curve math (Catmull-Rom fill, key correction) is `inbetween_core::curve`.
 
@@ -18,17 +19,19 @@ pub mod keys;
 pub mod networks;
 pub mod rollout;
 pub mod style;
+pub mod track;
 
 use crate::features::{CAM_DIM, CHAR_ENC};
 use crate::model::MAP_FRAMES;
 use crate::toric::Toric;
 
-pub use causal::{generate_causal, CausalCamera};
-pub use generate::{CameraFrame, CameraTrack, GenerateJob, GenerateOptions, KeyResidual};
+pub use causal::CausalCamera;
+pub use generate::{generate_causal, GenerateJob, GenerateOptions};
 pub use keys::{example_keys, Keyframe, Keys, ResolvedKey};
 pub use networks::{FastModel, Scratch, StepIn};
 pub use rollout::Rollout;
 pub use style::{NamedStyle, ReferenceClip, Style};
+pub use track::{CameraFrame, CameraTrack, KeyResidual};
 
 /// x^c as the networks see it (Eq. 2 order, f32).
 pub type Cam = [f32; CAM_DIM];

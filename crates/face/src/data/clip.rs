@@ -1,7 +1,7 @@
 //! [`BlendshapeClip`]: blendshape curves sampled at (not necessarily uniform) frame times.
 
-use super::error::FaceError;
 use super::names::{arkit_index, head_eye_index, ARKIT_NAMES, HEAD_EYE_NAMES, NUM_ARKIT, NUM_HEAD_EYE};
+use crate::error::FaceError;
 
 /// Blendshape curves: per frame, the 52 ARKit weights in [`ARKIT_NAMES`] order, then the 9 head/eye
 /// rotations in [`HEAD_EYE_NAMES`] order when present, then extra channels kept by name (the NeuroSync

@@ -23,9 +23,9 @@
 //! back the same clip.
 
 use super::clip::{BlendshapeClip, Layout};
-use super::error::{shown, FaceError};
 use super::text::{at, column, fields, lines, number, push_time, push_value, read_text};
 use super::LIVE_LINK_FPS;
+use crate::error::{shown, FaceError};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -25,10 +25,10 @@
 //! [`EMOTION_NAMES`]: super::EMOTION_NAMES
 
 use super::clip::{BlendshapeClip, Layout};
-use super::error::{shown, FaceError};
 use super::names::{is_emotion, NUM_ARKIT};
 use super::text::{at, column, fields, lines, number, push_value, read_text};
 use super::LIVE_LINK_FPS;
+use crate::error::{shown, FaceError};
 use std::path::Path;
 
 const EXPECTED_HEADER: &str =

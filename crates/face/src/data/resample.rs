@@ -4,7 +4,7 @@
 //! editing; an edited clip goes back to the capture's own frame times with [`BlendshapeClip::resample_at`].
 
 use super::clip::BlendshapeClip;
-use super::error::FaceError;
+use crate::error::FaceError;
 
 /// The model's frame rate (paper §4.1: 25 fps).
 pub const MODEL_FPS: f64 = 25.0;

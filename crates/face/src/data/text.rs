@@ -2,7 +2,7 @@
 //! wrapped in one pair of double quotes), LF or CRLF, a UTF-8 BOM allowed, blank lines ignored,
 //! spaces around fields ignored.
 
-use super::error::{shown, Column, FaceError};
+use crate::error::{shown, Column, FaceError};
 use std::path::Path;
 
 /// Reads a file as UTF-8 text.

@@ -4,6 +4,7 @@
 //! amplitude and timing asymmetry.
 
 use super::random::Rand;
+use inbetween_core::interp::smoothstep;
 
 /// Minimum time between two blink onsets, seconds.
 pub const REFRACTORY_S: f64 = 0.4;
@@ -54,12 +55,6 @@ impl Blink {
     pub fn at(&self, t: f64) -> (f64, f64) {
         (self.closure(t, self.amp_left), self.closure(t - self.delay_right, self.amp_right))
     }
-}
-
-/// Cubic ease 3x² − 2x³ on [0, 1].
-pub fn smoothstep(x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    x * x * (3.0 - 2.0 * x)
 }
 
 /// Blinks over `[0, duration)` at about `rate_per_min` onsets per minute (the mean waiting time beyond

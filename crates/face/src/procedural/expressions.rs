@@ -3,10 +3,10 @@
 //! random amplitude and a small left/right asymmetry. Brows also co-move with speech emphasis (short
 //! raises on the stressed vowel of some words, as the paper observes in §4.3.3).
 
-use super::blinks::smoothstep;
 use super::random::Rand;
 use super::speech::Phone;
 use crate::data::arkit_index;
+use inbetween_core::interp::smoothstep;
 
 /// An expression type: the shapes it moves and their gains (left/right pairs share a side flag).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

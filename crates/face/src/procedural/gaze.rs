@@ -11,8 +11,8 @@
 //!   angle, radians): `EyeLookInLeft` 1.75 × yaw⁺, `EyeLookOutLeft` 1.5 × yaw⁻, `EyeLookOutRight`
 //!   1.75 × yaw⁺, `EyeLookInRight` 1.65 × yaw⁻, `EyeLookDown*` 1.65 × pitch⁺, `EyeLookUp*` 2.35 × pitch⁻.
 
-use super::blinks::smoothstep;
 use super::random::Rand;
+use inbetween_core::interp::smoothstep;
 
 /// Look-shape gains per radian (see module docs).
 pub const GAIN_IN_LEFT: f64 = 1.75;

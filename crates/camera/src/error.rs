@@ -1,0 +1,27 @@
+//! The camera engine's error type.
+
+use crate::toric;
+use std::path::{Path, PathBuf};
+
+/// Errors of the camera engine; every one names the file (and line, frame or key) at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraError {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse { path: PathBuf, line: usize, column: usize, message: String },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+    #[error("{0}")]
+    Toric(#[from] toric::ToricError),
+    #[error("model: {0}")]
+    Model(String),
+    #[error("{0}")]
+    Weights(#[from] inbetween_nn::NnError),
+}
+
+impl CameraError {
+    pub fn invalid(path: &Path, message: impl Into<String>) -> CameraError {
+        CameraError::Invalid { path: path.to_path_buf(), message: message.into() }
+    }
+}
