@@ -5,8 +5,8 @@
 //! pair the command names; "top" and "wide" keep the room-relative placement.
 
 use glam::{DVec2, DVec3};
-use inbetween_core::toric::{to_pose, Lens, Toric};
 use inbetween_core::fk::forward;
+use inbetween_core::toric::{to_pose, Lens, Toric};
 
 use super::{Animation, CameraShot};
 use crate::motion::rig::Rig;
