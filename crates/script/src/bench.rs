@@ -274,7 +274,7 @@ fn story_table(
 pub const DEMO_CHARACTER_EDIT: (&str, &str) =
     ("Tom walks slowly to the sofa and sits on it.", "Tom walks to the table and sits on the sofa.");
 
-/// Times an edit of one character's sentence in a [`StorySession`](crate::animate::incremental::StorySession)
+/// Times an edit of one character's sentence in a [`StorySession`](crate::story::StorySession)
 /// (the demo, [`DEMO_CHARACTER_EDIT`]) against the full run, and says what was re-solved.
 fn story_edit_note(
     cat: &crate::catalogue::Catalogue,
@@ -284,7 +284,7 @@ fn story_edit_note(
     acfg: &crate::animate::AnimateConfig,
     ocfg: &crate::optimize::OptimizeConfig,
 ) -> String {
-    use crate::animate::incremental::StorySession;
+    use crate::story::StorySession;
     let mut session =
         StorySession::new(cat.clone(), db.clone(), compose_cfg.clone(), lib.clone(), acfg.clone(), Some(ocfg.clone()));
     let full = session.update(stories::DEMO);

@@ -3,13 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::animate::incremental::StorySession;
 use crate::catalogue::{builtin::builtin, kenney, Catalogue};
 use crate::compose::{ComposeConfig, Composition};
 use crate::database::SceneDatabase;
 use crate::error::Diagnostic;
 use crate::output;
 use crate::session::Session;
+use crate::story::StorySession;
 use crate::ScriptError;
 
 /// Variations per hand-authored room in the default database.

@@ -1,8 +1,8 @@
 //! Text to animation (Zhang et al., "Write-An-Animation: High-level Text-based Animation Editing
-//! with Character-Scene Interaction", Pacific Graphics 2021), part 1: text → semantic scene graph
-//! → furnished scene (§3.2, §4.1).
+//! with Character-Scene Interaction", Pacific Graphics 2021).
 //!
-//! The folders follow the paper's pipeline (Fig. 2):
+//! The folders follow the paper's pipeline (Fig. 2). Part 1, text → semantic scene graph →
+//! furnished scene (§3.2, §4.1):
 //! - [`script`]: the user's text split into scene descriptions (ending in `$`), character
 //!   directions and verbal commands (§3.2);
 //! - [`parse`]: tokenising, POS tagging, lemmatising and the rules that turn tags into a
@@ -15,7 +15,24 @@
 //!   reachable;
 //! - [`compose`]: matching + layout → a furnished [`scene::Scene`]; [`session`] re-solves only
 //!   what an edit touches;
-//! - [`output`]: JSON, glTF, top-down and perspective PNG previews.
+//! - [`semantic`] (and `embed`, feature `embeddings`): words outside the synonym tables read
+//!   through sentence embeddings.
+//!
+//! Part 2, characters acting in the scene (§3.2 template actions, §4.2 motion synthesis, §4.3
+//! joint optimisation):
+//! - [`motion`]: the motion library (procedural clips, CMU and Character Creator BVH retargeted
+//!   onto the common rig, Kenney animations), walking a route with foot locking, upper/lower-body
+//!   blending, two-bone IK;
+//! - [`animate`]: each character's timeline, one module per action (walk, sit, stand up, turn,
+//!   pick up, act on an object), several characters kept apart, camera shots;
+//! - [`optimize`]: Algorithm 2, the collision and contact costs (Eq. 1–3) minimised by annealing
+//!   over object positions and heights (Eq. 4);
+//! - [`story`]: the editing loop of part 2, re-animating only the characters an edit touches and
+//!   re-optimising only their objects (above both [`animate`] and [`optimize`]).
+//!
+//! Both parts write through [`output`] (scene JSON, glTF with boxes, meshes, animated skeletons
+//! or skinned characters, BVH, PNG and GIF previews); [`job`] runs them for the CLI, [`bench`]
+//! measures them, [`demo`] and [`stories`] hold the built-in texts.
 //!
 //! Units: metres, Y up, the floor at y = 0 (glTF's convention).
 
@@ -41,5 +58,6 @@ pub mod semantic;
 pub mod session;
 pub mod ssg;
 pub mod stories;
+pub mod story;
 
 pub use error::ScriptError;

@@ -4,7 +4,6 @@
 
 use std::collections::HashMap;
 
-use inbetween_script::animate::incremental::StorySession;
 use inbetween_script::animate::AnimateConfig;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput};
@@ -13,6 +12,7 @@ use inbetween_script::motion::MotionLibrary;
 use inbetween_script::optimize::{optimize, OptimizeConfig};
 use inbetween_script::parse::parse_script;
 use inbetween_script::stories::DEMO;
+use inbetween_script::story::StorySession;
 
 const ITERATIONS: usize = 20;
 
@@ -85,7 +85,7 @@ fn editing_one_characters_sentence_re_solves_only_that_character_and_its_objects
     let builds: HashMap<&str, usize> = second.character_builds.iter().map(|(n, b)| (n.as_str(), *b)).collect();
     assert_eq!(builds["Eve"], 0);
     assert!(builds["Tom"] >= 1);
-    let eve = |u: &inbetween_script::animate::incremental::StoryUpdate| {
+    let eve = |u: &inbetween_script::story::StoryUpdate| {
         u.animation.characters.iter().find(|c| c.name == "Eve").unwrap().clone()
     };
     assert!(eve(&first).motion == eve(&second).motion, "Eve's motion changed");

@@ -1,7 +1,7 @@
 //! Several characters in one room (beyond the paper, which animates its characters one by one):
 //! prioritised planning with a space-time reservation of every character's root.
 //!
-//! Every character is first built on its own timeline ([`super::build_character`]). Each
+//! Every character is first built on its own timeline ([`super::plan::build_character`]). Each
 //! character's reservation is its root (x, z) at every frame, held at its last position after its
 //! timeline ends, so standing, sitting and acting in place reserve space as much as walking.
 //! [`separate`] then repairs the earliest frame where two roots come closer than
@@ -14,7 +14,9 @@
 //! its window, so the loop ends. A conflict no choice solves (a character standing where another
 //! must go) stays, and a note gives the pair, the frame and the distance.
 
-use super::{build_character, route, Animation, CharacterPlan, Ctx, WalkCache, PASSING_DISTANCE};
+use super::action::walk::{route, WalkCache};
+use super::plan::{build_character, CharacterInput, CharacterPlan, Ctx};
+use super::{Animation, PASSING_DISTANCE};
 use crate::motion::rig::{Rig, FPS};
 use crate::motion::WalkParams;
 
@@ -168,18 +170,8 @@ pub(crate) fn separate(
         let fix = order.into_iter().find_map(|x| improve(ctx, plans, x, f, cache).map(|c| (x, c)));
         match fix {
             Some((x, choices)) => {
-                let p = &plans[x];
-                plans[x] = build_character(
-                    ctx,
-                    &names[x],
-                    p.actions.clone(),
-                    p.start,
-                    p.grid.clone(),
-                    p.blocked_by.clone(),
-                    p.avoid.clone(),
-                    choices,
-                    cache,
-                );
+                let input = CharacterInput { name: names[x].clone(), choices, ..plans[x].input.clone() };
+                plans[x] = build_character(ctx, input, cache);
                 resolved[x] = true;
                 builds[x] += 1;
                 accepted.retain(|&(p, q, _, _)| p != x && q != x);
@@ -241,7 +233,7 @@ fn improve(
     let others: Vec<&[[f32; 2]]> =
         plans.iter().enumerate().filter(|(i, _)| *i != x).map(|(_, q)| q.traj.as_slice()).collect();
     let horizon = others.iter().map(|t| t.len()).max().unwrap_or(0);
-    let cur = p.choices.get(w).cloned().unwrap_or_default();
+    let cur = p.input.choices.get(w).cloned().unwrap_or_default();
     let from = info.route[0];
     // The first frame from the wait on where waiting `d` frames and then walking `roots` comes
     // too close to someone, until the next walk (or for good after the last one); None: clear.
@@ -269,7 +261,7 @@ fn improve(
     let current = walk_roots(ctx, cache, &info.route, &info.params);
     // A detour around where the others stand still while this walk could happen.
     let detour = {
-        let mut g = p.grid.clone();
+        let mut g = p.input.grid.clone();
         let (t0, t1) = (info.wait_start, info.wait_start + MAX_WAIT + current.len());
         for o in &others {
             for t in (t0..t1).step_by(3) {
@@ -319,7 +311,7 @@ fn improve(
 
 /// `p`'s walk choices with walk `w`'s replaced.
 fn with_choice(p: &CharacterPlan, w: usize, c: super::WalkChoice) -> Vec<super::WalkChoice> {
-    let mut all = p.choices.clone();
+    let mut all = p.input.choices.clone();
     if all.len() <= w {
         all.resize(w + 1, super::WalkChoice::default());
     }

@@ -122,5 +122,5 @@ pub fn retarget_cc(src: &Motion, rig: &Rig, up_z: bool, drop_first: bool) -> Res
         pose.translations[rig.hips] = convert * g.positions[src_of(rig.hips)] * scale;
         poses.push(pose);
     }
-    super::cmu::grounded(rig, t, poses)
+    super::grounding::grounded(rig, t, poses)
 }

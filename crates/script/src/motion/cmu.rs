@@ -2,7 +2,7 @@
 //! tagged from its descriptions, and cgspeed BVH clips retargeted onto the common skeleton
 //! (§4.2 "rotate … skeletons to the standard T-pose").
 
-use super::rig::{arc, heading_of, local_from_global, yaw, Rig, FPS};
+use super::rig::{arc, local_from_global, Rig, FPS};
 use super::verbs::tags_of_description;
 use crate::ScriptError;
 use glam::{DQuat, DVec3};
@@ -183,36 +183,7 @@ pub fn retarget(src: &Motion, rig: &Rig) -> Result<Motion, String> {
         pose.translations[rig.hips] = g.positions[map[rig.hips].expect("hips")] * scale;
         poses.push(pose);
     }
-    grounded(rig, t, poses)
-}
-
-/// Retargeted poses made into a clip that starts at the origin facing +Z, with its lowest foot
-/// points (5th percentile, so a stumble does not lift the floor) at y = 0.
-pub(crate) fn grounded(rig: &Rig, t: &Skeleton, mut poses: Vec<Pose>) -> Result<Motion, String> {
-    if poses.is_empty() {
-        return Err("no frames".into());
-    }
-    let mut lows: Vec<f64> = poses
-        .iter()
-        .map(|p| {
-            let g = forward(t, p);
-            rig.legs
-                .iter()
-                .flat_map(|l| [g.positions[l[3]].y, g.positions[l[2]].y - rig.ankle_height])
-                .fold(f64::INFINITY, f64::min)
-        })
-        .collect();
-    lows.sort_by(f64::total_cmp);
-    let ground = lows[lows.len() / 20];
-    let r0 = poses[0].rotations[rig.hips];
-    let turn = yaw(-heading_of(r0));
-    let start = poses[0].translations[rig.hips];
-    for p in &mut poses {
-        let d = p.translations[rig.hips] - DVec3::new(start.x, ground, start.z);
-        p.translations[rig.hips] = turn * d;
-        p.rotations[rig.hips] = (turn * p.rotations[rig.hips]).normalize();
-    }
-    Motion::from_poses(t.clone(), 1.0 / FPS, &poses).map_err(|e| e.to_string())
+    super::grounding::grounded(rig, t, poses)
 }
 
 /// Reads a CMU BVH and retargets it: cgspeed layouts with [`retarget`], Character Creator

@@ -15,6 +15,7 @@ pub mod blend;
 pub mod cc;
 pub mod cmu;
 pub mod cycle;
+mod grounding;
 pub mod ik;
 pub mod kenney;
 pub mod library;

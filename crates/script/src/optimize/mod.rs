@@ -401,7 +401,7 @@ pub fn optimize_scene(
 /// The annealing of Algorithm 2 from `scene` (animated as `anim0`, with costs `before`), moving
 /// only the objects in `movable`; `animate` animates a disturbed scene, or refuses it (None: the
 /// move is rejected like one that breaks the layout). The incremental editor
-/// ([`crate::animate::incremental`]) restricts `movable` to the objects of the characters it
+/// ([`crate::story`]) restricts `movable` to the objects of the characters it
 /// re-solves.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn anneal(
@@ -476,31 +476,4 @@ pub fn plot_costs(path: &Path, curves: &CostCurves) -> Result<(), ScriptError> {
     ];
     line_plot(path, "Scene layout and motion optimisation", "iteration", "cost", &series)
         .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })
-}
-
-/// Touched boxes per object (label, n_c, n_a), for reports.
-pub fn collisions_by_object(anim: &Animation, box_size: f32) -> Vec<(String, usize, usize)> {
-    anim.scene
-        .objects
-        .iter()
-        .enumerate()
-        .filter_map(|(i, o)| {
-            let mut one = anim.clone();
-            one.scene.objects = vec![o.clone()];
-            one.scene.objects[0].support = None;
-            for c in &mut one.characters {
-                for s in &mut c.segments {
-                    s.touching = if s.touching.contains(&i) { vec![0] } else { Vec::new() };
-                }
-                c.props = c
-                    .props
-                    .iter()
-                    .filter(|p| p.object == i)
-                    .map(|p| crate::animate::CarriedProp { object: 0, ..p.clone() })
-                    .collect();
-            }
-            let (_, nc, _) = collision_cost(&one, box_size);
-            (nc > 0).then(|| (o.label.clone(), nc, boxes::object_boxes(o, box_size).len()))
-        })
-        .collect()
 }

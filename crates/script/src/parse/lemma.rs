@@ -1,7 +1,7 @@
 //! Lemmatising (§3.2: the SSG stores lemmas, "sits" → "sit", "chairs" → "chair").
 
 use super::lexicon::{contains, IRREGULAR_NOUNS, IRREGULAR_VERBS, PLURALIA_TANTUM, VERBS};
-use super::tag::Tag;
+use super::penn::Tag;
 
 /// The lemma of a word with its tag: nouns singular, verbs base form, everything else lower case.
 pub fn lemmatize(word: &str, tag: Tag) -> String {

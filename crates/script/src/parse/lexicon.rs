@@ -1,5 +1,9 @@
 //! Word lists for the rule tagger (§3.2: the paper tags with CoreNLP; we need no downloads, so
 //! closed-class words, a verb list and suffix rules stand in for its statistical model).
+//!
+//! Over 800 lines on purpose: it is data, one table per word class and nothing else, read by the
+//! tagger, the lemmatiser, the rules and the suggestions alike; splitting it would only scatter
+//! the tables.
 
 /// Determiners and quantifiers (Penn DT).
 pub const DETERMINERS: &[&str] = &[

@@ -1,9 +1,11 @@
 //! Text → semantic scene graph (§3.2 "Text Parsing", §4.1). The paper runs CoreNLP's tagger and
-//! dependency parser; we tokenise ([`token`]), tag with rules ([`tag`]), lemmatise ([`lemma`]) and
-//! turn tag patterns into the SSG ([`rules`]). No model files, deterministic.
+//! dependency parser; we tokenise ([`token`]), tag with rules ([`tag`], Penn tags in [`penn`]),
+//! lemmatise ([`lemma`]) and turn tag patterns into the SSG ([`rules`]). No model files,
+//! deterministic.
 
 pub mod lemma;
 pub mod lexicon;
+pub mod penn;
 pub mod rules;
 pub mod suggest;
 pub mod tag;

@@ -1,5 +1,6 @@
 //! Incremental story editing (beyond the paper; part 1's [`crate::session`] does the same for the
-//! scene): a [`StorySession`] keeps the previous run's per-character timelines and its optimised
+//! scene). It sits above both [`crate::animate`] and [`crate::optimize`], which it drives: a
+//! [`StorySession`] keeps the previous run's per-character timelines and its optimised
 //! scene, and a new version of the script re-solves only what the edit touches.
 //!
 //! - The scene: part 1's session keeps every object of an unchanged sentence in place; such an
@@ -9,7 +10,7 @@
 //!   touch (and their supports) has the same pose, its start spot and the end spots of the
 //!   characters before it are the same, and its walks are still as clear of the furniture as they
 //!   were. Otherwise it is re-solved. A kept character whose reservation cannot be kept clear of a
-//!   re-solved one by changing the re-solved one is re-solved too ([`super::crowd`]).
+//!   re-solved one by changing the re-solved one is re-solved too ([`crate::animate::crowd`]).
 //! - The §4.3 optimisation runs only over the objects the re-solved characters touch (and the
 //!   objects related to them, as in [`crate::optimize::movable_objects`]), leaving out any object a
 //!   kept character touches or whose move would carry one; every other object keeps its exact
@@ -23,7 +24,9 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
-use super::{animate_planned, characters, object_of_node, Actions, Animation, CharacterPlan, WalkCache};
+use crate::animate::{
+    animate_planned, characters, object_of_node, Actions, AnimateConfig, Animation, CharacterPlan, WalkCache,
+};
 use crate::catalogue::Catalogue;
 use crate::compose::{ComposeConfig, ObjectKey};
 use crate::database::SceneDatabase;
@@ -33,8 +36,6 @@ use crate::optimize::{anneal, costs, movable_objects, optimize, CostCurves, Cost
 use crate::scene::{PlacedObject, Scene};
 use crate::session::{Session, Update};
 use crate::ssg::Ssg;
-
-use super::AnimateConfig;
 
 /// An action compared across versions: verb, preposition, manner and the target's identity.
 type ActionSignature = (String, Option<String>, Vec<String>, Option<ObjectKey>);
@@ -298,7 +299,7 @@ impl StorySession {
             .into_iter()
             .map(|plan| Kept {
                 key: plan.track.name.to_lowercase(),
-                actions: action_signature(&plan.actions, scene, &comp.query, &keys),
+                actions: action_signature(&plan.input.actions, scene, &comp.query, &keys),
                 clearance: walk_clearance(&plan, scene),
                 plan,
             })
@@ -380,7 +381,8 @@ fn remap(
     for (m, (sentence, _)) in p.marks.iter_mut().zip(actions) {
         m.0 = *sentence;
     }
-    p.actions = actions.clone();
+    p.input.actions = actions.clone();
+    p.input.name = name.to_string();
     p.track.name = name.to_string();
     Some(p)
 }

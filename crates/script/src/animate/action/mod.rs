@@ -1,0 +1,98 @@
+//! A character's actions (§3.2 template actions, §4.2): each SSG action's verb is read once into
+//! a [`Verb`] ([`Step::read`]) and played by its own module on the character's
+//! [`Builder`]:
+//! - [`walk`]: locomotion to the target's stand point, or two metres ahead;
+//! - [`sit`]: sitting on the target's nearest free seat (or holding the seat already taken);
+//! - [`stand_up`]: leaving the seat;
+//! - [`turn`]: turning on the spot;
+//! - [`pick_up`]: walking to a small prop and taking it into the right hand;
+//! - [`act`]: any other verb, an action in place over the idle or seated lower body, hands on the
+//!   target's contacts (or a small prop picked up first and used in the hand).
+
+pub(crate) mod act;
+pub(crate) mod pick_up;
+pub(crate) mod sit;
+pub(crate) mod stand_up;
+pub(crate) mod turn;
+pub(crate) mod walk;
+
+use super::builder::Builder;
+use crate::motion::MotionLibrary;
+use crate::ssg::Action;
+
+/// What a verb does, decided once per action from its canonical tag.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Verb {
+    /// "walk", "run" or any verb the library has a locomotion cycle for.
+    Locomotion,
+    /// "sit" or "sit_down".
+    Sit,
+    /// "stand_up" (and its synonyms "rise", "get up").
+    StandUp,
+    /// "stand" and its synonyms: stands up when seated, else a standing action.
+    Stand,
+    /// "turn": on the spot by this many radians (left +π/2, right −π/2, else about); seated, an
+    /// action in place.
+    Turn(f64),
+    /// Any other verb: an action in place.
+    Act,
+}
+
+/// One action of the timeline, read: its SSG action, canonical verb, kind, target and speed.
+pub(crate) struct Step<'s> {
+    /// The action as parsed (verb lemma, preposition, manner).
+    pub action: &'s Action,
+    /// The library's canonical tag for the verb (the lemma itself when the table lacks it).
+    pub verb: String,
+    pub kind: Verb,
+    /// The scene object acted on.
+    pub object: Option<usize>,
+    /// Cruise speed (m/s) when the manner asks for a slow walk.
+    pub speed: Option<f64>,
+}
+
+impl Verb {
+    /// The kind of a canonical verb tag; `manner` gives a turn's direction.
+    pub fn of(verb: &str, manner: &[String], lib: &MotionLibrary) -> Verb {
+        if lib.cycle(verb).is_some() || verb == "walk" || verb == "run" {
+            return Verb::Locomotion;
+        }
+        match verb {
+            "sit" | "sit_down" => Verb::Sit,
+            "stand_up" => Verb::StandUp,
+            "stand" => Verb::Stand,
+            "turn" => Verb::Turn(if manner.iter().any(|m| m == "right") {
+                -std::f64::consts::FRAC_PI_2
+            } else if manner.iter().any(|m| m == "left") {
+                std::f64::consts::FRAC_PI_2
+            } else {
+                std::f64::consts::PI
+            }),
+            _ => Verb::Act,
+        }
+    }
+}
+
+impl<'s> Step<'s> {
+    /// Reads an SSG action acting on `object`.
+    pub fn read(action: &'s Action, object: Option<usize>, lib: &MotionLibrary, slow_speed: f64) -> Step<'s> {
+        let verb = crate::motion::verbs::canonical(&action.verb).unwrap_or(action.verb.as_str()).to_string();
+        let slow = action.manner.iter().any(|m| matches!(m.as_str(), "slowly" | "carefully" | "gently" | "lazily"));
+        let kind = Verb::of(&verb, &action.manner, lib);
+        Step { action, verb, kind, object, speed: slow.then_some(slow_speed) }
+    }
+}
+
+impl Builder<'_> {
+    /// Plays one action.
+    pub fn play(&mut self, step: &Step) {
+        match step.kind {
+            Verb::Locomotion => self.walk_to(step),
+            Verb::Sit => self.sit(step),
+            Verb::StandUp => self.stand_up(),
+            Verb::Stand if self.st.seated.is_some() => self.stand_up(),
+            Verb::Turn(dh) if self.st.seated.is_none() => self.turn(dh, step.object),
+            Verb::Stand | Verb::Turn(_) | Verb::Act => self.act(step),
+        }
+    }
+}

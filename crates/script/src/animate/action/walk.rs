@@ -1,0 +1,119 @@
+//! Walking (§4.3 route + locomotion, NSM's role in the paper): an A* route on the character's
+//! grid to where it is going, walked with foot locking ([`crate::motion::walk_route`]) after
+//! waiting as the crowd repair says ([`super::super::WalkChoice`]); [`WalkCache`] keeps walks
+//! already made, as the optimiser re-animates many nearly equal scenes.
+
+use std::collections::HashMap;
+
+use inbetween_core::Motion;
+
+use super::Step;
+use crate::animate::builder::Builder;
+use crate::animate::spots::{heading_to, stand_point};
+use crate::animate::WalkInfo;
+use crate::layout::{geom, grid::Grid};
+use crate::motion::{walk_route, MotionLibrary, WalkParams};
+
+/// Walks already generated, by route and parameters (a disturbed scene often leaves a route as
+/// it was).
+#[derive(Default)]
+pub(crate) struct WalkCache {
+    walks: HashMap<Vec<u64>, Motion>,
+}
+
+impl WalkCache {
+    pub fn walk(&mut self, route: &[[f32; 2]], lib: &MotionLibrary, p: &WalkParams) -> Motion {
+        let mut key: Vec<u64> = route.iter().map(|q| ((q[0].to_bits() as u64) << 32) | q[1].to_bits() as u64).collect();
+        key.push(p.speed.unwrap_or(-1.0).to_bits());
+        key.push(p.initial_heading.unwrap_or(9.0).to_bits());
+        key.push(p.final_heading.unwrap_or(9.0).to_bits());
+        key.push(p.verb.bytes().fold(0u64, |h, b| h.wrapping_mul(131).wrapping_add(b as u64)));
+        key.push(p.lock_feet as u64);
+        if let Some(m) = self.walks.get(&key) {
+            return m.clone();
+        }
+        let m = walk_route(route, lib, p);
+        self.walks.insert(key, m.clone());
+        m
+    }
+}
+
+/// A walking route on `grid` from `from` to `to`: when an end lies on a blocked cell (next to a
+/// seat, just stood up) the route goes through the nearest free cell.
+pub(crate) fn route(grid: &Grid, from: [f32; 2], to: [f32; 2]) -> Option<Vec<[f32; 2]>> {
+    let free = |p: [f32; 2]| if grid.is_free_at(p) { Some(p) } else { grid.nearest_free(p).map(|c| grid.center(c)) };
+    let (s, g) = (free(from)?, free(to)?);
+    let mut path = grid.astar(s, g)?;
+    if s != from {
+        path.insert(0, from);
+    }
+    if g != to {
+        path.push(to);
+    }
+    Some(path)
+}
+
+impl Builder<'_> {
+    /// A locomotion verb ("walks to the desk", "runs"): stands up if seated, then walks to the
+    /// target's stand point, ending turned towards it, or two metres ahead without a target.
+    pub fn walk_to(&mut self, step: &Step) {
+        self.stand_up();
+        let (scene, grid) = (self.ctx.scene, self.grid);
+        let start = self.frames.len();
+        let (to, h) = match step.object {
+            Some(o) => {
+                let to = stand_point(scene, self.ctx.cat, grid, o, self.st.pos, self.avoid);
+                (to, heading_to(to, geom::center(&scene.objects[o]), self.st.heading))
+            }
+            None => {
+                let f = [self.st.heading.sin() as f32, self.st.heading.cos() as f32];
+                let p = [self.st.pos[0] + 2.0 * f[0], self.st.pos[1] + 2.0 * f[1]];
+                let to = grid.nearest_free(p).map(|c| grid.center(c)).unwrap_or(self.st.pos);
+                (to, self.st.heading)
+            }
+        };
+        self.walk(to, h, &step.verb, step.speed);
+        self.push_segment(&step.verb, start, step.object, step.object.into_iter().collect(), Vec::new());
+    }
+
+    /// Walks along a route to `to`, turning to `final_heading`, after waiting in place as this
+    /// walk's [`crate::animate::WalkChoice`] says.
+    pub fn walk(&mut self, to: [f32; 2], final_heading: f64, verb: &str, speed: Option<f64>) {
+        let choice = self.choices.get(self.walks.len()).cloned().unwrap_or_default();
+        let route = match choice.route {
+            Some(r) => r,
+            None => route(self.grid, self.st.pos, to).unwrap_or_else(|| {
+                self.notes.push(format!(
+                    "{}: no route from ({:.2}, {:.2}) to ({:.2}, {:.2}); walking straight",
+                    self.name, self.st.pos[0], self.st.pos[1], to[0], to[1]
+                ));
+                vec![self.st.pos, to]
+            }),
+        };
+        let lib = self.ctx.lib;
+        let params = WalkParams {
+            verb: if lib.cycle(verb).is_some() { verb.to_string() } else { "walk".into() },
+            speed,
+            initial_heading: Some(self.st.heading),
+            final_heading: Some(final_heading),
+            lock_feet: self.ctx.cfg.lock_feet,
+            ..WalkParams::default()
+        };
+        let m = self.cache.walk(&route, lib, &params);
+        let wait_start = self.frames.len();
+        if choice.wait > 0 {
+            let idle = self.idle_clip();
+            let wait = self.looped(&idle, self.st.pos, self.st.heading, choice.wait);
+            self.append(wait);
+        }
+        let poses = m.poses();
+        if let Some(last) = poses.last() {
+            let r = last.translations[self.ctx.rig.hips];
+            self.st.pos = [r.x as f32, r.z as f32];
+        }
+        let walk_start = self.frames.len();
+        self.append(poses);
+        self.walks.push(WalkInfo { wait_start, walk_start, end: self.frames.len(), route, params });
+        self.st.heading = final_heading;
+    }
+}
