@@ -159,7 +159,7 @@ impl<'a> Ctx<'a> {
 
     /// Whether C_r (as configured) forbids the step `c → k`.
     pub fn forbids(&self, c: usize, k: usize) -> bool {
-        self.p.use_cr && !(self.p.allow_reverse && !self.motion.directed_at(c)) && self.plays_backwards(c, k)
+        self.p.use_cr && (!self.p.allow_reverse || self.motion.directed_at(c)) && self.plays_backwards(c, k)
     }
 
     /// S2 was empty: the cut an editor would make, to the unvisited frame of another shot closest
