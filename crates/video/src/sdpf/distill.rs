@@ -151,10 +151,12 @@ impl<'a> Ctx<'a> {
         let shot = self.motion.shot_of(c);
         let n = self.graph.n;
         let in_shot = |f: usize| self.motion.shot_of(f) == shot;
-        if !in_shot(k) || c == 0 || c + 1 >= n || !in_shot(c - 1) || !in_shot(c + 1) {
+        if !in_shot(k) || c == 0 || !in_shot(c - 1) {
             return false;
         }
-        self.edge(k, c - 1) < self.edge(k, c + 1)
+        // At the shot's last frame there is no future to compare with: c itself stands for it.
+        let future = if c + 1 < n && in_shot(c + 1) { c + 1 } else { c };
+        self.edge(k, c - 1) < self.edge(k, future)
     }
 
     /// Whether C_r (as configured) forbids the step `c → k`.
