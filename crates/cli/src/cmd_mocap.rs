@@ -393,6 +393,8 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
             let keys = match &d {
                 codec::IbkFile::Keys(k) => k.key_frames.len(),
                 codec::IbkFile::Samples(q) => q.header.num_frames,
+                // v4 stores every frame, as v3 does.
+                codec::IbkFile::Runtime(r) => r.poses.len(),
             };
             (d.motion()?, keys)
         }

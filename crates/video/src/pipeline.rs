@@ -435,11 +435,11 @@ mod tests {
         let clip = procedural_clip(ProceduralKind::Drift, 12, 64, 48, 3);
         let mut cfg = quick_config(dir.path());
         cfg.limits.max_frames = 10;
-        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("too many frames");
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().unwrap_or_else(|| panic!("too many frames"));
         assert!(matches!(e, VideoError::Limit { field: "max_frames", value: 12, limit: 10, .. }), "{e}");
         assert!(e.to_string().contains("12 frames is more than the limit of 10"), "{e}");
         cfg.limits = VideoLimits { max_pixels: 64 * 47, ..VideoLimits::default() };
-        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("too many pixels");
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().unwrap_or_else(|| panic!("too many pixels"));
         assert!(e.to_string().contains("64x48") && e.to_string().contains("max_pixels"), "{e}");
         let l = VideoLimits { max_length: 100, max_count: 3, ..VideoLimits::default() };
         assert!(l.check_request(Some(0), 12, 1).unwrap_err().to_string().contains("0 frames"));
@@ -457,17 +457,19 @@ mod tests {
         let mut cfg = quick_config(dir.path());
         cfg.cancel = Cancel::new();
         cfg.cancel.cancel();
-        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("cancelled");
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().unwrap_or_else(|| panic!("cancelled"));
         assert!(matches!(e, VideoError::Cancelled(_)), "{e}");
         // A deadline already past: the same, reported as the time limit.
         cfg.cancel = Cancel::with_time_limit(std::time::Duration::ZERO);
-        let e = analyse(&clip, &cfg, &Progress::hidden()).err().expect("time limit");
+        let e = analyse(&clip, &cfg, &Progress::hidden()).err().unwrap_or_else(|| panic!("time limit"));
         assert!(e.to_string().contains("time limit"), "{e}");
         // Cancelled after the analysis: the walk stops before its first step.
         cfg.cancel = Cancel::new();
         let a = analyse(&clip, &cfg, &Progress::hidden()).unwrap();
         cfg.cancel.cancel();
-        let e = resequence(&a, 0, &SdpfParams::default(), 1, &VideoLimits::default()).err().expect("cancelled walk");
+        let e = resequence(&a, 0, &SdpfParams::default(), 1, &VideoLimits::default())
+            .err()
+            .unwrap_or_else(|| panic!("cancelled walk"));
         assert!(matches!(e, VideoError::Cancelled(_)), "{e}");
     }
 
@@ -475,7 +477,8 @@ mod tests {
     fn pipeline_refuses_a_one_frame_clip() {
         let dir = tempfile::tempdir().unwrap();
         let clip = procedural_clip(ProceduralKind::Pendulum, 1, 32, 32, 1);
-        let e = analyse(&clip, &quick_config(dir.path()), &Progress::hidden()).err().expect("an error");
+        let e =
+            analyse(&clip, &quick_config(dir.path()), &Progress::hidden()).err().unwrap_or_else(|| panic!("an error"));
         assert!(e.to_string().contains("at least 2 frames"), "{e}");
     }
 }

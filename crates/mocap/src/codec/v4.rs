@@ -345,7 +345,7 @@ mod tests {
     fn truncated_and_damaged_files_are_refused_with_a_message() {
         let good = compress(&walk(), &Options::with_format(0.05, Format::V4)).unwrap().bytes;
         for n in 0..good.len() {
-            let e = Clip::open(&good[..n]).err().expect("a prefix opens");
+            let e = Clip::open(&good[..n]).err().unwrap_or_else(|| panic!("a prefix opens"));
             assert!(!e.to_string().is_empty());
             assert!(crate::codec::read(&good[..n]).is_err());
         }
@@ -362,7 +362,8 @@ mod tests {
             b
         };
         for n in 8..body.len() {
-            let e = Clip::open(&fix(body[..n].to_vec())).err().expect("a cut body opens").to_string();
+            let e =
+                Clip::open(&fix(body[..n].to_vec())).err().unwrap_or_else(|| panic!("a cut body opens")).to_string();
             assert!(e.contains("truncated") || e.contains("byte") || e.contains("segment"), "cut at {n}: {e}");
         }
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
