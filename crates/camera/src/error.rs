@@ -18,6 +18,12 @@ pub enum CameraError {
     Model(String),
     #[error("{0}")]
     Weights(#[from] inbetween_nn::NnError),
+    /// An input over one of the job's stated limits (the error names the limit's field).
+    #[error("{0}")]
+    Limit(#[from] inbetween_io::LimitExceeded),
+    /// The job's cancel token stopped it (cancelled, or its time limit passed).
+    #[error("camera job stopped: {0}")]
+    Cancelled(#[from] inbetween_core::cancel::Cancelled),
 }
 
 impl CameraError {

@@ -323,6 +323,7 @@ struct CameraObjective<'a, 'p> {
     data: &'a TrainData,
     device: Device,
     progress: Progress<'p>,
+    cancel: &'a inbetween_core::cancel::Cancel,
 }
 
 impl inbetween_nn::train::Objective<CameraModel> for CameraObjective<'_, '_> {
@@ -333,6 +334,10 @@ impl inbetween_nn::train::Objective<CameraModel> for CameraObjective<'_, '_> {
         let batch =
             sample_batch(self.data, &self.cfg.model, &which, gap, self.cfg.static_start, &mut rng, &self.device);
         Some(batch_loss(model, batch, self.cfg.loss_smoothing).0)
+    }
+
+    fn check_cancel(&self) -> Result<(), inbetween_core::cancel::Cancelled> {
+        self.cancel.check()
     }
 
     fn after_step(&mut self, _: &CameraModel, step: &Step, loss: Option<f64>) {
@@ -354,13 +359,28 @@ pub fn train(
     checkpoint_dir: Option<&Path>,
     progress: Progress,
 ) -> Result<(CameraModel, TrainSummary), CameraError> {
+    train_cancellable(cfg, checkpoint_dir, progress, &inbetween_core::cancel::Cancel::new())
+}
+
+/// [`train`] that stops before the next step once `cancel` is cancelled (or its time limit
+/// passes), returning [`CameraError::Cancelled`]; the unfinished epoch is not checkpointed.
+pub fn train_cancellable(
+    cfg: &TrainConfig,
+    checkpoint_dir: Option<&Path>,
+    progress: Progress,
+    cancel: &inbetween_core::cancel::Cancel,
+) -> Result<(CameraModel, TrainSummary), CameraError> {
     let device = inbetween_nn::backend::cpu_autodiff();
     let dataset = Dataset::generate(cfg.seed, cfg.scenes, crate::dataset::SCENE_FRAMES);
+    cancel.check()?;
     let data = TrainData::from_dataset(&dataset);
-    let mut objective = CameraObjective { cfg, data: &data, device: device.clone(), progress };
+    let mut objective = CameraObjective { cfg, data: &data, device: device.clone(), progress, cancel };
     let run =
         inbetween_nn::train::fit_with(&cfg.loop_config(checkpoint_dir), &device, |d| cfg.model.init(d), &mut objective)
-            .map_err(|e| CameraError::Model(e.to_string()))?;
+            .map_err(|e| match e {
+                inbetween_nn::NnError::Cancelled(c) => CameraError::Cancelled(c),
+                e => CameraError::Model(e.to_string()),
+            })?;
     let epochs_done = run.loss_history.len();
     let summary = TrainSummary {
         config: cfg.clone(),

@@ -4,10 +4,14 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_camera::bench;
 use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
-use inbetween_camera::infer::{GenerateJob, GenerateOptions, Keys, ReferenceClip, Style};
+use inbetween_camera::infer::{GenerateJob, GenerateLimits, GenerateOptions, Keys, ReferenceClip, Style};
 use inbetween_camera::train::{self, TrainConfig, TrainEvent};
 use inbetween_camera::weights::{self, CameraWeights};
+use inbetween_core::cancel::Cancel;
+use inbetween_io::{LimitExceeded, OutputSet};
 use std::path::{Path, PathBuf};
+
+use crate::errors;
 
 #[derive(Subcommand)]
 pub enum CameraCommand {
@@ -19,6 +23,19 @@ pub enum CameraCommand {
     Train(TrainArgs),
     /// Benchmark: Table 1, Table 2 (SD/TD/KD), §6.3 spline comparison, style PCA, frames/s.
     Bench(BenchArgs),
+    /// Scaling bench: `camera generate` on the demo's example (300 frames, 3 keys) at 1×, 10×,
+    /// 100×, with time and peak memory per run.
+    Scale(ScaleArgs),
+}
+
+#[derive(Args)]
+pub struct ScaleArgs {
+    /// Folder for the table (CSV, Markdown, text).
+    #[arg(short, long, default_value = "out/camera-scale")]
+    pub out: PathBuf,
+    /// Multiples of the example to run.
+    #[arg(long, value_delimiter = ',', default_value = "1,10,100")]
+    pub scales: Vec<usize>,
 }
 
 #[derive(Args)]
@@ -69,7 +86,19 @@ pub struct GenerateArgs {
     /// Weights (default: the committed weights).
     #[arg(long)]
     pub weights: Option<PathBuf>,
+    /// Most frames the scene may hold.
+    #[arg(long, default_value_t = GenerateLimits::default().max_frames)]
+    pub max_frames: usize,
+    /// Most keyframes the keys file may hold.
+    #[arg(long, default_value_t = GenerateLimits::default().max_keys)]
+    pub max_keys: usize,
+    /// Stop with an error, writing nothing, after this many seconds.
+    #[arg(long)]
+    pub time_limit: Option<f64>,
 }
+
+/// The generate job's limit fields and the flags that set them.
+const GENERATE_FLAGS: &[(&str, &str)] = &[("max_frames", "--max-frames"), ("max_keys", "--max-keys")];
 
 #[derive(Args)]
 pub struct SceneArgs {
@@ -80,6 +109,9 @@ pub struct SceneArgs {
     pub seed: u64,
     #[arg(long, default_value_t = 450)]
     pub frames: usize,
+    /// Most frames a scene may hold (the generate job's limit).
+    #[arg(long, default_value_t = GenerateLimits::default().max_frames)]
+    pub max_frames: usize,
 }
 
 #[derive(Args)]
@@ -120,14 +152,19 @@ pub struct TrainArgs {
     /// LSTM / FC width (the paper: 256).
     #[arg(long, default_value_t = 256)]
     pub hidden: usize,
+    /// Stop with an error after this many seconds, writing no weights (checkpoints of finished
+    /// epochs stay, so a rerun resumes). Unlike --minutes, which ends training early and saves it.
+    #[arg(long)]
+    pub time_limit: Option<f64>,
 }
 
 pub fn run(c: CameraCommand) -> anyhow::Result<()> {
     match c {
-        CameraCommand::Generate(a) => run_generate(a),
-        CameraCommand::Scene(a) => run_scene(a),
-        CameraCommand::Train(a) => run_train(a),
+        CameraCommand::Generate(a) => run_generate(a).map_err(|e| errors::name_flags(e, GENERATE_FLAGS)),
+        CameraCommand::Scene(a) => run_scene(a).map_err(|e| errors::name_flags(e, &[("max_frames", "--max-frames")])),
+        CameraCommand::Train(a) => run_train(a).map_err(|e| errors::name_flags(e, &[])),
         CameraCommand::Bench(a) => run_bench(a),
+        CameraCommand::Scale(a) => run_scale(a),
     }
 }
 
@@ -155,10 +192,25 @@ fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
 }
 
 fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
+    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let limits = GenerateLimits { max_frames: a.max_frames, max_keys: a.max_keys };
     let w = load_weights(a.weights.as_deref())?;
     let scene = Scene::load(&a.scene)?;
+    LimitExceeded::check_count(
+        a.scene.display().to_string(),
+        scene.num_frames(),
+        limits.max_frames,
+        "frames",
+        "max_frames",
+    )?;
     let keys = Keys::load(&a.keys)?;
-    let options = GenerateOptions { exact_keys: !a.no_exact_keys, causal: a.causal, ..GenerateOptions::default() };
+    let options = GenerateOptions {
+        exact_keys: !a.no_exact_keys,
+        causal: a.causal,
+        limits,
+        cancel: Some(&cancel),
+        ..GenerateOptions::default()
+    };
     let runs: Vec<(Style, PathBuf)> = if a.all_styles {
         BEHAVIOURS
             .iter()
@@ -172,36 +224,53 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
             .with_context(|| format!("unknown style `{name}` (direct, relative, side, orbit)"))?;
         vec![(behaviour_style(&w, b)?, a.out.clone())]
     };
+    // Every track, glTF and preview of the run appear together at the end, or none.
+    let mut set = OutputSet::new();
+    let mut lines = Vec::new();
     for (style, out) in runs {
         let name = style.name.clone();
         let track =
             GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin: &a.keys }
                 .run()?;
-        inbetween_camera::write_json(&out, &track)?;
+        let staged = |set: &mut OutputSet, p: &Path| set.file(p).with_context(|| format!("preparing {}", p.display()));
+        inbetween_camera::write_json(&staged(&mut set, &out)?, &track)?;
         let gltf = match &a.gltf {
             Some(g) if a.all_styles => with_suffix(g, &name),
             Some(g) => g.clone(),
             None => out.with_extension("gltf"),
         };
-        inbetween_camera::gltf::write_gltf(&gltf, &track, &scene)?;
+        inbetween_camera::gltf::write_gltf(&staged(&mut set, &gltf)?, &track, &scene)?;
         if let Some(g) = &a.gif {
             let g = if a.all_styles { with_suffix(g, &name) } else { g.clone() };
-            inbetween_camera::preview::write_preview(&g, &track, &scene, 3)?;
-            println!("  preview {}", g.display());
+            inbetween_camera::preview::write_preview(&staged(&mut set, &g)?, &track, &scene, 3)?;
+            lines.push(format!("  preview {}", g.display()));
         }
+        cancel.check()?;
         let worst = track.worst_key_miss();
-        println!(
+        lines.push(format!(
             "{name}: {} frames -> {} (network keyframe miss max {worst:.4}, after correction {:.1e})",
             track.frames.len(),
             out.display(),
             track.max_corrected_residual
-        );
+        ));
+    }
+    set.commit().context("moving the camera tracks into place")?;
+    for line in lines {
+        println!("{line}");
     }
     Ok(())
 }
 
 fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
-    let files = inbetween_camera::demo::write_example_scene(&a.out, a.seed, a.frames)?;
+    LimitExceeded::check_count("--frames", a.frames, a.max_frames, "frames", "max_frames")?;
+    if a.frames < 2 {
+        anyhow::bail!("--frames {}: a scene needs at least 2 frames", a.frames);
+    }
+    // The scene, keys and references appear together in OUT (merged into it when it exists), or none.
+    let mut set = OutputSet::new();
+    let staged = set.dir(&a.out).with_context(|| format!("preparing {}", a.out.display()))?;
+    let files = inbetween_camera::demo::write_example_scene(&staged, a.seed, a.frames)?;
+    set.commit().with_context(|| format!("moving the scene files into {}", a.out.display()))?;
     println!("wrote {} to {}", files.join(", "), a.out.display());
     Ok(())
 }
@@ -249,12 +318,15 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
             bar.println(format!("epoch {:>3}  loss {loss:.5}  lr {lr:.2e}  {seconds:.0} s", epoch + 1));
         }
     };
-    let (model, summary) = train::train(&cfg, Some(&a.checkpoints), &mut report)?;
+    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let (model, summary) = train::train_cancellable(&cfg, Some(&a.checkpoints), &mut report, &cancel)?;
     bar.finish();
-    if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    weights::save(&model, &summary, &a.out, a.overwrite_committed)?;
+    // The weights and their card appear together, or neither.
+    let mut set = OutputSet::new();
+    let staged = set.file(&a.out).with_context(|| format!("preparing {}", a.out.display()))?;
+    set.file(&a.out.with_extension("json")).with_context(|| format!("preparing {}", a.out.display()))?;
+    weights::save(&model, &summary, &staged, a.overwrite_committed)?;
+    set.commit().with_context(|| format!("moving the weights to {}", a.out.display()))?;
     println!(
         "trained {} epochs ({} iterations) in {:.1} min, final loss {:.4}; weights: {}",
         summary.epochs_done,
@@ -264,4 +336,58 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     Ok(())
+}
+
+fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
+    use inbetween_io::scale::scale_table;
+    let exe = std::env::current_exe().context("locating the inbetween binary")?;
+    // Inputs and outputs of the runs go to a scratch folder, removed at the end.
+    let scratch = std::env::temp_dir().join(format!("inbetween-scale-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
+    let result = scale_rows(&a, &exe, &scratch);
+    let _ = std::fs::remove_dir_all(&scratch);
+    let rows = result?;
+    let table = scale_table("camera_scale", "camera generate (orbit style) at multiples of the demo's example", &rows);
+    let mut report = inbetween_io::report::Report::new("report", "camera scaling");
+    print!("{}", table.to_text());
+    report.table(table);
+    let files = report.write(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+    println!("wrote {} files to {}", files.len(), a.out.display());
+    Ok(())
+}
+
+/// One measured run per scale of `a.scales`, inputs written to `work`.
+fn scale_rows(a: &ScaleArgs, exe: &Path, work: &Path) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
+    use inbetween_io::scale::{run_measured, ScaleRow};
+    let mut rows = Vec::new();
+    for &k in &a.scales {
+        // The demo's example, k times: a 300·k-frame scene with a key every 150 frames (3 at 1×).
+        let frames = 300 * k;
+        let scene = Scene::procedural(3, frames, 30.0);
+        let mut at: Vec<usize> = (0..frames).step_by(150).collect();
+        if at.last() != Some(&(frames - 1)) {
+            at.push(frames - 1);
+        }
+        let keys = inbetween_camera::infer::example_keys(&scene, &at);
+        let (scene_path, keys_path) = (work.join(format!("scene-{k}.json")), work.join(format!("keys-{k}.json")));
+        scene.save(&scene_path)?;
+        inbetween_camera::write_json(&keys_path, &keys)?;
+        let out = work.join(format!("cam-{k}.json"));
+        let run = run_measured(std::process::Command::new(exe).args([
+            "camera".as_ref(),
+            "generate".as_ref(),
+            "--scene".as_ref(),
+            scene_path.as_os_str(),
+            "--keys".as_ref(),
+            keys_path.as_os_str(),
+            "--style".as_ref(),
+            "orbit".as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]))
+        .context("running camera generate")?;
+        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
+        rows.push(ScaleRow { scale: k, input: format!("{frames} frames at 30 fps, {} keys", at.len()), run });
+    }
+    Ok(rows)
 }

@@ -5,17 +5,20 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
 
+use inbetween_core::cancel::Cancel;
 use inbetween_face::bench::{self, FaceBenchConfig};
-use inbetween_face::data::{read_clip, write_clip, BlendshapeClip, MODEL_FPS};
+use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::mask::{parse_span_spec, SpanSpec};
 use inbetween_face::edit::ConstraintKind;
-use inbetween_face::infer::{read_keys, EditJob, Guide, Inpainter, Method};
+use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide, Inpainter, Method};
 use inbetween_face::preview::{span_flags, write_edit_gif, write_edit_png, CurvePreview};
-use inbetween_face::train::{save_face_weights, train_face, FaceTrainConfig};
+use inbetween_face::train::{save_face_weights, train_face_cancellable, FaceTrainConfig};
 use inbetween_face::visemes::{phoneme_viseme, read_viseme_source, text_to_phonemes, PhonemeSpan};
 use inbetween_face::{corpus, procedural, weights};
-use inbetween_io::Progress;
+use inbetween_io::{OutputSet, Progress};
+
+use crate::errors;
 
 #[derive(Subcommand)]
 pub enum FaceCommand {
@@ -27,6 +30,19 @@ pub enum FaceCommand {
     Bench(BenchArgs),
     /// Write a procedural face capture (Live Link CSV or curve CSV/JSON) and its phoneme timing.
     Synth(SynthArgs),
+    /// Scaling bench: `face edit` on the demo's example (10 s clip, 3 s gap) at 1×, 10×, 100×, with
+    /// time and peak memory per run.
+    Scale(ScaleArgs),
+}
+
+#[derive(Args)]
+pub struct ScaleArgs {
+    /// Folder for the table (CSV, Markdown, text).
+    #[arg(short, long, default_value = "out/face-scale")]
+    pub out: PathBuf,
+    /// Multiples of the example to run.
+    #[arg(long, value_delimiter = ',', default_value = "1,10,100")]
+    pub scales: Vec<usize>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -84,7 +100,19 @@ pub struct EditArgs {
     pub gif: Option<PathBuf>,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Most rows (frames) the input clip or the noisy take may hold.
+    #[arg(long, default_value_t = EditLimits::default().max_rows)]
+    pub max_rows: usize,
+    /// Longest stretch, in seconds, from the first --mask span's start to the last one's end.
+    #[arg(long, default_value_t = EditLimits::default().max_mask_s)]
+    pub max_mask_seconds: f64,
+    /// Stop with an error, writing nothing, after this many seconds.
+    #[arg(long)]
+    pub time_limit: Option<f64>,
 }
+
+/// The edit job's limit fields and the flags that set them.
+const EDIT_FLAGS: &[(&str, &str)] = &[("max_rows", "--max-rows"), ("max_mask_s", "--max-mask-seconds")];
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum DataArg {
@@ -133,6 +161,11 @@ pub struct TrainArgs {
     pub captures: Option<PathBuf>,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Stop with an error after this many seconds over all networks, writing no weights (checkpoints
+    /// of finished epochs stay, so a rerun resumes). Unlike --minutes, which ends each network's
+    /// training early and saves it.
+    #[arg(long)]
+    pub time_limit: Option<f64>,
 }
 
 #[derive(Args)]
@@ -168,10 +201,11 @@ pub struct SynthArgs {
 
 pub fn run(c: FaceCommand) -> anyhow::Result<()> {
     match c {
-        FaceCommand::Edit(a) => run_edit(a),
-        FaceCommand::Train(a) => run_train(a),
+        FaceCommand::Edit(a) => run_edit(a).map_err(|e| errors::name_flags(e, EDIT_FLAGS)),
+        FaceCommand::Train(a) => run_train(a).map_err(|e| errors::name_flags(e, &[])),
         FaceCommand::Bench(a) => run_bench(a),
         FaceCommand::Synth(a) => run_synth(a),
+        FaceCommand::Scale(a) => run_scale(a),
     }
 }
 
@@ -205,6 +239,10 @@ fn span_seconds(text: &str, clip: &BlendshapeClip) -> anyhow::Result<(f64, f64)>
     if a >= duration {
         bail!("mask '{text}' lies outside the clip ({duration:.2} s long)");
     }
+    // A span in frames may end one frame past the last frame's time (it covers the last frame).
+    if b > duration + 1.0 / clip.fps() + 1e-9 {
+        bail!("mask '{text}' runs past the clip's end ({duration:.2} s long); end it at {duration:.2}s at the latest");
+    }
     Ok((a, b))
 }
 
@@ -223,7 +261,7 @@ fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow
     Ok(if let Some(k) = &a.keys {
         Guide::Keys(read_keys(k)?)
     } else if let Some(g) = &a.guide {
-        Guide::Noisy(read_clip(g)?)
+        Guide::Noisy(read_clip_limited(g, a.max_rows)?)
     } else if let Some(v) = &a.visemes {
         Guide::Visemes(viseme_runs(&read_viseme_source(v, a.tier.as_deref())?)?)
     } else if let Some(text) = &a.text {
@@ -242,7 +280,9 @@ fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow
 }
 
 fn run_edit(a: EditArgs) -> anyhow::Result<()> {
-    let clip = read_clip(&a.input)?;
+    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let limits = EditLimits { max_rows: a.max_rows, max_mask_s: a.max_mask_seconds };
+    let clip = read_clip_limited(&a.input, limits.max_rows)?;
     let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<anyhow::Result<Vec<_>>>()?;
     let channels = parse_groups(&a.groups).map_err(anyhow::Error::msg)?;
     let guide = guide_of(&a, &clip, &spans)?;
@@ -260,14 +300,28 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         (MethodArg::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
         (MethodArg::Network, None) => unreachable!("a network was loaded above"),
     };
-    let job = EditJob { clip: &clip, spans: spans.clone(), channels, guide, method, seed: a.seed };
+    let guide_file = [&a.keys, &a.guide, &a.visemes].into_iter().flatten().next().map(|p| p.display().to_string());
+    let job = EditJob {
+        clip: &clip,
+        spans: spans.clone(),
+        channels,
+        guide,
+        method,
+        seed: a.seed,
+        limits,
+        cancel: cancel.clone(),
+        guide_file,
+    };
     let t = std::time::Instant::now();
     let out = job.run()?;
     let ms = t.elapsed().as_secs_f64() * 1000.0;
     let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
         && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
         && is_live_link(&a.input);
-    write_clip(&a.out, &out.clip, live_link)?;
+    // The clip, its PNG and the GIF appear together or not at all.
+    let mut set = OutputSet::new();
+    let staged = |set: &mut OutputSet, p: &Path| set.file(p).with_context(|| format!("preparing {}", p.display()));
+    write_clip(&staged(&mut set, &a.out)?, &out.clip, live_link)?;
     let segs = out.mask.segments();
     let png = a.png.clone().unwrap_or_else(|| a.out.with_extension("png"));
     let title = format!("{} · {} · {}", a.input.display(), method.name(), job.guide.kind().name());
@@ -281,7 +335,8 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         extra: None,
         n_curves: 6,
     };
-    write_edit_png(&png, &preview).with_context(|| format!("writing {}", png.display()))?;
+    write_edit_png(&staged(&mut set, &png)?, &preview).with_context(|| format!("writing {}", png.display()))?;
+    cancel.check()?;
     if let Some(gif) = &a.gif {
         let first = segs.iter().map(|s| s.start).min().unwrap_or(0).saturating_sub(25);
         let last = (segs.iter().map(|s| s.end).max().unwrap_or(0) + 25).min(out.before.len());
@@ -289,7 +344,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
             segs.iter().map(|s| inbetween_face::edit::Segment { start: s.start - first, end: s.end - first }).collect();
         let progress = Progress::new((last - first) as u64, "face gif");
         write_edit_gif(
-            gif,
+            &staged(&mut set, gif)?,
             MODEL_FPS,
             &[("original", &out.before[first..last]), ("edited", &out.after[first..last])],
             None,
@@ -298,6 +353,10 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         )
         .with_context(|| format!("writing {}", gif.display()))?;
         progress.finish();
+        cancel.check()?;
+    }
+    set.commit().context("moving the edit's outputs into place")?;
+    if let Some(gif) = &a.gif {
         println!("  preview {}", gif.display());
     }
     println!(
@@ -340,7 +399,11 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         DataArg::Procedural => corpus::procedural_pool(a.clips, 20.0, a.seed)?,
         DataArg::Real => corpus::real_pool(&captures_dir(a.captures.as_deref())?)?,
     };
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let device = inbetween_nn::backend::cpu_autodiff();
+    // Every network's weights and card appear together at the end, or none.
+    let mut set = OutputSet::new();
+    let mut trained = Vec::new();
     for kind in kinds {
         if a.data == DataArg::Real && kind == ConstraintKind::Visemes {
             println!("visemes: skipped, the real captures have no phoneme labels");
@@ -356,12 +419,14 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         cfg.time_limit_s = a.minutes.map(|m| m * 60.0);
         cfg.checkpoint_dir = Some(a.checkpoints.join(kind.name()));
         let progress = Progress::new((cfg.epochs * cfg.steps_per_epoch) as u64, &format!("train {}", kind.name()));
-        let report = train_face(&cfg, &pool, &progress)?;
+        let report = train_face_cancellable(&cfg, &pool, &progress, &device, &cancel)?;
         progress.finish();
         let out = a.out.join(weights::committed_file(kind));
-        save_face_weights(&report, &out)?;
+        let staged = set.file(&out).with_context(|| format!("preparing {}", out.display()))?;
+        set.file(&out.with_extension("json")).with_context(|| format!("preparing {}", out.display()))?;
+        save_face_weights(&report, &staged)?;
         let f = report.final_losses();
-        println!(
+        trained.push(format!(
             "{}: {} steps in {:.1} min, final generator loss {:.4} (reconstruction {:.4}); weights {}",
             kind.name(),
             report.steps,
@@ -369,7 +434,11 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
             f.generator,
             f.rec,
             out.display()
-        );
+        ));
+    }
+    set.commit().with_context(|| format!("moving the weights into {}", a.out.display()))?;
+    for line in trained {
+        println!("{line}");
     }
     Ok(())
 }
@@ -395,11 +464,13 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
 
 fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
     let p = procedural::generate(&procedural::ProceduralConfig { duration_s: a.seconds, ..Default::default() }, a.seed);
-    write_clip(&a.out, &p.clip, a.live_link)?;
+    let mut set = OutputSet::new();
+    write_clip(&set.file(&a.out)?, &p.clip, a.live_link)?;
     let spans: Vec<PhonemeSpan> =
         p.phonemes.iter().map(|(s, e, ph)| PhonemeSpan { start_s: *s, end_s: *e, phoneme: ph.to_string() }).collect();
     let timing = a.out.with_extension("phonemes.csv");
-    inbetween_face::visemes::write_phoneme_timing(&timing, &spans)?;
+    inbetween_face::visemes::write_phoneme_timing(&set.file(&timing)?, &spans)?;
+    set.commit().with_context(|| format!("moving {} and {} into place", a.out.display(), timing.display()))?;
     println!(
         "wrote {} ({} frames at {MODEL_FPS} fps) and its phoneme timing {}",
         a.out.display(),
@@ -407,4 +478,52 @@ fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
         timing.display()
     );
     Ok(())
+}
+
+fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
+    use inbetween_io::scale::scale_table;
+    let exe = std::env::current_exe().context("locating the inbetween binary")?;
+    // Inputs and outputs of the runs go to a scratch folder, removed at the end.
+    let scratch = std::env::temp_dir().join(format!("inbetween-scale-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
+    let result = scale_rows(&a, &exe, &scratch);
+    let _ = std::fs::remove_dir_all(&scratch);
+    let rows = result?;
+    let table = scale_table("face_scale", "face edit (unguided network) at multiples of the demo's example", &rows);
+    let mut report = inbetween_io::report::Report::new("report", "face scaling");
+    print!("{}", table.to_text());
+    report.table(table);
+    let files = report.write(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+    println!("wrote {} files to {}", files.len(), a.out.display());
+    Ok(())
+}
+
+/// One measured run per scale of `a.scales`, inputs written to `work`.
+fn scale_rows(a: &ScaleArgs, exe: &Path, work: &Path) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
+    use inbetween_face::demo::OCCLUSION_S;
+    use inbetween_io::scale::{run_measured, ScaleRow};
+    let mut rows = Vec::new();
+    for &k in &a.scales {
+        // The demo's example, k times: a 10·k s procedural clip, a gap of 3·k s from 3.5 s.
+        let seconds = 10.0 * k as f64;
+        let (start, end) = (OCCLUSION_S.0, OCCLUSION_S.0 + (OCCLUSION_S.1 - OCCLUSION_S.0) * k as f64);
+        let p = procedural::generate(&procedural::ProceduralConfig { duration_s: seconds, ..Default::default() }, 1);
+        let input = work.join(format!("clip-{k}.csv"));
+        write_clip(&input, &p.clip, false)?;
+        let out = work.join(format!("edit-{k}.csv"));
+        let run = run_measured(std::process::Command::new(exe).args([
+            "face".as_ref(),
+            "edit".as_ref(),
+            input.as_os_str(),
+            "--mask".as_ref(),
+            format!("{start}s..{end}s").as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]))
+        .context("running face edit")?;
+        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
+        let input = format!("{seconds} s clip ({} rows), {:.1} s gap", p.clip.num_frames(), end - start);
+        rows.push(ScaleRow { scale: k, input, run });
+    }
+    Ok(rows)
 }

@@ -139,7 +139,10 @@ pub struct BudgetArgs {
     /// Number of keyframes (first and last frame included).
     #[arg(short, long, conflicts_with = "max_error")]
     pub k: Option<usize>,
-    /// Largest allowed position error of any joint in any frame, e.g. 1cm, 5mm.
+    /// Error bound with its unit (mm, cm or m), e.g. 1cm, 5mm. Version 3 and 4 files bound the
+    /// virtual-vertex error: three points 3 cm from each joint along its local axes (ACL's metric;
+    /// a joint itself may move a little more); version 2 (-k or --format v2) bounds each joint's
+    /// position error.
     #[arg(long)]
     pub max_error: Option<String>,
     /// Longest gap between two keys, in seconds (bounds the search; -k widens it as needed).
@@ -190,14 +193,16 @@ pub struct CompressArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub budget: BudgetArgs,
-    /// File format: `v3` (every frame, per-track step sizes, entropy coded; --max-error bounds the
-    /// virtual vertices 3 cm from each joint) or `v2` (keyframes; --max-error bounds the joints).
-    /// Default: v3 with --max-error, v2 with -k.
+    /// File format: `v4` (every frame, fixed-width values per segment: the runtime layout, a pose
+    /// samples in well under a microsecond), `v3` (every frame, entropy coded: smaller files,
+    /// slower to sample) or `v2` (keyframes). v3 and v4 bound the virtual vertices 3 cm from each
+    /// joint; v2 bounds each joint's position. Default: v4 with --max-error, v2 with -k.
     #[arg(long)]
     pub format: Option<String>,
-    /// Frames per segment of a v3 file (a pose decodes from its segment alone).
-    #[arg(long, default_value_t = inbetween_mocap::codec::v3::DEFAULT_SEGMENT_LEN)]
-    pub segment: usize,
+    /// Frames per segment of a v3 or v4 file (a pose decodes from its segment alone). Default: 32
+    /// for v3, 16 for v4.
+    #[arg(long)]
+    pub segment: Option<usize>,
 }
 
 #[derive(Args)]
@@ -265,6 +270,10 @@ pub struct BenchArgs {
     /// Run only the codec table on ACL's protocol (skip the keyframe-selection bench).
     #[arg(long)]
     pub codec_only: bool,
+    /// Bounds (cm) of the race against the real ACL (built from ../shared/peers/acl-race when it and
+    /// g++ exist; otherwise `skipped: ACL not built` and our rows only).
+    #[arg(long, value_delimiter = ',', default_value = "0.01,0.05")]
+    pub race_bounds: Vec<f64>,
     /// Frames per segment of the codec files on ACL's protocol.
     #[arg(long, default_value_t = inbetween_mocap::codec::v3::DEFAULT_SEGMENT_LEN)]
     pub acl_segment: usize,
@@ -288,81 +297,21 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
 
 fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
-    let v3 = match (a.format.as_deref(), a.budget.k) {
-        (None, None) | (Some("v3"), None) => true,
-        (None, Some(_)) | (Some("v2"), _) => false,
-        (Some("v3"), Some(_)) => {
-            bail!("-k picks keyframes, which version 3 does not store; use --format v2 or --max-error")
-        }
-        (Some(other), _) => bail!("unknown format '{other}'; expected v2 or v3"),
+    let job = codec::job::CompressJob {
+        budget: a.budget.budget()?,
+        version: a.format.as_deref().map(codec::job::Version::parse).transpose()?,
+        segment_len: a.segment,
+        max_gap: a.budget.max_gap(&m),
+        unit: a.budget.unit(&m),
     };
+    job.validate()?;
     let t = Instant::now();
-    let (bytes, lines) = if v3 {
-        let Budget::MaxErrorCm(cm) = a.budget.budget()? else { bail!("version 3 needs --max-error LENGTH") };
-        let opts = codec::alloc::Options { segment_len: a.segment, ..codec::alloc::Options::bound(cm) };
-        let c = codec::alloc::compress_in(&m, a.budget.unit(&m), &opts)
-            .with_context(|| format!("compressing {}", a.input.display()))?;
-        let lines = compress_report_v3(&m, &c);
-        (c.bytes, lines)
-    } else {
-        let c = codec::compress_in(&m, a.budget.unit(&m), a.budget.budget()?, a.budget.max_gap(&m))
-            .with_context(|| format!("compressing {}", a.input.display()))?;
-        let lines = compress_report(&m, &c);
-        (c.bytes, lines)
-    };
+    let report = job.run(&m).with_context(|| format!("compressing {}", a.input.display()))?;
     let secs = t.elapsed().as_secs_f64();
-    write_atomic(&a.output, &bytes).with_context(|| format!("writing {}", a.output.display()))?;
-    for l in lines {
-        println!("{l}");
-    }
+    write_atomic(&a.output, report.bytes()).with_context(|| format!("writing {}", a.output.display()))?;
+    println!("{report}");
     println!("wrote {} in {secs:.2} s", a.output.display());
     Ok(())
-}
-
-fn compress_report_v3(m: &Motion, c: &codec::alloc::Compressed) -> Vec<String> {
-    let raw = codec::raw_bytes(m);
-    let raw40 = 40 * m.skeleton.len() * m.num_frames();
-    let n = c.bytes.len() as f64;
-    vec![
-        c.unit.to_string(),
-        format!(
-            "{} frames, {} joints; version 3: {} bytes vs {} raw f32 channel bytes ({:.1}x) or {} bytes at 40 per joint and frame ({:.1}x)",
-            m.num_frames(),
-            m.skeleton.len(),
-            c.bytes.len(),
-            raw,
-            raw as f64 / n,
-            raw40,
-            raw40 as f64 / n
-        ),
-        format!(
-            "virtual-vertex error (3 cm from each joint, decoded file): max {:.4} cm, 99th percentile {:.4} cm",
-            c.max_error_cm, c.p99_error_cm
-        ),
-    ]
-}
-
-fn compress_report(m: &Motion, c: &codec::Compressed) -> Vec<String> {
-    let raw = codec::raw_bytes(m);
-    vec![
-        c.unit.to_string(),
-        format!(
-            "{} frames, {} joints, {} keys; {} bytes ({} bytes per key) vs {} raw f32 bytes: ratio {:.1}x",
-            m.num_frames(),
-            m.skeleton.len(),
-            c.keys.len(),
-            c.bytes.len(),
-            codec::bytes_per_key(&m.skeleton),
-            raw,
-            raw as f64 / c.bytes.len() as f64
-        ),
-        format!(
-            "error: mean {:.3} cm, max {:.3} cm (decoded file); mean local rotation error {:.3} deg",
-            c.decoded_mean_cm,
-            c.decoded_max_cm,
-            c.planned.mean_angle.to_degrees()
-        ),
-    ]
 }
 
 fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
@@ -460,6 +409,7 @@ fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
         bounds_cm: a.acl_bounds.clone(),
         segment_len: a.acl_segment,
         seed: a.seed,
+        race_bounds: a.race_bounds.clone(),
         ..Default::default()
     };
     let progress = inbetween_io::Progress::new(0, "codec (ACL protocol)");
@@ -475,11 +425,12 @@ fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
     let data_choice = match (a.procedural, a.all_takes) {
-        (true, _) => bench::run::TrainingData::Procedural,
-        (false, true) => bench::run::TrainingData::CmuAll,
-        (false, false) => bench::run::TrainingData::CmuSplit,
+        (true, _) => inbetween_mocap::corpus::TrainingData::Procedural,
+        (false, true) => inbetween_mocap::corpus::TrainingData::CmuAll,
+        (false, false) => inbetween_mocap::corpus::TrainingData::CmuSplit,
     };
-    let (windows, data) = bench::run::training_set(data_choice, a.data.as_deref(), a.unit, a.seed, a.stride)?;
+    let (windows, data) =
+        inbetween_mocap::corpus::training_set(data_choice, a.data.as_deref(), a.unit, a.seed, a.stride)?;
     let base = match a.preset.as_str() {
         "default" => TrainOptions::default(),
         "quick" => TrainOptions::quick(),
@@ -517,14 +468,15 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
         "pretraining: {} steps in {:.0} s; loss per {} steps {:?}",
         r.pretrain_steps,
         r.pretrain_seconds,
-        100,
+        r.pretrain_block,
         r.pretrain_loss.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
     );
     println!(
-        "fine-tuning: {} epochs, {} updates in {:.0} s; loss per 50 epochs {:?}; return per episode {:?}",
+        "fine-tuning: {} epochs, {} updates in {:.0} s; loss per {} epochs {:?}; return per episode {:?}",
         r.episodes,
         r.updates,
         r.finetune_seconds,
+        r.curve_block,
         r.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>(),
         r.return_curve.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>()
     );
@@ -575,6 +527,10 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
     for w in &got.warnings {
         eprintln!("warning: {w}");
     }
+    if got.motion.num_frames() == 0 {
+        // Nothing to keep: no output file, and the reason.
+        got.check_complete().context("no frame was rebuilt, so nothing was written")?;
+    }
     inbetween_io::write_bvh(&a.output, &got.motion)?;
     println!(
         "received {} keys ({} bytes, {} sessions, {}), emitted {} frames (frames {}..{} of the sender's {}-frame clip); wrote {}",
@@ -608,5 +564,8 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
             e.frames
         );
     }
+    got.check_complete().with_context(|| {
+        format!("the {} frames received were kept in {}", got.motion.num_frames(), a.output.display())
+    })?;
     Ok(())
 }

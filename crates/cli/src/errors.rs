@@ -39,10 +39,69 @@ pub fn render(error: &anyhow::Error, debug: bool) -> String {
     out
 }
 
+/// Names the flag that raises a limit: an error whose chain holds an
+/// [`inbetween_io::LimitExceeded`] for a field listed in `flags` (`(field, flag)`) becomes one line,
+/// `<contexts>: <limit message>; raise it with <flag>`; a time limit reached
+/// ([`inbetween_core::cancel::Cancelled::TimeLimit`]) names `--time-limit`. Other errors pass
+/// unchanged. The libraries speak of their fields; the commands own the flags.
+pub fn name_flags(e: anyhow::Error, flags: &[(&str, &str)]) -> anyhow::Error {
+    use inbetween_core::cancel::Cancelled;
+    use inbetween_io::LimitExceeded;
+    let mut above: Vec<String> = Vec::new();
+    for cause in e.chain() {
+        let hint = if let Some(l) = cause.downcast_ref::<LimitExceeded>() {
+            flags.iter().find(|(field, _)| *field == l.field).map(|(_, flag)| *flag)
+        } else if let Some(Cancelled::TimeLimit { .. }) = cause.downcast_ref::<Cancelled>() {
+            Some("--time-limit")
+        } else {
+            None
+        };
+        if let Some(flag) = hint {
+            let here = cause.to_string();
+            // An engine error that shows its source's message (`{0}`, `stopped: {0}`) repeats it:
+            // keep only what it adds.
+            above = above
+                .into_iter()
+                .filter_map(|m| {
+                    let own = m.strip_suffix(here.as_str()).map_or(m.as_str(), |p| p.trim_end_matches([':', ' ']));
+                    (!own.is_empty()).then(|| own.to_string())
+                })
+                .collect();
+            above.push(format!("{here}; raise it with {flag}"));
+            return anyhow::anyhow!("{}", above.join(": "));
+        }
+        above.push(cause.to_string());
+    }
+    e
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use anyhow::Context;
+
+    #[test]
+    fn limits_and_time_limits_name_their_flags() {
+        let limit = inbetween_io::LimitExceeded::check_count("a.csv", 3, 2, "rows", "max_rows").unwrap_err();
+        let e = anyhow::Error::new(limit.clone()).context("reading the input");
+        let named = name_flags(e, &[("max_rows", "--max-rows")]);
+        assert_eq!(
+            render(&named, false),
+            "error: reading the input: a.csv: 3 rows, more than the limit of 2 rows (max_rows); raise it with \
+             --max-rows\n"
+        );
+        let unmapped = name_flags(anyhow::Error::new(limit), &[("max_frames", "--max-frames")]);
+        assert!(!unmapped.to_string().contains("raise it"), "{unmapped}");
+        let stopped = anyhow::Error::new(inbetween_core::cancel::Cancelled::TimeLimit { limit_s: 2.0 });
+        assert_eq!(name_flags(stopped, &[]).to_string(), "time limit of 2 s reached; raise it with --time-limit");
+        let face = inbetween_face::data::FaceError::from(inbetween_core::cancel::Cancelled::TimeLimit { limit_s: 2.0 });
+        assert_eq!(
+            name_flags(face.into(), &[]).to_string(),
+            "face job stopped: time limit of 2 s reached; raise it with --time-limit"
+        );
+        let other = name_flags(anyhow::anyhow!("disk full"), &[("max_rows", "--max-rows")]);
+        assert_eq!(other.to_string(), "disk full");
+    }
 
     #[test]
     fn causes_are_listed_after_the_message() {

@@ -159,3 +159,82 @@ fn train_refuses_to_overwrite_the_committed_weights() {
     assert!(!out.status.success() && err.contains("--overwrite-committed"), "{err}");
     assert_eq!(std::fs::read(&committed).unwrap(), before, "the committed weights are untouched");
 }
+
+/// `stderr` of a run that must fail; checks it is one clear error, not a panic.
+fn fails(out: &std::process::Output) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "expected a failure; stdout {}", String::from_utf8_lossy(&out.stdout));
+    assert!(err.starts_with("error: ") && !err.contains("panicked") && !err.contains("internal error"), "{err}");
+    err
+}
+
+fn listing(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> =
+        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
+
+fn generate(scene: &Path, keys: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["camera", "generate", "--scene", s(scene), "--keys", s(keys), "-o", s(out)];
+    args.extend_from_slice(extra);
+    inbetween(&args)
+}
+
+#[test]
+fn scenes_with_coinciding_or_same_named_characters_blame_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert!(inbetween(&["camera", "scene", "-o", s(d), "--frames", "60"]).status.success());
+    let scene: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("scene.json")).unwrap()).unwrap();
+    let (keys, cam) = (d.join("keys.json"), d.join("cam.json"));
+    // Both characters at the same place.
+    let mut same_place = scene.clone();
+    let name = same_place["characters"][1]["name"].clone();
+    same_place["characters"][1] = same_place["characters"][0].clone();
+    same_place["characters"][1]["name"] = name;
+    let bad = d.join("same-place.json");
+    std::fs::write(&bad, serde_json::to_vec(&same_place).unwrap()).unwrap();
+    let err = fails(&generate(&bad, &keys, &cam, &[]));
+    assert!(
+        err.contains(&format!("{}: characters", bad.display()))
+            && err.contains("stand at the same position at frame 0"),
+        "{err}"
+    );
+    assert!(!err.contains("keys.json"), "the keys are not at fault: {err}");
+    // Two characters with one name.
+    let mut same_name = scene.clone();
+    same_name["characters"][1]["name"] = same_name["characters"][0]["name"].clone();
+    let bad = d.join("same-name.json");
+    std::fs::write(&bad, serde_json::to_vec(&same_name).unwrap()).unwrap();
+    let err = fails(&generate(&bad, &keys, &cam, &[]));
+    assert!(err.contains(&format!("{}: characters 0 and 1 are both named", bad.display())), "{err}");
+    assert!(!cam.exists());
+}
+
+#[test]
+fn camera_limits_and_time_limits_name_their_flags_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert!(inbetween(&["camera", "scene", "-o", s(d), "--frames", "60"]).status.success());
+    let before = listing(d);
+    let (scene, keys, cam) = (d.join("scene.json"), d.join("keys.json"), d.join("cam.json"));
+    let gif = d.join("cam.gif");
+    let err = fails(&generate(&scene, &keys, &cam, &["--max-frames", "50"]));
+    assert!(
+        err.contains("60 frames, more than the limit of 50 frames (max_frames); raise it with --max-frames"),
+        "{err}"
+    );
+    let err = fails(&generate(&scene, &keys, &cam, &["--max-keys", "2"]));
+    assert!(
+        err.contains("keys.json: 3 keys, more than the limit of 2 keys (max_keys); raise it with --max-keys"),
+        "{err}"
+    );
+    let err = fails(&generate(&scene, &keys, &cam, &["--all-styles", "--gif", s(&gif), "--time-limit", "0.000001"]));
+    assert!(err.contains("time limit of 0.000001 s reached; raise it with --time-limit"), "{err}");
+    assert_eq!(listing(d), before, "no track, glTF or preview of any style, and no staging folder");
+    let err =
+        fails(&inbetween(&["camera", "scene", "-o", s(&d.join("big")), "--frames", "200", "--max-frames", "100"]));
+    assert!(err.contains("raise it with --max-frames"), "{err}");
+    assert!(!d.join("big").exists());
+}

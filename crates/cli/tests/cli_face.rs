@@ -86,3 +86,132 @@ fn bad_face_inputs_are_clear_errors_and_write_nothing() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("'nose'"));
     assert!(!out_path.exists());
 }
+
+/// `stderr` of a run that must fail; checks it is one clear error, not a panic.
+fn fails(out: &std::process::Output) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "expected a failure; stdout {}", String::from_utf8_lossy(&out.stdout));
+    assert!(err.starts_with("error: ") && !err.contains("panicked") && !err.contains("internal error"), "{err}");
+    err
+}
+
+/// The names in a folder (staging folders included), sorted.
+fn listing(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> =
+        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn keys_json_of_the_wrong_shape_names_the_file_and_the_expected_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = d.join("take.csv");
+    ok(&inbetween(&["face", "synth", "-o", s(&input), "--seconds", "6"]));
+    let keys = d.join("keys.json");
+    let out_path = d.join("out.csv");
+    for (text, want) in [
+        ("{}", "an object without \"keys\""),
+        ("[1,2,3]", "key 0 is the number 1"),
+        ("\"NaN\"", "the file holds the string \"NaN\""),
+        ("{\"keys\": 5}", "\"keys\" is the number 5"),
+        ("[{\"time_s\": \"3\", \"shapes\": {\"JawOpen\": 0.5}}]", "\"time_s\" is the string \"3\""),
+        ("[{\"time_s\": 3, \"shapes\": {\"JawOpen\": 0.5}, \"x\": 1}]", "unknown field 'x'"),
+    ] {
+        std::fs::write(&keys, text).unwrap();
+        let err = fails(&inbetween(&[
+            "face",
+            "edit",
+            s(&input),
+            "--mask",
+            "2s..4s",
+            "--keys",
+            s(&keys),
+            "--method",
+            "linear",
+            "-o",
+            s(&out_path),
+        ]));
+        assert!(err.contains(&format!("{}: ", keys.display())) && err.contains(want), "{text}: {err}");
+        assert!(!err.contains("untagged") && !err.contains("KeysJson") && !err.contains(":0:"), "{text}: {err}");
+    }
+    assert!(!out_path.exists());
+}
+
+#[test]
+fn keys_masks_and_visemes_that_cannot_work_are_refused_naming_their_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = d.join("take.csv");
+    ok(&inbetween(&["face", "synth", "-o", s(&input), "--seconds", "8"]));
+    let out_path = d.join("out.csv");
+    let edit = |extra: &[&str]| {
+        let mut args = vec!["face", "edit", s(&input), "--method", "linear", "-o", s(&out_path)];
+        args.extend_from_slice(extra);
+        inbetween(&args)
+    };
+    let keys = d.join("keys.json");
+    // A key outside the mask names the keys file, the key and the spans.
+    std::fs::write(&keys, r#"{"keys":[{"time_s":6.0,"shapes":{"JawOpen":0.9}}]}"#).unwrap();
+    let err = fails(&edit(&["--mask", "2s..4s", "--keys", s(&keys)]));
+    assert!(err.contains(&format!("{}: key 0 at 6.000 s lies outside every edited span", keys.display())), "{err}");
+    // Two keys on one frame with different weights are refused; the same weight twice is merged.
+    std::fs::write(
+        &keys,
+        r#"{"keys":[{"time_s":3.0,"shapes":{"JawOpen":0.9}},{"time_s":3.01,"shapes":{"JawOpen":0.2}}]}"#,
+    )
+    .unwrap();
+    let err = fails(&edit(&["--mask", "2s..4s", "--keys", s(&keys)]));
+    assert!(
+        err.contains(&keys.display().to_string()) && err.contains("same frame") && err.contains("JawOpen"),
+        "{err}"
+    );
+    std::fs::write(
+        &keys,
+        r#"{"keys":[{"time_s":3.0,"shapes":{"JawOpen":0.9}},{"time_s":3.0,"shapes":{"JawOpen":0.9,"MouthClose":0.1}}]}"#,
+    )
+    .unwrap();
+    ok(&edit(&["--mask", "2s..4s", "--keys", s(&keys)]));
+    std::fs::remove_file(&out_path).unwrap();
+    std::fs::remove_file(out_path.with_extension("png")).unwrap();
+    // Visemes wholly past the clip's end.
+    let late = d.join("late.csv");
+    std::fs::write(&late, "start,end,phoneme\n100.0,100.2,AA1\n100.2,100.4,B\n").unwrap();
+    let err = fails(&edit(&["--mask", "2s..4s", "--visemes", s(&late)]));
+    assert!(err.contains("late.csv: every phoneme lies after the clip's end"), "{err}");
+    // A mask running past the clip's end.
+    let err = fails(&edit(&["--mask", "6s..20s"]));
+    assert!(err.contains("mask '6s..20s' runs past the clip's end"), "{err}");
+    assert!(!out_path.exists());
+    assert_eq!(listing(d), ["keys.json", "late.csv", "take.csv", "take.phonemes.csv"], "no output, no staging left");
+}
+
+#[test]
+fn limits_and_time_limits_are_named_with_their_flags_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = d.join("take.csv");
+    ok(&inbetween(&["face", "synth", "-o", s(&input), "--seconds", "8"]));
+    let out_path = d.join("out.csv");
+    let gif = d.join("out.gif");
+    let edit = |extra: &[&str]| {
+        let mut args = vec!["face", "edit", s(&input), "--mask", "2s..4s", "-o", s(&out_path), "--gif", s(&gif)];
+        args.extend_from_slice(extra);
+        inbetween(&args)
+    };
+    let err = fails(&edit(&["--max-rows", "100"]));
+    assert!(
+        err.contains("take.csv: 200 rows, more than the limit of 100 rows (max_rows); raise it with --max-rows"),
+        "{err}"
+    );
+    let err = fails(&edit(&["--max-mask-seconds", "1.5"]));
+    assert!(err.contains("more than the limit of 1.5 s (max_mask_s); raise it with --max-mask-seconds"), "{err}");
+    let err = fails(&edit(&["--time-limit", "0.000001"]));
+    assert!(err.contains("time limit of 0.000001 s reached; raise it with --time-limit"), "{err}");
+    let err = fails(&edit(&["--time-limit", "0"]));
+    assert!(err.contains("--time-limit") && err.contains("expected a number of seconds > 0"), "{err}");
+    assert_eq!(listing(d), ["take.csv", "take.phonemes.csv"], "no clip, PNG or GIF, and no staging folder");
+    ok(&edit(&[]));
+    assert_eq!(listing(d), ["out.csv", "out.gif", "out.png", "take.csv", "take.phonemes.csv"]);
+}

@@ -28,9 +28,19 @@ fn compress_decompress_preview_and_corrupt_input() {
     let dir = tempfile::tempdir().unwrap();
     let bvh = walk_bvh(dir.path());
     let ibk = dir.path().join("walk.ibk").to_string_lossy().into_owned();
-    // Version 3 (the default): every frame, variable step; the bound holds on virtual vertices.
+    // Version 4 (the default with --max-error): every frame, fixed-width values per segment; the
+    // bound holds on virtual vertices.
+    let v4 = dir.path().join("walk4.ibk").to_string_lossy().into_owned();
+    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "-o", &v4]);
+    assert!(o.status.success() && text(&o).contains("version 4"), "{}", text(&o));
+    assert!(max_cm(&text(&o)) <= 1.0, "{}", text(&o));
+    let out4 = dir.path().join("rec4.bvh").to_string_lossy().into_owned();
+    let o = inbetween(&["mocap", "decompress", &v4, "-o", &out4]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(inbetween_io::read_bvh(Path::new(&out4)).unwrap().num_frames(), 90);
+    // Version 3 on request: every frame, a variable-length stream (smaller, slower to sample).
     let v3 = dir.path().join("walk3.ibk").to_string_lossy().into_owned();
-    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "-o", &v3]);
+    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1cm", "--format", "v3", "-o", &v3]);
     assert!(o.status.success() && text(&o).contains("version 3"), "{}", text(&o));
     assert!(max_cm(&text(&o)) <= 1.0, "{}", text(&o));
     let out3 = dir.path().join("rec3.bvh").to_string_lossy().into_owned();
@@ -284,4 +294,52 @@ fn train_on_procedural_gaits_then_bench_a_folder_with_the_policy() {
     inbetween_io::write_bvh(&data.join("walk0.bvh"), &inbetween_core::procedural::gait(&p)).unwrap();
     let o = inbetween(&["mocap", "bench", "--data", data.to_str().unwrap()]);
     assert!(!o.status.success() && text(&o).contains("long enough"), "{}", text(&o));
+}
+
+/// A sender killed mid-stream: the receiver keeps the frames it rebuilt (written whole), says
+/// what it lost and exits non-zero.
+#[test]
+fn stream_receiver_of_a_killed_sender_keeps_its_frames_and_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let bvh = walk_bvh(dir.path());
+    let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let addr = format!("127.0.0.1:{port}");
+    let out = dir.path().join("cut.bvh").to_string_lossy().into_owned();
+    let exe = env!("CARGO_BIN_EXE_inbetween");
+    let recv = Command::new(exe)
+        .args(["mocap", "stream", "recv", "--addr", &addr, "-o", &out, "--timeout-s", "2"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    // Real time: 90 frames at 30 fps take 3 s; killed after about 1.2 s.
+    let mut sender = Command::new(exe)
+        .args(["mocap", "stream", "send", &bvh, "--addr", &addr, "--max-error", "1cm", "--retries", "0"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1200));
+    sender.kill().unwrap();
+    sender.wait().unwrap();
+    let r = recv.wait_with_output().unwrap();
+    let t = text(&r);
+    assert!(!r.status.success(), "{t}");
+    assert!(t.contains("without the sender's End") && t.contains("lost after them"), "{t}");
+    let kept = inbetween_io::read_bvh(Path::new(&out)).unwrap().num_frames();
+    assert!(kept > 0 && kept < 90, "{kept} frames kept; {t}");
+    assert!(t.contains(&format!("the {kept} frames received were kept")), "{t}");
+}
+
+/// `--max-error` without a unit is refused, showing the number with each unit.
+#[test]
+fn a_bound_without_a_unit_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let bvh = walk_bvh(dir.path());
+    let out = dir.path().join("x.ibk").to_string_lossy().into_owned();
+    let o = inbetween(&["mocap", "compress", &bvh, "--max-error", "1e9", "-o", &out]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("'1e9' has no length unit") && text(&o).contains("1e9cm"), "{}", text(&o));
+    assert!(!Path::new(&out).exists());
 }

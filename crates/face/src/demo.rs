@@ -52,6 +52,9 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<FaceDemo, FaceE
             guide: Guide::None,
             method,
             seed,
+            limits: crate::infer::EditLimits::default(),
+            cancel: inbetween_core::cancel::Cancel::new(),
+            guide_file: None,
         };
         let out = job.run()?;
         truth = out.before.clone();

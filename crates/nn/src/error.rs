@@ -28,4 +28,8 @@ pub enum NnError {
     /// The backend could not be set up (e.g. the global thread pool was already built).
     #[error("backend: {0}")]
     Backend(String),
+    /// The objective's cancel token stopped training mid-epoch ([`crate::train::Objective::check_cancel`]);
+    /// the unfinished epoch is not checkpointed, so a later run resumes from the last whole one.
+    #[error("training stopped: {0}")]
+    Cancelled(#[from] inbetween_core::cancel::Cancelled),
 }

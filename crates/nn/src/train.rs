@@ -175,6 +175,13 @@ pub trait Objective<M> {
     /// (e.g. a DQN filling its replay memory); the optimiser then skips the step.
     fn loss(&mut self, model: &M, step: &Step) -> Option<Tensor<1>>;
 
+    /// Checked before every step: an `Err` ends the run at once with [`NnError::Cancelled`], without
+    /// checkpointing the unfinished epoch (a cancel button or a job's time budget; see
+    /// `inbetween_core::cancel`). Never stops by default.
+    fn check_cancel(&self) -> Result<(), inbetween_core::cancel::Cancelled> {
+        Ok(())
+    }
+
     /// Called after every step, once the optimiser applied it, with the step's loss if it had one
     /// (logging, target-network updates, …).
     fn after_step(&mut self, _model: &M, _step: &Step, _loss: Option<f64>) {}
@@ -362,6 +369,10 @@ where
         let lr = config.lr_at(epoch);
         let (mut sum, mut losses) = (0.0, 0usize);
         for step in 0..config.steps_per_epoch {
+            if let Err(stop) = objective.check_cancel() {
+                bar.abandon();
+                return Err(stop.into());
+            }
             let step = Step { epoch, step, seed: step_seed(config.seed, epoch, step) };
             let mut scalar = None;
             if let Some(value) = objective.loss(&model, &step) {

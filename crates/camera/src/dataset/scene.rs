@@ -26,6 +26,10 @@ impl CharacterTrack {
     }
 }
 
+/// Closest two characters' framing targets may be, in metres (the Toric mapping needs two distinct
+/// points; it refuses below 1e-9 m).
+pub const TARGETS_APART: f64 = 1e-6;
+
 /// A scene: two or more characters sampled at `fps`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Scene {
@@ -61,6 +65,45 @@ impl Scene {
             }
             if let Some(f) = (0..n).find(|&f| (c.shoulder_r[f] - c.shoulder_l[f]).length() < 1e-6) {
                 return Err(format!("character `{}`: shoulders coincide at frame {f}", c.name));
+            }
+        }
+        // Keys name their targets, so a name must pick one character.
+        let mut names: Vec<(&str, usize)> =
+            self.characters.iter().enumerate().map(|(i, c)| (c.name.as_str(), i)).collect();
+        names.sort_unstable();
+        if let Some(w) = names.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(format!(
+                "characters {} and {} are both named `{}`; expected distinct names (keys name their targets)",
+                w[0].1, w[1].1, w[0].0
+            ));
+        }
+        self.check_targets_apart()
+    }
+
+    /// No two characters' framing targets (between the shoulders, above them) at the same place in
+    /// any frame: the camera could not frame such a pair. A grid of [`TARGETS_APART`] cells keeps it
+    /// O(frames · characters).
+    fn check_targets_apart(&self) -> Result<(), String> {
+        let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = std::collections::HashMap::new();
+        let cell = |p: DVec3| (p / TARGETS_APART).floor().as_i64vec3().to_array();
+        for f in 0..self.num_frames() {
+            grid.clear();
+            for (i, c) in self.characters.iter().enumerate() {
+                let p = c.frame(f).target();
+                let [x, y, z] = cell(p);
+                for d in 0..27i64 {
+                    let key = [x + d % 3 - 1, y + (d / 3) % 3 - 1, z + d / 9 - 1];
+                    for &j in grid.get(&key).into_iter().flatten() {
+                        if (self.characters[j].frame(f).target() - p).length() <= TARGETS_APART {
+                            return Err(format!(
+                                "characters `{}` and `{}` stand at the same position at frame {f} (their framing \
+                                 targets are less than {TARGETS_APART} m apart); expected two separate characters",
+                                self.characters[j].name, c.name
+                            ));
+                        }
+                    }
+                }
+                grid.entry(cell(p)).or_default().push(i);
             }
         }
         Ok(())
@@ -279,6 +322,37 @@ mod tests {
         for f in 1..root.len() {
             assert!((root[f] - root[f - 1]).length() * 30.0 < 3.0, "frame {f} too fast");
         }
+    }
+
+    #[test]
+    fn coinciding_and_same_named_characters_are_refused() {
+        let mut s = Scene::procedural(1, 40, 30.0);
+        s.characters.push(CharacterTrack { name: "C".into(), ..s.characters[0].clone() });
+        let e = s.validate().unwrap_err();
+        assert!(
+            e.contains(&format!("characters `{}` and `C` stand at the same position at frame 0", s.characters[0].name)),
+            "{e}"
+        );
+        // One frame in the middle is enough; a nudge of a millimetre is two characters.
+        let mut s = Scene::procedural(1, 40, 30.0);
+        let mut c = s.characters[1].clone();
+        c.name = "C".into();
+        for f in 0..40 {
+            let off = if f == 17 { DVec3::ZERO } else { DVec3::X * 0.5 };
+            c.root[f] = s.characters[0].root[f] + off;
+            c.shoulder_l[f] = s.characters[0].shoulder_l[f] + off;
+            c.shoulder_r[f] = s.characters[0].shoulder_r[f] + off;
+        }
+        s.characters.push(c.clone());
+        assert!(s.validate().unwrap_err().contains("at frame 17"));
+        s.characters[2].root[17].x += 1e-3;
+        s.characters[2].shoulder_l[17].x += 1e-3;
+        s.characters[2].shoulder_r[17].x += 1e-3;
+        assert_eq!(s.validate(), Ok(()));
+        let mut s = Scene::procedural(1, 40, 30.0);
+        s.characters[1].name = s.characters[0].name.clone();
+        let e = s.validate().unwrap_err();
+        assert!(e.starts_with("characters 0 and 1 are both named"), "{e}");
     }
 
     #[test]

@@ -11,12 +11,30 @@ use crate::dataset::{Scene, DOWNSAMPLE};
 use crate::features::{decode_camera, encode_camera, encode_character, CharacterFeatures};
 use crate::toric::{Lens, Toric};
 use crate::CameraError;
+use inbetween_core::cancel::Cancel;
 use inbetween_core::curve::{Curve, Track};
+use inbetween_io::LimitExceeded;
 use std::path::Path;
+
+/// The limits of a [`GenerateJob`], checked by [`GenerateJob::validate`] before any work: the
+/// cost of a run grows with the frames generated and posed, and with the keys resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GenerateLimits {
+    /// Most frames in the scene. Default 108 000: one hour at 30 fps.
+    pub max_frames: usize,
+    /// Most keyframes in the keys file. Default 10 000.
+    pub max_keys: usize,
+}
+
+impl Default for GenerateLimits {
+    fn default() -> Self {
+        GenerateLimits { max_frames: 108_000, max_keys: 10_000 }
+    }
+}
 
 /// Options of a [`GenerateJob`].
 #[derive(Debug, Clone, Copy)]
-pub struct GenerateOptions {
+pub struct GenerateOptions<'c> {
     /// Add the blended key residuals so every keyframe is hit exactly (beyond the paper; offline
     /// mode only).
     pub exact_keys: bool,
@@ -26,11 +44,33 @@ pub struct GenerateOptions {
     pub remap_at_keys: bool,
     /// Live mode: one frame at a time, no look-ahead, no correction ([`super::CausalCamera`]).
     pub causal: bool,
+    /// The input sizes the job accepts.
+    pub limits: GenerateLimits,
+    /// Checked in the offline generation's loops (every network step, every filled and posed
+    /// frame); a cancelled run returns [`CameraError::Cancelled`]. `None`: never cancelled.
+    pub cancel: Option<&'c Cancel>,
 }
 
-impl Default for GenerateOptions {
+impl Default for GenerateOptions<'_> {
     fn default() -> Self {
-        GenerateOptions { exact_keys: true, lens: Lens::default(), remap_at_keys: true, causal: false }
+        GenerateOptions {
+            exact_keys: true,
+            lens: Lens::default(),
+            remap_at_keys: true,
+            causal: false,
+            limits: GenerateLimits::default(),
+            cancel: None,
+        }
+    }
+}
+
+impl GenerateOptions<'_> {
+    /// `Err` once the cancel token (if any) is cancelled.
+    fn check_cancel(&self) -> Result<(), CameraError> {
+        match self.cancel {
+            Some(c) => Ok(c.check()?),
+            None => Ok(()),
+        }
     }
 }
 
@@ -42,7 +82,7 @@ pub struct GenerateJob<'a> {
     pub scene: &'a Scene,
     pub keys: &'a Keys,
     pub style: &'a Style,
-    pub options: GenerateOptions,
+    pub options: GenerateOptions<'a>,
     pub origin: &'a Path,
 }
 
@@ -55,6 +95,15 @@ impl<'a> GenerateJob<'a> {
     /// Checks the inputs without running the network: the scene, the keys against it (frames,
     /// targets, cameras) and the style code's size.
     pub fn validate(&self) -> Result<ResolvedKeys, CameraError> {
+        let limits = &self.options.limits;
+        LimitExceeded::check_count("the scene", self.scene.num_frames(), limits.max_frames, "frames", "max_frames")?;
+        LimitExceeded::check_count(
+            self.origin.display().to_string(),
+            self.keys.keys.len(),
+            limits.max_keys,
+            "keys",
+            "max_keys",
+        )?;
         self.scene.validate().map_err(|m| CameraError::invalid(self.origin, format!("scene: {m}")))?;
         let want = self.model.config.style_dim;
         if self.style.code.len() != want || self.style.code.iter().any(|v| !v.is_finite()) {
@@ -72,8 +121,10 @@ impl<'a> GenerateJob<'a> {
         if self.options.causal {
             return super::causal::run_causal(self.model, self.style, self.scene, &self.options.lens, &keys);
         }
-        let network = self.network_samples(&keys);
+        let network = self.network_samples(&keys)?;
+        self.options.check_cancel()?;
         let (track, max_corrected_residual) = self.fill_and_correct(&keys, &network.samples)?;
+        self.options.check_cancel()?;
         let frames = self.posed(&keys, &network.pairs, &track)?;
         Ok(CameraTrack {
             fps: self.scene.fps,
@@ -94,7 +145,7 @@ impl<'a> GenerateJob<'a> {
 
     /// The network's output every 5th frame from the first key: one segment per key, each key
     /// snapped to that grid for the network (its sample then moved to the key's own frame).
-    fn network_samples(&self, keys: &ResolvedKeys) -> NetworkSamples {
+    fn network_samples(&self, keys: &ResolvedKeys) -> Result<NetworkSamples, CameraError> {
         let (model, k) = (self.model, &keys.keys);
         let (first, last) = (keys.first_frame(), keys.last_frame(self.scene));
         let grid = |f: usize| first + ((f - first) as f64 / DOWNSAMPLE as f64).round() as usize * DOWNSAMPLE;
@@ -114,6 +165,7 @@ impl<'a> GenerateJob<'a> {
             let key = key_vector(&encode_camera(&target.camera), &self.character(keys, target.frame, target.pair));
             out.pairs.push((f + 1, target.pair));
             while f + DOWNSAMPLE <= end {
+                self.options.check_cancel()?;
                 f += DOWNSAMPLE;
                 let tta_frames = if single { model.config.tta_max as usize } else { end - f };
                 let next = rollout.step(&self.character(keys, f.min(last), target.pair), &key, tta_frames);
@@ -137,7 +189,7 @@ impl<'a> GenerateJob<'a> {
             }
         }
         out.samples.dedup_by_key(|s| s.0);
-        out
+        Ok(out)
     }
 
     /// Catmull-Rom fill of the network samples to every frame (§4.5 "filled with cubic
@@ -180,6 +232,9 @@ impl<'a> GenerateJob<'a> {
             .iter()
             .enumerate()
             .map(|(o, x)| {
+                if o % 256 == 0 {
+                    self.options.check_cancel()?;
+                }
                 let frame = first + o;
                 let pair = pairs.iter().rev().find(|(from, _)| *from <= frame).map_or(keys.keys[0].pair, |p| p.1);
                 camera_frame(self.scene, frame, pair, Toric::from_array(*x), lens)
@@ -215,6 +270,62 @@ mod tests {
 
     fn zero_style() -> Style {
         Style { name: "test".into(), code: vec![0.0; 4] }
+    }
+
+    #[test]
+    fn limits_are_checked_first_and_cancel_stops_generation() {
+        let (fast, style) = (small(), zero_style());
+        let scene = Scene::procedural(2, 200, 30.0);
+        let keys = example_keys(&scene, &[0, 97, 199]);
+        let limited = |max_frames, max_keys| GenerateJob {
+            options: GenerateOptions { limits: GenerateLimits { max_frames, max_keys }, ..GenerateOptions::default() },
+            origin: Path::new("k.json"),
+            ..GenerateJob::new(&fast, &scene, &keys, &style)
+        };
+        let e = limited(199, 10).run().unwrap_err();
+        assert!(matches!(&e, CameraError::Limit(l) if l.field == "max_frames"), "{e}");
+        assert_eq!(e.to_string(), "the scene: 200 frames, more than the limit of 199 frames (max_frames)");
+        let e = limited(200, 2).run().unwrap_err().to_string();
+        assert_eq!(e, "k.json: 3 keys, more than the limit of 2 keys (max_keys)");
+        assert!(limited(200, 3).validate().is_ok());
+        let cancel = Cancel::new();
+        cancel.cancel();
+        let job = GenerateJob {
+            options: GenerateOptions { cancel: Some(&cancel), ..GenerateOptions::default() },
+            ..GenerateJob::new(&fast, &scene, &keys, &style)
+        };
+        assert_eq!(job.run().unwrap_err().to_string(), "camera job stopped: cancelled");
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            rng_seed: proptest::test_runner::RngSeed::Fixed(inbetween_core::seed::PROPTEST_SEED),
+            ..proptest::prelude::ProptestConfig::with_cases(24)
+        })]
+
+        /// Scenes and key lists over a limit are refused before validation or generation, naming the field.
+        #[test]
+        fn oversized_jobs_are_refused_naming_the_limit(frames in 2usize..3000, keys in 1usize..400, cut in 0.0f64..1.0) {
+            let (fast, style) = (small(), zero_style());
+            // A scene of `frames` frames that is never generated (the limit stops it first).
+            let mut scene = Scene::procedural(1, 2, 30.0);
+            for c in &mut scene.characters {
+                c.root.resize(frames, c.root[1]);
+                c.shoulder_l.resize(frames, c.shoulder_l[1]);
+                c.shoulder_r.resize(frames, c.shoulder_r[1]);
+            }
+            // `keys` copies of one key: never resolved either.
+            let key_list = Keys { main: None, keys: vec![example_keys(&scene, &[0]).keys[0].clone(); keys] };
+            let below = |n: usize| ((n as f64 * cut) as usize).min(n - 1);
+            let job = |max_frames, max_keys| GenerateJob {
+                options: GenerateOptions { limits: GenerateLimits { max_frames, max_keys }, ..GenerateOptions::default() },
+                ..GenerateJob::new(&fast, &scene, &key_list, &style)
+            };
+            let e = job(below(frames), usize::MAX).validate().unwrap_err();
+            proptest::prop_assert!(matches!(&e, CameraError::Limit(l) if l.field == "max_frames"), "{}", e);
+            let e = job(frames, below(keys)).validate().unwrap_err();
+            proptest::prop_assert!(matches!(&e, CameraError::Limit(l) if l.field == "max_keys"), "{}", e);
+        }
     }
 
     #[test]

@@ -26,7 +26,7 @@ use crate::model::MAP_FRAMES;
 use crate::toric::Toric;
 
 pub use causal::CausalCamera;
-pub use generate::{generate_causal, GenerateJob, GenerateOptions};
+pub use generate::{generate_causal, GenerateJob, GenerateLimits, GenerateOptions};
 pub use keys::{example_keys, Keyframe, Keys, ResolvedKey};
 pub use networks::{FastModel, Scratch, StepIn};
 pub use rollout::Rollout;

@@ -212,7 +212,17 @@ fn edit(
     seed: u64,
 ) -> Result<(Vec<Frame>, Mask), FaceError> {
     let spans = vec![(seg.start as f64 / MODEL_FPS, seg.end as f64 / MODEL_FPS)];
-    let job = EditJob { clip: truth, spans, channels: [true; NUM_ARKIT], guide: guide.clone(), method, seed };
+    let job = EditJob {
+        clip: truth,
+        spans,
+        channels: [true; NUM_ARKIT],
+        guide: guide.clone(),
+        method,
+        seed,
+        limits: crate::infer::EditLimits::default(),
+        cancel: inbetween_core::cancel::Cancel::new(),
+        guide_file: None,
+    };
     let out = job.run()?;
     Ok((out.after, out.mask))
 }

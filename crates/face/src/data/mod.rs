@@ -53,6 +53,24 @@ pub fn read_clip(path: &std::path::Path) -> Result<BlendshapeClip, FaceError> {
     }
 }
 
+/// [`read_clip`] for inputs of a job with a row limit: a CSV with more than `max_rows` data rows
+/// (non-blank, non-comment lines after the header) is refused before it is parsed, a JSON clip once
+/// parsed. The error ([`FaceError::Limit`]) names the file and the limit's field, `max_rows`.
+pub fn read_clip_limited(path: &std::path::Path, max_rows: usize) -> Result<BlendshapeClip, FaceError> {
+    let file = path.display().to_string();
+    let check =
+        |rows: usize| inbetween_io::LimitExceeded::check_count(file.as_str(), rows, max_rows, "rows", "max_rows");
+    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+        let text = text::read_text(path)?;
+        let rows = text::lines(&text).filter(|(_, l)| !l.trim_start().starts_with('#')).count().saturating_sub(1);
+        check(rows)?;
+        drop(text);
+    }
+    let clip = read_clip(path)?;
+    check(clip.num_frames())?;
+    Ok(clip)
+}
+
 /// Writes a clip as Live Link Face CSV when `live_link`, else in the plain curve format chosen by the
 /// extension (`.json` or CSV). Atomic, like every writer here.
 pub fn write_clip(path: &std::path::Path, clip: &BlendshapeClip, live_link: bool) -> Result<(), FaceError> {

@@ -6,6 +6,8 @@
 //! → network input → generator → recomposition `X ⊙ (1 − M) + G ⊙ M` → post-processing (exact keys, C1
 //! borders, [0, 1]) → back to the capture's frame times, touching only frames inside the spans.
 
+use std::collections::BTreeMap;
+
 use crate::data::{BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT, NUM_HEAD_EYE};
 use crate::edit::hermite::{hermite, Knot};
 use crate::edit::{correct, interpolate, Constraint, ConstraintKind, Frame, Interp, Mask, Segment};
@@ -13,6 +15,26 @@ use crate::model::input;
 use crate::visemes::Viseme;
 
 use super::keys::KeyPose;
+use inbetween_core::cancel::Cancel;
+use inbetween_io::LimitExceeded;
+
+/// The limits of an edit, checked by [`EditJob::validate`] before any work: the cost of an edit
+/// grows with the clip's rows (resampling, recomposition) and with the stretch the generator runs
+/// over (the masked stretch plus [`CONTEXT_FRAMES`] on each side).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EditLimits {
+    /// Most frames (rows) in the input clip or a noisy guide. Default 216 000: one hour at 60 fps.
+    pub max_rows: usize,
+    /// Longest stretch, in seconds, from the first span's start to the last span's end. Default
+    /// 600 s (ten minutes; the networks are trained on 4 s windows).
+    pub max_mask_s: f64,
+}
+
+impl Default for EditLimits {
+    fn default() -> Self {
+        EditLimits { max_rows: 216_000, max_mask_s: 600.0 }
+    }
+}
 
 /// Something that fills erased entries from the network input (the trained generator).
 pub trait Inpainter: Sync {
@@ -83,6 +105,12 @@ pub struct EditJob<'a> {
     pub method: Method<'a>,
     /// Seed of the generator's noise.
     pub seed: u64,
+    /// The input sizes this job accepts.
+    pub limits: EditLimits,
+    /// Checked between the edit's stages; a cancelled edit returns [`FaceError::Cancelled`].
+    pub cancel: Cancel,
+    /// The file the guidance was read from (keys, noisy take, visemes), named in messages.
+    pub guide_file: Option<String>,
 }
 
 /// What an edit produced.
@@ -114,6 +142,9 @@ impl EditJob<'_> {
         if self.spans.is_empty() {
             return Err(invalid("no span to edit; give at least one --mask START..END"));
         }
+        LimitExceeded::check_count("the clip", self.clip.num_frames(), self.limits.max_rows, "rows", "max_rows")?;
+        // A span may end one frame past the last frame's time (a span in frames that covers the last frame).
+        let end_ok = duration + 1.0 / self.clip.fps() + 1e-9;
         for (a, b) in &self.spans {
             if !(a.is_finite() && b.is_finite() && *a >= 0.0 && b > a) {
                 return Err(invalid(format!("span {a} s..{b} s: expected 0 ≤ start < end")));
@@ -121,7 +152,20 @@ impl EditJob<'_> {
             if *a >= duration {
                 return Err(invalid(format!("span {a:.3} s..{b:.3} s starts after the clip ends ({duration:.3} s)")));
             }
+            if *b > end_ok {
+                return Err(invalid(format!(
+                    "span {a:.3} s..{b:.3} s runs past the clip's end ({duration:.3} s); end it at {duration:.3} s at the latest"
+                )));
+            }
         }
+        let first = self.spans.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
+        let last = self.spans.iter().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
+        LimitExceeded::check_seconds(
+            "the mask (first span's start to last span's end)",
+            last - first,
+            self.limits.max_mask_s,
+            "max_mask_s",
+        )?;
         if !self.channels.iter().any(|c| *c) {
             return Err(invalid("no blendshape selected to edit"));
         }
@@ -135,32 +179,84 @@ impl EditJob<'_> {
                 )));
             }
         }
-        if let Guide::Keys(keys) = &self.guide {
-            if keys.is_empty() {
-                return Err(invalid("the keys file holds no key"));
+        let file = self.guide_file.as_deref().map_or(String::new(), |f| format!("{f}: "));
+        match &self.guide {
+            Guide::Keys(keys) => {
+                if keys.is_empty() {
+                    return Err(invalid(format!("{file}the keys file holds no key")));
+                }
+                for (i, k) in keys.iter().enumerate() {
+                    if !self.spans.iter().any(|(a, b)| k.time_s >= *a && k.time_s <= *b) {
+                        return Err(invalid(format!(
+                            "{file}key {i} at {:.3} s lies outside every edited span ({}); keys guide the edit only \
+                             inside the mask",
+                            k.time_s,
+                            self.spans_text()
+                        )));
+                    }
+                }
+                self.check_key_conflicts(keys, &file)?;
             }
-            for k in keys {
-                if !self.spans.iter().any(|(a, b)| k.time_s >= *a && k.time_s <= *b) {
+            Guide::Noisy(g) => {
+                LimitExceeded::check_count(
+                    format!("{}the noisy take", file),
+                    g.num_frames(),
+                    self.limits.max_rows,
+                    "rows",
+                    "max_rows",
+                )?;
+            }
+            Guide::Visemes(runs) => {
+                if !runs.is_empty() && runs.iter().all(|(a, _, _)| *a >= duration) {
+                    let first = runs.iter().map(|r| r.0).fold(f64::INFINITY, f64::min);
                     return Err(invalid(format!(
-                        "key at {:.3} s lies outside every edited span; keys guide the edit only inside --mask",
-                        k.time_s
+                        "{file}every phoneme lies after the clip's end (the first starts at {first:.3} s, the clip is \
+                         {duration:.3} s long); expected times in seconds from the clip's first frame"
                     )));
                 }
+                if runs.is_empty() {
+                    return Err(invalid(format!("{file}no phoneme to guide the edit")));
+                }
             }
+            Guide::None => {}
         }
         Ok(())
+    }
+
+    /// The spans as `a s..b s` for messages.
+    fn spans_text(&self) -> String {
+        self.spans.iter().map(|(a, b)| format!("{a:.3} s..{b:.3} s")).collect::<Vec<_>>().join(", ")
+    }
+
+    /// Keys that land on the same model-rate frame are merged; the same shape with two different
+    /// weights there is refused (which one was meant cannot be told).
+    fn check_key_conflicts(&self, keys: &[KeyPose], file: &str) -> Result<(), FaceError> {
+        merge_keys(keys).map(|_| ()).map_err(|(ia, ib, c, va, vb)| {
+            invalid(format!(
+                "{file}keys {ia} ({:.3} s) and {ib} ({:.3} s) fall on the same frame at {MODEL_FPS} fps and set {} \
+                 to different weights ({va} and {vb}); expected one weight per shape and frame",
+                keys[ia].time_s,
+                keys[ib].time_s,
+                crate::data::ARKIT_NAMES[c]
+            ))
+        })
     }
 
     /// Run the edit.
     pub fn run(&self) -> Result<EditOutcome, FaceError> {
         self.validate()?;
+        self.cancel.check()?;
         let model = self.clip.resample(MODEL_FPS)?;
+        self.cancel.check()?;
         let before: Vec<Frame> = (0..model.num_frames()).map(|f| frame_of(model.arkit(f))).collect();
         let n = before.len();
         let segments = self.segments(n);
         let mask = Mask::from_segments(n, &segments, &self.channels);
         let keys = self.model_keys(&before);
         let constraint = self.constraint(&model, &keys)?;
+        self.cancel.check()?;
+        // One generator call over a window bounded by `limits.max_mask_s`; the cancel token is
+        // checked again right after it.
         let after = match self.method {
             Method::Network(net) => {
                 // The residual at the borders is taken against the network's own output there (not the
@@ -171,6 +267,7 @@ impl EditJob<'_> {
             Method::Linear => interpolate(&before, &mask, &keys, Interp::Linear),
             Method::Cubic => interpolate(&before, &mask, &keys, Interp::Cubic),
         };
+        self.cancel.check()?;
         let clip = self.back_to_capture_rate(&after, &mask)?;
         Ok(EditOutcome { clip, before, after, mask, keys })
     }
@@ -190,12 +287,15 @@ impl EditJob<'_> {
     /// Keys at model-rate frames, unset shapes taken from the input there.
     fn model_keys(&self, before: &[Frame]) -> Vec<(usize, Frame)> {
         let Guide::Keys(keys) = &self.guide else { return Vec::new() };
-        keys.iter()
-            .map(|k| {
-                let f = ((k.time_s * MODEL_FPS).round() as usize).min(before.len() - 1);
+        // Keys on the same frame are merged into one (validate refused conflicting weights).
+        let merged = merge_keys(keys).unwrap_or_default();
+        merged
+            .into_iter()
+            .map(|(f, shapes)| {
+                let f = f.min(before.len() - 1);
                 let mut frame = before[f];
-                for (c, v) in &k.shapes {
-                    frame[*c] = *v;
+                for (c, (v, _)) in shapes {
+                    frame[c] = v;
                 }
                 (f, frame)
             })
@@ -250,6 +350,33 @@ impl EditJob<'_> {
         }
         BlendshapeClip::new(clip.fps(), clip.times().to_vec(), clip.has_head_eye(), clip.extra_names().to_vec(), values)
     }
+}
+
+/// The model-rate frame of a time in seconds from the first frame (rounded to the nearest).
+fn model_frame(time_s: f64) -> usize {
+    (time_s * MODEL_FPS).round() as usize
+}
+
+/// A shape set by two keys on one frame to different weights: `(key, other key, shape, weight, other weight)`.
+type KeyConflict = (usize, usize, usize, f32, f32);
+
+/// Keys grouped by model-rate frame (ascending), each shape with its weight and the key that set it.
+#[allow(clippy::type_complexity)]
+fn merge_keys(keys: &[KeyPose]) -> Result<Vec<(usize, BTreeMap<usize, (f32, usize)>)>, KeyConflict> {
+    let mut frames: BTreeMap<usize, BTreeMap<usize, (f32, usize)>> = BTreeMap::new();
+    for (i, k) in keys.iter().enumerate() {
+        let shapes = frames.entry(model_frame(k.time_s)).or_default();
+        for (c, v) in &k.shapes {
+            match shapes.get(c) {
+                Some((w, j)) if w != v => return Err((*j, i, *c, *w, *v)),
+                Some(_) => {}
+                None => {
+                    shapes.insert(*c, (*v, i));
+                }
+            }
+        }
+    }
+    Ok(frames.into_iter().collect())
 }
 
 /// Context the network sees on each side of the edited spans (2 s at 25 fps): enough for the BiLSTM
@@ -354,7 +481,17 @@ mod tests {
     }
 
     fn job<'a>(clip: &'a BlendshapeClip, guide: Guide, method: Method<'a>) -> EditJob<'a> {
-        EditJob { clip, spans: vec![(2.0, 3.5)], channels: [true; NUM_ARKIT], guide, method, seed: 1 }
+        EditJob {
+            clip,
+            spans: vec![(2.0, 3.5)],
+            channels: [true; NUM_ARKIT],
+            guide,
+            method,
+            seed: 1,
+            limits: EditLimits::default(),
+            cancel: Cancel::new(),
+            guide_file: None,
+        }
     }
 
     #[test]
@@ -432,6 +569,119 @@ mod tests {
         let mut late = job(&clip, Guide::None, Method::Linear);
         late.spans = vec![(5.0, 6.0)];
         assert!(late.validate().unwrap_err().to_string().contains("after the clip ends"));
+    }
+
+    #[test]
+    fn limits_are_checked_before_any_work_and_name_their_field() {
+        let clip = capture(6.0);
+        let mut j = job(&clip, Guide::None, Method::Linear);
+        j.limits.max_rows = 100;
+        let e = j.run().unwrap_err();
+        assert!(matches!(&e, FaceError::Limit(l) if l.field == "max_rows"), "{e}");
+        assert_eq!(e.to_string(), "the clip: 360 rows, more than the limit of 100 rows (max_rows)");
+        let mut j = job(&clip, Guide::None, Method::Linear);
+        j.spans = vec![(0.5, 1.0), (4.0, 5.0)];
+        j.limits.max_mask_s = 4.0;
+        let e = j.validate().unwrap_err().to_string();
+        assert!(e.contains("4.500 s, more than the limit of 4 s (max_mask_s)"), "{e}");
+        j.limits.max_mask_s = 4.5;
+        assert!(j.validate().is_ok());
+        let mut j = job(&clip, Guide::Noisy(capture(7.0)), Method::Linear);
+        j.limits.max_rows = 400;
+        j.guide_file = Some("noisy.csv".into());
+        let e = j.validate().unwrap_err().to_string();
+        assert!(e.starts_with("noisy.csv: the noisy take: 420 rows") && e.contains("(max_rows)"), "{e}");
+    }
+
+    #[test]
+    fn spans_past_the_end_and_late_visemes_are_refused() {
+        let clip = capture(4.0);
+        let mut j = job(&clip, Guide::None, Method::Linear);
+        j.spans = vec![(3.0, 9.0)];
+        let e = j.validate().unwrap_err().to_string();
+        assert!(e.contains("runs past the clip's end"), "{e}");
+        // A span ending one frame past the last frame's time covers the last frame: accepted.
+        j.spans = vec![(3.0, clip.duration() + 1.0 / clip.fps())];
+        assert!(j.validate().is_ok());
+        let late = Guide::Visemes(vec![(10.0, 10.5, Viseme::Sil), (10.5, 11.0, Viseme::Sil)]);
+        let mut j = job(&clip, late, Method::Linear);
+        j.guide_file = Some("late.TextGrid".into());
+        let e = j.validate().unwrap_err().to_string();
+        assert!(e.contains("late.TextGrid: every phoneme lies after the clip's end"), "{e}");
+    }
+
+    #[test]
+    fn keys_on_one_frame_merge_unless_they_disagree() {
+        let clip = capture(6.0);
+        let jaw = arkit_index("JawOpen").unwrap();
+        let smile = arkit_index("MouthSmileLeft").unwrap();
+        let agree = vec![
+            KeyPose { time_s: 3.0, shapes: vec![(jaw, 0.9)] },
+            KeyPose { time_s: 3.01, shapes: vec![(jaw, 0.9), (smile, 0.4)] },
+        ];
+        let out = job(&clip, Guide::Keys(agree), Method::Cubic).run().unwrap();
+        assert_eq!(out.keys.len(), 1, "one key frame");
+        assert_eq!((out.after[75][jaw], out.after[75][smile]), (0.9, 0.4), "both keys' shapes are hit");
+        let disagree = vec![
+            KeyPose { time_s: 3.0, shapes: vec![(jaw, 0.9)] },
+            KeyPose { time_s: 2.0, shapes: vec![(smile, 0.1)] },
+            KeyPose { time_s: 2.99, shapes: vec![(jaw, 0.2)] },
+        ];
+        let mut j = job(&clip, Guide::Keys(disagree), Method::Cubic);
+        j.guide_file = Some("k.json".into());
+        let e = j.validate().unwrap_err().to_string();
+        assert!(e.contains("k.json: keys 0 (3.000 s) and 2 (2.990 s) fall on the same frame"), "{e}");
+        assert!(e.contains("JawOpen") && e.contains("0.9 and 0.2"), "{e}");
+        let outside = vec![KeyPose { time_s: 5.0, shapes: vec![(jaw, 0.9)] }];
+        let mut j = job(&clip, Guide::Keys(outside), Method::Cubic);
+        j.guide_file = Some("k.json".into());
+        let e = j.validate().unwrap_err().to_string();
+        assert!(e.contains("k.json: key 0 at 5.000 s lies outside every edited span (2.000 s..3.500 s)"), "{e}");
+    }
+
+    #[test]
+    fn a_cancelled_edit_stops_with_the_reason() {
+        let clip = capture(6.0);
+        let j = job(&clip, Guide::None, Method::Linear);
+        j.cancel.cancel();
+        assert_eq!(j.run().unwrap_err().to_string(), "face job stopped: cancelled");
+        let mut j = job(&clip, Guide::None, Method::Linear);
+        j.cancel = Cancel::with_time_limit(std::time::Duration::ZERO);
+        assert!(matches!(j.run(), Err(FaceError::Cancelled(inbetween_core::cancel::Cancelled::TimeLimit { .. }))));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            rng_seed: proptest::test_runner::RngSeed::Fixed(inbetween_core::seed::PROPTEST_SEED),
+            ..proptest::prelude::ProptestConfig::with_cases(32)
+        })]
+
+        /// Inputs over a limit are refused by validation (no work done), naming the limit's field.
+        #[test]
+        fn oversized_edits_are_refused_naming_the_limit(
+            rows in 3usize..2000, over in 1usize..500, spans in proptest::collection::vec((0.0f64..1.0, 0.0f64..1.0), 1..6)
+        ) {
+            let fps = 60.0;
+            let n = rows + over;
+            let times: Vec<f64> = (0..n).map(|i| i as f64 / fps).collect();
+            let clip = BlendshapeClip::new(fps, times, false, vec![], vec![0.5; n * NUM_ARKIT]).unwrap();
+            let duration = clip.duration();
+            let spans: Vec<(f64, f64)> = spans
+                .iter()
+                .map(|(a, b)| (a * duration * 0.9, a * duration * 0.9 + (b * 0.09 + 0.001) * duration))
+                .collect();
+            let mut j = job(&clip, Guide::None, Method::Linear);
+            j.spans = spans.clone();
+            j.limits.max_rows = rows;
+            let e = j.run().unwrap_err();
+            proptest::prop_assert!(matches!(&e, FaceError::Limit(l) if l.field == "max_rows"), "{}", e);
+            j.limits.max_rows = n;
+            let first = spans.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
+            let last = spans.iter().map(|s| s.1).fold(0.0, f64::max);
+            j.limits.max_mask_s = (last - first) * 0.99;
+            let e = j.run().unwrap_err();
+            proptest::prop_assert!(matches!(&e, FaceError::Limit(l) if l.field == "max_mask_s"), "{}", e);
+        }
     }
 
     #[test]

@@ -6,10 +6,7 @@
 //! a key can correct the mouth and leave the eyes as captured. Times are seconds from the clip's first
 //! frame; values must lie in [0, 1].
 
-use std::collections::BTreeMap;
 use std::path::Path;
-
-use serde::Deserialize;
 
 use crate::data::text::{at, column, fields, lines, number, read_text};
 use crate::data::{arkit_index, FaceError, ARKIT_NAMES};
@@ -21,20 +18,6 @@ pub struct KeyPose {
     pub time_s: f64,
     /// `(ARKit index, weight)` pairs.
     pub shapes: Vec<(usize, f32)>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct KeyJson {
-    time_s: f64,
-    shapes: BTreeMap<String, f64>,
-}
-
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum KeysJson {
-    Wrapped { keys: Vec<KeyJson> },
-    Bare(Vec<KeyJson>),
 }
 
 /// Reads a keys file, JSON or CSV by extension.
@@ -64,19 +47,48 @@ fn check_time(t: f64) -> Result<f64, String> {
     }
 }
 
-/// Parses the JSON form; `file` names it in errors.
+/// What a keys JSON file must look like, for messages.
+const JSON_FORM: &str = r#"{"keys": [{"time_s": 1.5, "shapes": {"JawOpen": 0.8}}, …]}"#;
+
+/// A JSON value's kind, for messages ("a string", "the number 1").
+fn kind_of(v: &serde_json::Value) -> String {
+    use serde_json::Value;
+    match v {
+        Value::Null => "null".into(),
+        Value::Bool(b) => format!("{b}"),
+        Value::Number(n) => format!("the number {n}"),
+        Value::String(s) => {
+            let short: String = s.chars().take(40).collect();
+            let more = if s.chars().count() > 40 { "…" } else { "" };
+            format!("the string \"{short}{more}\"")
+        }
+        Value::Array(_) => "an array".into(),
+        Value::Object(_) => "an object".into(),
+    }
+}
+
+/// Parses the JSON form; `file` names it in errors. The top level is `{"keys": [...]}` or a bare
+/// array of keys; every key is `{"time_s": seconds, "shapes": {name: weight, …}}`.
 pub fn parse_keys_json(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError> {
+    use serde_json::Value;
     let bad = |message: String| FaceError::File { file: file.into(), message };
-    let parsed: KeysJson = serde_json::from_str(text).map_err(|e| {
-        FaceError::parse(
-            file,
-            e.line(),
-            None,
-            format!("{e}; expected {{\"keys\": [{{\"time_s\": 1.5, \"shapes\": {{\"JawOpen\": 0.8}}}}]}}"),
-        )
+    let parsed: Value = serde_json::from_str(text).map_err(|e| {
+        // serde_json reports line 0 only for errors not tied to a position; name line 1 then.
+        FaceError::parse(file, e.line().max(1), None, format!("{e}; expected {JSON_FORM}"))
     })?;
     let keys = match parsed {
-        KeysJson::Wrapped { keys } | KeysJson::Bare(keys) => keys,
+        Value::Array(keys) => keys,
+        Value::Object(mut top) => {
+            if let Some(other) = top.keys().find(|k| k.as_str() != "keys") {
+                return Err(bad(format!("unknown field '{other}' at the top level; expected {JSON_FORM}")));
+            }
+            match top.remove("keys") {
+                Some(Value::Array(keys)) => keys,
+                Some(other) => return Err(bad(format!("\"keys\" is {}; expected an array of keys", kind_of(&other)))),
+                None => return Err(bad(format!("an object without \"keys\"; expected {JSON_FORM}"))),
+            }
+        }
+        other => return Err(bad(format!("the file holds {}; expected {JSON_FORM}", kind_of(&other)))),
     };
     if keys.is_empty() {
         return Err(bad("no keys; expected at least one".into()));
@@ -84,20 +96,54 @@ pub fn parse_keys_json(text: &str, file: &str) -> Result<Vec<KeyPose>, FaceError
     keys.into_iter()
         .enumerate()
         .map(|(i, k)| {
-            let time_s = check_time(k.time_s).map_err(|m| bad(format!("key {i}: {m}")))?;
-            let shapes = k
-                .shapes
-                .iter()
-                .map(|(name, v)| {
-                    let c = arkit_index(name)
-                        .ok_or_else(|| bad(format!("key {i}: '{name}' is not an ARKit blendshape name")))?;
-                    Ok((c, check_value(*v).map_err(|m| bad(format!("key {i}: {name}: {m}")))?))
-                })
-                .collect::<Result<Vec<_>, FaceError>>()?;
-            if shapes.is_empty() {
+            let k = match k {
+                Value::Object(k) => k,
+                other => {
+                    return Err(bad(format!(
+                        "key {i} is {}; expected an object {{\"time_s\": 1.5, \"shapes\": {{\"JawOpen\": 0.8}}}}",
+                        kind_of(&other)
+                    )))
+                }
+            };
+            if let Some(other) = k.keys().find(|f| !matches!(f.as_str(), "time_s" | "shapes")) {
+                return Err(bad(format!("key {i}: unknown field '{other}'; expected \"time_s\" and \"shapes\"")));
+            }
+            let time_s = match k.get("time_s") {
+                Some(Value::Number(n)) => n.as_f64().unwrap_or(f64::NAN),
+                Some(other) => {
+                    return Err(bad(format!("key {i}: \"time_s\" is {}; expected a number of seconds", kind_of(other))))
+                }
+                None => return Err(bad(format!("key {i} has no \"time_s\"; expected a number of seconds"))),
+            };
+            let time_s = check_time(time_s).map_err(|m| bad(format!("key {i}: {m}")))?;
+            let shapes = match k.get("shapes") {
+                Some(Value::Object(shapes)) => shapes,
+                Some(other) => {
+                    return Err(bad(format!(
+                        "key {i}: \"shapes\" is {}; expected an object of ARKit names and weights",
+                        kind_of(other)
+                    )))
+                }
+                None => return Err(bad(format!("key {i} has no \"shapes\"; expected {{\"JawOpen\": 0.8, …}}"))),
+            };
+            let mut out = Vec::with_capacity(shapes.len());
+            for (name, v) in shapes {
+                let c = arkit_index(name)
+                    .ok_or_else(|| bad(format!("key {i}: '{name}' is not an ARKit blendshape name")))?;
+                if out.iter().any(|(d, _)| *d == c) {
+                    return Err(bad(format!("key {i}: '{}' is set twice", ARKIT_NAMES[c])));
+                }
+                let Value::Number(n) = v else {
+                    return Err(bad(format!("key {i}: {name} is {}; expected a weight in [0, 1]", kind_of(v))));
+                };
+                let w =
+                    check_value(n.as_f64().unwrap_or(f64::NAN)).map_err(|m| bad(format!("key {i}: {name}: {m}")))?;
+                out.push((c, w));
+            }
+            if out.is_empty() {
                 return Err(bad(format!("key {i} sets no shape")));
             }
-            Ok(KeyPose { time_s, shapes })
+            Ok(KeyPose { time_s, shapes: out })
         })
         .collect()
 }

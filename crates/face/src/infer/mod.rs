@@ -3,5 +3,5 @@
 pub mod job;
 pub mod keys;
 
-pub use job::{EditJob, EditOutcome, Guide, Inpainter, Method};
+pub use job::{EditJob, EditLimits, EditOutcome, Guide, Inpainter, Method};
 pub use keys::{read_keys, KeyPose};

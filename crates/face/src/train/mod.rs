@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 
 use burn::module::Module;
 use burn::tensor::Device;
+use inbetween_core::cancel::Cancel;
 use inbetween_io::Progress;
 use inbetween_nn::burn;
 use inbetween_nn::train::{fit_with, Finish, TrainConfig};
@@ -235,9 +236,23 @@ pub fn train_face_on(
     progress: &Progress,
     device: &Device,
 ) -> Result<FaceTrainReport, TrainError> {
+    train_face_cancellable(config, pool, progress, device, &Cancel::new())
+}
+
+/// [`train_face_on`] that stops before the next step once `cancel` is cancelled (or its time limit
+/// passes), returning [`NnError::Cancelled`] inside [`TrainError::Nn`]. Nothing of the unfinished
+/// epoch is checkpointed, so a later run resumes from the last whole epoch.
+pub fn train_face_cancellable(
+    config: &FaceTrainConfig,
+    pool: &ClipPool,
+    progress: &Progress,
+    device: &Device,
+    cancel: &Cancel,
+) -> Result<FaceTrainReport, TrainError> {
     config.validate().map_err(TrainError::Setup)?;
     progress.set_length((config.epochs * config.steps_per_epoch) as u64);
     let mut objective = objective::GanObjective::new(config, pool, device, progress).map_err(TrainError::Setup)?;
+    objective.cancel = cancel.clone();
     let generator = config.generator();
     let run = fit_with(&config.loop_config(), device, |d| generator.init(d), &mut objective)?;
     Ok(FaceTrainReport {
@@ -365,6 +380,34 @@ mod tests {
         // Another seed trains another network.
         let other = train_face(&FaceTrainConfig { seed: 6, ..tiny(kind, 1, None) }, &pool, &hidden).unwrap();
         assert_ne!(param_bits(&other.generator), param_bits(&first.generator));
+    }
+
+    #[test]
+    fn train_cancelled_run_stops_before_a_step_and_checkpoints_nothing_new() {
+        let pool = toy_pool(2, 40);
+        let hidden = Progress::hidden();
+        let dir = tempfile::tempdir().unwrap();
+        let kind = ConstraintKind::None;
+        train_face(&tiny(kind, 1, Some(dir.path())), &pool, &hidden).unwrap();
+        let listing = |d: &Path| {
+            let mut v: Vec<_> = std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name()).collect();
+            v.sort();
+            v
+        };
+        let before = listing(dir.path());
+        let cancel = Cancel::new();
+        cancel.cancel();
+        let device = inbetween_nn::backend::cpu_autodiff();
+        let counted = Progress::hidden();
+        let e =
+            train_face_cancellable(&tiny(kind, 3, Some(dir.path())), &pool, &counted, &device, &cancel).unwrap_err();
+        assert!(matches!(e, TrainError::Nn(NnError::Cancelled(inbetween_core::cancel::Cancelled::Requested))), "{e}");
+        assert_eq!(e.to_string(), "training stopped: cancelled");
+        assert_eq!(counted.position(), 0, "no step reported");
+        assert_eq!(listing(dir.path()), before, "no checkpoint of the unfinished epoch");
+        let limited = Cancel::with_time_limit(std::time::Duration::ZERO);
+        let e = train_face_cancellable(&tiny(kind, 3, None), &pool, &counted, &device, &limited).unwrap_err();
+        assert_eq!(e.to_string(), "training stopped: time limit of 0 s reached");
     }
 
     #[test]

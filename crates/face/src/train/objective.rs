@@ -105,6 +105,8 @@ pub(crate) struct GanObjective<'a> {
     critic_config: CriticConfig,
     stats: Stats,
     progress: &'a Progress,
+    /// Checked before every step (`Objective::check_cancel`).
+    pub(crate) cancel: inbetween_core::cancel::Cancel,
 }
 
 fn scalar(t: Tensor<1>) -> f64 {
@@ -135,6 +137,7 @@ impl<'a> GanObjective<'a> {
             critic_config,
             stats: Stats::default(),
             progress,
+            cancel: inbetween_core::cancel::Cancel::new(),
         })
     }
 
@@ -193,6 +196,10 @@ impl Objective<Generator> for GanObjective<'_> {
         let terms = [scalar(loss.total.clone()), scalar(loss.rec), scalar(loss.dist), scalar(loss.adv), hinge, gp];
         self.stats.add(terms);
         Some(loss.total)
+    }
+
+    fn check_cancel(&self) -> Result<(), inbetween_core::cancel::Cancelled> {
+        self.cancel.check()
     }
 
     fn after_step(&mut self, _: &Generator, step: &Step, loss: Option<f64>) {
