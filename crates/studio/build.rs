@@ -16,7 +16,6 @@ const THREE_FILES: &[&str] = &[
     "build/three.core.js",
     "examples/jsm/controls/OrbitControls.js",
     "examples/jsm/loaders/GLTFLoader.js",
-    "examples/jsm/loaders/BVHLoader.js",
     "examples/jsm/utils/BufferGeometryUtils.js",
     "examples/jsm/utils/SkeletonUtils.js",
 ];

@@ -6,6 +6,7 @@ mod cmd_io;
 mod cmd_mocap;
 mod cmd_preview;
 mod cmd_script;
+mod cmd_studio;
 mod cmd_video;
 mod demo;
 mod errors;
@@ -53,6 +54,8 @@ enum Command {
     /// Script engine: text → semantic scene graph → furnished scene (Write-An-Animation).
     #[command(subcommand)]
     Script(cmd_script::ScriptCommand),
+    /// Local web studio (script and mocap panels): serves http://127.0.0.1:7878/ until Ctrl-C.
+    Studio(cmd_studio::StudioArgs),
 }
 
 fn main() -> ExitCode {
@@ -80,5 +83,6 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Face(c) => cmd_face::run(c),
         Command::Video(c) => cmd_video::run(c),
         Command::Script(c) => cmd_script::run(c),
+        Command::Studio(a) => cmd_studio::run(a),
     }
 }

@@ -15,6 +15,7 @@ pub mod fsutil;
 pub mod gltf_buffer;
 mod lexer;
 pub mod limits;
+pub mod motion_gltf;
 pub mod output_set;
 pub mod progress;
 pub mod report;

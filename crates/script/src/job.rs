@@ -181,7 +181,7 @@ pub fn run_story_in(
     source: &Path,
     job: &RunJob,
 ) -> Result<RunReport, ScriptError> {
-    use crate::animate::camera_pose;
+    use crate::animate::camera_track;
     use crate::optimize::plot_costs;
     let start = std::time::Instant::now();
     if crate::script::split(text).is_empty() {
@@ -200,7 +200,8 @@ pub fn run_story_in(
     let animation = u.animation;
     let chars: Vec<(&str, &inbetween_core::Motion)> =
         animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
-    let cam = |f: usize| camera_pose(&animation, f);
+    let track = camera_track(&animation);
+    let cam = |f: usize| track.pose(f);
     let gltf = dir.join("story.gltf");
     output::write_story_gltf(&gltf, &animation, cat, &cam)?;
     files.push(gltf);

@@ -73,6 +73,12 @@ fn set_method(m: &str) -> String {
     format!("(s => {{ s.value = {m:?}; return true; }})(document.querySelector('[data-testid=mocap-method]'))")
 }
 
+/// Resident memory of this process alone (bytes), from `/proc/self/statm` (Linux; None elsewhere).
+fn own_rss_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/statm").ok()?;
+    s.split_whitespace().nth(1)?.parse::<u64>().ok().map(|pages| pages * 4096)
+}
+
 /// Runs the bench, writes `studio-bench.{txt,md}`, the CSV and the screenshots into `out`, and
 /// returns the text table.
 pub fn run(out: &Path, repeats: usize) -> Result<String> {
@@ -105,16 +111,27 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
         job_times(&b, "(document.querySelector('[data-testid=script-run]').click(), window.inbetweenStudio.ready())")?;
     row(&mut t, "script: demo story, first run (full solve)", &mut [full_ms], &mut [full_server], "—");
     let (mut scene_edit, mut scene_server) = (Vec::new(), Vec::new());
+    // Where an edit's time goes in the page: the request (the server's job and the transfer), the
+    // GLB's fetch and parse, and the first frame drawn with it (software WebGL here).
+    let (mut request, mut glb, mut render) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..repeats {
         let (a, z) = if i % 2 == 0 { ("a lamp are", "a plant are") } else { ("a plant are", "a lamp are") };
         let (ms, server, _) = job_times(&b, &set_text(a, z))?;
         scene_edit.push(ms);
         scene_server.push(server);
+        let d = b.eval("window.inbetweenStudio.drawTimes()")?;
+        let f = |k: &str| d[k].as_f64().unwrap_or(f64::NAN);
+        request.push(f("request_ms"));
+        glb.push(f("fetch_ms") + f("parse_ms"));
+        render.push(f("render_ms"));
     }
     if repeats % 2 == 1 {
         job_times(&b, &set_text("a plant are", "a lamp are"))?;
     }
     row(&mut t, "script edit to redraw: scene sentence (lamp ↔ plant)", &mut scene_edit, &mut scene_server, "< 100");
+    row(&mut t, "  of which the request (server job + transfer)", &mut request, &mut [], "—");
+    row(&mut t, "  of which the story GLB's fetch and parse", &mut glb, &mut [], "—");
+    row(&mut t, "  of which the first frame drawn (SwiftShader)", &mut render, &mut [], "—");
     let (mut char_edit, mut char_server) = (Vec::new(), Vec::new());
     for i in 0..repeats {
         let (a, z) = if i % 2 == 0 {
@@ -145,7 +162,7 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
         &b,
         "(s => { s.value = 'builtin:walk-1000'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('mocap-corpus'))",
     )?;
-    for method in ["optimal", "uniform"] {
+    for method in ["optimal", "greedy", "uniform"] {
         b.eval(&set_method(method))?;
         let (mut k_ms, mut k_server) = (Vec::new(), Vec::new());
         for i in 0..repeats {
@@ -165,13 +182,17 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
     b.eval("window.inbetweenStudio.seek(420)")?;
     let mocap_png = b.screenshot()?;
 
-    let server_mb = tree_rss_bytes(std::process::id()).map(|v| v as f64 / 1e6);
+    // This process alone (the server and the bench driver; chromedriver and Chromium are its
+    // children, counted on the next line).
+    let server_mb = own_rss_bytes().map(|v| v as f64 / 1e6);
+    let server_peak_mb = inbetween_io::scale::own_peak_mib().map(|v| v * 1.048_576);
     let browser_mb = tree_rss_bytes(b.pid()).map(|v| v as f64 / 1e6);
     let mut mem = Table::new("studio-memory", "Memory after the run (resident set, MB)", &["process", "MB"]);
     mem.row([
         "studio server (this process: server + bench driver)".to_string(),
         server_mb.map_or("—".into(), |v| num(v, 1)),
     ]);
+    mem.row(["studio server, peak during the run".to_string(), server_peak_mb.map_or("—".into(), |v| num(v, 1))]);
     mem.row([
         "headless Chromium (all its processes, with chromedriver)".to_string(),
         browser_mb.map_or("—".into(), |v| num(v, 1)),

@@ -62,14 +62,9 @@ fn call(addr: SocketAddr, method: &str, path: &str, body: Option<&Value>) -> Res
         body.len()
     );
     s.write_all(head.as_bytes()).and_then(|_| s.write_all(body.as_bytes())).map_err(err)?;
-    let mut raw = Vec::new();
-    s.read_to_end(&mut raw).map_err(err)?;
-    let split = raw.windows(4).position(|w| w == b"\r\n\r\n").ok_or_else(|| err("chromedriver: no response head"))?;
-    let head = String::from_utf8_lossy(&raw[..split]).to_ascii_lowercase();
-    let mut payload = raw[split + 4..].to_vec();
-    if head.contains("transfer-encoding: chunked") {
-        payload = dechunk(&payload);
-    }
+    // chromedriver answers `Connection: close` but keeps the socket open, so the body is read by
+    // its Content-Length (or chunk by chunk), not to the end of the stream.
+    let payload = read_response(&mut s).map_err(|e| err(format!("chromedriver {path}: {e}")))?;
     let v: Value = serde_json::from_slice(&payload).map_err(|e| err(format!("chromedriver {path}: {e}")))?;
     let value = v.get("value").cloned().unwrap_or(Value::Null);
     if let Some(e) = value.get("error").and_then(|e| e.as_str()) {
@@ -78,6 +73,49 @@ fn call(addr: SocketAddr, method: &str, path: &str, body: Option<&Value>) -> Res
         return Err(StudioError::Browser(format!("{method} {path}: {e}: {first}")));
     }
     Ok(value)
+}
+
+/// Reads one HTTP response: the head, then `Content-Length` bytes, or chunks up to the last one,
+/// or (with neither) to the end of the stream.
+fn read_response(s: &mut TcpStream) -> std::io::Result<Vec<u8>> {
+    let mut raw = Vec::new();
+    let mut buf = [0u8; 16 * 1024];
+    let split = loop {
+        if let Some(i) = raw.windows(4).position(|w| w == b"\r\n\r\n") {
+            break i;
+        }
+        let n = s.read(&mut buf)?;
+        if n == 0 {
+            return Err(std::io::Error::new(std::io::ErrorKind::UnexpectedEof, "no response head"));
+        }
+        raw.extend_from_slice(&buf[..n]);
+    };
+    let head = String::from_utf8_lossy(&raw[..split]).to_ascii_lowercase();
+    let mut body = raw[split + 4..].to_vec();
+    let length =
+        head.lines().find_map(|l| l.strip_prefix("content-length:").and_then(|v| v.trim().parse::<usize>().ok()));
+    let chunked = head.contains("transfer-encoding: chunked") || head.contains("transfer-encoding:chunked");
+    loop {
+        let done = match length {
+            Some(n) => body.len() >= n,
+            None if chunked => body.windows(5).any(|w| w == b"0\r\n\r\n"),
+            None => false,
+        };
+        if done {
+            break;
+        }
+        let n = s.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        body.extend_from_slice(&buf[..n]);
+    }
+    if let Some(n) = length {
+        body.truncate(n);
+    } else if chunked {
+        body = dechunk(&body);
+    }
+    Ok(body)
 }
 
 fn dechunk(mut b: &[u8]) -> Vec<u8> {

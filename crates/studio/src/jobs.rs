@@ -52,6 +52,30 @@ impl Job {
         self.started.elapsed().as_secs_f64() * 1000.0
     }
 
+    /// Waits up to `within` for the job to end; its last event (`result`, `failed` or
+    /// `cancelled`) when it did, None while it still runs.
+    pub async fn ended_within(&self, within: std::time::Duration) -> Option<(String, Value)> {
+        let _ = tokio::time::timeout(within, async {
+            loop {
+                let seen = {
+                    let log = self.log.lock().unwrap_or_else(|p| p.into_inner());
+                    if log.1 {
+                        return;
+                    }
+                    log.0.len()
+                };
+                self.wait_past(seen).await;
+            }
+        })
+        .await;
+        let log = self.log.lock().unwrap_or_else(|p| p.into_inner());
+        if log.1 {
+            log.0.last().cloned()
+        } else {
+            None
+        }
+    }
+
     pub fn cancel(&self) {
         self.cancelled.store(true, Ordering::SeqCst);
         self.push("cancelled", json!({"job": self.id, "kind": self.kind, "ms": self.elapsed_ms()}), true);
@@ -89,6 +113,24 @@ pub struct Jobs {
 
 /// Jobs kept for late subscribers.
 pub const KEEP: u64 = 64;
+
+/// How long a request that starts a job waits for it before answering with the job's id only: a
+/// job done by then (a K change, an incremental story edit) is answered in the same response, so
+/// the page does not open an event stream for it.
+pub const ANSWER_WITHIN: std::time::Duration = std::time::Duration::from_millis(300);
+
+/// The answer to a request that started job `id`: `{"job": id}`, with `"event"` and `"data"`
+/// (the job's last event) when it ended within [`ANSWER_WITHIN`].
+pub async fn answer(jobs: &Jobs, id: u64) -> Value {
+    let ended = match jobs.get(id) {
+        Some(job) => job.ended_within(ANSWER_WITHIN).await,
+        None => None,
+    };
+    match ended {
+        Some((event, data)) => json!({"job": id, "event": event, "data": data}),
+        None => json!({"job": id}),
+    }
+}
 
 impl Jobs {
     pub fn get(&self, id: u64) -> Option<Arc<Job>> {

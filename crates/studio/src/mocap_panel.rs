@@ -11,27 +11,48 @@ use std::time::Instant;
 use axum::body::Bytes;
 use axum::extract::{Query, State};
 use axum::Json;
+use glam::DVec3;
 use inbetween_core::procedural::{gait, GaitParams};
 use inbetween_core::units::UnitChoice;
 use inbetween_core::{positions_clip, KeyframeSet, Motion};
-use inbetween_mocap::codec;
-use inbetween_mocap::error::SegmentModel;
+use inbetween_io::motion_gltf::motion_glb;
+use inbetween_mocap::codec::job::{CompressJob, CompressReport};
+use inbetween_mocap::codec::{self, Budget};
+use inbetween_mocap::metrics::SegmentModel;
 use inbetween_mocap::rotations::reconstruct_from_keys;
 use inbetween_mocap::select::{self, sidql::SidqlPolicy};
-use inbetween_mocap::{Objective, RotationMotion, SegmentTable, SphericalMotion};
+use inbetween_mocap::{ErrorMeasure, RotationMotion, SegmentTable, SphericalMotion};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
-use crate::jobs::Job;
+use crate::jobs::{answer, Job};
 use crate::safety::resolve_under_root;
 use crate::server::AppState;
 
-/// The open take.
+/// The open take, with what every keys job needs computed once when it opens (so a K change
+/// pays only for its selection and reconstruction).
 struct Take {
     name: String,
     motion: Motion,
     unit: UnitChoice,
+    /// The spherical representation the selectors work on (§3.1), lengths in cm.
+    rep: SphericalMotion,
+    /// Local rotations per frame, the key poses of a reconstruction.
+    rotations: RotationMotion,
+    /// World joint positions per frame (file units), the reference of the per-frame error.
+    positions: Vec<Vec<DVec3>>,
+}
+
+impl Take {
+    fn new(name: String, motion: Motion, unit: UnitChoice) -> Result<Take> {
+        let cm = unit.cm_per_unit();
+        let mut rep = SphericalMotion::from_motion(&motion)?;
+        rep.cm_per_unit = cm;
+        let rotations = RotationMotion::from_motion_in(&motion, cm)?;
+        let positions = positions_clip(&motion);
+        Ok(Take { name, motion, unit, rep, rotations, positions })
+    }
 }
 
 /// The panel's take and an ASF waiting for its AMC.
@@ -108,7 +129,7 @@ pub async fn open_path(State(st): State<Arc<AppState>>, Json(req): Json<OpenRequ
         };
         opened(&state, job, name, motion)
     });
-    Ok(Json(json!({"job": id})))
+    Ok(Json(answer(&st.jobs, id).await))
 }
 
 enum Source {
@@ -171,7 +192,7 @@ pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body
                 };
                 opened(&state, job, name.clone(), motion)
             });
-            Ok(Json(json!({"job": id})))
+            Ok(Json(answer(&st.jobs, id).await))
         }
         _ => Ok(Json(failed_now(
             &st,
@@ -202,13 +223,15 @@ fn opened(st: &AppState, job: &Job, name: String, motion: Motion) -> Result<Valu
     if motion.num_frames() < 2 {
         return Err(StudioError::Engine(format!("{name}: {} frame(s); a take needs at least 2", motion.num_frames())));
     }
-    job.progress("converting to BVH for the viewer", 0.6);
+    job.progress("converting to glTF for the viewer", 0.6);
     let unit = UnitChoice::resolve(None, &motion.skeleton);
     let v = st.mocap.next_version();
-    let bvh = st.put_file(
+    let glb = st.put_file("mocap/original.glb", "model/gltf-binary", motion_glb(&motion, "original", 1.0), v);
+    let copy = motion.clone();
+    let bvh = st.put_lazy(
         "mocap/original.bvh",
         "text/plain; charset=utf-8",
-        inbetween_io::to_bvh_string(&motion).into_bytes(),
+        move || inbetween_io::to_bvh_string(&copy).into_bytes(),
         v,
     );
     let msg = format!(
@@ -227,9 +250,11 @@ fn opened(st: &AppState, job: &Job, name: String, motion: Motion) -> Result<Valu
         "unit": unit.unit.describe(),
         "unit_reason": unit.reason,
         "cm_per_unit": unit.cm_per_unit(),
-        "files": {"original": bvh},
+        "files": {"original": bvh, "original_glb": glb},
     });
-    *st.mocap.take.lock().unwrap_or_else(|p| p.into_inner()) = Some(Arc::new(Take { name, motion, unit }));
+    job.progress("preparing the key selectors", 0.8);
+    let take = Take::new(name, motion, unit)?;
+    *st.mocap.take.lock().unwrap_or_else(|p| p.into_inner()) = Some(Arc::new(take));
     Ok(out)
 }
 
@@ -255,16 +280,14 @@ pub async fn keys(State(st): State<Arc<AppState>>, Json(req): Json<KeysRequest>)
     let take = current(&st)?;
     let state = st.clone();
     let id = st.jobs.spawn("keys", move |job| keys_job(&state, job, &take, &req));
-    Ok(Json(json!({"job": id})))
+    Ok(Json(answer(&st.jobs, id).await))
 }
 
 fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<Value> {
     let m = &take.motion;
     let n = m.num_frames();
     let cm = take.unit.cm_per_unit();
-    job.progress("spherical representation", 0.05);
-    let mut rep = SphericalMotion::from_motion(m)?;
-    rep.cm_per_unit = cm;
+    let rep = &take.rep;
     let need_k = || -> Result<usize> {
         let k = req.k.ok_or_else(|| StudioError::BadRequest(format!("method '{}' needs K", req.method)))?;
         select::check_k(n, k)?;
@@ -279,17 +302,17 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
         }
         "greedy" => {
             let k = need_k()?;
-            (select::greedy(&rep, k, Objective::Angle)?, format!("greedy K={k}"))
+            (select::greedy(rep, k, ErrorMeasure::Angle)?, format!("greedy K={k}"))
         }
         "optimal" => {
             let k = need_k()?;
-            (select::optimal_spherical(&rep, k, Objective::Angle)?, format!("optimal K={k}"))
+            (select::optimal_spherical(rep, k, ErrorMeasure::Angle)?, format!("optimal K={k}"))
         }
         "sidql" => {
             let k = need_k()?;
             // The committed policy (weights compiled into the binary), loaded per job.
             let policy = SidqlPolicy::committed()?;
-            (select::sidql::sidql(&policy, &rep, k)?, format!("SIDQL K={k}"))
+            (select::sidql::sidql(&policy, rep, k)?, format!("SIDQL K={k}"))
         }
         "bound" => {
             let b = req
@@ -300,8 +323,8 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
             }
             // The CLI's default longest gap between keys (`--max-gap-s 0.5`).
             let max_gap = ((0.5 / m.frame_time).round() as usize).clamp(1, n - 1);
-            let table = SegmentTable::bounded(&rep, max_gap, b);
-            let keys = select::error_bounded(&table, b, Objective::Angle)?;
+            let table = SegmentTable::bounded(rep, max_gap, b);
+            let keys = select::error_bounded(&table, b, ErrorMeasure::Angle)?;
             let k = keys.frames().len();
             (keys, format!("fewest keys under {b} cm: K={k}"))
         }
@@ -317,13 +340,16 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
     }
     job.progress("reconstructing", 0.6);
     let planned = rep.error(&keys);
-    let rec = reconstruct(m, cm, &keys)?;
-    let (per_frame, mean, max) = per_frame_error(m, &rec, cm);
+    let rec = reconstruct(take, &keys)?;
+    let (per_frame, mean, max) = per_frame_error(&take.positions, &rec, cm);
     let v = st.mocap.next_version();
-    let url = st.put_file(
+    // The viewer loads the glTF (a binary buffer the page reads at once); the BVH is made when
+    // downloaded.
+    let glb = st.put_file("mocap/reconstructed.glb", "model/gltf-binary", motion_glb(&rec, "reconstructed", 1.0), v);
+    let url = st.put_lazy(
         "mocap/reconstructed.bvh",
         "text/plain; charset=utf-8",
-        inbetween_io::to_bvh_string(&rec).into_bytes(),
+        move || inbetween_io::to_bvh_string(&rec).into_bytes(),
         v,
     );
     let ms = job.elapsed_ms();
@@ -340,30 +366,33 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
         "spherical_mean_cm": planned.mean_cm,
         "spherical_max_cm": planned.max_cm,
         "mean_angle_deg": planned.mean_angle.to_degrees(),
-        "files": {"reconstructed": url},
+        "files": {"reconstructed": url, "reconstructed_glb": glb},
     }))
 }
 
 /// The clip rebuilt from its key poses (the engine's rotation reconstruction).
-fn reconstruct(m: &Motion, cm: f64, keys: &KeyframeSet) -> Result<Motion> {
-    let model = RotationMotion::from_motion_in(m, cm)?;
+fn reconstruct(take: &Take, keys: &KeyframeSet) -> Result<Motion> {
     let frames = keys.frames();
-    let poses: Vec<_> = frames.iter().map(|&f| model.frames[f].clone()).collect();
-    Ok(reconstruct_from_keys(&m.skeleton, m.frame_time, frames, &poses)?)
+    let poses: Vec<_> = frames.iter().map(|&f| take.rotations.frames[f].clone()).collect();
+    Ok(reconstruct_from_keys(&take.motion.skeleton, take.motion.frame_time, frames, &poses)?)
 }
 
 /// Per frame, the mean distance (cm) between original and rebuilt joints; the mean over frames
 /// and the largest joint distance.
-fn per_frame_error(a: &Motion, b: &Motion, cm: f64) -> (Vec<f64>, f64, f64) {
-    let (pa, pb) = (positions_clip(a), positions_clip(b));
+fn per_frame_error(original: &[Vec<DVec3>], b: &Motion, cm: f64) -> (Vec<f64>, f64, f64) {
+    let pb = positions_clip(b);
     let mut max = 0.0f64;
-    let per: Vec<f64> = pa
+    let per: Vec<f64> = original
         .iter()
         .zip(&pb)
         .map(|(fa, fb)| {
-            let d: Vec<f64> = fa.iter().zip(fb).map(|(x, y)| x.distance(*y) * cm).collect();
-            max = d.iter().fold(max, |m, &v| m.max(v));
-            d.iter().sum::<f64>() / d.len().max(1) as f64
+            let mut sum = 0.0;
+            for (x, y) in fa.iter().zip(fb) {
+                let d = x.distance(*y) * cm;
+                max = max.max(d);
+                sum += d;
+            }
+            sum / fa.len().max(1) as f64
         })
         .collect();
     let mean = per.iter().sum::<f64>() / per.len().max(1) as f64;
@@ -376,8 +405,9 @@ pub struct CompressRequest {
     pub bound_cm: f64,
 }
 
-/// `POST /api/mocap/compress`: the `.ibk` file (version 3, the CLI's default with
-/// `--max-error`), its ratio to the raw float channels and the decoded file's error.
+/// `POST /api/mocap/compress`: the `.ibk` file the CLI's `mocap compress --max-error` writes
+/// (the engine's `CompressJob`: version 4, every frame, the bound on the decoded file), its ratio
+/// to the raw float channels and the decoded file's error.
 pub async fn compress(State(st): State<Arc<AppState>>, Json(req): Json<CompressRequest>) -> Result<Json<Value>> {
     let take = current(&st)?;
     if !(req.bound_cm.is_finite() && req.bound_cm > 0.0) {
@@ -390,7 +420,17 @@ pub async fn compress(State(st): State<Arc<AppState>>, Json(req): Json<CompressR
     let id = st.jobs.spawn("compress", move |job| {
         let m = &take.motion;
         job.progress("compressing", 0.05);
-        let c = codec::alloc::compress_in(m, take.unit.clone(), &codec::alloc::Options::bound(req.bound_cm))?;
+        let cj = CompressJob {
+            budget: Budget::MaxErrorCm(req.bound_cm),
+            version: None,
+            segment_len: None,
+            max_gap: m.num_frames().saturating_sub(1).max(1),
+            unit: take.unit.clone(),
+        };
+        let report = cj.run(m)?;
+        let CompressReport::Sampled { compressed: c, version, .. } = report else {
+            return Err(StudioError::Engine("an error bound writes a sampled file (version 3 or 4)".into()));
+        };
         if job.is_cancelled() {
             return Err(StudioError::Engine("cancelled".into()));
         }
@@ -409,17 +449,17 @@ pub async fn compress(State(st): State<Arc<AppState>>, Json(req): Json<CompressR
             .to_string();
         let bytes = c.bytes.len();
         let ibk = state.put_file(&format!("mocap/{stem}.ibk"), "application/octet-stream", c.bytes, v);
-        let dec = state.put_file(
+        let dec = state.put_lazy(
             &format!("mocap/{stem}-decoded.bvh"),
             "text/plain; charset=utf-8",
-            inbetween_io::to_bvh_string(&decoded).into_bytes(),
+            move || inbetween_io::to_bvh_string(&decoded).into_bytes(),
             v,
         );
         let ms = job.elapsed_ms();
         Ok(json!({
             "ok": true,
             "message": format!(
-                "compress ≤ {} cm: {ms:.1} ms, {bytes} bytes, ratio {ratio:.1}:1, decoded max {:.3} cm (p99 {:.3} cm)",
+                "compress ≤ {} cm: {ms:.1} ms, .ibk version {version}, {bytes} bytes, ratio {ratio:.1}:1, decoded max {:.3} cm (p99 {:.3} cm)",
                 req.bound_cm, c.max_error_cm, c.p99_error_cm
             ),
             "bytes": bytes,
@@ -431,5 +471,5 @@ pub async fn compress(State(st): State<Arc<AppState>>, Json(req): Json<CompressR
             "files": {"ibk": ibk, "decoded": dec},
         }))
     });
-    Ok(Json(json!({"job": id})))
+    Ok(Json(answer(&st.jobs, id).await))
 }

@@ -6,21 +6,21 @@
 //! each character's BVH, the scene JSON, and a JSON summary (objects, action segments, camera per
 //! frame, parse diagnostics).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use axum::extract::State;
 use axum::Json;
-use inbetween_script::animate::incremental::StorySession;
-use inbetween_script::animate::{camera_pose, Animation};
+use inbetween_script::animate::{camera_track, Animation};
 use inbetween_script::compose::ComposeConfig;
 use inbetween_script::job::{story_session, RunJob, SceneJob};
 use inbetween_script::output;
+use inbetween_script::story::StorySession;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
-use crate::jobs::Job;
+use crate::jobs::{answer, Job};
 use crate::server::AppState;
 
 /// The options a session was made with; a run with other options starts a new session.
@@ -80,7 +80,7 @@ pub async fn run(State(st): State<Arc<AppState>>, Json(req): Json<RunRequest>) -
     }
     let state = st.clone();
     let id = st.jobs.spawn("script", move |job| run_job(&state, job, req));
-    Ok(Json(json!({"job": id})))
+    Ok(Json(answer(&st.jobs, id).await))
 }
 
 fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
@@ -117,22 +117,31 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let anim = &up.animation;
     let cat = live.session.catalogue();
     let v = live.version;
-    let dir = tempfile::tempdir().map_err(|e| StudioError::io(std::env::temp_dir(), e))?;
-    let cam = |f: usize| camera_pose(anim, f);
-    let glb_path = dir.path().join("story.glb");
-    output::write_story_gltf(&glb_path, anim, cat, &cam)?;
-    let glb = st.put_file("script/story.glb", "model/gltf-binary", read(&glb_path)?, v);
-    let gltf_path = dir.path().join("story.gltf");
-    output::write_story_gltf(&gltf_path, anim, cat, &cam)?;
-    let gltf = st.put_file("script/story.gltf", "model/gltf+json", read(&gltf_path)?, v);
-    let scene_json = serde_json::to_vec_pretty(&anim.scene).map_err(|e| StudioError::Engine(e.to_string()))?;
-    let scene_url = st.put_file("script/scene.json", "application/json", scene_json, v);
+    // The shot camera per frame, computed once (the glTF and the page both use it).
+    let t_camera = std::time::Instant::now();
+    let track = camera_track(anim);
+    let camera_ms = t_camera.elapsed().as_secs_f64() * 1000.0;
+    let cam = |f: usize| track.pose(f);
+    let t_gltf = std::time::Instant::now();
+    // One document, sent as GLB to the viewer and offered as .gltf for download.
+    let (doc, bin) = output::story_gltf_document(anim, cat, &cam)?;
+    let glb = st.put_file("script/story.glb", "model/gltf-binary", output::glb_bytes(&doc, &bin), v);
+    let gltf = st.put_lazy("script/story.gltf", "model/gltf+json", move || output::gltf_text_bytes(doc, &bin), v);
+    let gltf_ms = t_gltf.elapsed().as_secs_f64() * 1000.0;
+    let t_rest = std::time::Instant::now();
+    let scene = anim.scene.clone();
+    let scene_url = st.put_lazy(
+        "script/scene.json",
+        "application/json",
+        move || serde_json::to_vec_pretty(&scene).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}").into_bytes()),
+        v,
+    );
     let mut characters = Vec::new();
     for c in &anim.characters {
         let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
-        let p = dir.path().join(format!("{safe}.bvh"));
-        output::write_character_bvh(&p, &c.motion)?;
-        let url = st.put_file(&format!("script/{safe}.bvh"), "text/plain; charset=utf-8", read(&p)?, v);
+        let motion = c.motion.clone();
+        let bvh = move || inbetween_io::to_bvh_string(&motion).into_bytes();
+        let url = st.put_lazy(&format!("script/{safe}.bvh"), "text/plain; charset=utf-8", bvh, v);
         characters.push(json!({
             "name": c.name,
             "joints": c.motion.skeleton.len(),
@@ -157,7 +166,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let frames = anim.frames();
     let camera: Vec<[f32; 7]> = (0..frames)
         .map(|f| {
-            let (e, t, fov) = camera_pose(anim, f);
+            let (e, t, fov) = cam(f);
             [e[0], e[1], e[2], t[0], t[1], t[2], fov]
         })
         .collect();
@@ -186,14 +195,13 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
         "resolved_characters": up.resolved_characters,
         "kept_characters": up.kept_characters,
         "engine_ms": up.seconds * 1000.0,
+        "gltf_ms": gltf_ms,
+        "files_ms": t_rest.elapsed().as_secs_f64() * 1000.0,
+        "camera_ms": camera_ms,
         "cost_before": up.before.total,
         "cost_after": up.after.total,
         "files": {"glb": glb, "gltf": gltf, "scene": scene_url},
     }))
-}
-
-fn read(p: &Path) -> Result<Vec<u8>> {
-    std::fs::read(p).map_err(|e| StudioError::io(p, e))
 }
 
 /// Objects as the page's `state()` reports them: metres, Y up, yaw in radians.

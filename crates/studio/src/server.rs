@@ -53,8 +53,30 @@ impl Default for StudioConfig {
     }
 }
 
-/// Artifacts of the latest jobs, served at `/api/files/{name}`: (content type, bytes).
-pub type Files = Mutex<HashMap<String, (String, Arc<Vec<u8>>)>>;
+/// What makes a lazy artifact's bytes.
+type MakeBytes = Box<dyn FnOnce() -> Vec<u8> + Send>;
+
+/// A result file: its bytes, or the function that makes them on the first download (files only
+/// offered for download, such as a story's BVH and .gltf, cost nothing until asked for).
+pub struct Artifact {
+    content_type: String,
+    bytes: std::sync::OnceLock<Arc<Vec<u8>>>,
+    make: Mutex<Option<MakeBytes>>,
+}
+
+impl Artifact {
+    fn bytes(&self) -> Arc<Vec<u8>> {
+        self.bytes
+            .get_or_init(|| {
+                let make = self.make.lock().unwrap_or_else(|p| p.into_inner()).take();
+                Arc::new(make.map(|f| f()).unwrap_or_default())
+            })
+            .clone()
+    }
+}
+
+/// Artifacts of the latest jobs, served at `/api/files/{name}`.
+pub type Files = Mutex<HashMap<String, Arc<Artifact>>>;
 
 /// Shared state of the server.
 pub struct AppState {
@@ -69,10 +91,29 @@ pub struct AppState {
 impl AppState {
     /// Stores an artifact; returns its URL (with a version so the browser never caches an old one).
     pub fn put_file(&self, name: &str, content_type: &str, bytes: Vec<u8>, version: u64) -> String {
-        self.files
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .insert(name.to_string(), (content_type.to_string(), Arc::new(bytes)));
+        let bytes = std::sync::OnceLock::from(Arc::new(bytes));
+        self.put(name, Artifact { content_type: content_type.to_string(), bytes, make: Mutex::new(None) }, version)
+    }
+
+    /// Stores an artifact made by `make` on its first download; returns its URL.
+    pub fn put_lazy(
+        &self,
+        name: &str,
+        content_type: &str,
+        make: impl FnOnce() -> Vec<u8> + Send + 'static,
+        version: u64,
+    ) -> String {
+        let make: MakeBytes = Box::new(make);
+        let a = Artifact {
+            content_type: content_type.to_string(),
+            bytes: std::sync::OnceLock::new(),
+            make: Mutex::new(Some(make)),
+        };
+        self.put(name, a, version)
+    }
+
+    fn put(&self, name: &str, artifact: Artifact, version: u64) -> String {
+        self.files.lock().unwrap_or_else(|p| p.into_inner()).insert(name.to_string(), Arc::new(artifact));
         format!("/api/files/{name}?v={version}")
     }
 }
@@ -179,8 +220,16 @@ struct FileQuery {
 
 async fn file(State(st): State<Arc<AppState>>, UrlPath(name): UrlPath<String>, q: Query<FileQuery>) -> Response {
     let found = st.files.lock().unwrap_or_else(|p| p.into_inner()).get(&name).cloned();
-    let Some((ct, bytes)) = found else {
+    let Some(artifact) = found else {
         return StudioError::NotFound(format!("no result file '{name}' (run the job first)")).into_response();
+    };
+    let ct = artifact.content_type.clone();
+    let bytes = match tokio::task::spawn_blocking(move || artifact.bytes()).await {
+        Ok(b) => b,
+        Err(e) => {
+            return StudioError::Engine(format!("making '{name}' failed: {e} (the studio keeps serving)"))
+                .into_response()
+        }
     };
     let mut headers = HeaderMap::new();
     headers.insert(

@@ -75,10 +75,53 @@ pub fn view_at(anim: &Animation, frame: usize) -> &str {
 /// right: +x), 2.2 m above for "top"-like views, 1.3 m away for "close", at the front wall's top
 /// corner side for "wide", clamped into the room.
 pub fn camera_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) {
-    if let Some(shot) = two_shot(anim, frame) {
+    let head = |c: usize| smoothed_head(&anim.characters[c], frame);
+    if let Some(shot) = two_shot(anim, frame, head) {
         return shot;
     }
-    room_pose(anim, frame)
+    room_pose(anim, frame, chest_at(anim, frame))
+}
+
+/// [`camera_pose`] for every frame of the animation (at least one), the same values, with each
+/// character's forward kinematics run once per frame instead of once per frame and neighbour.
+/// [`CameraTrack::pose`] answers any frame from it (past its end through [`camera_pose`]).
+pub fn camera_track(anim: &Animation) -> CameraTrack<'_> {
+    CameraTrack { anim, poses: camera_poses(anim) }
+}
+
+/// The camera of every frame of an animation, computed once.
+pub struct CameraTrack<'a> {
+    anim: &'a Animation,
+    /// (eye, target, vertical field of view in degrees) per frame.
+    pub poses: Vec<([f32; 3], [f32; 3], f32)>,
+}
+
+impl CameraTrack<'_> {
+    /// The camera at `frame`: [`camera_pose`]'s value.
+    pub fn pose(&self, frame: usize) -> ([f32; 3], [f32; 3], f32) {
+        match self.poses.get(frame) {
+            Some(p) => *p,
+            None => camera_pose(self.anim, frame),
+        }
+    }
+}
+
+fn camera_poses(anim: &Animation) -> Vec<([f32; 3], [f32; 3], f32)> {
+    let heads: Vec<Option<Vec<DVec3>>> = anim.characters.iter().take(2).map(head_positions).collect();
+    let chest = chest_positions(anim);
+    (0..anim.frames().max(1))
+        .map(|frame| {
+            let head = |c: usize| heads[c].as_deref().map(|h| smoothed(h, frame));
+            if let Some(shot) = two_shot(anim, frame, head) {
+                return shot;
+            }
+            let chest = match &chest {
+                Some(c) if !c.is_empty() => Some(c[frame.min(c.len() - 1)]),
+                _ => chest_at(anim, frame),
+            };
+            room_pose(anim, frame, chest)
+        })
+        .collect()
 }
 
 /// Vertical field of view of two-shots (degrees) and the preview's aspect ratio.
@@ -102,6 +145,42 @@ fn smoothed_head(track: &super::CharacterTrack, frame: usize) -> Option<DVec3> {
     let count = range.clone().count() as f64;
     let sum: DVec3 = range.map(|k| forward(&rig.skeleton, &track.motion.pose(k)).positions[rig.head]).sum();
     Some(sum / count)
+}
+
+/// A character's head at every frame (None where [`smoothed_head`] gives None).
+fn head_positions(track: &super::CharacterTrack) -> Option<Vec<DVec3>> {
+    let n = track.motion.num_frames();
+    if n == 0 {
+        return None;
+    }
+    let rig = Rig::try_of(track.motion.skeleton.clone()).ok()?;
+    Some((0..n).map(|k| forward(&rig.skeleton, &track.motion.pose(k)).positions[rig.head]).collect())
+}
+
+/// [`smoothed_head`] from the heads of every frame (the same sum in the same order).
+fn smoothed(heads: &[DVec3], frame: usize) -> DVec3 {
+    let f = frame.min(heads.len() - 1);
+    let range = f.saturating_sub(TARGET_SMOOTHING)..=(f + TARGET_SMOOTHING).min(heads.len() - 1);
+    let count = range.clone().count() as f64;
+    let sum: DVec3 = heads[range].iter().copied().sum();
+    sum / count
+}
+
+/// The first character's chest at a frame (None without characters or frames).
+fn chest_at(anim: &Animation, frame: usize) -> Option<DVec3> {
+    let c = anim.characters.first().filter(|c| c.motion.num_frames() > 0)?;
+    let f = frame.min(c.motion.num_frames() - 1);
+    Some(match Rig::try_of(c.motion.skeleton.clone()) {
+        Ok(rig) => forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1],
+        Err(_) => c.motion.pose(f).translations[0] + DVec3::Y * 0.3,
+    })
+}
+
+/// [`chest_at`] for every frame of the first character.
+fn chest_positions(anim: &Animation) -> Option<Vec<DVec3>> {
+    let c = anim.characters.first()?;
+    let rig = Rig::try_of(c.motion.skeleton.clone()).ok()?;
+    Some((0..c.motion.num_frames()).map(|f| forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1]).collect())
 }
 
 /// The Toric framing of a view (A: the first character, B: the second): both heads in the upper
@@ -133,13 +212,18 @@ fn side_score(view: &str, eye: DVec3, mid: DVec3) -> f64 {
 /// Two-shot of the first two characters through the camera engine, or None (fewer than two
 /// characters, a "top"/"wide" view, heads too close, or no framing that puts the camera inside
 /// the room on the named side).
-fn two_shot(anim: &Animation, frame: usize) -> Option<([f32; 3], [f32; 3], f32)> {
+/// `head(c)`: character `c`'s smoothed head at this frame.
+fn two_shot(
+    anim: &Animation,
+    frame: usize,
+    head: impl Fn(usize) -> Option<DVec3>,
+) -> Option<([f32; 3], [f32; 3], f32)> {
     let view = view_at(anim, frame);
     if anim.characters.len() < 2 || view == "top" || view == "wide" {
         return None;
     }
-    let a = smoothed_head(&anim.characters[0], frame)?;
-    let b = smoothed_head(&anim.characters[1], frame)?;
+    let a = head(0)?;
+    let b = head(1)?;
     if a.distance(b) < MIN_PAIR_DISTANCE {
         return None;
     }
@@ -170,19 +254,10 @@ fn two_shot(anim: &Animation, frame: usize) -> Option<([f32; 3], [f32; 3], f32)>
     Some((f(pose.position), f(target), TWO_SHOT_FOV as f32))
 }
 
-/// The room-relative placement around the first character (see [`camera_pose`]).
-fn room_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) {
+/// The room-relative placement around the first character's `chest` (see [`camera_pose`]).
+fn room_pose(anim: &Animation, frame: usize, chest: Option<DVec3>) -> ([f32; 3], [f32; 3], f32) {
     let room = &anim.scene.room;
-    let chest = match anim.characters.first() {
-        Some(c) if c.motion.num_frames() > 0 => {
-            let f = frame.min(c.motion.num_frames() - 1);
-            match Rig::try_of(c.motion.skeleton.clone()) {
-                Ok(rig) => forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1],
-                Err(_) => c.motion.pose(f).translations[0] + DVec3::Y * 0.3,
-            }
-        }
-        _ => DVec3::new(room.width as f64 / 2.0, 1.3, room.depth as f64 / 2.0),
-    };
+    let chest = chest.unwrap_or_else(|| DVec3::new(room.width as f64 / 2.0, 1.3, room.depth as f64 / 2.0));
     let t = [chest.x as f32, chest.y as f32, chest.z as f32];
     let (w, h, d) = (room.width, room.height, room.depth);
     let eye_h = 1.6f32.min(h - 0.05);
@@ -250,6 +325,35 @@ mod tests {
     }
 
     #[test]
+    fn the_camera_track_equals_the_camera_of_each_frame_bit_for_bit() {
+        for view in ["front", "back", "left", "top", "wide", "close"] {
+            let mut anim = two_people(view);
+            // Moving characters, so the smoothing window matters.
+            for (c, track) in anim.characters.iter_mut().enumerate() {
+                let rig = Rig::standard();
+                let poses: Vec<_> = (0..40)
+                    .map(|f| {
+                        let mut p = track.motion.pose(f);
+                        p.translations[rig.hips].x += 0.02 * f as f64 * (c as f64 - 0.5);
+                        p
+                    })
+                    .collect();
+                track.motion = Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, &poses).unwrap();
+            }
+            let track = camera_track(&anim);
+            assert_eq!(track.poses.len(), anim.frames());
+            for f in 0..anim.frames() + 3 {
+                assert_eq!(track.pose(f), camera_pose(&anim, f), "{view}, frame {f}");
+            }
+            anim.characters.truncate(1);
+            let track = camera_track(&anim);
+            for f in 0..anim.frames() + 3 {
+                assert_eq!(track.pose(f), camera_pose(&anim, f), "{view}, one character, frame {f}");
+            }
+        }
+    }
+
+    #[test]
     fn two_characters_are_framed_together_from_the_named_side() {
         for (view, side) in [("front", DVec3::Z), ("back", DVec3::NEG_Z)] {
             let anim = two_people(view);
@@ -268,9 +372,9 @@ mod tests {
     #[test]
     fn one_character_or_a_top_view_keeps_the_room_camera() {
         let mut anim = two_people("top");
-        assert_eq!(camera_pose(&anim, 5), room_pose(&anim, 5));
+        assert_eq!(camera_pose(&anim, 5), room_pose(&anim, 5, chest_at(&anim, 5)));
         anim.camera[0].view = "front".into();
         anim.characters.truncate(1);
-        assert_eq!(camera_pose(&anim, 5), room_pose(&anim, 5));
+        assert_eq!(camera_pose(&anim, 5), room_pose(&anim, 5, chest_at(&anim, 5)));
     }
 }

@@ -49,7 +49,7 @@ mod props;
 pub(crate) mod spots;
 
 pub(crate) use action::walk::WalkCache;
-pub use camera::{camera_pose, camera_shots};
+pub use camera::{camera_pose, camera_shots, camera_track, CameraTrack};
 pub use crowd::{min_clearance, Clearance};
 pub(crate) use crowd::{WalkChoice, WalkInfo};
 pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan};

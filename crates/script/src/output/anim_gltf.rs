@@ -345,12 +345,24 @@ pub fn write_story_gltf(
     cat: &Catalogue,
     camera: &CameraFn,
 ) -> Result<(), ScriptError> {
+    let (doc, bin) = story_gltf_document(anim, cat, camera)?;
+    write_document(path, doc, bin)
+}
+
+/// The document and binary buffer [`write_story_gltf`] writes, in memory (for a server that
+/// sends the story as GLB and offers the .gltf: build once, serialise both ways with
+/// [`super::gltf::glb_bytes`] and [`super::gltf::gltf_text_bytes`]).
+pub fn story_gltf_document(
+    anim: &crate::animate::Animation,
+    cat: &Catalogue,
+    camera: &CameraFn,
+) -> Result<(Value, Vec<u8>), ScriptError> {
     let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
     let (mut doc, mut bin, _notes) = animated_gltf_document(&anim.scene, cat, &chars, camera, anim.fps, &lookup)?;
     let n = animation_frames(&chars, anim.fps);
     add_prop_channels(&mut doc, &mut bin, anim, n);
-    write_document(path, doc, bin)
+    Ok((doc, bin))
 }
 
 /// Channels moving every carried prop's object node (the scene's node named by its label) over

@@ -8,8 +8,11 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
-use inbetween_io::gltf_buffer::{data_uri, pad_to_4, ElementType, GltfBuffer, ARRAY_BUFFER};
+use inbetween_io::gltf_buffer::{data_uri, ElementType, GltfBuffer, ARRAY_BUFFER};
 use serde_json::{json, Value};
+
+/// GLB container assembly lives in io (one writer for every engine).
+pub use inbetween_io::motion_gltf::glb_bytes;
 
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
@@ -52,28 +55,10 @@ pub fn parse_glb(bytes: &[u8]) -> Result<Glb, String> {
     Ok(Glb { json: json.ok_or("no JSON chunk")?, bin })
 }
 
-/// Assembles a GLB file from a document (its buffer 0 without uri) and the binary buffer.
-pub fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut js = doc.to_string().into_bytes();
-    while !js.len().is_multiple_of(4) {
-        js.push(b' ');
-    }
-    let mut b = bin.to_vec();
-    pad_to_4(&mut b);
-    let total = 12 + 8 + js.len() + if b.is_empty() { 0 } else { 8 + b.len() };
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(js.len() as u32).to_le_bytes());
-    out.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
-    out.extend_from_slice(&js);
-    if !b.is_empty() {
-        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-        out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
-        out.extend_from_slice(&b);
-    }
-    out
+/// A `.gltf` file's bytes: the document with its one buffer inline as a data URI.
+pub fn gltf_text_bytes(mut doc: Value, bin: &[u8]) -> Vec<u8> {
+    doc["buffers"][0]["uri"] = json!(data_uri(bin));
+    doc.to_string().into_bytes()
 }
 
 fn srgb_to_linear(c: u8) -> f32 {
@@ -472,14 +457,9 @@ pub fn write_gltf_with_models(
 
 /// Writes a document with its buffer as `.glb` (by extension) or `.gltf` with an embedded buffer,
 /// atomically.
-pub(crate) fn write_document(path: &Path, mut doc: Value, bin: Vec<u8>) -> Result<(), ScriptError> {
+pub(crate) fn write_document(path: &Path, doc: Value, bin: Vec<u8>) -> Result<(), ScriptError> {
     let glb = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    let bytes = if glb {
-        glb_bytes(&doc, &bin)
-    } else {
-        doc["buffers"][0]["uri"] = json!(data_uri(&bin));
-        doc.to_string().into_bytes()
-    };
+    let bytes = if glb { glb_bytes(&doc, &bin) } else { gltf_text_bytes(doc, &bin) };
     inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))
 }
 

@@ -15,10 +15,10 @@ use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::scene::Scene;
 
-pub use anim_gltf::{animated_gltf_document, write_animated_gltf, write_story_gltf};
+pub use anim_gltf::{animated_gltf_document, story_gltf_document, write_animated_gltf, write_story_gltf};
 pub use anim_preview::{render_preview_gif, render_top_down_trails, AnimPreviewOptions};
 pub use bvh_out::write_character_bvh;
-pub use gltf::{gltf_document, write_gltf, write_gltf_with_models};
+pub use gltf::{glb_bytes, gltf_document, gltf_text_bytes, write_gltf, write_gltf_with_models};
 pub use preview::{perspective, top_down, VIEWS};
 
 /// Writes the scene as pretty JSON (atomic).

@@ -965,7 +965,8 @@ pub fn write_skinned_story(
         bodies.push(body);
     }
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
-    let cam = |f: usize| crate::animate::camera_pose(anim, f);
+    let track = crate::animate::camera_track(anim);
+    let cam = |f: usize| track.pose(f);
     let gltf = dir.join(SKINNED_GLTF);
     // As `write_skinned_gltf`, with the carried props moving as in story.gltf.
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());

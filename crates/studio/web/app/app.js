@@ -3,7 +3,6 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { BVHLoader } from 'three/addons/loaders/BVHLoader.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -126,8 +125,17 @@ function follow(id) {
   });
 }
 
+// A job the server finished before answering comes back in the same response (`event`, `data`);
+// a longer one is followed over its event stream.
 async function job(url, body, headers) {
   const j = await post(url, body, headers);
+  if (j.job && j.event) {
+    currentJob = j.job;
+    if (j.event === 'result') return j.data;
+    const err = new Error(j.event === 'cancelled' ? 'cancelled' : j.data.error);
+    err.job = j.data; err.cancelled = j.event === 'cancelled';
+    throw err;
+  }
   return j.job ? follow(j.job) : j;
 }
 
@@ -200,9 +208,24 @@ function syncBackdrop(diags) {
 function runScript() { return start('script', runScriptJob); }
 
 async function runScriptJob() {
+  const t0 = performance.now();
   const r = await job('/api/script/run', { text: text.value, optimize: $('script-optimize').checked });
+  const requestMs = performance.now() - t0;
   await drawScript(r);
+  S.drawTimes.request_ms = requestMs;
   return r;
+}
+
+// Frees the GPU buffers and textures of objects leaving the scene (a story run or a K change
+// replaces them; without this every edit would leave its meshes in GPU memory).
+function disposeTree(root) {
+  root.traverse((o) => {
+    if (o.geometry) o.geometry.dispose();
+    for (const m of [].concat(o.material || [])) {
+      for (const v of Object.values(m)) if (v && v.isTexture) v.dispose();
+      m.dispose();
+    }
+  });
 }
 
 function parseGlb(buf) {
@@ -210,9 +233,13 @@ function parseGlb(buf) {
 }
 
 async function drawScript(r) {
+  const t0 = performance.now();
   const buf = await (await fetch(r.files.glb)).arrayBuffer();
+  const t1 = performance.now();
   const gltf = await parseGlb(buf);
+  const t2 = performance.now();
   const g = groups.script;
+  for (const c of [...g.children]) disposeTree(c);
   g.clear();
   g.add(gltf.scene);
   const st = S.script;
@@ -244,6 +271,7 @@ async function drawScript(r) {
   }
   for (const n of r.notes || []) { const li = document.createElement('li'); li.textContent = n; ul.appendChild(li); }
   syncBackdrop(r.diagnostics);
+  S.drawTimes = { fetch_ms: t1 - t0, parse_ms: t2 - t1, build_ms: performance.now() - t2 };
   // Exports.
   const ex = $('script-export');
   ex.innerHTML = '';
@@ -256,7 +284,9 @@ async function drawScript(r) {
   S.frame = Math.min(S.frame, r.frames - 1);
   seek(S.frame);
   drawTimeline();
+  const t3 = performance.now();
   renderNow();
+  S.drawTimes.render_ms = performance.now() - t3;
 }
 
 // ---------------------------------------------------------------- mocap panel
@@ -297,7 +327,22 @@ function openFiles(files) {
   });
 }
 
-function loadBvh(textData) { return new BVHLoader().parse(textData); }
+// A take as the server sends it to the viewer: a glTF whose nodes are the joints and whose one
+// animation samples every frame. The nodes become bones (so SkeletonHelper draws them) and the
+// clip drives them by name.
+async function loadTake(url) {
+  const gltf = await parseGlb(await (await fetch(url)).arrayBuffer());
+  const bones = [];
+  const toBone = (node) => {
+    const b = new THREE.Bone();
+    b.name = node.name; b.position.copy(node.position); b.quaternion.copy(node.quaternion);
+    bones.push(b);
+    for (const c of node.children) b.add(toBone(c));
+    return b;
+  };
+  toBone(gltf.scene.children[0]);
+  return { skeleton: { bones }, clip: gltf.animations[0] };
+}
 
 function bvhFigure(result, color, radius) {
   const root = result.skeleton.bones[0];
@@ -316,10 +361,10 @@ function bvhFigure(result, color, radius) {
 
 async function drawTake(r) {
   const m = S.mocap;
-  const txt = await (await fetch(r.files.original)).text();
-  const parsed = loadBvh(txt);
+  const parsed = await loadTake(r.files.original_glb);
   m.take = r; m.fps = r.fps; m.frames = r.frames; m.scale = r.cm_per_unit / 100; m.keysResult = null;
   const g = groups.mocap;
+  for (const c of [...g.children]) disposeTree(c);
   g.clear(); m.rec = null;
   m.orig = bvhFigure(parsed, 0xe8e8e8, 0.025);
   g.add(m.orig.holder, m.orig.helper);
@@ -375,9 +420,8 @@ $('mocap-compress').addEventListener('click', () => start('compress', async () =
 
 async function drawKeys(r) {
   const m = S.mocap;
-  const txt = await (await fetch(r.files.reconstructed)).text();
-  const parsed = loadBvh(txt);
-  if (m.rec) { groups.mocap.remove(m.rec.holder, m.rec.helper); }
+  const parsed = await loadTake(r.files.reconstructed_glb);
+  if (m.rec) { groups.mocap.remove(m.rec.holder, m.rec.helper); disposeTree(m.rec.holder); disposeTree(m.rec.helper); m.rec.mixer.stopAllAction(); }
   m.rec = bvhFigure(parsed, 0xff8c1a, 0.02);
   groups.mocap.add(m.rec.holder, m.rec.helper);
   m.keysResult = r;
@@ -530,6 +574,9 @@ window.inbetweenStudio = {
   // How many jobs the page has started (lets a test wait for a job a file change starts).
   started: () => started,
   firstPaintMs: null,
+  // The last story drawn: ms of its request (job included), to fetch its GLB, to parse it, to
+  // build the view (for the bench).
+  drawTimes: () => S.drawTimes || null,
 };
 
 // ---------------------------------------------------------------- start
