@@ -53,11 +53,8 @@ pub(crate) struct Builder<'a> {
     pub notes: Vec<String>,
 }
 
-/// Smoothstep on [0, 1] (clamped).
-pub(crate) fn smooth(t: f64) -> f64 {
-    let t = t.clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
+/// Smoothstep on [0, 1] (clamped): the core's one.
+pub(crate) use inbetween_core::interp::smoothstep as smooth;
 
 impl<'a> Builder<'a> {
     /// A builder with an empty timeline, standing at `start` facing −Z.

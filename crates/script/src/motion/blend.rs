@@ -40,10 +40,7 @@ impl BlendParams {
         if f < self.start || f >= end {
             return 0.0;
         }
-        let smooth = |t: f64| {
-            let t = t.clamp(0.0, 1.0);
-            t * t * (3.0 - 2.0 * t)
-        };
+        let smooth = inbetween_core::interp::smoothstep;
         let fade_in = if self.blend_in == 0 { 1.0 } else { smooth((f - self.start + 1) as f64 / self.blend_in as f64) };
         let fade_out = if self.blend_out == 0 || self.end.is_none() {
             1.0

@@ -323,10 +323,7 @@ pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &Wa
     (out, stats)
 }
 
-fn smooth01(t: f64) -> f64 {
-    let t = t.clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
+use inbetween_core::interp::smoothstep as smooth01;
 
 /// Thresholds of foot-contact detection and locking.
 #[derive(Clone, Debug, PartialEq)]

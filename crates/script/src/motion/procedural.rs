@@ -21,10 +21,7 @@ pub fn seat_point() -> DVec3 {
     DVec3::new(0.0, SEAT_HEIGHT, -0.38)
 }
 
-fn smooth(t: f64) -> f64 {
-    let t = t.clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
+use inbetween_core::interp::smoothstep as smooth;
 
 /// Amplitude jitter from the seed (±5 %), so libraries built with different seeds differ slightly.
 struct Jitter<R: Rng>(R);
