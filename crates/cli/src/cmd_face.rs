@@ -98,8 +98,14 @@ pub struct EditArgs {
     /// GIF of the schematic face, original beside edited, over the spans ±1 s.
     #[arg(long)]
     pub gif: Option<PathBuf>,
+    /// Seed of the generator's noise (the network's fills are stochastic; the same seed gives the
+    /// same fill).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Write N fills with seeds SEED, SEED+1, …: OUT's name with -1 … -N before its extension (and
+    /// the same for the PNG and GIF), and print how far each lies from the first.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub variants: u32,
     /// Most rows (frames) the input clip or the noisy take may hold.
     #[arg(long, default_value_t = EditLimits::default().max_rows)]
     pub max_rows: usize,
@@ -301,7 +307,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         (MethodArg::Network, None) => unreachable!("a network was loaded above"),
     };
     let guide_file = [&a.keys, &a.guide, &a.visemes].into_iter().flatten().next().map(|p| p.display().to_string());
-    let job = EditJob {
+    let mut job = EditJob {
         clip: &clip,
         spans: spans.clone(),
         channels,
@@ -312,18 +318,90 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         cancel: cancel.clone(),
         guide_file,
     };
-    let t = std::time::Instant::now();
-    let out = job.run()?;
-    let ms = t.elapsed().as_secs_f64() * 1000.0;
     let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
         && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
         && is_live_link(&a.input);
-    // The clip, its PNG and the GIF appear together or not at all.
+    // Every variant's clip, PNG and GIF appear together or not at all.
     let mut set = OutputSet::new();
+    let mut first: Option<Vec<inbetween_face::edit::Frame>> = None;
+    let mut spreads = Vec::new();
+    for k in 1..=a.variants {
+        job.seed = a.seed + u64::from(k - 1);
+        let named = |p: &Path| if a.variants == 1 { p.to_path_buf() } else { variant_path(p, k) };
+        let (out, ms) = edit_once(&a, &job, &mut set, live_link, &named)?;
+        println!(
+            "edited {} span(s) of {} ({} frames at {:.3} fps) with {} (seed {}) in {ms:.1} ms -> {}",
+            spans.len(),
+            a.input.display(),
+            clip.num_frames(),
+            clip.measured_fps(),
+            job.method.name(),
+            job.seed,
+            named(&a.out).display(),
+        );
+        match &first {
+            None => first = Some(out.after.clone()),
+            Some(f) => spreads.push(mean_abs_difference(f, &out.after, &out.mask.segments())),
+        }
+    }
+    set.commit().context("moving the edit's outputs into place")?;
+    if !spreads.is_empty() {
+        let list: Vec<String> = spreads.iter().map(|d| format!("{d:.4}")).collect();
+        println!(
+            "variants 2..{}: mean |difference| from variant 1 inside the spans (blendshape weight, 0..1): {}",
+            a.variants,
+            list.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// `out.csv` → `out-<k>.csv`.
+fn variant_path(p: &Path, k: u32) -> PathBuf {
+    let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = match p.extension() {
+        Some(e) => format!("{stem}-{k}.{}", e.to_string_lossy()),
+        None => format!("{stem}-{k}"),
+    };
+    p.with_file_name(name)
+}
+
+/// Mean absolute difference of two edits over the frames of `segs`, every channel.
+fn mean_abs_difference(
+    a: &[inbetween_face::edit::Frame],
+    b: &[inbetween_face::edit::Frame],
+    segs: &[inbetween_face::edit::Segment],
+) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for s in segs {
+        for f in s.start..s.end.min(a.len()).min(b.len()) {
+            for (x, y) in a[f].iter().zip(&b[f]) {
+                sum += (x - y).abs() as f64;
+                n += 1;
+            }
+        }
+    }
+    sum / n.max(1) as f64
+}
+
+/// One edit: runs the job, stages its clip, PNG and (with --gif) GIF under `named` paths.
+fn edit_once(
+    a: &EditArgs,
+    job: &EditJob,
+    set: &mut OutputSet,
+    live_link: bool,
+    named: &dyn Fn(&Path) -> PathBuf,
+) -> anyhow::Result<(inbetween_face::infer::EditOutcome, f64)> {
+    let cancel = &job.cancel;
+    let method = job.method;
+    let t = std::time::Instant::now();
+    let out = job.run()?;
+    let ms = t.elapsed().as_secs_f64() * 1000.0;
     let staged = |set: &mut OutputSet, p: &Path| set.file(p).with_context(|| format!("preparing {}", p.display()));
-    write_clip(&staged(&mut set, &a.out)?, &out.clip, live_link)?;
+    let out_path = named(&a.out);
+    write_clip(&staged(set, &out_path)?, &out.clip, live_link)?;
     let segs = out.mask.segments();
-    let png = a.png.clone().unwrap_or_else(|| a.out.with_extension("png"));
+    let png = named(&a.png.clone().unwrap_or_else(|| a.out.with_extension("png")));
     let title = format!("{} · {} · {}", a.input.display(), method.name(), job.guide.kind().name());
     let preview = CurvePreview {
         title: &title,
@@ -335,16 +413,16 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         extra: None,
         n_curves: 6,
     };
-    write_edit_png(&staged(&mut set, &png)?, &preview).with_context(|| format!("writing {}", png.display()))?;
+    write_edit_png(&staged(set, &png)?, &preview).with_context(|| format!("writing {}", png.display()))?;
     cancel.check()?;
-    if let Some(gif) = &a.gif {
+    if let Some(gif) = a.gif.as_deref().map(named) {
         let first = segs.iter().map(|s| s.start).min().unwrap_or(0).saturating_sub(25);
         let last = (segs.iter().map(|s| s.end).max().unwrap_or(0) + 25).min(out.before.len());
         let local: Vec<_> =
             segs.iter().map(|s| inbetween_face::edit::Segment { start: s.start - first, end: s.end - first }).collect();
         let progress = Progress::new((last - first) as u64, "face gif");
         write_edit_gif(
-            &staged(&mut set, gif)?,
+            &staged(set, &gif)?,
             MODEL_FPS,
             &[("original", &out.before[first..last]), ("edited", &out.after[first..last])],
             None,
@@ -355,21 +433,11 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         progress.finish();
         cancel.check()?;
     }
-    set.commit().context("moving the edit's outputs into place")?;
-    if let Some(gif) = &a.gif {
+    if let Some(gif) = a.gif.as_deref().map(named) {
         println!("  preview {}", gif.display());
     }
-    println!(
-        "edited {} span(s) of {} ({} frames at {:.3} fps) with {} in {ms:.1} ms -> {} (curves: {})",
-        spans.len(),
-        a.input.display(),
-        clip.num_frames(),
-        clip.measured_fps(),
-        method.name(),
-        a.out.display(),
-        png.display()
-    );
-    Ok(())
+    println!("  curves {}", png.display());
+    Ok((out, ms))
 }
 
 fn is_live_link(path: &Path) -> bool {

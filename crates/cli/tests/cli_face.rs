@@ -215,3 +215,29 @@ fn limits_and_time_limits_are_named_with_their_flags_and_nothing_is_written() {
     ok(&edit(&[]));
     assert_eq!(listing(d), ["out.csv", "out.gif", "out.png", "take.csv", "take.phonemes.csv"]);
 }
+
+#[test]
+fn variants_write_one_fill_per_seed_and_the_same_seed_gives_the_same_fill() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = d.join("take.csv");
+    ok(&inbetween(&["face", "synth", "-o", s(&input), "--seconds", "6"]));
+    let out = d.join("out.csv");
+    let o =
+        inbetween(&["face", "edit", s(&input), "--mask", "2s..4s", "--variants", "3", "--seed", "5", "-o", s(&out)]);
+    ok(&o);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("variants 2..3: mean |difference| from variant 1 inside the spans"), "{text}");
+    assert_eq!(
+        listing(d),
+        ["out-1.csv", "out-1.png", "out-2.csv", "out-2.png", "out-3.csv", "out-3.png", "take.csv", "take.phonemes.csv"]
+    );
+    // Variant 2 is seed 6: a single edit with --seed 6 writes the same bytes.
+    let one = d.join("one.csv");
+    ok(&inbetween(&["face", "edit", s(&input), "--mask", "2s..4s", "--seed", "6", "-o", s(&one)]));
+    assert_eq!(std::fs::read(&one).unwrap(), std::fs::read(d.join("out-2.csv")).unwrap());
+    // The seed reaches the fill: another seed gives another file.
+    assert_ne!(std::fs::read(d.join("out-1.csv")).unwrap(), std::fs::read(d.join("out-2.csv")).unwrap());
+    let bad = inbetween(&["face", "edit", s(&input), "--mask", "2s..4s", "--variants", "0", "-o", s(&out)]);
+    assert!(!bad.status.success());
+}

@@ -140,7 +140,7 @@ impl EditJob<'_> {
             return Err(invalid("the clip has a single frame; an edit needs at least two"));
         }
         if self.spans.is_empty() {
-            return Err(invalid("no span to edit; give at least one --mask START..END"));
+            return Err(invalid("no span to edit: `spans` is empty; give at least one span (start s .. end s)"));
         }
         LimitExceeded::check_count("the clip", self.clip.num_frames(), self.limits.max_rows, "rows", "max_rows")?;
         // A span may end one frame past the last frame's time (a span in frames that covers the last frame).
