@@ -123,8 +123,14 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let camera_ms = t_camera.elapsed().as_secs_f64() * 1000.0;
     let cam = |f: usize| track.pose(f);
     let t_gltf = std::time::Instant::now();
-    // One document, sent as GLB to the viewer and offered as .gltf for download.
-    let (doc, bin) = output::story_gltf_document(anim, cat, &cam)?;
+    // One document, sent as GLB to the viewer and offered as .gltf for download: every character
+    // a skinned Kenney blocky character when those models are in the shared data, the engine's
+    // joint hierarchy with bone boxes otherwise.
+    let bodies = output::skinned::skinned_bodies(anim, None).ok();
+    let (doc, bin) = match &bodies {
+        Some((bodies, _)) => output::skinned::skinned_story_document(anim, cat, bodies, &cam)?,
+        None => output::story_gltf_document(anim, cat, &cam)?,
+    };
     let glb = st.put_file("script/story.glb", "model/gltf-binary", output::glb_bytes(&doc, &bin), v);
     let gltf = st.put_lazy("script/story.gltf", "model/gltf+json", move || output::gltf_text_bytes(doc, &bin), v);
     let gltf_ms = t_gltf.elapsed().as_secs_f64() * 1000.0;
@@ -200,6 +206,8 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
         "camera_ms": camera_ms,
         "cost_before": up.before.total,
         "cost_after": up.after.total,
+        "skinned": bodies.is_some(),
+        "bodies": bodies.as_ref().map(|b| b.1.clone()).unwrap_or_default(),
         "files": {"glb": glb, "gltf": gltf, "scene": scene_url},
     }))
 }

@@ -950,33 +950,58 @@ pub fn write_skinned_story(
     models: Option<&Path>,
 ) -> Result<SkinnedStory, ScriptError> {
     let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let (bodies, notes) = skinned_bodies(anim, models)?;
+    let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
+    let track = crate::animate::camera_track(anim);
+    let cam = |f: usize| track.pose(f);
+    let gltf = dir.join(SKINNED_GLTF);
+    let (doc, bin) = skinned_story_document(anim, cat, &bodies, &cam)?;
+    write_document(&gltf, doc, bin)?;
+    let png = dir.join(SKINNED_PNG);
+    let cast = SkinnedCast { scene: &anim.scene, cat, characters: &chars, bodies: &refs, camera: &cam, fps: anim.fps };
+    let frames = super::anim_gltf::animation_frames(&chars, anim.fps);
+    let img = render_skinned_frame(&cast, frames / 2, (640, 480));
+    super::write_png(&png, &img)?;
+    Ok(SkinnedStory { files: vec![gltf, png], notes })
+}
+
+/// Every character's Kenney blocky body (`character-a.glb`, `-c`, … in story order, found by
+/// [`find_character_dir`]) bound to its rig, and a note per character (which GLB, how tall).
+pub fn skinned_bodies(
+    anim: &crate::animate::Animation,
+    models: Option<&Path>,
+) -> Result<(Vec<SkinnedBody>, Vec<String>), ScriptError> {
     let glbs = find_character_dir(models)?;
     let mut bodies = Vec::new();
     let mut notes = Vec::new();
-    for (i, (name, m)) in chars.iter().enumerate() {
+    for (i, c) in anim.characters.iter().enumerate() {
         let file = character_file(&glbs, i);
-        let body = bind_body(&read_character(&file)?, &m.skeleton)?;
+        let body = bind_body(&read_character(&file)?, &c.motion.skeleton)?;
         notes.push(format!(
-            "{name} wears {} ({} triangles, {:.2} m tall)",
+            "{} wears {} ({} triangles, {:.2} m tall)",
+            c.name,
             file.display(),
             body.indices.len() / 3,
             body.height()
         ));
         bodies.push(body);
     }
+    Ok((bodies, notes))
+}
+
+/// The document and buffer of [`SKINNED_GLTF`] in memory: the story with each character wearing
+/// its body from [`skinned_bodies`], and the carried props moving as in story.gltf.
+pub fn skinned_story_document(
+    anim: &crate::animate::Animation,
+    cat: &Catalogue,
+    bodies: &[SkinnedBody],
+    camera: &super::anim_gltf::CameraFn,
+) -> Result<(Value, Vec<u8>), ScriptError> {
+    let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
-    let track = crate::animate::camera_track(anim);
-    let cam = |f: usize| track.pose(f);
-    let gltf = dir.join(SKINNED_GLTF);
-    // As `write_skinned_gltf`, with the carried props moving as in story.gltf.
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
-    let cast = SkinnedCast { scene: &anim.scene, cat, characters: &chars, bodies: &refs, camera: &cam, fps: anim.fps };
+    let cast = SkinnedCast { scene: &anim.scene, cat, characters: &chars, bodies: &refs, camera, fps: anim.fps };
     let (mut doc, mut bin, _) = skinned_gltf_document(&cast, &lookup)?;
     super::anim_gltf::add_prop_channels(&mut doc, &mut bin, anim, super::anim_gltf::animation_frames(&chars, anim.fps));
-    write_document(&gltf, doc, bin)?;
-    let png = dir.join(SKINNED_PNG);
-    let frames = super::anim_gltf::animation_frames(&chars, anim.fps);
-    let img = render_skinned_frame(&cast, frames / 2, (640, 480));
-    super::write_png(&png, &img)?;
-    Ok(SkinnedStory { files: vec![gltf, png], notes })
+    Ok((doc, bin))
 }
