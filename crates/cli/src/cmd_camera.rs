@@ -339,21 +339,13 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
-    use inbetween_io::scale::scale_table;
-    let exe = std::env::current_exe().context("locating the inbetween binary")?;
-    // Inputs and outputs of the runs go to a scratch folder, removed at the end.
-    let scratch = std::env::temp_dir().join(format!("inbetween-scale-{}", std::process::id()));
-    std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
-    let result = scale_rows(&a, &exe, &scratch);
-    let _ = std::fs::remove_dir_all(&scratch);
-    let rows = result?;
-    let table = scale_table("camera_scale", "camera generate (orbit style) at multiples of the demo's example", &rows);
-    let mut report = inbetween_io::report::Report::new("report", "camera scaling");
-    print!("{}", table.to_text());
-    report.table(table);
-    let files = report.write(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
-    println!("wrote {} files to {}", files.len(), a.out.display());
-    Ok(())
+    crate::scale::run(
+        &a.out,
+        "camera_scale",
+        "camera generate (orbit style) at multiples of the demo's example",
+        "camera scaling",
+        |exe, work| scale_rows(&a, exe, work),
+    )
 }
 
 /// One measured run per scale of `a.scales`, inputs written to `work`.

@@ -10,6 +10,7 @@ mod cmd_studio;
 mod cmd_video;
 mod demo;
 mod errors;
+mod scale;
 
 use std::process::ExitCode;
 

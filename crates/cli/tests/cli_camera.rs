@@ -3,6 +3,9 @@
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+use common::{fails, listing};
+
 fn inbetween(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_inbetween")).args(args).output().expect("run inbetween")
 }
@@ -158,21 +161,6 @@ fn train_refuses_to_overwrite_the_committed_weights() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("--overwrite-committed"), "{err}");
     assert_eq!(std::fs::read(&committed).unwrap(), before, "the committed weights are untouched");
-}
-
-/// `stderr` of a run that must fail; checks it is one clear error, not a panic.
-fn fails(out: &std::process::Output) -> String {
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "expected a failure; stdout {}", String::from_utf8_lossy(&out.stdout));
-    assert!(err.starts_with("error: ") && !err.contains("panicked") && !err.contains("internal error"), "{err}");
-    err
-}
-
-fn listing(d: &Path) -> Vec<String> {
-    let mut v: Vec<String> =
-        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    v.sort();
-    v
 }
 
 fn generate(scene: &Path, keys: &Path, out: &Path, extra: &[&str]) -> std::process::Output {

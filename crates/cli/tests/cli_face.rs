@@ -3,6 +3,9 @@
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+use common::{fails, listing};
+
 fn inbetween(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_inbetween")).args(args).output().expect("run inbetween")
 }
@@ -85,22 +88,6 @@ fn bad_face_inputs_are_clear_errors_and_write_nothing() {
     let out = inbetween(&["face", "edit", s(&input), "--mask", "1s..2s", "--groups", "nose", "-o", s(&out_path)]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("'nose'"));
     assert!(!out_path.exists());
-}
-
-/// `stderr` of a run that must fail; checks it is one clear error, not a panic.
-fn fails(out: &std::process::Output) -> String {
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "expected a failure; stdout {}", String::from_utf8_lossy(&out.stdout));
-    assert!(err.starts_with("error: ") && !err.contains("panicked") && !err.contains("internal error"), "{err}");
-    err
-}
-
-/// The names in a folder (staging folders included), sorted.
-fn listing(d: &Path) -> Vec<String> {
-    let mut v: Vec<String> =
-        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    v.sort();
-    v
 }
 
 #[test]
