@@ -5,8 +5,11 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use inbetween_io::Progress;
+
+use crate::errors;
 use inbetween_script::compose::{ComposeConfig, Matcher};
 use inbetween_script::job::{read_script, run_scene, RunJob, SceneJob};
+use inbetween_script::limits::ScriptLimits;
 use inbetween_script::stories;
 
 #[derive(Subcommand)]
@@ -63,7 +66,35 @@ pub struct SceneArgs {
     /// Folder of the embedding model (default: ~/.cache/inbetween/models/all-MiniLM-L6-v2).
     #[arg(long, requires = "semantic")]
     pub model_dir: Option<PathBuf>,
+    /// Most sentences the script may hold.
+    #[arg(long, default_value_t = ScriptLimits::default().max_sentences)]
+    pub max_sentences: usize,
+    /// Most words the script may hold.
+    #[arg(long, default_value_t = ScriptLimits::default().max_words)]
+    pub max_words: usize,
+    /// Most characters the script may name.
+    #[arg(long, default_value_t = ScriptLimits::default().max_characters)]
+    pub max_characters: usize,
+    /// Most objects the scene sentences may ask for ("two chairs" counts 2).
+    #[arg(long, default_value_t = ScriptLimits::default().max_objects)]
+    pub max_objects: usize,
+    /// Most character actions (verbs) the script may hold.
+    #[arg(long, default_value_t = ScriptLimits::default().max_actions)]
+    pub max_actions: usize,
+    /// Longest animation, seconds, checked before any output is written.
+    #[arg(long, default_value_t = ScriptLimits::default().max_animation_s)]
+    pub max_animation_seconds: f64,
 }
+
+/// The limits' fields and the flags that raise them.
+const LIMIT_FLAGS: &[(&str, &str)] = &[
+    ("max_sentences", "--max-sentences"),
+    ("max_words", "--max-words"),
+    ("max_characters", "--max-characters"),
+    ("max_objects", "--max-objects"),
+    ("max_actions", "--max-actions"),
+    ("max_animation_s", "--max-animation-seconds"),
+];
 
 #[derive(Args)]
 pub struct RunArgs {
@@ -120,9 +151,9 @@ pub struct BenchArgs {
 
 pub fn run(c: ScriptCommand) -> anyhow::Result<()> {
     match c {
-        ScriptCommand::Scene(a) => scene(a),
-        ScriptCommand::Run(a) => run_story(a),
-        ScriptCommand::Watch(a) => watch(a),
+        ScriptCommand::Scene(a) => scene(a).map_err(|e| errors::name_flags(e, LIMIT_FLAGS)),
+        ScriptCommand::Run(a) => run_story(a).map_err(|e| errors::name_flags(e, LIMIT_FLAGS)),
+        ScriptCommand::Watch(a) => watch(a).map_err(|e| errors::name_flags(e, LIMIT_FLAGS)),
         ScriptCommand::Parse(a) => parse(a),
         ScriptCommand::Stories(a) => list_stories(a),
         ScriptCommand::Bench(a) => bench(a),
@@ -155,6 +186,14 @@ fn scene_job(a: &SceneArgs) -> SceneJob {
         models: a.models.clone(),
         config: ComposeConfig { seed: a.seed, matcher, furnish: !a.bare },
         semantic: a.semantic.then(|| a.model_dir.clone()),
+        limits: ScriptLimits {
+            max_sentences: a.max_sentences,
+            max_words: a.max_words,
+            max_characters: a.max_characters,
+            max_objects: a.max_objects,
+            max_actions: a.max_actions,
+            max_animation_s: a.max_animation_seconds,
+        },
     }
 }
 

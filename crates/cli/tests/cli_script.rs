@@ -107,3 +107,39 @@ fn run_writes_the_animated_story_and_watch_reruns_on_save() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(dir.path().join("w").join("story.gltf").is_file());
 }
+
+#[test]
+fn an_oversized_story_is_refused_at_once_naming_the_limit_and_its_flag_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("long.txt");
+    let mut text = String::from("In the office, a desk is near a bookshelf$\n");
+    for _ in 0..300 {
+        text.push_str("Eve walks to the desk.\n");
+    }
+    std::fs::write(&script, &text).unwrap();
+    let out = dir.path().join("out");
+    let t = std::time::Instant::now();
+    let o = inbetween().args(["script", "run"]).arg(&script).arg("-o").arg(&out).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("long.txt: 301 sentences, more than the limit of 200 sentences"), "{err}");
+    assert!(err.contains("raise it with --max-sentences"), "{err}");
+    assert!(!out.exists(), "nothing is written");
+    assert!(t.elapsed().as_secs_f64() < 20.0, "refused before any work: {:?}", t.elapsed());
+    // Raised, the sentence limit passes and the next one (actions) is named.
+    let o = inbetween()
+        .args(["script", "scene"])
+        .arg(&script)
+        .args(["--max-sentences", "400", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("300 character actions") && err.contains("raise it with --max-actions"), "{err}");
+    // One endless sentence is bounded by its words.
+    let line = vec!["Eve walks to the desk"; 2000].join(" and ");
+    std::fs::write(&script, format!("In the office, a desk is near a bookshelf$\n{line}.\n")).unwrap();
+    let o = inbetween().args(["script", "run"]).arg(&script).arg("-o").arg(&out).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("words") && err.contains("raise it with --max-words"), "{err}");
+}

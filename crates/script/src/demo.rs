@@ -13,6 +13,7 @@ use crate::ScriptError;
 pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
     let out = dir.join("script");
     let job = SceneJob {
+        limits: crate::limits::ScriptLimits::default(),
         out_dir: out.clone(),
         seed,
         view: None,

@@ -52,6 +52,9 @@ pub enum ScriptError {
     Asset { path: PathBuf, message: String },
     #[error("{0}")]
     Invalid(String),
+    /// The script asks for more than one of the job's stated limits (the error names the field).
+    #[error("{0}")]
+    Limit(#[from] inbetween_io::LimitExceeded),
 }
 
 impl ScriptError {

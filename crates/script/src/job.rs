@@ -7,6 +7,7 @@ use crate::catalogue::{builtin::builtin, kenney, Catalogue};
 use crate::compose::{ComposeConfig, Composition};
 use crate::database::SceneDatabase;
 use crate::error::Diagnostic;
+use crate::limits::ScriptLimits;
 use crate::output;
 use crate::session::Session;
 use crate::story::StorySession;
@@ -29,6 +30,8 @@ pub struct SceneJob {
     /// Read words outside the synonym tables through sentence embeddings (feature `embeddings`);
     /// `Some(None)` uses the default model folder.
     pub semantic: Option<Option<PathBuf>>,
+    /// What the script may ask for, checked before any work ([`ScriptLimits::check_text`]).
+    pub limits: ScriptLimits,
 }
 
 /// What a scene job wrote and found.
@@ -104,6 +107,7 @@ pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneRepor
         return Err(ScriptError::Empty { path: source.to_path_buf() });
     }
     let (cat, notes) = script_catalogue(text, job)?;
+    job.limits.check_text(text, &source.display().to_string(), &cat)?;
     let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, job.seed);
     let mut session = Session::new(cat, db, ComposeConfig { seed: job.seed, ..job.config.clone() });
     let update = session.update(text);
@@ -187,8 +191,11 @@ pub fn run_story_in(
     if crate::script::split(text).is_empty() {
         return Err(ScriptError::Empty { path: source.to_path_buf() });
     }
+    let name = source.display().to_string();
+    job.scene.limits.check_text(text, &name, session.catalogue())?;
     let u = session.update(text);
     let cat = session.catalogue();
+    job.scene.limits.check_animation(&name, u.animation.frames(), u.animation.fps)?;
     let scene_files = write_scene(&u.scene.composition, cat, &job.scene)?;
     let mut files = scene_files.clone();
     let dir = &job.scene.out_dir;

@@ -47,6 +47,7 @@ pub mod embed;
 pub mod error;
 pub mod job;
 pub mod layout;
+pub mod limits;
 pub mod matching;
 pub mod motion;
 pub mod optimize;

@@ -14,6 +14,7 @@ use axum::Json;
 use inbetween_script::animate::{camera_track, Animation};
 use inbetween_script::compose::ComposeConfig;
 use inbetween_script::job::{story_session, RunJob, SceneJob};
+use inbetween_script::limits::ScriptLimits;
 use inbetween_script::output;
 use inbetween_script::story::StorySession;
 use serde::Deserialize;
@@ -91,6 +92,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
         job.progress("loading the catalogue and scene database", 0.05);
         let run = RunJob {
             scene: SceneJob {
+                limits: ScriptLimits::default(),
                 out_dir: PathBuf::new(),
                 seed: options.seed,
                 view: None,
