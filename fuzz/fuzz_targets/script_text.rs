@@ -1,5 +1,7 @@
 //! Script parser and scene composition on arbitrary text: must never panic (a sentence the rules
-//! cannot use becomes a diagnostic). Composition runs on short inputs only, to keep runs fast.
+//! cannot use becomes a diagnostic). Texts over the job's default limits are refused first, as the
+//! CLI refuses them (issue 29), so the parser's work per input is bounded; composition runs on
+//! short inputs only, to keep runs fast.
 #![no_main]
 
 use std::collections::HashMap;
@@ -8,6 +10,7 @@ use std::sync::OnceLock;
 use inbetween_script::catalogue::{builtin::builtin, Catalogue};
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput};
 use inbetween_script::database::SceneDatabase;
+use inbetween_script::limits::ScriptLimits;
 use inbetween_script::parse::parse_script;
 use libfuzzer_sys::fuzz_target;
 
@@ -23,6 +26,9 @@ fn world() -> &'static (Catalogue, SceneDatabase) {
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
     let (cat, db) = world();
+    if ScriptLimits::default().check_text(&text, "fuzz input", cat).is_err() {
+        return;
+    }
     let parsed = parse_script(&text, cat);
     if data.len() <= 400 {
         let pins = HashMap::new();

@@ -188,3 +188,26 @@ fn every_builtin_story_animates() {
         }
     }
 }
+
+/// Common verbs have motion (issue 27): "gets up" (the parser splits it into "get" and the
+/// particle "up") stands up, and put, close, give and point reach; none falls back to standing.
+#[test]
+fn common_verbs_have_motion_instead_of_standing() {
+    let cat = builtin();
+    let db = SceneDatabase::builtin(&cat, 2, 7);
+    let text = "In the office, a chair is near a desk, and a door is next to a window$\nA book is on the desk$\n\
+                Tom sits on the chair. Tom gets up. Tom walks to the desk. Tom picks up the book. \
+                Tom puts down the book. Tom opens the door. Tom closes the door. Tom points at the window. \
+                Tom gives the book to Eve. Eve waves.\n";
+    let parsed = parse_script(text, &cat);
+    let comp = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+        &ComposeConfig::default(),
+    );
+    let anim = animate(&comp, &cat, &MotionLibrary::procedural(0), &AnimateConfig::default());
+    let fallbacks: Vec<&String> = anim.notes.iter().filter(|n| n.contains("standing instead")).collect();
+    assert!(fallbacks.is_empty(), "{fallbacks:?}");
+    let tom = anim.characters.iter().find(|c| c.name == "Tom").unwrap();
+    let verbs: Vec<&str> = tom.segments.iter().map(|s| s.verb.as_str()).collect();
+    assert!(verbs.contains(&"stand_up"), "{verbs:?}");
+}

@@ -22,7 +22,13 @@ pub const VERBS: &[(&str, &[&str])] = &[
     ("dance", &["dance", "waltz", "salsa", "pirouette", "twirl", "spin", "arabesque", "jete"]),
     ("wave", &["wave", "greet", "beckon", "signal"]),
     ("climb", &["climb", "scale", "ascend", "hang", "dangle"]),
-    ("reach", &["reach", "grab", "pick", "take", "push", "press", "touch", "pull", "lift", "scoop", "open", "fetch"]),
+    (
+        "reach",
+        &[
+            "reach", "grab", "pick", "take", "push", "press", "touch", "pull", "lift", "scoop", "open", "fetch",
+            "close", "shut", "put", "place", "set", "drop", "give", "hand", "pass", "offer", "point", "indicate",
+        ],
+    ),
     ("type", &["type", "play", "use", "operate", "work", "tap", "text", "dribble", "shoot"]),
     ("call", &["call", "phone", "talk", "speak", "chat", "tell", "say", "sing", "shout", "ask", "answer"]),
     ("drink", &["drink", "sip", "eat"]),

@@ -76,7 +76,12 @@ impl Verb {
 impl<'s> Step<'s> {
     /// Reads an SSG action acting on `object`.
     pub fn read(action: &'s Action, object: Option<usize>, lib: &MotionLibrary, slow_speed: f64) -> Step<'s> {
-        let verb = crate::motion::verbs::canonical(&action.verb).unwrap_or(action.verb.as_str()).to_string();
+        // A phrasal verb the parser split ("get" with the particle "up") is looked up whole
+        // ("get_up" → stand_up) when the verb alone is not in the table.
+        let phrasal =
+            || action.manner.iter().find_map(|m| crate::motion::verbs::canonical(&format!("{}_{m}", action.verb)));
+        let verb =
+            crate::motion::verbs::canonical(&action.verb).or_else(phrasal).unwrap_or(action.verb.as_str()).to_string();
         let slow = action.manner.iter().any(|m| matches!(m.as_str(), "slowly" | "carefully" | "gently" | "lazily"));
         let kind = Verb::of(&verb, &action.manner, lib);
         Step { action, verb, kind, object, speed: slow.then_some(slow_speed) }
