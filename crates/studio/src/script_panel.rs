@@ -16,6 +16,7 @@ use inbetween_script::compose::ComposeConfig;
 use inbetween_script::job::{story_session, RunJob, SceneJob};
 use inbetween_script::limits::ScriptLimits;
 use inbetween_script::output;
+use inbetween_script::output::skinned::SkinnedBody;
 use inbetween_script::story::StorySession;
 use serde::Deserialize;
 use serde_json::{json, Value};
@@ -36,6 +37,9 @@ struct Live {
     options: Options,
     session: StorySession,
     version: u64,
+    /// The characters' skinned bodies, bound to these skeletons (reused while the cast's
+    /// skeletons stay the same: reading and binding the Kenney models is the slow part).
+    bodies: Option<(Vec<inbetween_core::Skeleton>, Vec<SkinnedBody>, Vec<String>)>,
 }
 
 /// The panel's editing session (one per studio: it is a local, single-user tool).
@@ -106,7 +110,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
         };
         let (session, n) = story_session(&req.text, &run)?;
         notes = n;
-        *live = Some(Live { options, session, version: 0 });
+        *live = Some(Live { options, session, version: 0, bodies: None });
     }
     let live = live.as_mut().expect("a session was just made");
     job.progress("composing the scene and animating the characters", 0.15);
@@ -128,8 +132,12 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     // One document, sent as GLB to the viewer and offered as .gltf for download: every character
     // a skinned Kenney blocky character when those models are in the shared data, the engine's
     // joint hierarchy with bone boxes otherwise.
-    let bodies = output::skinned::skinned_bodies(anim, None).ok();
-    let (doc, bin) = match &bodies {
+    let skeletons: Vec<inbetween_core::Skeleton> = anim.characters.iter().map(|c| c.motion.skeleton.clone()).collect();
+    if live.bodies.as_ref().is_none_or(|(s, _, _)| *s != skeletons) {
+        live.bodies = output::skinned::skinned_bodies(anim, None).ok().map(|(b, n)| (skeletons, b, n));
+    }
+    let bodies = live.bodies.as_ref().map(|(_, b, n)| (b, n));
+    let (doc, bin) = match bodies {
         Some((bodies, _)) => output::skinned::skinned_story_document(anim, cat, bodies, &cam)?,
         None => output::story_gltf_document(anim, cat, &cam)?,
     };
@@ -209,7 +217,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
         "cost_before": up.before.total,
         "cost_after": up.after.total,
         "skinned": bodies.is_some(),
-        "bodies": bodies.as_ref().map(|b| b.1.clone()).unwrap_or_default(),
+        "bodies": bodies.map(|b| b.1.clone()).unwrap_or_default(),
         "files": {"glb": glb, "gltf": gltf, "scene": scene_url},
     }))
 }
