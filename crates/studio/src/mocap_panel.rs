@@ -312,7 +312,8 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
             let k = need_k()?;
             // The committed policy (weights compiled into the binary), loaded per job.
             let policy = SidqlPolicy::committed()?;
-            (select::sidql::sidql(&policy, rep, k)?, format!("SIDQL K={k}"))
+            // Windows of at most 64 frames on a longer take (the policy's range).
+            (select::sidql::sidql_long(&policy, m, cm, k)?, format!("SIDQL K={k}"))
         }
         "bound" => {
             let b = req

@@ -177,6 +177,17 @@ fn studio_in_headless_chromium() {
         assert!(st["lastJob"]["error_cm"].as_f64().unwrap() > 0.0, "{st}");
         assert!(st["lastJob"]["message"].as_str().unwrap().contains("cm"), "{st}");
     }
+    // SIDQL on a take longer than its 64-frame windows.
+    let st = b
+        .eval(&format!(
+            "(m => {{ m.value = 'sidql'; m.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); }})({})",
+            js_sel("mocap-method")
+        ))
+        .map(|_| state(&b))
+        .unwrap();
+    assert_eq!(st["lastJob"]["ok"], true, "{st}");
+    assert_eq!(st["keys"].as_array().unwrap().len(), 12, "{st}");
+    assert!(st["lastJob"]["message"].as_str().unwrap().starts_with("SIDQL K=12"), "{st}");
     let covered = viewport_coverage(&b);
     assert!(covered > 0.002, "the mocap view looks blank: {covered:.4}");
 

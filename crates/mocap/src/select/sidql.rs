@@ -1,14 +1,118 @@
 //! SIDQL selection (§4): a trained deep Q-network adds, one at a time, the frame with the highest
 //! Q-value until `k` keys are chosen; beyond the paper, the keys are then checked against uniform
 //! keys and refined ([`crate::dqn::Finish`]). Training lives in [`crate::dqn`].
+//!
+//! The policy keys windows of at most [`MAX_FRAMES`] frames (the paper's windows). [`sidql_long`]
+//! keys a take of any length: windows of at most that length sharing their end frames, each
+//! window's keys chosen by the policy, the keys beyond the windows' ends given one at a time to the
+//! window whose error drops most.
 
 pub use crate::dqn::SidqlPolicy;
 
+use crate::dqn::env::MAX_FRAMES;
+use crate::metrics::SegmentModel;
 use crate::representation::SphericalMotion;
-use crate::Result;
-use inbetween_core::KeyframeSet;
+use crate::{MocapError, Result};
+use inbetween_core::{KeyframeSet, Motion};
 
 /// `k` keys for a window chosen by `policy`.
 pub fn sidql(policy: &SidqlPolicy, rep: &SphericalMotion, k: usize) -> Result<KeyframeSet> {
     policy.select(rep, k)
+}
+
+/// `k` keys (first and last frame included) for a take of any length, `cm_per_unit` its length
+/// unit. Up to [`MAX_FRAMES`] frames this is [`sidql`]. Longer takes are cut into the fewest
+/// windows of at most [`MAX_FRAMES`] frames that share their end frames (all of them keys, so `k`
+/// must cover them: an error says how many are needed); each window starts with its two end keys
+/// and every further key goes to the window whose summed angle error (Eq. 18 times its frames)
+/// drops most when the policy keys it with one more.
+pub fn sidql_long(policy: &SidqlPolicy, motion: &Motion, cm_per_unit: f64, k: usize) -> Result<KeyframeSet> {
+    let n = motion.num_frames();
+    crate::select::check_k(n, k)?;
+    let window_rep = |a: usize, b: usize| -> Result<SphericalMotion> {
+        let m = motion.crop(a, b + 1).map_err(|e| MocapError::Invalid(e.to_string()))?;
+        let mut rep = SphericalMotion::from_motion(&m)?;
+        rep.cm_per_unit = cm_per_unit;
+        Ok(rep)
+    };
+    if n <= MAX_FRAMES {
+        return sidql(policy, &window_rep(0, n - 1)?, k);
+    }
+    let span = MAX_FRAMES - 1;
+    let windows = (n - 1).div_ceil(span);
+    let ends: Vec<(usize, usize)> = (0..windows).map(|w| (w * span, ((w + 1) * span).min(n - 1))).collect();
+    if k < windows + 1 {
+        return Err(MocapError::Invalid(format!(
+            "SIDQL keys windows of at most {MAX_FRAMES} frames: a {n}-frame take is {windows} windows whose {} end \
+             frames are all keys, so K must be at least {} (got {k}); use more keys, or uniform, greedy or optimal keys",
+            windows + 1,
+            windows + 1
+        )));
+    }
+    let reps: Vec<SphericalMotion> = ends.iter().map(|&(a, b)| window_rep(a, b)).collect::<Result<_>>()?;
+    // Summed angle error of window `w` keyed with `kw` keys by the policy, and those keys.
+    let keyed = |w: usize, kw: usize| -> Result<(f64, KeyframeSet)> {
+        let rep = &reps[w];
+        let keys = sidql(policy, rep, kw.min(rep.num_frames))?;
+        Ok((rep.error(&keys).mean_angle * rep.num_frames as f64, keys))
+    };
+    let mut per: Vec<usize> = vec![2; windows];
+    let mut now: Vec<(f64, KeyframeSet)> = (0..windows).map(|w| keyed(w, 2)).collect::<Result<_>>()?;
+    let mut next: Vec<Option<(f64, KeyframeSet)>> =
+        (0..windows).map(|w| (reps[w].num_frames > 2).then(|| keyed(w, 3)).transpose()).collect::<Result<_>>()?;
+    for _ in 0..k - (windows + 1) {
+        // The window whose error drops most with one more key (ties: the earliest).
+        let best = (0..windows)
+            .filter_map(|w| next[w].as_ref().map(|(e, _)| (w, now[w].0 - e)))
+            .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)));
+        let Some((w, _)) = best else { break };
+        per[w] += 1;
+        now[w] = next[w].take().expect("the chosen window has a next keying");
+        next[w] = (per[w] < reps[w].num_frames).then(|| keyed(w, per[w] + 1)).transpose()?;
+    }
+    let mut keys: Vec<usize> = Vec::with_capacity(k);
+    for (w, (_, ks)) in now.iter().enumerate() {
+        let a = ends[w].0;
+        for &f in ks.frames() {
+            // A window's first key is the previous window's last.
+            if keys.last() != Some(&(a + f)) {
+                keys.push(a + f);
+            }
+        }
+    }
+    Ok(KeyframeSet::new(keys, n)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use inbetween_core::procedural::{gait, GaitParams, CM_PER_CMU_UNIT};
+
+    #[test]
+    fn a_long_take_gets_exactly_k_keys_and_a_short_one_the_window_policy_s() {
+        let policy = SidqlPolicy::committed().unwrap();
+        let m = gait(&GaitParams { frames: 300, ..GaitParams::walk() });
+        // 300 frames: 5 windows of at most 64 frames, 6 end keys.
+        let err = sidql_long(&policy, &m, CM_PER_CMU_UNIT, 5).unwrap_err().to_string();
+        assert!(err.contains("K must be at least 6"), "{err}");
+        for k in [6, 10, 17] {
+            let keys = sidql_long(&policy, &m, CM_PER_CMU_UNIT, k).unwrap();
+            assert_eq!(keys.frames().len(), k, "{:?}", keys.frames());
+            assert_eq!(keys.frames()[0], 0);
+            assert_eq!(*keys.frames().last().unwrap(), 299);
+            for end in [63, 126, 189, 252] {
+                assert!(keys.frames().contains(&end), "window end {end} is a key: {:?}", keys.frames());
+            }
+        }
+        // Eleven more keys cost less angle error over the whole take.
+        let mut rep = SphericalMotion::from_motion(&m).unwrap();
+        rep.cm_per_unit = CM_PER_CMU_UNIT;
+        let e = |k| rep.error(&sidql_long(&policy, &m, CM_PER_CMU_UNIT, k).unwrap()).mean_angle;
+        assert!(e(17) < e(6), "{} {}", e(6), e(17));
+        // Up to 64 frames it is the window policy itself.
+        let short = m.crop(0, 50).unwrap();
+        let mut r = SphericalMotion::from_motion(&short).unwrap();
+        r.cm_per_unit = CM_PER_CMU_UNIT;
+        assert_eq!(sidql_long(&policy, &short, CM_PER_CMU_UNIT, 7).unwrap(), sidql(&policy, &r, 7).unwrap());
+    }
 }
