@@ -139,11 +139,16 @@ fn mocap_jobs_on_the_builtin_walk() {
         assert!(max > 0.0 && max.is_finite(), "{method}: {r}");
         assert!(r["message"].as_str().unwrap().contains("cm"), "{r}");
     }
-    // SIDQL takes windows of at most 64 frames: a 240-frame take is refused with the engine's words.
+    // SIDQL keys 64-frame windows: a 240-frame take is 4 windows, so K = 10 works and K = 4 is
+    // refused with the engine's words (its 5 window ends are all keys).
     let body = json!({"method": "sidql", "k": 10}).to_string();
     let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
+    assert_eq!(event, "result", "{r}");
+    assert_eq!(r["keys"].as_array().unwrap().len(), 10, "{r}");
+    let body = json!({"method": "sidql", "k": 4}).to_string();
+    let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
     assert_eq!(event, "failed", "{r}");
-    assert!(r["error"].as_str().unwrap().contains("64"), "{r}");
+    assert!(r["error"].as_str().unwrap().contains("K must be at least 5"), "{r}");
     // The error bound: every frame under it.
     let body = json!({"method": "bound", "bound_cm": 2.0}).to_string();
     let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
