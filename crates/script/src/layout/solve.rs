@@ -1,0 +1,685 @@
+//! The constructive search of [`solve`]: items placed in relation-graph order, each at the best
+//! of its candidate poses, restarted with derived seeds (see the parent module).
+
+use super::*;
+
+/// The best layout found: items placed in relation-graph order, restarted with derived seeds
+/// while items were dropped or violations remain (at most [`ATTEMPTS`] runs).
+pub fn solve(problem: &LayoutProblem, seed: u64) -> LayoutOutcome {
+    let order = placement_order(problem);
+    let mut best: Option<(usize, usize, LayoutOutcome)> = None;
+    for attempt in 0..ATTEMPTS {
+        let out = Solver::new(problem, inbetween_core::seed::rng(inbetween_core::seed::derive(seed, attempt as u64)))
+            .run(&order);
+        let key = (out.dropped.len(), out.violations.total());
+        if best.as_ref().is_none_or(|(d, v, _)| key < (*d, *v)) {
+            let done = key == (0, 0);
+            best = Some((key.0, key.1, out));
+            if done {
+                break;
+            }
+        }
+    }
+    best.map(|b| b.2).expect("at least one attempt")
+}
+
+/// Restarts of the constructive search (each with its own derived seed).
+pub const ATTEMPTS: usize = 6;
+
+/// Pinned items first, then anchors before their actives (longest anchor chain), floor objects
+/// before wall, ceiling and surface ones, bigger footprints first.
+fn placement_order(p: &LayoutProblem) -> Vec<usize> {
+    let n = p.items.len();
+    let mut depth = vec![0usize; n];
+    // Longest chain of anchors, relaxed n times so cycles stay bounded.
+    for _ in 0..n {
+        let mut changed = false;
+        for c in &p.relations {
+            if c.active < n
+                && c.anchor < n
+                && c.active != c.anchor
+                && depth[c.active] < depth[c.anchor] + 1
+                && depth[c.anchor] < n
+            {
+                depth[c.active] = depth[c.anchor] + 1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let rank = |s: Support| match s {
+        Support::Floor => 0,
+        Support::Wall => 1,
+        Support::Ceiling => 2,
+        Support::Surface => 3,
+    };
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        let (ia, ib) = (&p.items[a], &p.items[b]);
+        let area = |i: &LayoutItem| i.size[0] * i.size[2];
+        (ia.pinned.is_none(), depth[a], rank(ia.support))
+            .cmp(&(ib.pinned.is_none(), depth[b], rank(ib.support)))
+            .then(area(ib).total_cmp(&area(ia)))
+            .then(a.cmp(&b))
+    });
+    order
+}
+
+/// A candidate pose for one item.
+#[derive(Debug, Clone, Copy)]
+struct Pose {
+    position: [f32; 3],
+    yaw: f32,
+    /// Item index it rests on.
+    support: Option<usize>,
+    penalty: f32,
+}
+
+/// One run of the constructive search.
+struct Solver<'a, R: Rng> {
+    p: &'a LayoutProblem,
+    rng: R,
+    /// Per item: its pose once placed (`support` there is an item index).
+    poses: Vec<Option<PlacedObject>>,
+    dropped: Vec<(usize, String)>,
+}
+
+/// Candidates whose walkability is tested per item (the best-scoring ones first).
+const REACH_TESTS: usize = 40;
+/// Door area kept clear of floor objects when possible: half width, depth (metres).
+const DOOR_ZONE: [f32; 2] = [0.5, 0.9];
+
+const QUARTER: f32 = std::f32::consts::FRAC_PI_2;
+const HALF: f32 = std::f32::consts::PI;
+
+/// Yaw in (-π, π].
+fn wrap(yaw: f32) -> f32 {
+    let mut y = yaw % std::f32::consts::TAU;
+    if y <= -HALF {
+        y += std::f32::consts::TAU;
+    } else if y > HALF {
+        y -= std::f32::consts::TAU;
+    }
+    y
+}
+
+impl<'a, R: Rng> Solver<'a, R> {
+    fn new(p: &'a LayoutProblem, rng: R) -> Self {
+        Solver { p, rng, poses: vec![None; p.items.len()], dropped: Vec::new() }
+    }
+
+    fn run(mut self, order: &[usize]) -> LayoutOutcome {
+        for &i in order {
+            self.place(i);
+            self.repair(i);
+        }
+        self.settle_pinned_supports();
+        self.finish()
+    }
+
+    /// Pinned items are placed first, not in support order, so one resting on a surface pinned
+    /// after it found no support when placed: look again once everything stands (an edit's
+    /// re-run must give the same supports as the first run).
+    fn settle_pinned_supports(&mut self) {
+        for i in 0..self.p.items.len() {
+            if self.p.items[i].pinned.is_none() {
+                continue;
+            }
+            let Some((position, yaw)) =
+                self.poses[i].as_ref().filter(|o| o.support.is_none()).map(|o| (o.position, o.yaw))
+            else {
+                continue;
+            };
+            let support = self.support_at(i, position, yaw);
+            if let Some(o) = self.poses[i].as_mut() {
+                o.support = support;
+            }
+        }
+    }
+
+    /// Relations with `i` as the active end that are live and unmet.
+    fn unmet_as_active(&self, i: usize) -> Vec<LayoutConstraint> {
+        let Some(o) = self.poses[i].as_ref() else { return Vec::new() };
+        self.live_relations(i)
+            .into_iter()
+            .filter(|c| c.active == i && !relation_holds(c.relation, o, self.poses[c.anchor].as_ref().expect("live")))
+            .collect()
+    }
+
+    /// Local repair: when item `i` could not meet a relation to its anchor, move the anchor (if
+    /// nothing else leans on it) next to `i` and place `i` again; kept only if it helps.
+    fn repair(&mut self, i: usize) {
+        let unmet = self.unmet_as_active(i);
+        let Some(c) = unmet.first() else { return };
+        let j = c.anchor;
+        if self.p.items[j].pinned.is_some() {
+            return;
+        }
+        let others_lean = self
+            .poses
+            .iter()
+            .enumerate()
+            .any(|(k, o)| k != i && k != j && o.as_ref().is_some_and(|o| o.support == Some(j)))
+            || self.p.relations.iter().any(|r| {
+                let other = if r.anchor == j {
+                    r.active
+                } else if r.active == j {
+                    r.anchor
+                } else {
+                    return false;
+                };
+                other != i && self.poses[other].is_some()
+            });
+        if others_lean {
+            return;
+        }
+        let (poses, dropped) = (self.poses.clone(), self.dropped.clone());
+        self.poses[j] = None;
+        self.place(j);
+        self.poses[i] = None;
+        self.place(i);
+        let ok = self.poses[i].is_some() && self.poses[j].is_some() && self.unmet_as_active(i).len() < unmet.len();
+        if !ok {
+            self.poses = poses;
+            self.dropped = dropped;
+        }
+    }
+
+    fn object(&self, i: usize, pose: &Pose) -> PlacedObject {
+        let it = &self.p.items[i];
+        PlacedObject {
+            label: it.label.clone(),
+            category: it.category.clone(),
+            attributes: it.attributes.clone(),
+            position: pose.position,
+            yaw: wrap(pose.yaw),
+            size: it.size,
+            support: pose.support,
+            origin: it.origin.clone(),
+        }
+    }
+
+    /// Relations touching item `i` whose other end is placed: (relation, active, anchor).
+    fn live_relations(&self, i: usize) -> Vec<LayoutConstraint> {
+        let n = self.p.items.len();
+        self.p
+            .relations
+            .iter()
+            .filter(|c| c.active < n && c.anchor < n && c.active != c.anchor)
+            .filter(|c| {
+                (c.active == i && self.poses[c.anchor].is_some()) || (c.anchor == i && self.poses[c.active].is_some())
+            })
+            .copied()
+            .collect()
+    }
+
+    fn place(&mut self, i: usize) {
+        let item = &self.p.items[i];
+        let r = &self.p.room;
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite() && *x > 0.0);
+        if !finite(&[r.width, r.depth, r.height]) {
+            self.dropped.push((
+                i,
+                format!(
+                    "cannot place '{}': the room's size {} × {} × {} m is not usable",
+                    item.label, r.width, r.depth, r.height
+                ),
+            ));
+            return;
+        }
+        if !finite(&item.size) {
+            self.dropped.push((i, format!("cannot place '{}': its size {:?} m is not usable", item.label, item.size)));
+            return;
+        }
+        if let Some((position, yaw)) = item.pinned {
+            let support = self.support_at(i, position, yaw);
+            self.poses[i] = Some(self.object(i, &Pose { position, yaw, support, penalty: 0.0 }));
+            return;
+        }
+        let live = self.live_relations(i);
+        let mut cands = self.candidates(i, &live);
+        // Score: unmet relations dominate, then the candidate's own penalty.
+        let mut scored: Vec<(f32, PlacedObject)> = Vec::with_capacity(cands.len());
+        for pose in cands.drain(..) {
+            let obj = self.object(i, &pose);
+            if !inside_room(&self.p.room, &obj) || self.collides(i, &obj) {
+                continue;
+            }
+            let unmet = live
+                .iter()
+                .filter(|c| {
+                    let (a, b) = if c.active == i {
+                        (&obj, self.poses[c.anchor].as_ref().expect("live"))
+                    } else {
+                        (self.poses[c.active].as_ref().expect("live"), &obj)
+                    };
+                    !relation_holds(c.relation, a, b)
+                })
+                .count();
+            let loose = live
+                .iter()
+                .filter(|c| {
+                    let (a, b) = if c.active == i {
+                        (&obj, self.poses[c.anchor].as_ref().expect("live"))
+                    } else {
+                        (self.poses[c.active].as_ref().expect("live"), &obj)
+                    };
+                    !strictly_holds(c.relation, a, b)
+                })
+                .count();
+            // The authored pose is kept whenever the shared definitions hold there.
+            let tidy = if pose.penalty < 0.0 { 0.0 } else { 2.0 * loose as f32 };
+            let mut score = 100.0 * unmet as f32 + tidy + pose.penalty;
+            if grid::blocks_walking(&obj) && self.in_door_zone(&obj) {
+                score += 20.0;
+            }
+            scored.push((score, obj));
+        }
+        scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let before = self.unreachable_now(None);
+        for (_, obj) in scored.into_iter().take(REACH_TESTS) {
+            if !grid::blocks_walking(&obj) || self.unreachable_now(Some((i, &obj))).iter().all(|k| before.contains(k)) {
+                self.poses[i] = Some(obj);
+                return;
+            }
+        }
+        let r = &self.p.room;
+        let space = match item.support {
+            Support::Floor => "free floor space",
+            Support::Surface => "free surface or floor space",
+            Support::Wall => "free wall space",
+            Support::Ceiling => "free ceiling space",
+        };
+        self.dropped
+            .push((i, format!("no {space} for '{}' in the {:.1} × {:.1} m room", item.label, r.width, r.depth)));
+    }
+
+    /// Item indices (placed, plus `extra`) that cannot be walked up to.
+    fn unreachable_now(&self, extra: Option<(usize, &PlacedObject)>) -> Vec<usize> {
+        let mut ids = Vec::new();
+        let mut objs = Vec::new();
+        for (k, o) in self.poses.iter().enumerate() {
+            if let Some(o) = o {
+                ids.push(k);
+                objs.push(o.clone());
+            }
+        }
+        if let Some((k, o)) = extra {
+            ids.push(k);
+            objs.push(o.clone());
+        }
+        // Supports are item indices here; only their presence matters to reachability.
+        let pos = |item: usize| ids.iter().position(|&k| k == item);
+        let rels: Vec<(Relation, usize, usize)> =
+            self.p.relations.iter().filter_map(|c| Some((c.relation, pos(c.active)?, pos(c.anchor)?))).collect();
+        unreachable(&self.p.room, &objs, &rels).into_iter().map(|k| ids[k]).collect()
+    }
+
+    fn in_door_zone(&self, o: &PlacedObject) -> bool {
+        let d = door(&self.p.room);
+        let c = [d[0], d[1] - DOOR_ZONE[1] / 2.0];
+        geom::box_penetration(geom::center(o), o.half_extents_xz(), c, [DOOR_ZONE[0], DOOR_ZONE[1] / 2.0]) > 0.0
+    }
+
+    /// Whether `obj` (for item `i`) interpenetrates a placed item it is not stacked with.
+    fn collides(&self, i: usize, obj: &PlacedObject) -> bool {
+        self.poses.iter().enumerate().any(|(j, o)| {
+            let Some(o) = o else { return false };
+            let linked = obj.support == Some(j)
+                || o.support == Some(i)
+                || self.p.relations.iter().any(|c| {
+                    stacking(c.relation) && ((c.active, c.anchor) == (i, j) || (c.active, c.anchor) == (j, i))
+                });
+            !linked && interpenetrate(obj, o)
+        })
+    }
+
+    /// The placed surface item a pose at `position` rests on, if any.
+    fn support_at(&self, i: usize, position: [f32; 3], yaw: f32) -> Option<usize> {
+        if position[1] < 0.05 {
+            return None;
+        }
+        let probe =
+            PlacedObject { position, yaw, ..self.object(i, &Pose { position, yaw, support: None, penalty: 0.0 }) };
+        self.poses
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| j != i)
+            .find(|(_, o)| {
+                o.as_ref().is_some_and(|o| (o.top() - position[1]).abs() <= EPS && geom::center_inside(&probe, o))
+            })
+            .map(|(j, _)| j)
+    }
+
+    fn candidates(&mut self, i: usize, live: &[LayoutConstraint]) -> Vec<Pose> {
+        let item = &self.p.items[i];
+        let mut out = Vec::new();
+        if let Some(h) = &item.hint {
+            let support = self.support_at(i, h.position, h.yaw);
+            out.push(Pose { position: h.position, yaw: h.yaw, support, penalty: -1.0 });
+            for _ in 0..8 {
+                let d = [self.rng.random_range(-0.4..0.4), self.rng.random_range(-0.4..0.4)];
+                let position = [h.position[0] + d[0], h.position[1], h.position[2] + d[1]];
+                let support = self.support_at(i, position, h.yaw);
+                out.push(Pose { position, yaw: h.yaw, support, penalty: 2.0 * (d[0].hypot(d[1])) });
+            }
+        }
+        for c in live {
+            if c.active == i {
+                let anchor = self.poses[c.anchor].clone().expect("live relation");
+                self.relation_candidates(i, c.relation, c.anchor, &anchor, &mut out);
+            } else {
+                let active = self.poses[c.active].clone().expect("live relation");
+                self.around(i, &active, &mut out);
+            }
+        }
+        let generic_from = out.len();
+        let anchors_above_wall =
+            self.p.relations.iter().any(|c| {
+                c.anchor == i && c.relation == Relation::Above && self.p.items[c.active].support == Support::Wall
+            });
+        let free = !self.p.relations.iter().any(|c| c.active == i);
+        match item.support {
+            Support::Floor => {
+                // Free furniture goes against walls; anchors of wall pictures "above" must.
+                let wall_weight = if anchors_above_wall {
+                    8.0
+                } else if free {
+                    0.6
+                } else {
+                    0.0
+                };
+                self.wall_candidates(i, 0.0, 10, 0.0, &mut out);
+                self.interior_candidates(i, 16, wall_weight, &mut out);
+            }
+            Support::Surface => {
+                self.surface_candidates(i, 6, &mut out);
+                let mut floor = Vec::new();
+                self.wall_candidates(i, 0.0, 6, 0.0, &mut floor);
+                self.interior_candidates(i, 10, 0.0, &mut floor);
+                out.extend(floor.into_iter().map(|p| Pose { penalty: p.penalty + 30.0, ..p }));
+            }
+            Support::Wall => {
+                let h = item.size[1];
+                let y = (WALL_CENTER_HEIGHT - h / 2.0).min(self.p.room.height - h).max(0.0);
+                self.wall_candidates(i, y, 12, 0.0, &mut out);
+            }
+            Support::Ceiling => {
+                for _ in 0..24 {
+                    let pose = self.random_floor_pose(i);
+                    let y = (self.p.room.height - item.size[1]).max(0.0);
+                    out.push(Pose { position: [pose.position[0], y, pose.position[2]], ..pose });
+                }
+            }
+        }
+        // Poses made for a relation beat generic ones that meet it by chance (a chair that happens
+        // to stand in front of the desk but faces away).
+        if live.iter().any(|c| c.active == i) {
+            for p in &mut out[generic_from..] {
+                p.penalty += 1.0;
+            }
+        }
+        // Tiny seeded jitter breaks ties differently per attempt.
+        for p in &mut out {
+            p.penalty += self.rng.random_range(0.0..0.01);
+        }
+        out
+    }
+
+    /// The base height an item gets when it is not stacked: floor, wall height or under the ceiling.
+    fn rest_height(&self, i: usize) -> f32 {
+        let it = &self.p.items[i];
+        match it.support {
+            Support::Floor | Support::Surface => 0.0,
+            Support::Wall => (WALL_CENTER_HEIGHT - it.size[1] / 2.0).min(self.p.room.height - it.size[1]).max(0.0),
+            Support::Ceiling => (self.p.room.height - it.size[1]).max(0.0),
+        }
+    }
+
+    /// Poses with the item's back against each wall, facing into the room, at base height `y`.
+    fn wall_candidates(&mut self, i: usize, y: f32, per_wall: usize, penalty: f32, out: &mut Vec<Pose>) {
+        let [w, _, d] = self.p.items[i].size;
+        let r = &self.p.room;
+        // (yaw, wall length, along → world x/z)
+        let walls: [(f32, f32); 4] = [(0.0, r.width), (HALF, r.width), (QUARTER, r.depth), (-QUARTER, r.depth)];
+        for (k, &(yaw, len)) in walls.iter().enumerate() {
+            if len < w {
+                continue;
+            }
+            for s in 0..per_wall {
+                let t = if s == 0 {
+                    w / 2.0
+                } else if s == 1 {
+                    len - w / 2.0
+                } else {
+                    self.rng.random_range(w / 2.0..=len - w / 2.0)
+                };
+                let (x, z) = match k {
+                    0 => (t, d / 2.0),
+                    1 => (t, r.depth - d / 2.0),
+                    2 => (d / 2.0, t),
+                    _ => (r.width - d / 2.0, t),
+                };
+                out.push(Pose { position: [x, y, z], yaw, support: None, penalty });
+            }
+        }
+    }
+
+    /// A random floor pose facing one of the four axes (turned towards the room centre).
+    fn random_floor_pose(&mut self, i: usize) -> Pose {
+        let r = &self.p.room;
+        let [w, _, d] = self.p.items[i].size;
+        let m = w.max(d) / 2.0;
+        let x = if r.width > 2.0 * m { self.rng.random_range(m..r.width - m) } else { r.width / 2.0 };
+        let z = if r.depth > 2.0 * m { self.rng.random_range(m..r.depth - m) } else { r.depth / 2.0 };
+        let (dx, dz) = (r.width / 2.0 - x, r.depth / 2.0 - z);
+        let yaw = if dx.abs() > dz.abs() {
+            if dx > 0.0 {
+                QUARTER
+            } else {
+                -QUARTER
+            }
+        } else if dz >= 0.0 {
+            0.0
+        } else {
+            HALF
+        };
+        Pose { position: [x, 0.0, z], yaw, support: None, penalty: 0.0 }
+    }
+
+    /// Random interior poses; `wall_weight` per metre between the item's back and the nearest wall.
+    fn interior_candidates(&mut self, i: usize, n: usize, wall_weight: f32, out: &mut Vec<Pose>) {
+        for _ in 0..n {
+            let mut p = self.random_floor_pose(i);
+            p.penalty += wall_weight * self.back_gap(i, &p);
+            out.push(p);
+        }
+    }
+
+    /// Distance from the item's back to the wall behind it.
+    fn back_gap(&self, i: usize, p: &Pose) -> f32 {
+        let r = &self.p.room;
+        let d = self.p.items[i].size[2] / 2.0;
+        let f = geom::forward(p.yaw);
+        let back = [p.position[0] - f[0] * d, p.position[2] - f[1] * d];
+        let along = if f[1].abs() >= f[0].abs() {
+            if f[1] > 0.0 {
+                back[1]
+            } else {
+                r.depth - back[1]
+            }
+        } else if f[0] > 0.0 {
+            back[0]
+        } else {
+            r.width - back[0]
+        };
+        along.max(0.0)
+    }
+
+    /// Poses on top of placed surface items, where the footprint fits.
+    fn surface_candidates(&mut self, i: usize, per_surface: usize, out: &mut Vec<Pose>) {
+        let [w, _, d] = self.p.items[i].size;
+        let surfaces: Vec<(usize, PlacedObject)> = self
+            .poses
+            .iter()
+            .enumerate()
+            .filter(|&(j, o)| j != i && o.is_some() && self.p.items[j].surface)
+            .map(|(j, o)| (j, o.clone().expect("placed")))
+            .collect();
+        for (j, s) in surfaces {
+            for _ in 0..per_surface {
+                let l = [self.random_within(s.size[0], w), self.random_within(s.size[2], d)];
+                let c = geom::to_world(geom::center(&s), s.yaw, l);
+                out.push(Pose { position: [c[0], s.top(), c[1]], yaw: s.yaw, support: Some(j), penalty: 0.0 });
+            }
+        }
+    }
+
+    /// A random offset that keeps an extent `inner` inside `outer` (0 when it cannot fit).
+    fn random_within(&mut self, outer: f32, inner: f32) -> f32 {
+        let room = (outer - inner) / 2.0;
+        if room > 1e-3 {
+            self.rng.random_range(-room..room)
+        } else {
+            0.0
+        }
+    }
+
+    /// Poses beside `other` on all four sides at a few gaps and the four yaws (for relations whose
+    /// other end is already placed, scored by the relation test).
+    fn around(&mut self, i: usize, other: &PlacedObject, out: &mut Vec<Pose>) {
+        let [w, _, d] = self.p.items[i].size;
+        let y = self.rest_height(i);
+        let (ow, od) = (other.size[0] / 2.0, other.size[2] / 2.0);
+        for k in 0..4 {
+            let yaw = other.yaw + k as f32 * QUARTER;
+            let (s, c) = (yaw - other.yaw).sin_cos();
+            let h = [w / 2.0 * c.abs() + d / 2.0 * s.abs(), w / 2.0 * s.abs() + d / 2.0 * c.abs()];
+            for gap in [0.05, 0.25, 0.7] {
+                for l in [
+                    [0.0, od + h[1] + gap],
+                    [0.0, -(od + h[1] + gap)],
+                    [ow + h[0] + gap, 0.0],
+                    [-(ow + h[0] + gap), 0.0],
+                ] {
+                    let p = geom::to_world(geom::center(other), other.yaw, l);
+                    out.push(Pose { position: [p[0], y, p[1]], yaw, support: None, penalty: gap });
+                }
+            }
+        }
+    }
+
+    /// Poses that make `rel` hold against the placed `anchor` (item `j`).
+    fn relation_candidates(&mut self, i: usize, rel: Relation, j: usize, anchor: &PlacedObject, out: &mut Vec<Pose>) {
+        let item = &self.p.items[i];
+        let [w, h, d] = item.size;
+        let (aw, ad) = (anchor.size[0] / 2.0, anchor.size[2] / 2.0);
+        let ac = geom::center(anchor);
+        let at = |l: [f32; 2]| geom::to_world(ac, anchor.yaw, l);
+        let base = self.rest_height(i);
+        let mut push = |p: [f32; 2], y: f32, yaw: f32, support: Option<usize>, penalty: f32| {
+            out.push(Pose { position: [p[0], y, p[1]], yaw, support, penalty });
+        };
+        match rel {
+            Relation::On | Relation::Under | Relation::In => {
+                let y = match rel {
+                    Relation::On => anchor.top(),
+                    _ => anchor.position[1],
+                };
+                let support = (rel == Relation::On).then_some(j);
+                push(at([0.0, 0.0]), y, anchor.yaw, support, 0.0);
+                for _ in 0..10 {
+                    let l = [self.random_within(anchor.size[0], w), self.random_within(anchor.size[2], d)];
+                    push(at(l), y, anchor.yaw, support, 0.1);
+                }
+            }
+            Relation::Near | Relation::NextTo => {
+                let max_gap = if rel == Relation::Near { 0.8 } else { 0.2 };
+                for k in 0..2 {
+                    // Same facing as the anchor, or turned a quarter to face it (chairs round a table).
+                    let (s, c) = (k as f32 * QUARTER).sin_cos();
+                    let hh = [w / 2.0 * c.abs() + d / 2.0 * s.abs(), w / 2.0 * s.abs() + d / 2.0 * c.abs()];
+                    for side in [-1.0f32, 1.0] {
+                        let yaw = anchor.yaw - k as f32 * side * QUARTER;
+                        for _ in 0..4 {
+                            let g = self.rng.random_range(0.02..max_gap);
+                            // Backs flush with the anchor's back, or centred, or anywhere along.
+                            let lz = match self.rng.random_range(0..3) {
+                                0 => -ad + hh[1],
+                                1 => 0.0,
+                                _ => self.random_within(2.0 * ad, 2.0 * hh[1]),
+                            };
+                            push(at([side * (aw + hh[0] + g), lz]), base, yaw, None, g);
+                            if rel == Relation::Near {
+                                let lx = self.random_within(2.0 * aw, 2.0 * hh[0]);
+                                push(at([lx, side * (ad + hh[1] + g)]), base, yaw, None, g + 0.1);
+                            }
+                        }
+                    }
+                }
+            }
+            Relation::InFrontOf | Relation::Behind => {
+                let sign = if rel == Relation::InFrontOf { 1.0 } else { -1.0 };
+                // In front: facing the anchor; behind: facing the same way.
+                let yaw = if rel == Relation::InFrontOf { anchor.yaw + HALF } else { anchor.yaw };
+                for k in 0..24 {
+                    let g = if k == 0 { 0.1 } else { self.rng.random_range(0.05..FRONT_GAP - 0.1) };
+                    let lx = if k < 3 { 0.0 } else { self.rng.random_range(-0.5..=0.5) * aw };
+                    push(at([lx, sign * (ad + d / 2.0 + g)]), base, yaw, None, 0.3 * (g - 0.4).abs());
+                }
+            }
+            Relation::Above => {
+                if item.support == Support::Wall {
+                    // On the wall the anchor backs onto, over it.
+                    let f = geom::forward(anchor.yaw);
+                    let back = [ac[0] - f[0] * ad, ac[1] - f[1] * ad];
+                    let y = (WALL_CENTER_HEIGHT - h / 2.0).max(anchor.top() + 0.1).min(self.p.room.height - h);
+                    let r = &self.p.room;
+                    let walls = [
+                        (0.0, [back[0], d / 2.0]),
+                        (HALF, [back[0], r.depth - d / 2.0]),
+                        (QUARTER, [d / 2.0, back[1]]),
+                        (-QUARTER, [r.width - d / 2.0, back[1]]),
+                    ];
+                    for (yaw, p) in walls {
+                        push(p, y, yaw, None, 0.0);
+                    }
+                } else {
+                    let y = if item.support == Support::Ceiling { self.p.room.height - h } else { anchor.top() + 0.3 };
+                    push(ac, y.max(anchor.top()), anchor.yaw, None, 0.0);
+                    let y = (self.p.room.height - h).max(anchor.top());
+                    push(ac, y, anchor.yaw, None, 0.1);
+                }
+            }
+        }
+    }
+
+    fn finish(self) -> LayoutOutcome {
+        let n = self.p.items.len();
+        let mut placed = vec![None; n];
+        let mut objects = Vec::new();
+        for (i, o) in self.poses.iter().enumerate() {
+            if let Some(o) = o {
+                placed[i] = Some(objects.len());
+                objects.push(o.clone());
+            }
+        }
+        for o in &mut objects {
+            o.support = o.support.and_then(|s| placed[s]);
+        }
+        let rels: Vec<(Relation, usize, usize)> = self
+            .p
+            .relations
+            .iter()
+            .filter_map(|c| {
+                Some((c.relation, placed.get(c.active).copied().flatten()?, placed.get(c.anchor).copied().flatten()?))
+            })
+            .collect();
+        let violations = check(&self.p.room, &objects, &rels);
+        let mut dropped = self.dropped;
+        dropped.sort_by_key(|d| d.0);
+        LayoutOutcome { objects, placed, dropped, violations }
+    }
+}
