@@ -76,7 +76,7 @@ pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) 
             // coloured at its centre.
             let px = [(pa.0, pa.1), (pb.0, pb.1), (pc.0, pc.1)];
             let uv = tri.map(|v| body.uvs[v as usize]);
-            for (sub, suv) in subdivide(px, uv, 2) {
+            for (sub, suv) in inbetween_render::subdivide_triangle(px, uv, 2) {
                 let c = [0, 1].map(|k| (suv[0][k] + suv[1][k] + suv[2][k]) / 3.0);
                 items.push((depth, Err((sub, scale_color(paint.at(c), shade)))));
             }
@@ -93,28 +93,4 @@ pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) 
         }
     }
     cv.into_image()
-}
-
-type Tri2 = ([(f32, f32); 3], [[f32; 2]; 3]);
-
-/// Midpoint subdivision, `levels` times (4^levels triangles), of a pixel triangle and its uvs.
-fn subdivide(px: [(f32, f32); 3], uv: [[f32; 2]; 3], levels: u32) -> Vec<Tri2> {
-    let mut tris = vec![(px, uv)];
-    for _ in 0..levels {
-        tris = tris
-            .into_iter()
-            .flat_map(|(p, u)| {
-                let mp = |i: usize, j: usize| ((p[i].0 + p[j].0) / 2.0, (p[i].1 + p[j].1) / 2.0);
-                let mu = |i: usize, j: usize| [(u[i][0] + u[j][0]) / 2.0, (u[i][1] + u[j][1]) / 2.0];
-                let (p01, p12, p20, u01, u12, u20) = (mp(0, 1), mp(1, 2), mp(2, 0), mu(0, 1), mu(1, 2), mu(2, 0));
-                [
-                    ([p[0], p01, p20], [u[0], u01, u20]),
-                    ([p01, p[1], p12], [u01, u[1], u12]),
-                    ([p20, p12, p[2]], [u20, u12, u[2]]),
-                    ([p01, p12, p20], [u01, u12, u20]),
-                ]
-            })
-            .collect();
-    }
-    tris
 }
