@@ -10,8 +10,10 @@ use inbetween_face::bench::{self, FaceBenchConfig};
 use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::mask::{parse_span_spec, SpanSpec};
-use inbetween_face::edit::ConstraintKind;
-use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide, Inpainter, Method};
+use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
+use inbetween_face::infer::{
+    read_keys, EditJob, EditLimits, Guide, Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
+};
 use inbetween_face::preview::{span_flags, write_edit_gif, write_edit_png, CurvePreview};
 use inbetween_face::train::{save_face_weights, train_face_cancellable, FaceTrainConfig};
 use inbetween_face::visemes::{phoneme_viseme, read_viseme_source, text_to_phonemes, PhonemeSpan};
@@ -47,12 +49,18 @@ pub struct ScaleArgs {
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum MethodArg {
-    /// The trained network for the guidance given (the default).
+    /// The best measured method for the guidance given (face bench): retrieval when unguided or
+    /// guided by a noisy take, the trained network for keys and visemes (and whenever --weights is given).
+    Auto,
+    /// The trained network for the guidance given.
     Network,
     /// Linear interpolation through the span's borders and keys.
     Linear,
     /// Cubic Hermite interpolation through the span's borders (values and slopes) and keys.
     Cubic,
+    /// Segments of recorded motion (--library, and the clip itself outside the spans) joined at the
+    /// borders; the seed draws among the best matches.
+    Retrieval,
 }
 
 #[derive(Args)]
@@ -84,11 +92,15 @@ pub struct EditArgs {
     /// Blendshape groups to regenerate: eyes, brows, jaw, mouth, cheeks, tongue, lower, upper, all.
     #[arg(long, default_value = "all")]
     pub groups: String,
-    #[arg(long, value_enum, default_value = "network")]
+    #[arg(long, value_enum, default_value = "auto")]
     pub method: MethodArg,
     /// Weights for the network (default: the committed ones for the guidance given).
     #[arg(long)]
     pub weights: Option<PathBuf>,
+    /// Clips for --method retrieval to draw from (any clip format; comma-separated or repeated).
+    /// Default: 120 s of procedural faces. The clip itself outside the spans is always searched.
+    #[arg(long, value_delimiter = ',')]
+    pub library: Vec<PathBuf>,
     /// Output file; Live Link CSV when the input is, else curve CSV/JSON by extension.
     #[arg(short, long)]
     pub out: PathBuf,
@@ -285,6 +297,19 @@ fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow
     })
 }
 
+/// The clips of `--library` at the model rate, or the default procedural library.
+fn retrieval_library(files: &[PathBuf], max_rows: usize) -> anyhow::Result<MotionLibrary> {
+    if files.is_empty() {
+        return Ok(MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED));
+    }
+    let mut lib = MotionLibrary::default();
+    for f in files {
+        let clip = read_clip_limited(f, max_rows)?.resample(MODEL_FPS).with_context(|| format!("{}", f.display()))?;
+        lib.push((0..clip.num_frames()).map(|i| std::array::from_fn(|c| clip.arkit(i)[c])).collect());
+    }
+    Ok(lib)
+}
+
 fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
     let limits = EditLimits { max_rows: a.max_rows, max_mask_s: a.max_mask_seconds };
@@ -292,7 +317,15 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<anyhow::Result<Vec<_>>>()?;
     let channels = parse_groups(&a.groups).map_err(anyhow::Error::msg)?;
     let guide = guide_of(&a, &clip, &spans)?;
-    let net = match a.method {
+    let chosen = match a.method {
+        MethodArg::Auto if a.weights.is_some() => MethodArg::Network,
+        MethodArg::Auto => match guide.kind() {
+            ConstraintKind::None | ConstraintKind::Noisy => MethodArg::Retrieval,
+            ConstraintKind::Keyframes | ConstraintKind::Visemes => MethodArg::Network,
+        },
+        m => m,
+    };
+    let net = match chosen {
         MethodArg::Network => Some(match &a.weights {
             Some(w) => weights::load(w).with_context(|| format!("loading face weights {}", w.display()))?,
             None => weights::committed(guide.kind())
@@ -300,11 +333,27 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         }),
         _ => None,
     };
-    let method = match (&a.method, &net) {
+    if !a.library.is_empty() && !matches!(chosen, MethodArg::Retrieval) {
+        bail!("--library is read only by --method retrieval (with --keys or --visemes, auto picks the network)");
+    }
+    let library = match chosen {
+        MethodArg::Retrieval => Some(retrieval_library(&a.library, limits.max_rows)?),
+        _ => None,
+    };
+    let method = match (&chosen, &net) {
         (MethodArg::Linear, _) => Method::Linear,
         (MethodArg::Cubic, _) => Method::Cubic,
+        (MethodArg::Retrieval, _) => {
+            // Enough candidates that every variant is a different segment.
+            let candidates = RetrievalOptions::default().candidates.max(a.variants as usize);
+            Method::Retrieval(
+                library.as_ref().expect("built above"),
+                RetrievalOptions { candidates, ..Default::default() },
+            )
+        }
         (MethodArg::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
         (MethodArg::Network, None) => unreachable!("a network was loaded above"),
+        (MethodArg::Auto, _) => unreachable!("auto was resolved above"),
     };
     let guide_file = [&a.keys, &a.guide, &a.visemes].into_iter().flatten().next().map(|p| p.display().to_string());
     let mut job = EditJob {

@@ -170,8 +170,18 @@ fn keys_masks_and_visemes_that_cannot_work_are_refused_naming_their_file() {
     // A mask running past the clip's end.
     let err = fails(&edit(&["--mask", "6s..20s"]));
     assert!(err.contains("mask '6s..20s' runs past the clip's end"), "{err}");
+    // Retrieval has no phoneme labels to follow, and --library belongs to retrieval only.
+    let phon = d.join("take.phonemes.csv");
+    let base = ["face", "edit", s(&input), "--mask", "2s..4s", "-o", s(&out_path)];
+    let err = fails(&inbetween(&[&base[..], &["--method", "retrieval", "--visemes", s(&phon)]].concat()));
+    assert!(err.contains("retrieval cannot follow visemes"), "{err}");
+    let err = fails(&inbetween(&[&base[..], &["--visemes", s(&phon), "--library", s(&input)]].concat()));
+    assert!(err.contains("--library is read only by --method retrieval"), "{err}");
     assert!(!out_path.exists());
     assert_eq!(listing(d), ["keys.json", "late.csv", "take.csv", "take.phonemes.csv"], "no output, no staging left");
+    // A library of the user's own takes is read (any clip format) and drawn from.
+    ok(&inbetween(&[&base[..], &["--method", "retrieval", "--library", s(&input)]].concat()));
+    assert!(out_path.exists());
 }
 
 #[test]
@@ -223,8 +233,15 @@ fn variants_write_one_fill_per_seed_and_the_same_seed_gives_the_same_fill() {
     let one = d.join("one.csv");
     ok(&inbetween(&["face", "edit", s(&input), "--mask", "2s..4s", "--seed", "6", "-o", s(&one)]));
     assert_eq!(std::fs::read(&one).unwrap(), std::fs::read(d.join("out-2.csv")).unwrap());
-    // The seed reaches the fill: another seed gives another file.
+    // The seed reaches the fill: another seed gives another file, and the default (retrieval) fills
+    // differ visibly (a mean of at least 0.005 in weight inside the span), not by noise the network ignores.
     assert_ne!(std::fs::read(d.join("out-1.csv")).unwrap(), std::fs::read(d.join("out-2.csv")).unwrap());
+    assert!(text.contains("with retrieval (seed 5)"), "{text}");
+    let spread = text.lines().find(|l| l.starts_with("variants 2..3")).unwrap();
+    for v in spread.rsplit(':').next().unwrap().split(',') {
+        let v: f64 = v.trim().parse().unwrap();
+        assert!(v >= 0.005, "variants too alike: {spread}");
+    }
     let bad = inbetween(&["face", "edit", s(&input), "--mask", "2s..4s", "--variants", "0", "-o", s(&out)]);
     assert!(!bad.status.success());
 }

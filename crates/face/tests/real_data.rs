@@ -108,3 +108,67 @@ fn every_face_csv_parses_and_round_trips() {
         }
     });
 }
+
+/// Issue 25's example: a held-out capture (not in the retrieval library), a 2.5 s unguided span at
+/// 4.0–6.5 s. The retrieval fill (procedural library, the default of `face edit`) is a face, not a
+/// line: its eyes never stay half closed (every closed run that starts inside the span opens again
+/// within 0.5 s), its mouth and jaw move at least half as fast as outside the span, where linear
+/// interpolation's barely move; and two seeds give visibly different fills.
+#[test]
+fn unguided_retrieval_on_a_held_out_capture_blinks_whole_and_moves() {
+    use inbetween_face::bench::plausibility::GapStats;
+    use inbetween_face::edit::{Frame, MotionLibrary, RetrievalOptions};
+    use inbetween_face::infer::{EditJob, EditLimits, Guide, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
+    with_shared_data("the held-out face capture", |data| {
+        let path = data.join("face/neurosync").join(inbetween_face::bench::TEST_FILES[0]);
+        let clip = read_live_link(&path).unwrap();
+        let library = MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED);
+        let run = |method: Method, seed: u64| {
+            EditJob {
+                clip: &clip,
+                spans: vec![(4.0, 6.5)],
+                channels: [true; inbetween_face::data::NUM_ARKIT],
+                guide: Guide::None,
+                method,
+                seed,
+                limits: EditLimits::default(),
+                cancel: inbetween_core::cancel::Cancel::new(),
+                guide_file: None,
+            }
+            .run()
+            .unwrap()
+        };
+        let retrieval = Method::Retrieval(&library, RetrievalOptions::default());
+        let (a, b, lin) = (run(retrieval, 1), run(retrieval, 2), run(Method::Linear, 1));
+        let (s, e) = ((4.0 * MODEL_FPS) as usize, (6.5 * MODEL_FPS) as usize);
+        let inside = |f: &[Frame]| GapStats::of(&f[s..e]);
+        let outside = {
+            let mut o = GapStats::of(&a.before[..s]);
+            o.add(&GapStats::of(&a.before[e..]));
+            o
+        };
+        let speed = |g: &GapStats| g.values()[2];
+        assert!(speed(&inside(&a.after)) >= 0.5 * speed(&outside), "retrieval fill barely moves");
+        assert!(speed(&inside(&lin.after)) < 0.5 * speed(&outside), "linear moves: the check tells nothing");
+        // Whole blinks: a run of closed frames (mean eyeBlink > 0.5) that starts inside the span ends
+        // within 0.5 s (12 frames at 25 fps), unless the span's end cuts it.
+        let blink = |f: &Frame| 0.5 * (f[0] + f[7]);
+        assert_eq!(inbetween_face::data::ARKIT_NAMES[7], "EyeBlinkRight");
+        let mut run_len = 0;
+        for f in s..e {
+            if blink(&a.after[f]) > 0.5 {
+                run_len += 1;
+            } else {
+                assert!(run_len <= 12, "an eye stayed closed {run_len} frames before frame {f}");
+                run_len = 0;
+            }
+        }
+        let diff: f64 = (s..e)
+            .flat_map(|f| (0..inbetween_face::data::NUM_ARKIT).map(move |c| (f, c)))
+            .map(|(f, c)| f64::from((a.after[f][c] - b.after[f][c]).abs()))
+            .sum::<f64>()
+            / ((e - s) * inbetween_face::data::NUM_ARKIT) as f64;
+        assert!(diff > 0.005, "seeds 1 and 2 give fills {diff} apart");
+        println!("retrieval: seeds 1 and 2 differ by {diff:.4} inside the span");
+    });
+}

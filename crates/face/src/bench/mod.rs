@@ -25,7 +25,7 @@ use rand::Rng;
 use crate::data::{read_live_link, BlendshapeClip, FaceError, ARKIT_NAMES, MODEL_FPS, NUM_ARKIT};
 use crate::edit::constraints::{noisy_guide, sample_keyframes, TrackerNoise};
 use crate::edit::distances::{distances, DISTANCE_NAMES, NUM_DISTANCES};
-use crate::edit::{ConstraintKind, Frame, Mask, Segment};
+use crate::edit::{ConstraintKind, Frame, Mask, MotionLibrary, RetrievalOptions, Segment};
 use crate::infer::{EditJob, Guide, Inpainter, KeyPose, Method};
 use crate::procedural;
 use crate::visemes::Viseme;
@@ -191,16 +191,46 @@ pub fn viseme_runs(labels: &[Viseme]) -> Vec<(f64, f64, Viseme)> {
     runs
 }
 
-/// The methods compared for one constraint type: linear, cubic, each network set's network, and for
-/// the noisy guide the guide itself.
-fn methods<'a>(kind: ConstraintKind, sets: &'a [NetworkSet]) -> Vec<(String, Method<'a>)> {
+/// The methods compared for one constraint type: linear, cubic, each network set's network, each
+/// retrieval library (not for visemes: the libraries have no phoneme labels), and for the noisy guide
+/// the guide itself.
+fn methods<'a>(kind: ConstraintKind, sets: &'a [NetworkSet], libs: &'a [Library]) -> Vec<(String, Method<'a>)> {
     let mut m = vec![("linear".to_string(), Method::Linear), ("cubic".to_string(), Method::Cubic)];
     for s in sets {
         if let Some(net) = s.get(kind) {
             m.push((format!("ours ({})", s.label), Method::Network(net)));
         }
     }
+    if kind != ConstraintKind::Visemes {
+        for l in libs {
+            m.push((format!("retrieval ({})", l.label), Method::Retrieval(&l.library, RetrievalOptions::default())));
+        }
+    }
     m
+}
+
+/// A retrieval library under its table label.
+pub struct Library {
+    /// Label in the tables ("real split", "procedural").
+    pub label: String,
+    /// The motion.
+    pub library: MotionLibrary,
+}
+
+/// The bench's retrieval libraries: the real training split (never the held-out files) and the
+/// procedural library that `face edit --method retrieval` uses by default.
+pub fn libraries(cfg: &FaceBenchConfig) -> Result<Vec<Library>, FaceError> {
+    let mut real = MotionLibrary::default();
+    for f in TRAIN_FILES {
+        real.push(frames_of(&read_live_link(&cfg.captures.join(f))?.resample(MODEL_FPS)?));
+    }
+    Ok(vec![
+        Library { label: "real split".into(), library: real },
+        Library {
+            label: "procedural".into(),
+            library: MotionLibrary::procedural(crate::infer::DEFAULT_LIBRARY_S, crate::infer::DEFAULT_LIBRARY_SEED),
+        },
+    ])
 }
 
 /// One edit of `truth` (25 fps) on `seg` with `method`; returns the model-rate output and mask.
@@ -250,6 +280,7 @@ fn evaluate_clip(
     visemes: Option<&[Viseme]>,
     kinds: &[ConstraintKind],
     sets: &[NetworkSet],
+    libs: &[Library],
     edits: usize,
     seed: u64,
     cells: &mut Cells,
@@ -270,7 +301,7 @@ fn evaluate_clip(
             let mask = Mask::from_segments(n, &[seg], &[true; NUM_ARKIT]);
             for kind in kinds {
                 let guide = guide_for(*kind, &truth, &mask, visemes, derive(s, 1));
-                for (name, method) in methods(*kind, sets) {
+                for (name, method) in methods(*kind, sets, libs) {
                     let (out, mask) = edit(truth_clip, seg, &guide, method, derive(s, 2))?;
                     cell(cells, (*kind, *gap_s, name)).add(&truth, &out, &mask);
                 }
@@ -329,6 +360,7 @@ pub fn test_clips(captures: &Path, one: bool) -> Result<Vec<(String, BlendshapeC
 pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> Result<Report, FaceError> {
     let mut report = Report::new("face-bench", "Face engine benchmark (facial animation editing, Berson et al.)");
     let tests = test_clips(&cfg.captures, cfg.one_test_file)?;
+    let libs = libraries(cfg)?;
     let real_kinds = [ConstraintKind::None, ConstraintKind::Keyframes, ConstraintKind::Noisy];
     let proc_clips = procedural::generate_corpus(cfg.procedural_clips, cfg.procedural_seconds, derive(cfg.seed, 99));
     progress.set_length(((tests.len() + proc_clips.len()) * GAPS_S.len() * cfg.edits_per_gap) as u64);
@@ -340,6 +372,7 @@ pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> R
             None,
             &real_kinds,
             sets,
+            &libs,
             cfg.edits_per_gap,
             derive(cfg.seed, i as u64),
             &mut cells,
@@ -360,6 +393,7 @@ pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> R
             Some(&p.visemes),
             &kinds,
             sets,
+            &libs,
             cfg.edits_per_gap,
             derive(cfg.seed, 1000 + i as u64),
             &mut vcells,
@@ -371,10 +405,10 @@ pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> R
         "Viseme editing on held-out procedural clips (the captures have no phoneme labels)",
         &by_constraint(&vcells),
     ));
-    let (auc_t, stats_t) = plausibility_tables(&tests, sets, cfg, progress)?;
+    let (auc_t, stats_t) = plausibility_tables(&tests, sets, &libs, cfg, progress)?;
     report.table(auc_t);
     report.table(stats_t);
-    report.table(table4(&tests, &proc_clips, sets, cfg.seed)?);
+    report.table(table4(&tests, &proc_clips, sets, &libs, cfg.seed)?);
     report.table(table3(&tests, &proc_clips, sets, cfg.seed)?);
     charts(&mut report, &cells);
     progress.finish();
@@ -413,6 +447,7 @@ fn pcell(cells: &mut PCells, key: (ConstraintKind, f64, String)) -> &mut Plausib
 fn plausibility_tables(
     tests: &[(String, BlendshapeClip)],
     sets: &[NetworkSet],
+    libs: &[Library],
     cfg: &FaceBenchConfig,
     progress: &Progress,
 ) -> Result<(Table, Table), FaceError> {
@@ -443,7 +478,7 @@ fn plausibility_tables(
                 for kind in kinds {
                     let guide = guide_for(kind, &truth, &mask, None, derive(s, 1));
                     let mut fills: Vec<(String, Vec<Frame>)> = vec![(real_label.clone(), truth.clone())];
-                    for (name, method) in methods(kind, sets) {
+                    for (name, method) in methods(kind, sets, libs) {
                         fills.push((name, edit(clip, seg, &guide, method, derive(s, 2))?.0));
                     }
                     if kind == ConstraintKind::Noisy {
@@ -476,7 +511,7 @@ fn plausibility_tables(
             for kind in [ConstraintKind::Keyframes, ConstraintKind::Noisy] {
                 let guide = guide_for(kind, chunk, &mask, None, derive(s, 1));
                 let mut fills: Vec<(String, Vec<Frame>)> = vec![(real_label.clone(), chunk.to_vec())];
-                for (name, method) in methods(kind, sets) {
+                for (name, method) in methods(kind, sets, libs) {
                     fills.push((name, edit(&wclip, seg, &guide, method, derive(s, 2))?.0));
                 }
                 for (name, out) in fills {
@@ -555,6 +590,7 @@ fn table4(
     tests: &[(String, BlendshapeClip)],
     procs: &[procedural::ProceduralClip],
     sets: &[NetworkSet],
+    libs: &[Library],
     seed: u64,
 ) -> Result<Table, FaceError> {
     let mut t = Table::new(
@@ -577,7 +613,7 @@ fn table4(
             let labels = visemes.map(|v| &v[w * window..(w + 1) * window]);
             let guide = guide_for(kind, &truth, &mask, labels, derive(s, w as u64));
             let seg = Segment { start: 0, end: truth.len() };
-            for (name, method) in methods(kind, sets) {
+            for (name, method) in methods(kind, sets, libs) {
                 let (out, mask) = edit(&clip, seg, &guide, method, derive(s, 7))?;
                 cell(&mut cells, (kind, 0.0, name)).add(&truth, &out, &mask);
             }

@@ -10,7 +10,10 @@ use std::collections::BTreeMap;
 
 use crate::data::{BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT, NUM_HEAD_EYE};
 use crate::edit::hermite::{hermite, Knot};
-use crate::edit::{correct, interpolate, Constraint, ConstraintKind, Frame, Interp, Mask, Segment};
+use crate::edit::{
+    correct, interpolate, retrieve, Constraint, ConstraintKind, Frame, Interp, Mask, MotionLibrary, RetrievalOptions,
+    Segment,
+};
 use crate::model::input;
 use crate::visemes::Viseme;
 
@@ -53,6 +56,9 @@ pub enum Method<'a> {
     Linear,
     /// Cubic Hermite interpolation through the borders (values and slopes) and keys.
     Cubic,
+    /// Segments of recorded motion from the library and the clip itself ([`crate::edit::retrieve`]),
+    /// drawn with the job's seed; unguided, keyframe or noisy guidance.
+    Retrieval(&'a MotionLibrary, RetrievalOptions),
 }
 
 impl Method<'_> {
@@ -62,6 +68,7 @@ impl Method<'_> {
             Method::Network(n) => format!("network ({})", n.kind().name()),
             Method::Linear => "linear".into(),
             Method::Cubic => "cubic".into(),
+            Method::Retrieval(..) => "retrieval".into(),
         }
     }
 }
@@ -179,6 +186,11 @@ impl EditJob<'_> {
                 )));
             }
         }
+        if matches!(self.method, Method::Retrieval(..)) && matches!(self.guide, Guide::Visemes(_)) {
+            return Err(invalid(
+                "retrieval cannot follow visemes (its library has no phoneme labels); use the viseme network",
+            ));
+        }
         let file = self.guide_file.as_deref().map_or(String::new(), |f| format!("{f}: "));
         match &self.guide {
             Guide::Keys(keys) => {
@@ -266,6 +278,12 @@ impl EditJob<'_> {
             }
             Method::Linear => interpolate(&before, &mask, &keys, Interp::Linear),
             Method::Cubic => interpolate(&before, &mask, &keys, Interp::Cubic),
+            Method::Retrieval(library, options) => {
+                // Spans with no segment of their length anywhere keep the linear fill.
+                let base = interpolate(&before, &mask, &keys, Interp::Linear);
+                let (filled, _) = retrieve(&base, &mask, &constraint, library, &options, self.seed);
+                correct(&filled, &before, &mask, &keys)
+            }
         };
         self.cancel.check()?;
         let clip = self.back_to_capture_rate(&after, &mask)?;

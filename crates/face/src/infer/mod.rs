@@ -5,3 +5,9 @@ pub mod keys;
 
 pub use job::{EditJob, EditLimits, EditOutcome, Guide, Inpainter, Method};
 pub use keys::{read_keys, KeyPose};
+
+/// Seconds of procedural motion in the default retrieval library (`face edit --method retrieval`
+/// without `--library`).
+pub const DEFAULT_LIBRARY_S: f64 = 120.0;
+/// Seed of the default retrieval library (fixed, so the library is the same on every run).
+pub const DEFAULT_LIBRARY_SEED: u64 = 2025;
