@@ -357,6 +357,10 @@ impl EditJob<'_> {
             let x = ((t - t0) * MODEL_FPS).clamp(0.0, last as f64);
             let (f0, f1) = (x.floor() as usize, (x.ceil() as usize).min(last));
             let w = (x - f0 as f64) as f32;
+            // Rows outside every span keep the input bit for bit, even within one model frame of a span.
+            if !inside[i] {
+                continue;
+            }
             for c in 0..NUM_ARKIT {
                 if mask.erased(f0, c) || mask.erased(f1, c) {
                     values[i * stride + c] = after[f0][c] + (after[f1][c] - after[f0][c]) * w;
