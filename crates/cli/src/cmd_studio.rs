@@ -32,9 +32,9 @@ pub struct StudioArgs {
 
 #[derive(Subcommand)]
 pub enum StudioCommand {
-    /// Drive headless Chromium through both panels and print the timing table (first paint,
-    /// script edit to redraw, K change to redraw on a 1000-frame take, memory); writes the table
-    /// and PNG screenshots.
+    /// Drive headless Chromium through the panels and print the timing table (first paint,
+    /// script edit to redraw, K change to redraw on a 1000-frame take, face span edit to redraw,
+    /// memory); writes the table and PNG screenshots.
     Bench(BenchArgs),
 }
 

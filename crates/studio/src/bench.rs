@@ -1,9 +1,10 @@
-//! `inbetween studio bench`: drives headless Chromium through both panels and measures what a user
+//! `inbetween studio bench`: drives headless Chromium through the panels and measures what a user
 //! waits for (issue 23): first paint, script edit to redraw (goal < 100 ms), K change to redraw on
 //! a 1000-frame take (goal < 50 ms), and memory. Each timed action is repeated; the table gives
 //! the median and the range. Times are measured in the page, from the click (or the input's
 //! change event) to the frame drawn with the job's result, so they include the request, the
-//! engine call, the transfer and the drawing. Screenshots of both panels go beside the table.
+//! engine call, the transfer and the drawing. Screenshots of the panels go beside the table. Face
+//! (issue 24): a 2 s span refilled on a 12 s take (goal < 50 ms).
 
 use std::path::Path;
 
@@ -66,6 +67,15 @@ fn set_k(k: usize) -> String {
     format!(
         "(i => {{ i.value = {k}; i.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); }})\
          (document.querySelector('[data-testid=mocap-k]'))"
+    )
+}
+
+/// Sets the face panel's span and constraint, clicks Generate and waits for the redraw.
+fn face_edit(a: f64, z: f64, constraint: &str) -> String {
+    format!(
+        "(() => {{ const q = (id) => document.querySelector(`[data-testid=${{id}}]`); q('face-mask-start').value = {a}; \
+         q('face-mask-end').value = {z}; q('face-constraint').value = {constraint:?}; q('face-generate').click(); \
+         return window.inbetweenStudio.ready(); }})()"
     )
 }
 
@@ -183,6 +193,27 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
     b.eval("window.inbetweenStudio.seek(420)")?;
     let mocap_png = b.screenshot()?;
 
+    // Face: the built-in 12 s procedural take at 60 fps, 2 s spans refilled.
+    b.eval("(document.querySelector('[data-testid=nav-face]').click(), true)")?;
+    job_times(
+        &b,
+        "(s => { s.value = 'builtin:procedural'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('face-corpus'))",
+    )?;
+    for (constraint, label) in [("none", "unguided (retrieval)"), ("text", "visemes from text (network)")] {
+        let (mut f_ms, mut f_server) = (Vec::new(), Vec::new());
+        for i in 0..repeats {
+            let (a, z) = if i % 2 == 0 { (4.0, 6.0) } else { (6.5, 8.5) };
+            let (ms, server, _) = job_times(&b, &face_edit(a, z, constraint))?;
+            f_ms.push(ms);
+            f_server.push(server);
+        }
+        row(&mut t, &format!("face 2 s span edit to redraw, {label}"), &mut f_ms, &mut f_server, "< 50");
+    }
+    // The screenshot shows a fresh unguided fill over 7–9 s, the playhead inside it.
+    job_times(&b, &face_edit(7.0, 9.0, "none"))?;
+    b.eval("window.inbetweenStudio.seek(200)")?;
+    let face_png = b.screenshot()?;
+
     // This process alone (the server and the bench driver; chromedriver and Chromium are its
     // children, counted on the next line).
     let server_mb = own_rss_bytes().map(|v| v as f64 / 1e6);
@@ -202,10 +233,10 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
     report.table(t).table(mem).text(format!(
         "{repeats} runs per timed action; page {}×{} px, WebGL through SwiftShader (software), debug-profile server \
          unless built with --release. Screenshots: script.png (demo story, frame 200), mocap.png (1000-frame walk, \
-         optimal K = 16, frame 420).",
+         optimal K = 16, frame 420), face.png (built-in 12 s procedural take, unguided fill over 7–9 s, row 200).",
         VIEW.0, VIEW.1
     ));
-    report.file("script.png", script_png).file("mocap.png", mocap_png);
+    report.file("script.png", script_png).file("mocap.png", mocap_png).file("face.png", face_png);
     report.write(out)?;
     Ok(report.to_text())
 }

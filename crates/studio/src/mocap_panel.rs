@@ -202,7 +202,7 @@ pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body
 }
 
 /// The upload as text, or an error naming the file, the line and the first byte that is not UTF-8.
-fn utf8(name: &str, bytes: &[u8]) -> Result<String> {
+pub(crate) fn utf8(name: &str, bytes: &[u8]) -> Result<String> {
     String::from_utf8(bytes.to_vec()).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         StudioError::Engine(format!(
@@ -214,7 +214,7 @@ fn utf8(name: &str, bytes: &[u8]) -> Result<String> {
 }
 
 /// A job that fails at once (so the page's `ready()` sees the error like any other job's).
-fn failed_now(st: &AppState, e: StudioError) -> Value {
+pub(crate) fn failed_now(st: &AppState, e: StudioError) -> Value {
     let id = st.jobs.spawn("open", move |_| Err(e));
     json!({"job": id})
 }

@@ -20,7 +20,7 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::Jobs;
-use crate::{assets, mocap_panel, safety, script_panel};
+use crate::{assets, face_panel, mocap_panel, safety, script_panel};
 
 /// Default `--max-upload`: 512 MB.
 pub const DEFAULT_MAX_UPLOAD: u64 = 512 * 1000 * 1000;
@@ -86,6 +86,7 @@ pub struct AppState {
     pub files: Files,
     pub script: script_panel::ScriptState,
     pub mocap: mocap_panel::MocapState,
+    pub face: face_panel::FaceState,
 }
 
 impl AppState {
@@ -167,7 +168,13 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/mocap/open", post(mocap_panel::open_path))
         .route("/api/mocap/upload", post(mocap_panel::upload))
         .route("/api/mocap/keys", post(mocap_panel::keys))
-        .route("/api/mocap/compress", post(mocap_panel::compress));
+        .route("/api/mocap/compress", post(mocap_panel::compress))
+        .route("/api/face/corpus", get(face_panel::corpus))
+        .route("/api/face/open", post(face_panel::open_path))
+        .route("/api/face/upload", post(face_panel::upload))
+        .route("/api/face/guide", post(face_panel::guide))
+        .route("/api/face/edit", post(face_panel::edit))
+        .route("/api/face/history", post(face_panel::history));
     if state.config.test_routes {
         app = app.route("/api/test/panic", post(test_panic));
     }
@@ -338,6 +345,7 @@ fn state(config: StudioConfig, bound: SocketAddr) -> Arc<AppState> {
         files: Files::default(),
         script: script_panel::ScriptState::default(),
         mocap: mocap_panel::MocapState::default(),
+        face: face_panel::FaceState::default(),
     })
 }
 

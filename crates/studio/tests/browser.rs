@@ -212,3 +212,204 @@ fn studio_in_headless_chromium() {
     assert_eq!(st["lastJob"]["ok"], true, "{st}");
     assert_eq!(error_text(&b), "");
 }
+
+/// Share of an element's pixels that differ from `bg`, from a screenshot.
+fn coverage(b: &Browser, testid: &str, bg: [i32; 3]) -> f64 {
+    let rect = b
+        .eval(&format!(
+            "(r => [r.left, r.top, r.width, r.height])(document.querySelector('[data-testid={testid}]').getBoundingClientRect())"
+        ))
+        .unwrap();
+    let r: Vec<u32> = rect.as_array().unwrap().iter().map(|v| v.as_f64().unwrap().round() as u32).collect();
+    let img = image::load_from_memory(&b.screenshot().unwrap()).unwrap().to_rgb8();
+    let (mut differ, mut total) = (0u64, 0u64);
+    for y in r[1]..(r[1] + r[3]).min(img.height()) {
+        for x in r[0]..(r[0] + r[2]).min(img.width()) {
+            total += 1;
+            if img.get_pixel(x, y).0.iter().zip(bg).any(|(a, b)| (*a as i32 - b).abs() > 12) {
+                differ += 1;
+            }
+        }
+    }
+    differ as f64 / total.max(1) as f64
+}
+
+/// Sets an input's value and fires its change event.
+fn set_value(b: &Browser, testid: &str, value: &str) {
+    b.eval(&format!(
+        "(i => {{ i.value = {value:?}; i.dispatchEvent(new Event('change')); return true; }})({})",
+        js_sel(testid)
+    ))
+    .unwrap();
+}
+
+/// The face panel's columns as `name -> values per input row`.
+fn edited(st: &Value) -> serde_json::Map<String, Value> {
+    st["face"]["edited"].as_object().unwrap().clone()
+}
+
+fn col(m: &serde_json::Map<String, Value>, name: &str) -> Vec<f64> {
+    m[name].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+}
+
+/// Rows whose time (from the first row) lies inside `[a, b]`, and the file's times.
+fn rows_inside(times: &[f64], a: f64, b: f64) -> Vec<usize> {
+    (0..times.len()).filter(|&i| times[i] >= a && times[i] <= b).collect()
+}
+
+#[test]
+fn face_panel_in_headless_chromium() {
+    let (chromium, driver) = match available() {
+        Ok(found) => found,
+        Err(why) => {
+            println!("skipped: {why}");
+            return;
+        }
+    };
+    if inbetween_studio::assets::missing().is_some() {
+        println!("skipped: the studio was built without three.js (no Node at build time)");
+        return;
+    }
+    let data = inbetween_io::shared_data_dir();
+    let studio =
+        Studio::start(StudioConfig { port: 0, root: data.clone().ok(), ..StudioConfig::default() }).expect("start");
+    let b = Browser::launch(&chromium, &driver, 1280, 800).expect("launch chromium");
+    b.goto(&studio.url()).unwrap();
+    b.eval("window.inbetweenStudio.ready()").unwrap();
+    b.eval("(document.querySelector('[data-testid=nav-face]').click(), true)").unwrap();
+    assert_eq!(state(&b)["panel"], "face");
+
+    // A real capture from the corpus (the built-in procedural take without data).
+    let real = "face/neurosync/livelink/Fearful/MySlate_162_iPhone_cal.csv";
+    let have_real = data.as_ref().map(|d| d.join(real).is_file()).unwrap_or(false);
+    let path = if have_real {
+        real
+    } else {
+        println!(
+            "skipped: no data at {} (real face capture; using the built-in take)",
+            data.as_ref().map_or_else(|e| e.display().to_string(), |d| d.display().to_string())
+        );
+        "builtin:procedural"
+    };
+    b.eval(&format!(
+        "(s => {{ s.value = {path:?}; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); }})(document.getElementById('face-corpus'))"
+    ))
+    .unwrap();
+    let st = state(&b);
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["kind"], "face-open", "{}", st["lastJob"]);
+    let frames = st["frames"].as_u64().unwrap() as usize;
+    assert!(frames > 500, "{}", st["lastJob"]);
+    let original = edited(&st);
+    assert_eq!(original.len(), 52);
+    assert_eq!(col(&original, "JawOpen").len(), frames, "one value per input row");
+    let times: Vec<f64> = serde_json::from_value(b.eval("window.inbetweenStudio.faceTimes()").unwrap()).unwrap();
+    assert_eq!(times.len(), frames);
+
+    // A 2 s unguided span: the frames inside change, the ones outside do not.
+    set_value(&b, "face-mask-start", "4");
+    set_value(&b, "face-mask-end", "6");
+    set_value(&b, "face-constraint", "none");
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let mask: Vec<f64> = serde_json::from_value(st["face"]["mask"].clone()).unwrap();
+    assert_eq!(mask, [4.0, 6.0]);
+    assert!(st["lastJob"]["message"].as_str().unwrap().starts_with("retrieval fill"), "{}", st["lastJob"]);
+    assert!(st["lastJob"]["masked_mse"].as_f64().unwrap() > 0.0);
+    let first = edited(&st);
+    let inside = rows_inside(&times, 4.0 + 0.05, 6.0 - 0.05);
+    let mut changed_inside = 0;
+    for name in original.keys() {
+        let (o, e) = (col(&original, name), col(&first, name));
+        for i in 0..frames {
+            let t = times[i];
+            if !(4.0 - 0.02..=6.0 + 0.02).contains(&t) {
+                assert_eq!(o[i], e[i], "{name} changed at row {i} ({t:.3} s), outside the span");
+            }
+        }
+        changed_inside += inside.iter().filter(|&&i| (o[i] - e[i]).abs() > 1e-4).count();
+    }
+    assert!(changed_inside > inside.len(), "the fill changed only {changed_inside} values inside the span");
+    let covered = coverage(&b, "face-curves", [0x1b, 0x1d, 0x22]);
+    assert!(covered > 0.02, "the curves look blank: {covered:.3}");
+    let covered = coverage(&b, "face-edited", [0x23, 0x26, 0x2d]);
+    assert!(covered > 0.2, "the schematic face looks blank: {covered:.3}");
+
+    // Undo brings the original back, redo the fill.
+    let st = click_and_wait(&b, "face-undo");
+    assert_eq!(edited(&st), original, "undo");
+    let st = click_and_wait(&b, "face-redo");
+    assert_eq!(edited(&st), first, "redo");
+
+    // Keyframes: a key inside the span is hit.
+    set_value(&b, "face-constraint", "keys");
+    b.eval("(window.inbetweenStudio.faceKey(5.0, 'JawOpen', 0.8), true)").unwrap();
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert!(st["lastJob"]["message"].as_str().unwrap().starts_with("network fill"), "{}", st["lastJob"]);
+    let jaw = col(&edited(&st), "JawOpen");
+    let at = (0..frames).min_by(|&i, &j| (times[i] - 5.0).abs().total_cmp(&(times[j] - 5.0).abs())).unwrap();
+    assert!((jaw[at] - 0.8).abs() < 0.03, "JawOpen at 5.0 s is {} (key 0.8)", jaw[at]);
+
+    // Visemes from text, only the mouth and jaw: the eyes stay as they were.
+    let before = edited(&st);
+    set_value(&b, "face-constraint", "text");
+    set_value(&b, "face-text", "our little brother");
+    set_value(&b, "face-groups", "mouth,jaw");
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let after = edited(&st);
+    assert_eq!(col(&before, "EyeBlinkLeft"), col(&after, "EyeBlinkLeft"), "the eyes changed under groups mouth,jaw");
+    assert_ne!(col(&before, "JawOpen"), col(&after, "JawOpen"));
+
+    // A noisy guide file: the take itself stands in for a second tracker's take.
+    set_value(&b, "face-groups", "all");
+    let guide = match &data {
+        Ok(d) if have_real => d.join(real),
+        _ => {
+            let p = std::env::temp_dir().join(format!("inbetween-face-guide-{}.csv", std::process::id()));
+            let f: String = b
+                .eval("fetch(document.querySelector('#face-export a').href).then(r => r.text())")
+                .unwrap()
+                .as_str()
+                .unwrap()
+                .to_string();
+            std::fs::write(&p, f).unwrap();
+            p
+        }
+    };
+    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
+    b.set_files(&sel("face-guide"), &[guide.as_path()]).unwrap();
+    b.eval(&format!(
+        "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
+           window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
+           : Date.now() - t0 > 20000 ? fail(new Error('no job started')) : setTimeout(poll, 20); poll(); }})"
+    ))
+    .unwrap();
+    assert_eq!(error_text(&b), "");
+    assert_eq!(b.eval(&format!("{}.value", js_sel("face-constraint"))).unwrap(), "noisy");
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert!(st["lastJob"]["message"].as_str().unwrap().starts_with("retrieval fill"), "{}", st["lastJob"]);
+
+    // Export: the input's own layout, one row per input row.
+    let text = b.eval("fetch(document.querySelector('#face-export a').href).then(r => r.text())").unwrap();
+    let text = text.as_str().unwrap();
+    if have_real {
+        assert!(text.starts_with("Timecode,BlendshapeCount,EyeBlinkLeft"), "{}", &text[..80.min(text.len())]);
+    }
+    assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), frames + 1);
+
+    // A garbage file: its error names it; the server keeps serving.
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("garbage.csv");
+    std::fs::write(&junk, "Timecode,BlendShapeCount,EyeBlinkLeft\n00:00:00:00.000,1,banana\n").unwrap();
+    open_files(&b, &[junk.as_path()]);
+    let err = error_text(&b);
+    assert!(err.contains("garbage.csv"), "the error should name the file: {err:?}");
+    assert_eq!(state(&b)["lastJob"]["ok"], false);
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert_eq!(error_text(&b), "");
+}

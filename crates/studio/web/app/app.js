@@ -49,6 +49,7 @@ const S = {
   lastJob: null,
   script: { result: null, gltf: null, mixer: null, shotCam: null, camHelper: null, fps: 30, frames: 0 },
   mocap: { take: null, keysResult: null, orig: null, rec: null, fps: 30, frames: 0, scale: 0.01 },
+  face: { take: null, orig: null, cur: null, keys: [], changed: [], lastEdit: null, fps: 60, frames: 0 },
 };
 const panelState = () => S[S.panel];
 
@@ -75,6 +76,7 @@ function start(kind, work) {
         S.lastJob = {
           kind: r.kind || kind, ms: r.ms, ok: true, message: r.message,
           error_cm: r.error_cm ?? null, ratio: r.ratio ?? null, bytes: r.bytes ?? null, redraw_ms: redraw,
+          masked_mse: r.masked_mse ?? null,
         };
         setStatus(r.message);
       }
@@ -149,6 +151,8 @@ function showPanel(name) {
   for (const p of document.querySelectorAll('section.panel')) p.hidden = p.dataset.panel !== name;
   groups.script.visible = name === 'script';
   groups.mocap.visible = name === 'mocap';
+  canvas.hidden = name === 'face';
+  $('face-view').hidden = name !== 'face';
   S.frame = Math.min(S.frame, Math.max(0, panelState().frames - 1));
   seek(S.frame);
   resize();
@@ -435,12 +439,316 @@ async function drawKeys(r) {
   renderNow();
 }
 
+// ---------------------------------------------------------------- face panel
+const faceCorpus = $('face-corpus');
+async function loadFaceCorpus() {
+  const r = await (await fetch('/api/face/corpus')).json();
+  faceCorpus.innerHTML = '<option value="">(choose a take)</option>';
+  for (const f of [...r.builtin, ...r.files]) {
+    const o = document.createElement('option'); o.value = f; o.textContent = f; faceCorpus.appendChild(o);
+  }
+}
+faceCorpus.addEventListener('change', () => {
+  const path = faceCorpus.value;
+  if (path) start('face-open', async () => { const r = await job('/api/face/open', { path }); drawFaceTake(r); return r; });
+});
+const uploadCheck = (f) => { if (f.size > maxUpload) throw new Error(`${f.name}: ${(f.size / 1e6).toFixed(1)} MB is larger than this studio's upload cap of ${(maxUpload / 1e6).toFixed(0)} MB (start it with --max-upload SIZE)`); };
+$('face-file').addEventListener('change', (e) => {
+  const f = e.target.files[0];
+  if (f) start('face-open', async () => {
+    uploadCheck(f);
+    const r = await job(`/api/face/upload?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
+    drawFaceTake(r);
+    return r;
+  });
+});
+$('face-guide').addEventListener('change', (e) => {
+  const f = e.target.files[0];
+  if (f) start('face-guide', async () => {
+    uploadCheck(f);
+    const r = await job(`/api/face/guide?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
+    $('face-constraint').value = r.phonemes ? 'visemes' : 'noisy';
+    return r;
+  });
+});
+
+// The span in seconds of the file's own time (from its first row).
+function faceMask() {
+  const a = parseFloat($('face-mask-start').value), b = parseFloat($('face-mask-end').value);
+  return [Math.min(a, b), Math.max(a, b)];
+}
+for (const id of ['face-mask-start', 'face-mask-end', 'face-groups']) $(id).addEventListener('change', () => { drawTimeline(); drawFaceView(); });
+
+function exportLink(url) {
+  const ex = $('face-export');
+  ex.innerHTML = '';
+  const a = document.createElement('a'); const name = url.split('/').pop().split('?')[0];
+  a.href = url + '&download=1'; a.textContent = `export ${name}`; a.download = name; ex.appendChild(a);
+}
+
+function drawFaceTake(r) {
+  const f = S.face;
+  f.take = r; f.fps = r.fps; f.frames = r.frames; f.keys = []; f.changed = []; f.lastEdit = null; f.version = 0; f.versions = 1;
+  f.orig = r.columns;
+  f.cur = Object.fromEntries(Object.entries(r.columns).map(([k, v]) => [k, v.slice()]));
+  $('face-take').textContent = `${r.name}: ${r.frames} rows at ${r.fps.toFixed(3)} fps, ${r.duration_s.toFixed(2)} s.`;
+  const dur = r.duration_s;
+  if (parseFloat($('face-mask-end').value) > dur) { $('face-mask-start').value = (dur * 0.4).toFixed(2); $('face-mask-end').value = Math.min(dur, dur * 0.4 + 2).toFixed(2); }
+  exportLink(r.files.export);
+  updateKeysCount();
+  S.frame = 0; seek(0);
+}
+
+function faceRequest() {
+  const [a, b] = faceMask();
+  const byTime = new Map();
+  for (const k of S.face.keys) {
+    if (k.time_s < a || k.time_s > b) continue;
+    const e = byTime.get(k.time_s) || { time_s: k.time_s, shapes: {} };
+    e.shapes[k.shape] = k.value; byTime.set(k.time_s, e);
+  }
+  return {
+    start_s: a, end_s: b, constraint: $('face-constraint').value, text: $('face-text').value,
+    keys: [...byTime.values()], groups: $('face-groups').value || 'all', method: $('face-method').value,
+    seed: parseInt($('face-seed').value, 10) || 0,
+  };
+}
+
+function applyColumns(r) {
+  const f = S.face;
+  const [a] = r.rows;
+  f.changed = [];
+  for (const [name, vals] of Object.entries(r.columns)) {
+    const col = f.cur[name];
+    let moved = 0;
+    for (let i = 0; i < vals.length; i++) { moved = Math.max(moved, Math.abs(vals[i] - f.orig[name][a + i])); col[a + i] = vals[i]; }
+    f.changed.push([name, moved]);
+  }
+  f.changed.sort((p, q) => q[1] - p[1]);
+  f.version = r.version; f.versions = r.versions;
+  exportLink(r.files.export);
+}
+
+function runFaceEdit() {
+  return start('face-edit', async () => {
+    if (!S.face.take) throw new Error('open a face take first');
+    const r = await job('/api/face/edit', faceRequest());
+    applyColumns(r);
+    S.face.lastEdit = { method: r.method, masked_mse: r.masked_mse, mask: r.mask, ms: r.ms };
+    drawTimeline(); drawFaceView();
+    return r;
+  });
+}
+$('face-generate').addEventListener('click', runFaceEdit);
+for (const step of ['undo', 'redo']) {
+  $(`face-${step}`).addEventListener('click', () => start(`face-${step}`, async () => {
+    const r = await post('/api/face/history', { step });
+    applyColumns(r);
+    drawTimeline(); drawFaceView();
+    return r;
+  }));
+}
+
+// Groups of the panel's text field, as in `face edit --groups`.
+function selectedGroups() {
+  const words = ($('face-groups').value || 'all').toLowerCase().split(',').map((w) => w.trim()).filter(Boolean);
+  const out = new Set();
+  for (const w of words) {
+    if (w === 'all') ['eyes', 'brows', 'jaw', 'mouth', 'cheeks', 'tongue'].forEach((g) => out.add(g));
+    else if (w === 'upper') ['eyes', 'brows'].forEach((g) => out.add(g));
+    else if (w === 'lower') ['jaw', 'mouth', 'cheeks', 'tongue'].forEach((g) => out.add(g));
+    else out.add(w);
+  }
+  return out;
+}
+
+// Six curves of the selected groups (the ones the last edit moved most first, then the most active)
+// and the six lip / eyelid distances, over the span ± 2 s.
+const CURVE_ROWS = 6;
+function faceCurves() {
+  const f = S.face, groupsOf = f.take.groups, sel = selectedGroups();
+  const inSel = (n) => sel.has(groupsOf[n]);
+  const moved = f.changed.filter(([n, m]) => m > 1e-4 && inSel(n)).map(([n]) => n);
+  const spread = (n) => { const v = f.orig[n]; let lo = 1, hi = 0; for (let i = 0; i < v.length; i += 4) { lo = Math.min(lo, v[i]); hi = Math.max(hi, v[i]); } return hi - lo; };
+  const rest = Object.keys(f.orig).filter((n) => inSel(n) && !moved.includes(n)).sort((p, q) => spread(q) - spread(p));
+  return [...moved, ...rest].slice(0, CURVE_ROWS);
+}
+function distancesAt(cols, f) {
+  const t = S.face.take, W = t.distance_matrix, names = Object.keys(cols), k = t.distance_bases.length;
+  const d = t.distance_bases.slice();
+  const arkit = Object.keys(t.groups);
+  for (let c = 0; c < arkit.length; c++) {
+    const x = cols[arkit[c]][f];
+    if (!x) continue;
+    for (let j = 0; j < k; j++) d[j] += x * W[c * k + j];
+  }
+  void names;
+  return d;
+}
+
+let faceLayout = null;
+function drawFaceView() {
+  if (S.panel !== 'face') return;
+  const cv = $('face-curves');
+  const w = cv.clientWidth, h = cv.clientHeight;
+  if (cv.width !== w) cv.width = w;
+  if (cv.height !== h) cv.height = h;
+  const c = cv.getContext('2d');
+  c.fillStyle = '#1b1d22'; c.fillRect(0, 0, w, h);
+  const f = S.face;
+  c.font = '11px system-ui, sans-serif';
+  if (!f.take) { c.fillStyle = '#8a919c'; c.fillText('Open a face take (Live Link Face CSV, curve CSV or JSON).', 20, 30); drawFaces(); return; }
+  const times = f.take.times, n = times.length;
+  const [ma, mb] = faceMask();
+  const t0 = Math.max(0, ma - 2), t1 = Math.min(times[n - 1], mb + 2);
+  const rowOf = (t) => { let lo = 0, hi = n - 1; while (lo < hi) { const m = (lo + hi) >> 1; if (times[m] < t) lo = m + 1; else hi = m; } return lo; };
+  const r0 = rowOf(t0), r1 = Math.min(n - 1, rowOf(t1));
+  const L = 120, R = 10;
+  const X = (t) => L + (w - L - R) * (t - t0) / Math.max(1e-9, t1 - t0);
+  const curves = faceCurves();
+  const rows = curves.length + 6, rh = (h - 20) / rows;
+  faceLayout = { L, R, t0, t1, rh, curves, X, rowOf };
+  c.fillStyle = 'rgba(255, 196, 0, 0.18)'; c.fillRect(X(ma), 0, X(mb) - X(ma), h);
+  const step = Math.max(1, Math.floor((r1 - r0) / (w - L)));
+  const plot = (vals, y0, lo, hi, colr) => {
+    c.strokeStyle = colr; c.beginPath();
+    for (let i = r0; i <= r1; i += step) { const px = X(times[i]), py = y0 + rh - 4 - (rh - 10) * (vals(i) - lo) / (hi - lo); i === r0 ? c.moveTo(px, py) : c.lineTo(px, py); }
+    c.stroke();
+  };
+  curves.forEach((name, k) => {
+    const y0 = 16 + k * rh;
+    c.strokeStyle = '#2c3038'; c.beginPath(); c.moveTo(L, y0 + rh - 2); c.lineTo(w - R, y0 + rh - 2); c.stroke();
+    c.fillStyle = '#aab1bc'; c.fillText(name, 4, y0 + rh / 2 + 4);
+    plot((i) => f.orig[name][i], y0, 0, 1, '#8a8f98');
+    c.lineWidth = 1.5; plot((i) => f.cur[name][i], y0, 0, 1, '#4da3ff'); c.lineWidth = 1;
+    c.fillStyle = '#ffd84d';
+    for (const key of f.keys) if (key.shape === name) { c.beginPath(); c.arc(X(key.time_s), y0 + rh - 4 - (rh - 10) * key.value, 4, 0, 7); c.fill(); }
+  });
+  const dn = f.take.distance_names;
+  const dOrig = [], dCur = [];
+  for (let i = r0; i <= r1; i += step) { dOrig[i] = distancesAt(f.orig, i); dCur[i] = distancesAt(f.cur, i); }
+  dn.forEach((name, k) => {
+    const y0 = 16 + (curves.length + k) * rh;
+    let lo = Infinity, hi = -Infinity;
+    for (let i = r0; i <= r1; i += step) { lo = Math.min(lo, dOrig[i][k], dCur[i][k]); hi = Math.max(hi, dOrig[i][k], dCur[i][k]); }
+    if (hi - lo < 0.05) { lo -= 0.025; hi += 0.025; }
+    c.strokeStyle = '#2c3038'; c.beginPath(); c.moveTo(L, y0 + rh - 2); c.lineTo(w - R, y0 + rh - 2); c.stroke();
+    c.fillStyle = '#c9b6ff'; c.fillText(name.replace(/_/g, ' '), 4, y0 + rh / 2 + 4);
+    const at = (arr) => (i) => { let j = i; while (j > r0 && !arr[j]) j--; return arr[j][k]; };
+    plot(at(dOrig), y0, lo, hi, '#8a8f98');
+    c.lineWidth = 1.5; plot(at(dCur), y0, lo, hi, '#c9b6ff'); c.lineWidth = 1;
+  });
+  c.fillStyle = '#6d7480';
+  for (let s = Math.ceil(t0); s <= t1; s += 1) { c.fillText(`${s}s`, X(s) + 2, 11); c.strokeStyle = '#2c3038'; c.beginPath(); c.moveTo(X(s), 14); c.lineTo(X(s), h); c.stroke(); }
+  const tp = times[S.frame];
+  if (tp >= t0 && tp <= t1) { c.strokeStyle = '#4da3ff'; c.lineWidth = 2; c.beginPath(); c.moveTo(X(tp), 0); c.lineTo(X(tp), h); c.stroke(); c.lineWidth = 1; }
+  drawFaces();
+}
+
+// The schematic face of one version at the playhead: eyelids and lips from the six distances,
+// brows and gaze from their shapes.
+function drawFace(cv, cols) {
+  const c = cv.getContext('2d'), W = cv.width, H = cv.height;
+  c.fillStyle = '#23262d'; c.fillRect(0, 0, W, H);
+  if (!cols) return;
+  const f = S.frame, d = distancesAt(cols, f), v = (n) => (cols[n] ? cols[n][f] : 0);
+  const cx = W / 2, cy = H / 2 + 6;
+  c.fillStyle = '#e2c4a8'; c.beginPath(); c.ellipse(cx, cy, 80, 104, 0, 0, 7); c.fill();
+  for (const side of [-1, 1]) {
+    const L = side < 0, ex = cx + side * 34, ey = cy - 24;
+    const open = Math.max(0, Math.min(1.4, d[L ? 4 : 5]));
+    c.fillStyle = '#fff'; c.beginPath(); c.ellipse(ex, ey, 17, Math.max(0.8, 10 * open), 0, 0, 7); c.fill();
+    if (open > 0.15) {
+      const gx = (v(L ? 'EyeLookOutLeft' : 'EyeLookInRight') - v(L ? 'EyeLookInLeft' : 'EyeLookOutRight')) * 8 * side;
+      const gy = (v(L ? 'EyeLookDownLeft' : 'EyeLookDownRight') - v(L ? 'EyeLookUpLeft' : 'EyeLookUpRight')) * 5;
+      c.fillStyle = '#3a2a1e'; c.beginPath(); c.arc(ex + gx, ey + gy, Math.min(6, 10 * open), 0, 7); c.fill();
+    }
+    c.strokeStyle = '#5a3a25'; c.lineWidth = 3;
+    const inner = v('BrowInnerUp') * 12 - v(L ? 'BrowDownLeft' : 'BrowDownRight') * 8;
+    const outer = v(L ? 'BrowOuterUpLeft' : 'BrowOuterUpRight') * 12 - v(L ? 'BrowDownLeft' : 'BrowDownRight') * 4;
+    c.beginPath(); c.moveTo(ex - side * 16, ey - 20 - inner); c.lineTo(ex + side * 18, ey - 18 - outer); c.stroke();
+  }
+  const mw = 26 * Math.max(0.4, d[3]), my = cy + 46;
+  const smileL = (v('MouthSmileLeft') - v('MouthFrownLeft')) * 10, smileR = (v('MouthSmileRight') - v('MouthFrownRight')) * 10;
+  const gap = (k) => Math.max(0, d[k]) * 30;
+  c.fillStyle = '#7a2e2e'; c.strokeStyle = '#a04848'; c.lineWidth = 3;
+  c.beginPath();
+  c.moveTo(cx - mw, my - smileL);
+  c.quadraticCurveTo(cx - mw / 2, my - 4 - gap(0) * 0.3, cx, my - 3 - gap(1) * 0.3);
+  c.quadraticCurveTo(cx + mw / 2, my - 4 - gap(2) * 0.3, cx + mw, my - smileR);
+  c.quadraticCurveTo(cx + mw / 2, my + 3 + gap(2) * 0.7, cx, my + 3 + gap(1) * 0.7);
+  c.quadraticCurveTo(cx - mw / 2, my + 3 + gap(0) * 0.7, cx - mw, my - smileL);
+  c.closePath(); c.fill(); c.stroke(); c.lineWidth = 1;
+}
+function drawFaces() {
+  drawFace($('face-original'), S.face.orig);
+  drawFace($('face-edited'), S.face.cur);
+}
+
+// Keys: click a curve inside the span (keyframes constraint), drag to move, right-click to delete.
+const faceCv = $('face-curves');
+let dragKey = null;
+function curveHit(e) {
+  if (!faceLayout || !S.face.take) return null;
+  const r = faceCv.getBoundingClientRect(), x = e.clientX - r.left, y = e.clientY - r.top;
+  const { L, R, t0, t1, rh, curves } = faceLayout;
+  const row = Math.floor((y - 16) / rh);
+  if (row < 0 || row >= curves.length || x < L) return null;
+  const t = t0 + (x - L) / (r.width - L - R) * (t1 - t0);
+  const value = Math.max(0, Math.min(1, (16 + row * rh + rh - 4 - y) / (rh - 10)));
+  return { shape: curves[row], t, value, x, y };
+}
+function nearestKey(hit) {
+  const { X, rh, curves } = faceLayout;
+  let best = null, bd = 10;
+  for (const k of S.face.keys) {
+    if (k.shape !== hit.shape) continue;
+    const row = curves.indexOf(k.shape);
+    const dx = X(k.time_s) - hit.x, dy = (16 + row * rh + rh - 4 - (rh - 10) * k.value) - hit.y;
+    const dd = Math.hypot(dx, dy);
+    if (dd < bd) { bd = dd; best = k; }
+  }
+  return best;
+}
+function updateKeysCount() { $('face-keys-count').textContent = `${S.face.keys.length} key${S.face.keys.length === 1 ? '' : 's'}`; }
+faceCv.addEventListener('pointerdown', (e) => {
+  const hit = curveHit(e);
+  if (!hit) return;
+  if (e.button === 2) return;
+  const near = nearestKey(hit);
+  if (near) { dragKey = near; faceCv.setPointerCapture(e.pointerId); return; }
+  if ($('face-constraint').value !== 'keys') { seek(faceLayout.rowOf(hit.t)); return; }
+  const [a, b] = faceMask();
+  if (hit.t < a || hit.t > b) { showError(`a key at ${hit.t.toFixed(2)} s lies outside the span ${a.toFixed(2)}–${b.toFixed(2)} s; keys guide the edit only inside it`); return; }
+  clearError();
+  const k = { time_s: Math.round(hit.t * 100) / 100, shape: hit.shape, value: Math.round(hit.value * 1000) / 1000 };
+  S.face.keys.push(k); dragKey = k; faceCv.setPointerCapture(e.pointerId);
+  updateKeysCount(); drawFaceView();
+});
+faceCv.addEventListener('pointermove', (e) => {
+  if (!dragKey) return;
+  const hit = curveHit(e);
+  if (!hit) return;
+  const [a, b] = faceMask();
+  dragKey.time_s = Math.round(Math.max(a, Math.min(b, hit.t)) * 100) / 100;
+  dragKey.value = Math.round(hit.value * 1000) / 1000;
+  drawFaceView();
+});
+faceCv.addEventListener('pointerup', () => { dragKey = null; });
+faceCv.addEventListener('contextmenu', (e) => {
+  e.preventDefault();
+  const hit = curveHit(e); if (!hit) return;
+  const near = nearestKey(hit);
+  if (near) { S.face.keys = S.face.keys.filter((k) => k !== near); updateKeysCount(); drawFaceView(); }
+});
+$('face-clear-keys').addEventListener('click', () => { S.face.keys = []; updateKeysCount(); drawFaceView(); });
+
 // ---------------------------------------------------------------- playback
 function seek(frame) {
   const st = panelState();
   const n = Math.max(1, st.frames);
   S.frame = Math.max(0, Math.min(n - 1, Math.round(frame)));
-  const t = S.frame / (st.fps || 30);
+  const t = S.panel === 'face' && st.take ? st.take.times[S.frame] : S.frame / (st.fps || 30);
   if (S.panel === 'script' && st.mixer) {
     st.mixer.setTime(t);
     if (st.camHelper) { st.gltf.scene.updateMatrixWorld(true); st.camHelper.update(); }
@@ -449,6 +757,7 @@ function seek(frame) {
     if (st.orig) st.orig.mixer.setTime(t);
     if (st.rec) st.rec.mixer.setTime(t);
   }
+  if (S.panel === 'face') drawFaceView();
   $('frame').textContent = `${S.frame} / ${Math.max(0, n - 1)}`;
   $('time').textContent = `${t.toFixed(2)} s`;
   drawTimeline();
@@ -463,6 +772,7 @@ let playFrame = 0;
 function loop(now) {
   requestAnimationFrame(loop);
   resize();
+  if (S.panel === 'face') { const cv = $('face-curves'); if (cv.width !== cv.clientWidth || cv.height !== cv.clientHeight) { drawFaceView(); drawTimeline(); } }
   if (S.playing) {
     const st = panelState();
     playFrame = (S.frame + (now - last) / 1000 * (st.fps || 30));
@@ -534,6 +844,21 @@ function drawTimeline() {
     for (const k of r.keys) { const px = x(k); c.beginPath(); c.moveTo(px, 16); c.lineTo(px + 5, 22); c.lineTo(px, 28); c.lineTo(px - 5, 22); c.closePath(); c.fill(); }
     c.fillStyle = '#aab1bc'; c.fillText(`${r.keys.length} keys`, 2, 26);
   }
+  if (S.panel === 'face' && st.take) {
+    const [a, b] = faceMask();
+    const fa = a * st.fps, fb = b * st.fps;
+    c.fillStyle = 'rgba(255, 196, 0, 0.25)'; c.fillRect(x(fa), 14, Math.max(2, x(fb) - x(fa)), h - 14);
+    c.fillStyle = '#ffc400'; c.fillText(`span ${a.toFixed(2)}–${b.toFixed(2)} s (drag on the timeline to set it)`, 44, 26);
+    // Blink and jaw curves of the current version, for orientation.
+    for (const [name, col] of [['EyeBlinkLeft', '#9fe0a8'], ['JawOpen', '#ff8c1a']]) {
+      const v = st.cur[name]; if (!v) continue;
+      c.strokeStyle = col; c.beginPath();
+      const step = Math.max(1, Math.floor(v.length / w));
+      for (let f = 0; f < v.length; f += step) { const px = x(f), py = h - 6 - (h - 40) * v[f]; f ? c.lineTo(px, py) : c.moveTo(px, py); }
+      c.stroke();
+    }
+    c.fillStyle = '#9fe0a8'; c.fillText('EyeBlinkLeft', 2, h - 20); c.fillStyle = '#ff8c1a'; c.fillText('JawOpen', 2, h - 8);
+  }
   // Playhead.
   c.strokeStyle = '#4da3ff'; c.lineWidth = 2;
   c.beginPath(); c.moveTo(x(S.frame), 0); c.lineTo(x(S.frame), h); c.stroke(); c.lineWidth = 1;
@@ -544,9 +869,20 @@ const scrub = (e) => {
   const r = tl.getBoundingClientRect();
   seek((e.clientX - r.left - 40) / (r.width - 50) * (n - 1));
 };
-tl.addEventListener('pointerdown', (e) => { scrubbing = true; tl.setPointerCapture(e.pointerId); scrub(e); });
-tl.addEventListener('pointermove', (e) => { if (scrubbing) scrub(e); });
-tl.addEventListener('pointerup', () => { scrubbing = false; });
+// On the face panel a drag sets the span (seconds of the file's own time); a click seeks.
+let dragFrom = null;
+const tlFrame = (e) => { const st = panelState(); const n = Math.max(1, st.frames); const r = tl.getBoundingClientRect(); return Math.max(0, Math.min(n - 1, (e.clientX - r.left - 40) / (r.width - 50) * (n - 1))); };
+tl.addEventListener('pointerdown', (e) => { scrubbing = true; tl.setPointerCapture(e.pointerId); dragFrom = { x: e.clientX, f: tlFrame(e) }; scrub(e); });
+tl.addEventListener('pointermove', (e) => {
+  if (!scrubbing) return;
+  if (S.panel === 'face' && S.face.take && dragFrom && Math.abs(e.clientX - dragFrom.x) > 4) {
+    const t = S.face.take.times, f = tlFrame(e);
+    const a = t[Math.round(Math.min(dragFrom.f, f))], b = t[Math.round(Math.max(dragFrom.f, f))];
+    $('face-mask-start').value = a.toFixed(2); $('face-mask-end').value = b.toFixed(2);
+    drawTimeline(); drawFaceView();
+  } else scrub(e);
+});
+tl.addEventListener('pointerup', () => { scrubbing = false; dragFrom = null; });
 
 // ---------------------------------------------------------------- test hooks
 function state() {
@@ -564,7 +900,9 @@ function state() {
     if (st.keysResult) keys = [...st.keysResult.keys];
   }
   if (!camera) camera = { eye: orbitCam.position.toArray(), target: controls.target.toArray(), fov: orbitCam.fov, shot: false };
-  return JSON.parse(JSON.stringify({ panel: S.panel, fps: st.fps, frames: st.frames, frame: S.frame, objects, characters, camera, keys, lastJob: S.lastJob }));
+  let face = null;
+  if (S.face.take) face = { mask: faceMask(), edited: S.face.cur, keys: S.face.keys, version: S.face.version ?? 0, versions: S.face.versions ?? 1, lastEdit: S.face.lastEdit };
+  return JSON.parse(JSON.stringify({ panel: S.panel, fps: st.fps, frames: st.frames, frame: S.frame, objects, characters, camera, keys, face, lastJob: S.lastJob }));
 }
 
 window.inbetweenStudio = {
@@ -577,6 +915,10 @@ window.inbetweenStudio = {
   // The last story drawn: ms of its request (job included), to fetch its GLB, to parse it, to
   // build the view (for the bench).
   drawTimes: () => S.drawTimes || null,
+  // The face take's row times, seconds from its first row.
+  faceTimes: () => (S.face.take ? S.face.take.times : []),
+  // Adds a face key as a click on a curve would (keyframes constraint).
+  faceKey: (time_s, shape, value) => { S.face.keys.push({ time_s, shape, value }); updateKeysCount(); drawFaceView(); },
 };
 
 // ---------------------------------------------------------------- start
@@ -584,7 +926,7 @@ showPanel('script');
 requestAnimationFrame(loop);
 pending = (async () => {
   try {
-    await Promise.all([loadStories(), loadCorpus()]);
+    await Promise.all([loadStories(), loadCorpus(), loadFaceCorpus()]);
     maxUpload = (await (await fetch('/api/info')).json()).max_upload;
     setStatus('ready: run the story (Ctrl-Enter) or open a take');
   } catch (e) { showError(`could not reach the studio server: ${e.message}`); }

@@ -1,0 +1,534 @@
+//! The face panel (issue 24): open a Live Link Face CSV or a curve CSV/JSON (uploaded, named under
+//! `--root`, or a built-in procedural take), mask a span, choose a constraint (none, keys, a noisy
+//! guide file, visemes from text or a TextGrid / phoneme file) and the blendshape groups, and fill it
+//! with the face engine's [`EditJob`]; undo and redo; export in the input's own layout. Uploads go
+//! through the same parsers as `face edit`, so a bad file's message names file and line.
+//!
+//! Every edit applies to the current version of the take (edits compose); the page receives only the
+//! rows the edit changed, so a 2 s span costs a few kilobytes however long the take.
+
+use std::path::Path;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use axum::body::Bytes;
+use axum::extract::{Query, State};
+use axum::Json;
+use inbetween_face::data::{
+    parse_curve_csv, parse_curve_json, parse_live_link, to_curve_csv_string, to_curve_json_string, to_live_link_string,
+    BlendshapeClip, ARKIT_NAMES, MODEL_FPS, NUM_ARKIT,
+};
+use inbetween_face::edit::distances::{distance_bases, distance_matrix, DISTANCE_NAMES};
+use inbetween_face::edit::groups::{parse_groups, Group};
+use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
+use inbetween_face::infer::{
+    EditJob, EditLimits, Guide, Inpainter, KeyPose, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
+};
+use inbetween_face::visemes::{
+    parse_phoneme_csv, parse_textgrid, phoneme_viseme, text_to_phonemes, PhonemeSpan, Viseme,
+};
+use inbetween_face::weights::{self, Network};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use crate::error::{Result, StudioError};
+use crate::jobs::answer;
+use crate::mocap_panel::{utf8, UploadQuery};
+use crate::safety::resolve_under_root;
+use crate::server::AppState;
+
+/// The layout the take was read in, which export writes back.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Layout {
+    LiveLink,
+    CurveCsv,
+    CurveJson,
+}
+
+/// The open take and its versions (index 0 is the file as opened).
+struct Session {
+    name: String,
+    layout: Layout,
+    versions: Vec<BlendshapeClip>,
+    /// The version shown; versions after it are the redo stack.
+    current: usize,
+}
+
+/// A guide file for the next edits.
+enum GuideFile {
+    Noisy(BlendshapeClip),
+    Visemes(Vec<(f64, f64, Viseme)>),
+}
+
+/// The panel's take, its guide file, and what edits reuse (networks, the retrieval library).
+#[derive(Default)]
+pub struct FaceState {
+    session: Mutex<Option<Session>>,
+    guide: Mutex<Option<(String, Arc<GuideFile>)>>,
+    version: std::sync::atomic::AtomicU64,
+    library: OnceLock<MotionLibrary>,
+    nets: Mutex<Vec<(ConstraintKind, Arc<Network>)>>,
+}
+
+impl FaceState {
+    fn next_version(&self) -> u64 {
+        self.version.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1
+    }
+
+    fn library(&self) -> &MotionLibrary {
+        self.library.get_or_init(|| MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED))
+    }
+
+    fn network(&self, kind: ConstraintKind) -> Result<Arc<Network>> {
+        let mut nets = self.nets.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some((_, n)) = nets.iter().find(|(k, _)| *k == kind) {
+            return Ok(n.clone());
+        }
+        let n = Arc::new(weights::committed(kind).map_err(face_err)?);
+        nets.push((kind, n.clone()));
+        Ok(n)
+    }
+}
+
+fn face_err(e: inbetween_face::data::FaceError) -> StudioError {
+    StudioError::Engine(e.to_string())
+}
+
+/// Built-in take: a procedural face (blinks, speech, expressions) of this many seconds, at the
+/// procedural generator's 25 fps.
+pub const BUILTIN: (&str, f64) = ("builtin:procedural", 12.0);
+
+/// `GET /api/face/corpus`: face captures under `--root` (CSV and JSON files below a folder named
+/// `face`) and the built-in take.
+pub async fn corpus(State(st): State<Arc<AppState>>) -> Json<Value> {
+    let mut files = Vec::new();
+    if let Some(root) = &st.config.root {
+        list(root, root, 0, &mut files);
+    }
+    files.sort();
+    Json(json!({
+        "root": st.config.root.as_ref().map(|p| p.display().to_string()),
+        "files": files,
+        "builtin": [BUILTIN.0],
+    }))
+}
+
+fn list(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        if out.len() >= 2000 {
+            return;
+        }
+        let p = e.path();
+        let Ok(kind) = e.file_type() else { continue };
+        if kind.is_dir() && depth < 6 {
+            list(root, &p, depth + 1, out);
+        } else if kind.is_file() {
+            let ext = p.extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+            let Ok(rel) = p.strip_prefix(root) else { continue };
+            let rel = rel.to_string_lossy().replace('\\', "/");
+            if matches!(ext.as_deref(), Some("csv" | "json")) && rel.split('/').any(|c| c == "face") {
+                out.push(rel);
+            }
+        }
+    }
+}
+
+#[derive(Deserialize)]
+pub struct OpenRequest {
+    /// `builtin:procedural`, or a path relative to `--root`.
+    pub path: String,
+}
+
+/// `POST /api/face/open`: the built-in take or a file under `--root`.
+pub async fn open_path(State(st): State<Arc<AppState>>, Json(req): Json<OpenRequest>) -> Result<Json<Value>> {
+    let file =
+        if req.path == BUILTIN.0 { None } else { Some(resolve_under_root(st.config.root.as_deref(), &req.path)?) };
+    let state = st.clone();
+    let id = st.jobs.spawn("face-open", move |job| {
+        job.progress("reading the take", 0.1);
+        let (name, layout, clip) = match file {
+            None => {
+                let cfg = inbetween_face::procedural::ProceduralConfig::with_duration(BUILTIN.1);
+                (BUILTIN.0.to_string(), Layout::LiveLink, inbetween_face::procedural::generate(&cfg, 1).clip)
+            }
+            Some(path) => {
+                let shown = req.path.clone();
+                let bytes = std::fs::read(&path).map_err(|e| StudioError::io(&shown, e))?;
+                let (layout, clip) = parse_take(&shown, &bytes)?;
+                (shown, layout, clip)
+            }
+        };
+        opened(&state, name, layout, clip)
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+/// `POST /api/face/upload?name=…`: a take's bytes (Live Link CSV, curve CSV or JSON).
+pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
+    let name = clean_name(&q.name);
+    let state = st.clone();
+    let id = st.jobs.spawn("face-open", move |job| {
+        job.progress("parsing", 0.1);
+        let (layout, clip) = parse_take(&name, &body)?;
+        opened(&state, name, layout, clip)
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+fn clean_name(name: &str) -> String {
+    name.chars().filter(|c| !c.is_control() && *c != '/' && *c != '\\').take(200).collect()
+}
+
+/// A take from its bytes, by extension: `.json` curves; `.csv` Live Link when its header is, else curves.
+fn parse_take(name: &str, bytes: &[u8]) -> Result<(Layout, BlendshapeClip)> {
+    let text = utf8(name, bytes)?;
+    let ext = Path::new(name).extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+    let (layout, clip) = match ext.as_deref() {
+        Some("json") => (Layout::CurveJson, parse_curve_json(&text, name)),
+        Some("csv") => {
+            let first = text.trim_start_matches('\u{feff}').lines().find(|l| !l.trim_start().starts_with('#'));
+            if first.is_some_and(|l| l.starts_with("Timecode")) {
+                (Layout::LiveLink, parse_live_link(&text, name))
+            } else {
+                (Layout::CurveCsv, parse_curve_csv(&text, name))
+            }
+        }
+        _ => {
+            return Err(StudioError::BadRequest(format!(
+                "{name}: expected a Live Link Face CSV, or a curve CSV or JSON (time_s and the 52 ARKit names)"
+            )))
+        }
+    };
+    let clip = clip.map_err(face_err)?;
+    if clip.num_frames() < 2 {
+        return Err(StudioError::Engine(format!("{name}: {} row(s); a take needs at least 2", clip.num_frames())));
+    }
+    Ok((layout, clip))
+}
+
+/// The 52 ARKit columns of `clip`, rows `a..b`, rounded to 5 decimals.
+fn columns(
+    clip: &BlendshapeClip,
+    a: usize,
+    b: usize,
+    only: Option<&[bool; NUM_ARKIT]>,
+) -> serde_json::Map<String, Value> {
+    let mut out = serde_json::Map::new();
+    for (c, name) in ARKIT_NAMES.iter().enumerate() {
+        if only.is_some_and(|o| !o[c]) {
+            continue;
+        }
+        let v: Vec<f64> = (a..b).map(|f| (f64::from(clip.arkit(f)[c]) * 1e5).round() / 1e5).collect();
+        out.insert(name.to_string(), json!(v));
+    }
+    out
+}
+
+/// The take opened: its session replaces the old one; the page gets every column.
+fn opened(st: &AppState, name: String, layout: Layout, clip: BlendshapeClip) -> Result<Value> {
+    let n = clip.num_frames();
+    let msg = format!("opened {name}: {n} rows at {:.3} fps, {:.2} s", clip.fps(), clip.duration());
+    let v = st.face.next_version();
+    let export = export_url(st, &name, layout, &clip, v);
+    let out = json!({
+        "ok": true,
+        "message": msg,
+        "name": name,
+        "frames": n,
+        "fps": clip.fps(),
+        "duration_s": clip.duration(),
+        "times": clip.times().iter().map(|t| t - clip.times()[0]).collect::<Vec<_>>(),
+        "columns": columns(&clip, 0, n, None),
+        "groups": ARKIT_NAMES.iter().map(|n| (n.to_string(), json!(Group::of_shape(n).name()))).collect::<serde_json::Map<_, _>>(),
+        "distance_names": DISTANCE_NAMES,
+        "distance_bases": distance_bases(),
+        "distance_matrix": distance_matrix(),
+        "files": {"export": export},
+    });
+    *st.face.session.lock().unwrap_or_else(|p| p.into_inner()) =
+        Some(Session { name, layout, versions: vec![clip], current: 0 });
+    Ok(out)
+}
+
+/// The URL of the current version in the input's layout (made on download).
+fn export_url(st: &AppState, name: &str, layout: Layout, clip: &BlendshapeClip, version: u64) -> String {
+    let stem = Path::new(name).file_stem().and_then(|s| s.to_str()).unwrap_or("take").replace(':', "-");
+    let (ext, ctype) = match layout {
+        Layout::CurveJson => ("json", "application/json"),
+        _ => ("csv", "text/csv; charset=utf-8"),
+    };
+    let clip = clip.clone();
+    st.put_lazy(
+        &format!("face/{stem}-edited.{ext}"),
+        ctype,
+        move || match layout {
+            Layout::LiveLink => to_live_link_string(&clip).unwrap_or_else(|_| to_curve_csv_string(&clip)).into_bytes(),
+            Layout::CurveCsv => to_curve_csv_string(&clip).into_bytes(),
+            Layout::CurveJson => to_curve_json_string(&clip).into_bytes(),
+        },
+        version,
+    )
+}
+
+/// `POST /api/face/guide?name=…`: a noisy take (a clip file) or phoneme timings (`.TextGrid`, or a
+/// CSV whose header is `start,end,phoneme`) for the next edits.
+pub async fn guide(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
+    let name = clean_name(&q.name);
+    let state = st.clone();
+    let id = st.jobs.spawn("face-guide", move |_| {
+        let text = utf8(&name, &body)?;
+        let ext = Path::new(&name).extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+        let phonemes = ext.as_deref() == Some("textgrid")
+            || text.trim_start_matches('\u{feff}').trim_start().to_ascii_lowercase().starts_with("start,");
+        let (g, what) = if phonemes {
+            let spans = if ext.as_deref() == Some("textgrid") {
+                parse_textgrid(&text, &name, None)
+            } else {
+                parse_phoneme_csv(&text, &name)
+            }
+            .map_err(face_err)?;
+            let runs = viseme_runs(&spans)?;
+            let n = runs.len();
+            (GuideFile::Visemes(runs), format!("{n} phonemes"))
+        } else {
+            let (_, clip) = parse_take(&name, &body)?;
+            let what = format!("a noisy take of {} rows", clip.num_frames());
+            (GuideFile::Noisy(clip), what)
+        };
+        *state.face.guide.lock().unwrap_or_else(|p| p.into_inner()) = Some((name.clone(), Arc::new(g)));
+        Ok(json!({"ok": true, "message": format!("guide {name}: {what}"), "guide": name, "phonemes": phonemes}))
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+fn viseme_runs(spans: &[PhonemeSpan]) -> Result<Vec<(f64, f64, Viseme)>> {
+    spans
+        .iter()
+        .map(|s| {
+            phoneme_viseme(&s.phoneme).map(|v| (s.start_s, s.end_s, v)).ok_or_else(|| {
+                StudioError::Engine(format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))
+            })
+        })
+        .collect()
+}
+
+/// One key of the page: a time and the shapes it sets.
+#[derive(Deserialize)]
+pub struct KeyRequest {
+    pub time_s: f64,
+    pub shapes: std::collections::BTreeMap<String, f32>,
+}
+
+#[derive(Deserialize)]
+pub struct EditRequest {
+    /// The span, seconds from the take's first row.
+    pub start_s: f64,
+    pub end_s: f64,
+    /// `none`, `keys`, `noisy` (the uploaded guide), `visemes` (the uploaded phonemes) or `text`.
+    #[serde(default = "none")]
+    pub constraint: String,
+    /// Words spoken over the span (constraint `text`).
+    #[serde(default)]
+    pub text: String,
+    /// Keys (constraint `keys`).
+    #[serde(default)]
+    pub keys: Vec<KeyRequest>,
+    /// Groups to regenerate (`all`, `mouth,jaw`, …).
+    #[serde(default = "all")]
+    pub groups: String,
+    /// `auto` (the face bench's best: retrieval unguided or noisy, the network otherwise), `network`,
+    /// `retrieval`, `linear` or `cubic`.
+    #[serde(default = "auto")]
+    pub method: String,
+    #[serde(default = "one")]
+    pub seed: u64,
+}
+
+fn none() -> String {
+    "none".into()
+}
+fn all() -> String {
+    "all".into()
+}
+fn auto() -> String {
+    "auto".into()
+}
+fn one() -> u64 {
+    1
+}
+
+/// `POST /api/face/edit`: fill the span of the current version; the new version replaces the redo stack.
+pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>) -> Result<Json<Value>> {
+    let state = st.clone();
+    let id = st.jobs.spawn("face-edit", move |job| {
+        let (name, layout, clip) = {
+            let s = state.face.session.lock().unwrap_or_else(|p| p.into_inner());
+            let s = s.as_ref().ok_or_else(|| StudioError::BadRequest("open a face take first".into()))?;
+            (s.name.clone(), s.layout, s.versions[s.current].clone())
+        };
+        let channels = parse_groups(&req.groups).map_err(StudioError::BadRequest)?;
+        let guide = match req.constraint.as_str() {
+            "none" => Guide::None,
+            "keys" => {
+                let mut keys = Vec::new();
+                for (i, k) in req.keys.iter().enumerate() {
+                    let mut shapes = Vec::new();
+                    for (shape, v) in &k.shapes {
+                        let c = inbetween_face::data::arkit_index(shape).ok_or_else(|| {
+                            StudioError::BadRequest(format!("key {i}: '{shape}' is not an ARKit blendshape name"))
+                        })?;
+                        shapes.push((c, *v));
+                    }
+                    keys.push(KeyPose { time_s: k.time_s, shapes });
+                }
+                Guide::Keys(keys)
+            }
+            "text" => {
+                let ph = text_to_phonemes(&req.text, req.start_s, req.end_s).map_err(face_err)?;
+                Guide::Visemes(viseme_runs(&ph.spans)?)
+            }
+            "noisy" | "visemes" => {
+                let g = state.face.guide.lock().unwrap_or_else(|p| p.into_inner()).clone();
+                match (req.constraint.as_str(), g.as_ref().map(|g| g.1.as_ref())) {
+                    ("noisy", Some(GuideFile::Noisy(c))) => Guide::Noisy(c.clone()),
+                    ("visemes", Some(GuideFile::Visemes(v))) => Guide::Visemes(v.clone()),
+                    _ => {
+                        return Err(StudioError::BadRequest(format!(
+                            "constraint '{}' needs its file: open {} as the guide first",
+                            req.constraint,
+                            if req.constraint == "noisy" {
+                                "a noisy take of the same performance"
+                            } else {
+                                "a TextGrid or phoneme CSV"
+                            }
+                        )))
+                    }
+                }
+            }
+            other => {
+                return Err(StudioError::BadRequest(format!(
+                    "constraint '{other}': expected none, keys, noisy, visemes or text"
+                )))
+            }
+        };
+        let kind = guide.kind();
+        let method_name = match req.method.as_str() {
+            "auto" => match kind {
+                ConstraintKind::None | ConstraintKind::Noisy => "retrieval",
+                _ => "network",
+            },
+            m @ ("network" | "retrieval" | "linear" | "cubic") => m,
+            other => {
+                return Err(StudioError::BadRequest(format!(
+                    "method '{other}': expected auto, network, retrieval, linear or cubic"
+                )))
+            }
+        };
+        let net = if method_name == "network" { Some(state.face.network(kind)?) } else { None };
+        let method = match method_name {
+            "network" => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
+            "retrieval" => Method::Retrieval(state.face.library(), RetrievalOptions::default()),
+            "linear" => Method::Linear,
+            _ => Method::Cubic,
+        };
+        job.progress("filling the span", 0.2);
+        let out = EditJob {
+            clip: &clip,
+            spans: vec![(req.start_s, req.end_s)],
+            channels,
+            guide,
+            method,
+            seed: req.seed,
+            limits: EditLimits::default(),
+            cancel: inbetween_core::cancel::Cancel::new(),
+            guide_file: None,
+        }
+        .run()
+        .map_err(face_err)?;
+        // The masked error against what was there, at the model rate.
+        let (mut sq, mut count) = (0.0f64, 0usize);
+        for f in 0..out.mask.frames() {
+            for c in 0..NUM_ARKIT {
+                if out.mask.erased(f, c) {
+                    sq += f64::from(out.after[f][c] - out.before[f][c]).powi(2);
+                    count += 1;
+                }
+            }
+        }
+        let mse = sq / count.max(1) as f64;
+        // Rows the edit changed, and the changed columns' values there.
+        let (old, new) = (clip.values(), out.clip.values());
+        let stride = clip.num_channels();
+        let changed_rows: Vec<usize> = (0..clip.num_frames())
+            .filter(|f| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride])
+            .collect();
+        let (a, b) = match (changed_rows.first(), changed_rows.last()) {
+            (Some(a), Some(b)) => (*a, b + 1),
+            _ => (0, 0),
+        };
+        let mut changed = [false; NUM_ARKIT];
+        for f in a..b {
+            for (c, ch) in changed.iter_mut().enumerate() {
+                *ch |= old[f * stride + c] != new[f * stride + c];
+            }
+        }
+        let v = state.face.next_version();
+        let export = export_url(&state, &name, layout, &out.clip, v);
+        let model_frames = out.mask.segments().iter().map(|s| s.len()).sum::<usize>();
+        let msg = format!(
+            "{method_name} fill of {:.2} s..{:.2} s ({model_frames} frames at {MODEL_FPS} fps), masked error against \
+             what was there: MSE {mse:.5}",
+            req.start_s, req.end_s
+        );
+        let mut s = state.face.session.lock().unwrap_or_else(|p| p.into_inner());
+        let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("the take was closed during the edit".into()))?;
+        s.versions.truncate(s.current + 1);
+        s.versions.push(out.clip.clone());
+        s.current += 1;
+        Ok(json!({
+            "ok": true,
+            "message": msg,
+            "method": method_name,
+            "masked_mse": mse,
+            "rows": [a, b],
+            "columns": columns(&out.clip, a, b, Some(&changed)),
+            "mask": [req.start_s, req.end_s],
+            "version": s.current,
+            "versions": s.versions.len(),
+            "files": {"export": export},
+        }))
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+#[derive(Deserialize)]
+pub struct StepRequest {
+    /// `undo` or `redo`.
+    pub step: String,
+}
+
+/// `POST /api/face/history`: undo or redo; answers with every column of the version now shown.
+pub async fn history(State(st): State<Arc<AppState>>, Json(req): Json<StepRequest>) -> Result<Json<Value>> {
+    let mut s = st.face.session.lock().unwrap_or_else(|p| p.into_inner());
+    let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("open a face take first".into()))?;
+    match req.step.as_str() {
+        "undo" if s.current > 0 => s.current -= 1,
+        "redo" if s.current + 1 < s.versions.len() => s.current += 1,
+        "undo" | "redo" => {}
+        other => return Err(StudioError::BadRequest(format!("step '{other}': expected undo or redo"))),
+    }
+    let clip = &s.versions[s.current];
+    let (name, layout) = (s.name.clone(), s.layout);
+    let v = st.face.next_version();
+    let export = export_url(&st, &name, layout, clip, v);
+    Ok(Json(json!({
+        "ok": true,
+        "kind": format!("face-{}", req.step),
+        "message": format!("{}: version {} of {}", req.step, s.current, s.versions.len() - 1),
+        "rows": [0, clip.num_frames()],
+        "columns": columns(clip, 0, clip.num_frames(), None),
+        "version": s.current,
+        "versions": s.versions.len(),
+        "files": {"export": export},
+    })))
+}
