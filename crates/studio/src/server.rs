@@ -20,7 +20,7 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::Jobs;
-use crate::{assets, face_panel, mocap_panel, safety, script_panel};
+use crate::{assets, face_panel, mocap_panel, safety, script_panel, video_panel};
 
 /// Default `--max-upload`: 512 MB.
 pub const DEFAULT_MAX_UPLOAD: u64 = 512 * 1000 * 1000;
@@ -87,6 +87,7 @@ pub struct AppState {
     pub script: script_panel::ScriptState,
     pub mocap: mocap_panel::MocapState,
     pub face: face_panel::FaceState,
+    pub video: video_panel::VideoState,
 }
 
 impl AppState {
@@ -174,7 +175,11 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/face/upload", post(face_panel::upload))
         .route("/api/face/guide", post(face_panel::guide))
         .route("/api/face/edit", post(face_panel::edit))
-        .route("/api/face/history", post(face_panel::history));
+        .route("/api/face/history", post(face_panel::history))
+        .route("/api/video/corpus", get(video_panel::corpus))
+        .route("/api/video/open", post(video_panel::open_path))
+        .route("/api/video/upload", post(video_panel::upload))
+        .route("/api/video/generate", post(video_panel::generate));
     if state.config.test_routes {
         app = app.route("/api/test/panic", post(test_panic));
     }
@@ -346,6 +351,7 @@ fn state(config: StudioConfig, bound: SocketAddr) -> Arc<AppState> {
         script: script_panel::ScriptState::default(),
         mocap: mocap_panel::MocapState::default(),
         face: face_panel::FaceState::default(),
+        video: video_panel::VideoState::default(),
     })
 }
 

@@ -413,3 +413,134 @@ fn face_panel_in_headless_chromium() {
     assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
     assert_eq!(error_text(&b), "");
 }
+
+#[test]
+fn video_panel_in_headless_chromium() {
+    let (chromium, driver) = match available() {
+        Ok(found) => found,
+        Err(why) => {
+            println!("skipped: {why}");
+            return;
+        }
+    };
+    if inbetween_studio::assets::missing().is_some() {
+        println!("skipped: the studio was built without three.js (no Node at build time)");
+        return;
+    }
+    let data = inbetween_io::shared_data_dir();
+    let studio =
+        Studio::start(StudioConfig { port: 0, root: data.clone().ok(), ..StudioConfig::default() }).expect("start");
+    let b = Browser::launch(&chromium, &driver, 1280, 800).expect("launch chromium");
+    b.goto(&studio.url()).unwrap();
+    b.eval("window.inbetweenStudio.ready()").unwrap();
+    b.eval("(document.querySelector('[data-testid=nav-video]').click(), true)").unwrap();
+    assert_eq!(state(&b)["panel"], "video");
+
+    // Real footage with a scene cut: the corpus has no clip with one, so the test joins 40 frames of
+    // two of its clips (Big Buck Bunny, then the carphone sequence) into one GIF and opens it as a
+    // user would. Without the data, the built-in procedural clip (which has a cut) is opened.
+    let dir = tempfile::tempdir().unwrap();
+    let joined = dir.path().join("bunny-then-carphone.gif");
+    let have_real = match &data {
+        Ok(d) if d.join("video/bigbuckbunny.mp4").is_file() && d.join("video/carphone_pristine.mp4").is_file() => {
+            use inbetween_video::frames::{read_clip, write_clip, Clip, ReadOptions};
+            let opts = ReadOptions { max_frames: Some(40), ..ReadOptions::default() };
+            let mut frames = Vec::new();
+            for f in ["video/bigbuckbunny.mp4", "video/carphone_pristine.mp4"] {
+                let (clip, _) = read_clip(&d.join(f), &opts).unwrap();
+                frames.extend(
+                    clip.frames
+                        .iter()
+                        .map(|im| image::imageops::resize(im, 192, 108, image::imageops::FilterType::Triangle)),
+                );
+            }
+            write_clip(&joined, &Clip { frames, fps: 25.0, source: "joined".into() }).unwrap();
+            true
+        }
+        _ => false,
+    };
+    if have_real {
+        open_files(&b, &[joined.as_path()]);
+    } else {
+        println!(
+            "skipped: no data at {} (real clips; using the built-in one)",
+            data.as_ref().map_or_else(|e| e.display().to_string(), |d| d.display().to_string())
+        );
+        b.eval("(s => { s.value = 'builtin:mixed'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('video-corpus'))").unwrap();
+    }
+    let st = state(&b);
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["kind"], "video-open", "{}", st["lastJob"]);
+    let frames = st["frames"].as_u64().unwrap() as usize;
+    assert_eq!(frames, if have_real { 80 } else { 96 });
+    let cuts = st["video"]["cuts"].as_array().unwrap().len();
+    assert!(cuts >= 1, "the clip has a scene cut: {}", st["video"]);
+    let covered = coverage(&b, "video-strip", [0x15, 0x17, 0x1c]);
+    assert!(covered > 0.3, "the frame strip looks blank: {covered:.3}");
+
+    // A new order of 60 frames from frame 10.
+    set_value(&b, "video-start", "10");
+    set_value(&b, "video-length", "60");
+    let st = click_and_wait(&b, "video-generate");
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let order: Vec<usize> = serde_json::from_value(st["video"]["order"].clone()).unwrap();
+    assert_eq!(order.len(), 60);
+    assert_eq!(order[0], 10);
+    assert!(order.iter().all(|&f| f < frames));
+    assert_eq!(st["frames"].as_u64().unwrap(), 60, "the timeline spans the new order");
+    let text = b.eval(&format!("{}.textContent", js_sel("video-order"))).unwrap();
+    let shown: Vec<usize> = text.as_str().unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(shown, order);
+    let md = st["video"]["md"].as_f64().unwrap();
+    assert!(md.is_finite() && md > 0.0, "{}", st["video"]);
+    // Every jump the state lists is a step that is not the next source frame.
+    for j in st["video"]["jumps"].as_array().unwrap() {
+        let (p, to) = (j["position"].as_u64().unwrap() as usize, j["to"].as_u64().unwrap() as usize);
+        assert_eq!(order[p], to, "{j}");
+        assert_ne!(order[p], order[p - 1] + 1, "{j}");
+    }
+    let steps = order.windows(2).filter(|w| w[1] != w[0] + 1).count();
+    assert_eq!(st["video"]["jumps"].as_array().unwrap().len(), steps, "one mark per jump");
+    // Hovering a jump's mark shows its explanation.
+    if let Some(j) = st["video"]["jumps"].as_array().unwrap().first() {
+        let p = j["position"].as_u64().unwrap();
+        let tip = b
+            .eval(&format!(
+                "(() => {{ const tl = document.querySelector('[data-testid=timeline]'); const r = tl.getBoundingClientRect(); \
+                 const x = r.left + 40 + (r.width - 50) * Math.min({p}, 59) / 59; \
+                 tl.dispatchEvent(new MouseEvent('mousemove', {{ clientX: x, clientY: r.top + 60, bubbles: true }})); \
+                 const t = document.getElementById('video-tip'); return t.hidden ? '' : t.textContent; }})()"
+            ))
+            .unwrap();
+        assert!(tip.as_str().unwrap().contains("S1"), "the tip should explain the step: {tip}");
+    }
+
+    // Regenerate with another seed and the loop on: the analysis is reused.
+    set_value(&b, "video-seed", "3");
+    b.eval(&format!("({}.checked = true, true)", js_sel("video-loop"))).unwrap();
+    let st = click_and_wait(&b, "video-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert!(st["lastJob"]["ms"].as_f64().unwrap() < 30_000.0);
+
+    // Export: a GIF of the new order.
+    let gif = b
+        .eval(
+            "fetch([...document.querySelectorAll('#video-export a')].find(a => a.textContent.endsWith('.gif')).href)\
+             .then(r => r.arrayBuffer()).then(b => { const u = new Uint8Array(b); return [u.length, String.fromCharCode(...u.slice(0, 4))]; })",
+        )
+        .unwrap();
+    assert_eq!(gif[1], "GIF8", "{gif}");
+    assert!(gif[0].as_u64().unwrap() > 1000, "{gif}");
+
+    // A garbage file: its error names it; the server keeps serving.
+    let junk = dir.path().join("garbage.mp4");
+    std::fs::write(&junk, b"\0\0\0\x18ftypisom this is not a movie").unwrap();
+    open_files(&b, &[junk.as_path()]);
+    let err = error_text(&b);
+    assert!(err.contains("garbage.mp4"), "the error should name the file: {err:?}");
+    assert_eq!(state(&b)["lastJob"]["ok"], false);
+    let st = click_and_wait(&b, "video-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert_eq!(error_text(&b), "");
+}

@@ -50,6 +50,7 @@ const S = {
   script: { result: null, gltf: null, mixer: null, shotCam: null, camHelper: null, fps: 30, frames: 0 },
   mocap: { take: null, keysResult: null, orig: null, rec: null, fps: 30, frames: 0, scale: 0.01 },
   face: { take: null, orig: null, cur: null, keys: [], changed: [], lastEdit: null, fps: 60, frames: 0 },
+  video: { clip: null, sprite: null, result: null, fps: 25, frames: 0 },
 };
 const panelState = () => S[S.panel];
 
@@ -151,8 +152,9 @@ function showPanel(name) {
   for (const p of document.querySelectorAll('section.panel')) p.hidden = p.dataset.panel !== name;
   groups.script.visible = name === 'script';
   groups.mocap.visible = name === 'mocap';
-  canvas.hidden = name === 'face';
+  canvas.hidden = name === 'face' || name === 'video';
   $('face-view').hidden = name !== 'face';
+  $('video-view').hidden = name !== 'video';
   S.frame = Math.min(S.frame, Math.max(0, panelState().frames - 1));
   seek(S.frame);
   resize();
@@ -743,6 +745,153 @@ faceCv.addEventListener('contextmenu', (e) => {
 });
 $('face-clear-keys').addEventListener('click', () => { S.face.keys = []; updateKeysCount(); drawFaceView(); });
 
+// ---------------------------------------------------------------- video panel
+const videoCorpus = $('video-corpus');
+async function loadVideoCorpus() {
+  const r = await (await fetch('/api/video/corpus')).json();
+  videoCorpus.innerHTML = '<option value="">(choose a clip)</option>';
+  for (const f of [...r.builtin, ...r.files]) {
+    const o = document.createElement('option'); o.value = f; o.textContent = f; videoCorpus.appendChild(o);
+  }
+}
+videoCorpus.addEventListener('change', () => {
+  const path = videoCorpus.value;
+  if (path) start('video-open', async () => { const r = await job('/api/video/open', { path }); await drawVideoClip(r); return r; });
+});
+$('video-file').addEventListener('change', (e) => {
+  const f = e.target.files[0];
+  if (f) start('video-open', async () => {
+    uploadCheck(f);
+    const r = await job(`/api/video/upload?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
+    await drawVideoClip(r);
+    return r;
+  });
+});
+
+function loadImage(url) {
+  return new Promise((ok, fail) => { const i = new Image(); i.onload = () => ok(i); i.onerror = () => fail(new Error(`could not load ${url}`)); i.src = url; });
+}
+
+async function drawVideoClip(r) {
+  const v = S.video;
+  v.clip = r; v.sprite = await loadImage(r.sprite.url); v.result = null;
+  v.fps = r.fps; v.frames = r.frames;
+  $('video-take').textContent = `${r.name}: ${r.frames} frames ${r.width}×${r.height} at ${r.fps.toFixed(2)} fps, ${r.cuts.length + 1} shot(s)${r.cuts.length ? ` (cuts before frames ${r.cuts.join(', ')})` : ''}; M_D of the source ${r.source_md.toFixed(4)}.`;
+  $('video-start').max = r.frames - 1;
+  if (parseInt($('video-start').value, 10) >= r.frames) $('video-start').value = 0;
+  $('video-order').textContent = ''; $('video-stats').textContent = '';
+  $('video-export').innerHTML = '<span class="muted">Export appears after Generate.</span>';
+  S.frame = 0; seek(0); drawVideoStrip(); drawTimeline();
+}
+
+function videoRequest() {
+  const len = parseInt($('video-length').value, 10);
+  return { start: parseInt($('video-start').value, 10) || 0, length: Number.isFinite(len) && len > 0 ? len : null, loop: $('video-loop').checked, seed: parseInt($('video-seed').value, 10) || 0 };
+}
+function runVideo() {
+  return start('video-generate', async () => {
+    if (!S.video.clip) throw new Error('open a clip first');
+    const r = await job('/api/video/generate', videoRequest());
+    const v = S.video;
+    v.result = r; v.frames = r.order.length;
+    $('video-order').textContent = r.order.join(' ');
+    $('video-stats').textContent = `${r.order.length} frames, ${r.jumps.length} jumps; M_D ${r.md.toFixed(4)} (source ${r.source_md.toFixed(4)}; lower is steadier)${r.closes_loop ? '; the loop closes' : ''}.`;
+    const ex = $('video-export'); ex.innerHTML = '';
+    for (const url of [r.files.mp4, r.files.gif]) {
+      const a = document.createElement('a'); const name = url.split('/').pop().split('?')[0];
+      a.href = url + '&download=1'; a.textContent = name; a.download = name; ex.appendChild(a);
+    }
+    S.frame = 0; seek(0); drawVideoStrip(); drawTimeline();
+    return r;
+  });
+}
+$('video-generate').addEventListener('click', runVideo);
+$('video-start').addEventListener('change', () => drawVideoStrip());
+
+// Draws source frame `i` of the sprite into `cv`, letterboxed.
+function drawSpriteFrame(cv, i) {
+  const v = S.video, c = cv.getContext('2d');
+  const w = cv.clientWidth, h = cv.clientHeight;
+  if (cv.width !== w) cv.width = w;
+  if (cv.height !== h) cv.height = h;
+  c.fillStyle = '#111'; c.fillRect(0, 0, w, h);
+  if (!v.sprite || i == null) return;
+  const sp = v.clip.sprite, sx = (i % sp.columns) * sp.width, sy = Math.floor(i / sp.columns) * sp.height;
+  const k = Math.min(w / sp.width, h / sp.height), dw = sp.width * k, dh = sp.height * k;
+  c.drawImage(v.sprite, sx, sy, sp.width, sp.height, (w - dw) / 2, (h - dh) / 2, dw, dh);
+}
+function drawVideoView() {
+  if (S.panel !== 'video') return;
+  const v = S.video;
+  if (!v.clip) { drawSpriteFrame($('video-source'), null); drawSpriteFrame($('video-new'), null); return; }
+  const n = v.clip.frames, t = S.frame;
+  const src = Math.min(t, n - 1);
+  drawSpriteFrame($('video-source'), src);
+  $('video-source-cap').textContent = `source: frame ${src}`;
+  if (v.result) {
+    const f = v.result.order[Math.min(t, v.result.order.length - 1)];
+    drawSpriteFrame($('video-new'), f);
+    $('video-new-cap').textContent = `new order: position ${t} = source frame ${f}`;
+  } else {
+    drawSpriteFrame($('video-new'), null);
+    $('video-new-cap').textContent = 'new order (Generate)';
+  }
+}
+
+// The strip: every source frame, shot boundaries in red, the start frame outlined; a click picks the start.
+function drawVideoStrip() {
+  const cv = $('video-strip'), v = S.video;
+  const w = cv.clientWidth, h = cv.clientHeight;
+  if (cv.width !== w) cv.width = w;
+  if (cv.height !== h) cv.height = h;
+  const c = cv.getContext('2d');
+  c.fillStyle = '#15171c'; c.fillRect(0, 0, w, h);
+  if (!v.clip || !v.sprite) return;
+  const n = v.clip.frames, sp = v.clip.sprite, cw = w / n;
+  const th = h - 14, tw = th * sp.width / sp.height;
+  const every = Math.max(1, Math.ceil(tw / cw));
+  for (let i = 0; i < n; i += every) {
+    c.drawImage(v.sprite, (i % sp.columns) * sp.width, Math.floor(i / sp.columns) * sp.height, sp.width, sp.height, i * cw, 0, tw, th);
+  }
+  c.fillStyle = '#ff5a5a';
+  for (const cut of v.clip.cuts) c.fillRect(cut * cw - 1, 0, 3, h);
+  const s = parseInt($('video-start').value, 10) || 0;
+  c.strokeStyle = '#ffd84d'; c.lineWidth = 2; c.strokeRect(s * cw, 1, Math.max(3, cw), h - 2); c.lineWidth = 1;
+  if (v.result) {
+    c.fillStyle = '#4da3ff';
+    const used = new Set(v.result.order);
+    for (let i = 0; i < n; i++) if (used.has(i)) c.fillRect(i * cw, h - 5, Math.max(1, cw), 4);
+  }
+  c.fillStyle = '#aab1bc'; c.font = '10px system-ui, sans-serif';
+  c.fillText(`start ${s} · red: shot boundary · blue: frames the new order uses`, 4, h - 7);
+}
+$('video-strip').addEventListener('click', (e) => {
+  const v = S.video; if (!v.clip) return;
+  const r = $('video-strip').getBoundingClientRect();
+  $('video-start').value = Math.max(0, Math.min(v.clip.frames - 1, Math.floor((e.clientX - r.left) / r.width * v.clip.frames)));
+  drawVideoStrip();
+});
+
+// Hovering a jump mark on the timeline shows that step's explanation.
+const JUMP_COLORS = { jump: '#ffd84d', back: '#ff5a5a', cut: '#4da3ff', loop: '#c77dff', repeat: '#7d6a99' };
+function jumpAt(e) {
+  const v = S.video; if (S.panel !== 'video' || !v.result) return null;
+  const r = $('timeline').getBoundingClientRect(), n = Math.max(1, v.frames);
+  const x = (f) => 40 + (r.width - 50) * (n > 1 ? f / (n - 1) : 0);
+  let best = null, bd = 6;
+  for (const j of v.result.jumps) { const d = Math.abs(x(Math.min(j.position, n - 1)) - (e.clientX - r.left)); if (d < bd) { bd = d; best = j; } }
+  return best;
+}
+$('timeline').addEventListener('mousemove', (e) => {
+  const j = jumpAt(e), tip = $('video-tip');
+  if (!j) { tip.hidden = true; return; }
+  tip.textContent = `position ${j.position}: ${j.kind}\n${j.text}`;
+  tip.hidden = false;
+  tip.style.left = `${Math.min(e.clientX + 12, window.innerWidth - 580)}px`;
+  tip.style.top = `${Math.max(8, e.clientY - 20 - tip.offsetHeight)}px`;
+});
+$('timeline').addEventListener('mouseleave', () => { $('video-tip').hidden = true; });
+
 // ---------------------------------------------------------------- playback
 function seek(frame) {
   const st = panelState();
@@ -758,6 +907,7 @@ function seek(frame) {
     if (st.rec) st.rec.mixer.setTime(t);
   }
   if (S.panel === 'face') drawFaceView();
+  if (S.panel === 'video') drawVideoView();
   $('frame').textContent = `${S.frame} / ${Math.max(0, n - 1)}`;
   $('time').textContent = `${t.toFixed(2)} s`;
   drawTimeline();
@@ -773,6 +923,7 @@ function loop(now) {
   requestAnimationFrame(loop);
   resize();
   if (S.panel === 'face') { const cv = $('face-curves'); if (cv.width !== cv.clientWidth || cv.height !== cv.clientHeight) { drawFaceView(); drawTimeline(); } }
+  if (S.panel === 'video') { const cv = $('video-source'); if (cv.width !== cv.clientWidth || cv.height !== cv.clientHeight || $('video-strip').width !== $('video-strip').clientWidth) { drawVideoView(); drawVideoStrip(); drawTimeline(); } }
   if (S.playing) {
     const st = panelState();
     playFrame = (S.frame + (now - last) / 1000 * (st.fps || 30));
@@ -844,6 +995,15 @@ function drawTimeline() {
     for (const k of r.keys) { const px = x(k); c.beginPath(); c.moveTo(px, 16); c.lineTo(px + 5, 22); c.lineTo(px, 28); c.lineTo(px - 5, 22); c.closePath(); c.fill(); }
     c.fillStyle = '#aab1bc'; c.fillText(`${r.keys.length} keys`, 2, 26);
   }
+  if (S.panel === 'video' && st.result) {
+    c.fillStyle = '#aab1bc'; c.fillText(`new order: ${st.result.order.length} frames, ${st.result.jumps.length} jumps (rest the pointer on a mark)`, 44, 26);
+    for (const j of st.result.jumps) {
+      const px = x(Math.min(j.position, n - 1));
+      c.fillStyle = JUMP_COLORS[j.kind] || '#ffd84d';
+      c.fillRect(px - 1.5, 32, 3, h - 40);
+      c.beginPath(); c.moveTo(px, 32); c.lineTo(px + 5, 38); c.lineTo(px, 44); c.lineTo(px - 5, 38); c.closePath(); c.fill();
+    }
+  }
   if (S.panel === 'face' && st.take) {
     const [a, b] = faceMask();
     const fa = a * st.fps, fb = b * st.fps;
@@ -900,9 +1060,11 @@ function state() {
     if (st.keysResult) keys = [...st.keysResult.keys];
   }
   if (!camera) camera = { eye: orbitCam.position.toArray(), target: controls.target.toArray(), fov: orbitCam.fov, shot: false };
+  let video = null;
+  if (S.video.clip) video = { order: S.video.result ? S.video.result.order : null, md: S.video.result ? S.video.result.md : null, source_md: S.video.clip.source_md, cuts: S.video.clip.cuts, jumps: S.video.result ? S.video.result.jumps.map((j) => ({ position: j.position, from: j.from, to: j.to, kind: j.kind })) : [] };
   let face = null;
   if (S.face.take) face = { mask: faceMask(), edited: S.face.cur, keys: S.face.keys, version: S.face.version ?? 0, versions: S.face.versions ?? 1, lastEdit: S.face.lastEdit };
-  return JSON.parse(JSON.stringify({ panel: S.panel, fps: st.fps, frames: st.frames, frame: S.frame, objects, characters, camera, keys, face, lastJob: S.lastJob }));
+  return JSON.parse(JSON.stringify({ panel: S.panel, fps: st.fps, frames: st.frames, frame: S.frame, objects, characters, camera, keys, face, video, lastJob: S.lastJob }));
 }
 
 window.inbetweenStudio = {
@@ -926,7 +1088,7 @@ showPanel('script');
 requestAnimationFrame(loop);
 pending = (async () => {
   try {
-    await Promise.all([loadStories(), loadCorpus(), loadFaceCorpus()]);
+    await Promise.all([loadStories(), loadCorpus(), loadFaceCorpus(), loadVideoCorpus()]);
     maxUpload = (await (await fetch('/api/info')).json()).max_upload;
     setStatus('ready: run the story (Ctrl-Enter) or open a take');
   } catch (e) { showError(`could not reach the studio server: ${e.message}`); }

@@ -34,6 +34,16 @@ pub fn explain(path: &SdpfPath) -> String {
     s
 }
 
+/// One transition in words (its head line and its candidates, what each constraint removed, the
+/// probabilities and the choice): the block [`explain`] prints for that step. The studio shows it
+/// when the pointer rests on the step.
+pub fn explain_step(t: &Transition) -> String {
+    let mut s = head(t);
+    s.push('\n');
+    body(&mut s, t);
+    s
+}
+
 fn stop_words(stop: StopReason) -> &'static str {
     match stop {
         StopReason::TargetLength => "target length reached",

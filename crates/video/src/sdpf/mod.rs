@@ -62,7 +62,7 @@ pub mod types;
 
 pub use cuts::{cut_scores, detect_cuts, detect_cuts_with, detect_shots, shots_from_cuts, CutParams};
 pub use distill::{eta, softmax};
-pub use explain::explain;
+pub use explain::{explain, explain_step};
 pub use metrics::{frame_rms, overlap, overlap_delta_o, source_md, stability_md, try_stability_md, Overlap};
 pub use reverse::{
     backward_positions, backward_steps, direction_flips, direction_words, is_backward_step, judge_directed,

@@ -1,0 +1,341 @@
+//! The video panel (issue 24): open an MP4, a GIF or a folder of PNG/JPEG frames (uploaded, named
+//! under `--root`, or a built-in procedural clip with a scene cut), analyse it once (optical flows,
+//! RSFNet trained on the clip or read from its cache, graph, shots: the video engine's [`analyse`]),
+//! then generate new orders from a start frame with SDPF ([`resequence`]) as often as asked: each
+//! regeneration reuses the analysis. The page draws frames from one JPEG sprite of the clip, so a new
+//! order costs only its indices; each jump (a step that is not the next source frame) carries the
+//! engine's explanation of that step. Export writes MP4 and GIF through the engine's writer.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use axum::body::Bytes;
+use axum::extract::{Query, State};
+use axum::Json;
+use image::{imageops, RgbImage};
+use inbetween_io::Progress;
+use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, ProceduralKind, ReadOptions};
+use inbetween_video::pipeline::{analyse, reorder, resequence, Analysis, ResequenceConfig};
+use inbetween_video::sdpf::{explain_step, stability_md, SdpfParams, StepKind};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use crate::error::{Result, StudioError};
+use crate::jobs::{answer, Job};
+use crate::mocap_panel::UploadQuery;
+use crate::safety::resolve_under_root;
+use crate::server::AppState;
+
+/// The open clip and its analysis.
+struct Opened {
+    name: String,
+    clip: Clip,
+    analysis: Analysis,
+    source_md: f64,
+}
+
+/// The panel's clip.
+#[derive(Default)]
+pub struct VideoState {
+    open: Mutex<Option<Arc<Opened>>>,
+    version: std::sync::atomic::AtomicU64,
+}
+
+impl VideoState {
+    fn next_version(&self) -> u64 {
+        self.version.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1
+    }
+}
+
+/// Built-in clip: the procedural "mixed" clip (a pendulum, a linear stretch and a scene cut).
+pub const BUILTIN: (&str, usize) = ("builtin:mixed", 96);
+
+/// Width of a frame in the page's sprite, pixels.
+pub const THUMB_WIDTH: u32 = 320;
+/// Frames per sprite row.
+pub const SPRITE_COLUMNS: u32 = 12;
+
+/// `GET /api/video/corpus`: MP4 and GIF files and folders of PNG/JPEG frames under `--root` (below a
+/// folder named `video`), and the built-in clip.
+pub async fn corpus(State(st): State<Arc<AppState>>) -> Json<Value> {
+    let mut files = Vec::new();
+    if let Some(root) = &st.config.root {
+        list(root, root, 0, &mut files);
+    }
+    files.sort();
+    Json(json!({ "files": files, "builtin": [BUILTIN.0] }))
+}
+
+fn list(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        if out.len() >= 2000 {
+            return;
+        }
+        let p = e.path();
+        let Ok(kind) = e.file_type() else { continue };
+        let Ok(rel) = p.strip_prefix(root) else { continue };
+        let rel = rel.to_string_lossy().replace('\\', "/");
+        let in_video = rel.split('/').any(|c| c == "video");
+        if kind.is_dir() {
+            let images = std::fs::read_dir(&p)
+                .map(|rd| {
+                    rd.flatten().any(|f| {
+                        let n = f.file_name().to_string_lossy().to_ascii_lowercase();
+                        n.ends_with(".png") || n.ends_with(".jpg") || n.ends_with(".jpeg")
+                    })
+                })
+                .unwrap_or(false);
+            if images && in_video {
+                out.push(format!("{rel}/"));
+            } else if depth < 6 {
+                list(root, &p, depth + 1, out);
+            }
+        } else if kind.is_file() && in_video {
+            let ext = p.extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+            if matches!(ext.as_deref(), Some("mp4" | "m4v" | "mov" | "gif")) {
+                out.push(rel);
+            }
+        }
+    }
+}
+
+#[derive(Deserialize)]
+pub struct OpenRequest {
+    /// `builtin:mixed`, or a file or folder relative to `--root`.
+    pub path: String,
+}
+
+/// `POST /api/video/open`: the built-in clip or a file / folder under `--root`; decodes and analyses.
+pub async fn open_path(State(st): State<Arc<AppState>>, Json(req): Json<OpenRequest>) -> Result<Json<Value>> {
+    let file = if req.path == BUILTIN.0 {
+        None
+    } else {
+        Some(resolve_under_root(st.config.root.as_deref(), req.path.trim_end_matches('/'))?)
+    };
+    let state = st.clone();
+    let id = st.jobs.spawn("video-open", move |job| {
+        job.progress("decoding", 0.05);
+        let (name, clip) = match file {
+            None => (BUILTIN.0.to_string(), procedural_clip(ProceduralKind::Mixed, BUILTIN.1, 192, 144, 7)),
+            Some(path) => (req.path.clone(), decode(&path, &req.path)?),
+        };
+        opened(&state, job, name, clip)
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+fn decode(path: &Path, shown: &str) -> Result<Clip> {
+    let (clip, _) = read_clip(path, &ReadOptions::default()).map_err(|e| {
+        // The page shows the name the user knows, not a temporary or absolute path.
+        StudioError::Engine(e.to_string().replace(&path.display().to_string(), shown))
+    })?;
+    Ok(clip)
+}
+
+/// `POST /api/video/upload?name=…`: an MP4 or GIF's bytes; decodes and analyses.
+pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
+    let name: String = q.name.chars().filter(|c| !c.is_control() && *c != '/' && *c != '\\').take(200).collect();
+    let state = st.clone();
+    let id = st.jobs.spawn("video-open", move |job| {
+        job.progress("decoding", 0.05);
+        let ext = Path::new(&name).extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
+        if !matches!(ext.as_deref(), Some("mp4" | "m4v" | "mov" | "gif")) {
+            return Err(StudioError::BadRequest(format!(
+                "{name}: expected an .mp4 (H.264) or an animated .gif (or, from the corpus, a folder of PNG/JPEG frames)"
+            )));
+        }
+        let dir = tempfile::tempdir().map_err(|e| StudioError::io(std::env::temp_dir(), e))?;
+        let path: PathBuf = dir.path().join(format!("upload.{}", ext.unwrap_or_default()));
+        std::fs::write(&path, &body).map_err(|e| StudioError::io(&path, e))?;
+        let clip = decode(&path, &name)?;
+        opened(&state, job, name.clone(), clip)
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+/// The clip's frames scaled to [`THUMB_WIDTH`] in one JPEG, [`SPRITE_COLUMNS`] per row.
+fn sprite(clip: &Clip) -> Result<(Vec<u8>, u32, u32)> {
+    let (w, h) = (clip.width().max(1), clip.height().max(1));
+    let tw = THUMB_WIDTH.min(w);
+    let th = ((u64::from(h) * u64::from(tw)) / u64::from(w)).max(1) as u32;
+    let n = clip.len() as u32;
+    let cols = SPRITE_COLUMNS.min(n.max(1));
+    let rows = n.div_ceil(cols);
+    let mut sheet = RgbImage::new(cols * tw, rows * th);
+    for (i, f) in clip.frames.iter().enumerate() {
+        let small = imageops::resize(f, tw, th, imageops::FilterType::Triangle);
+        let (x, y) = ((i as u32 % cols) * tw, (i as u32 / cols) * th);
+        imageops::replace(&mut sheet, &small, i64::from(x), i64::from(y));
+    }
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 80)
+        .encode_image(&sheet)
+        .map_err(|e| StudioError::Runtime(format!("encoding the frame sprite: {e}")))?;
+    Ok((jpeg, tw, th))
+}
+
+fn opened(st: &AppState, job: &Job, name: String, clip: Clip) -> Result<Value> {
+    if clip.len() < 2 {
+        return Err(StudioError::Engine(format!("{name}: {} frame(s); a clip needs at least 2", clip.len())));
+    }
+    job.progress("analysing: optical flow, RSFNet (trained on the clip, or from its cache), graph, cuts", 0.15);
+    let cfg = ResequenceConfig::default();
+    cfg.limits.check_clip(&clip).map_err(|e| StudioError::Engine(e.to_string()))?;
+    let analysis = analyse(&clip, &cfg, &Progress::hidden()).map_err(|e| StudioError::Engine(e.to_string()))?;
+    if job.is_cancelled() {
+        return Err(StudioError::Engine("cancelled".into()));
+    }
+    job.progress("frame sprite for the page", 0.9);
+    let (jpeg, tw, th) = sprite(&clip)?;
+    let v = st.video.next_version();
+    let sprite_url = st.put_file("video/frames.jpg", "image/jpeg", jpeg, v);
+    let source: Vec<usize> = (0..clip.len()).collect();
+    let source_md = stability_md(&clip.frames, &source);
+    let shots = analysis.info.shot.clone();
+    let boundaries: Vec<usize> = (1..shots.len()).filter(|&i| shots[i] != shots[i - 1]).collect();
+    let msg = format!(
+        "opened {name}: {} frames {}x{} at {:.3} fps, {} shot(s); {}",
+        clip.len(),
+        clip.width(),
+        clip.height(),
+        clip.fps,
+        boundaries.len() + 1,
+        analysis.metric_note
+    );
+    let out = json!({
+        "ok": true,
+        "message": msg,
+        "name": name,
+        "frames": clip.len(),
+        "fps": clip.fps,
+        "width": clip.width(),
+        "height": clip.height(),
+        "shots": shots,
+        "cuts": boundaries,
+        "directed": analysis.direction.iter().map(|d| d.0).collect::<Vec<_>>(),
+        "stages": analysis.stages.iter().map(|(s, t)| json!({"stage": s, "s": t})).collect::<Vec<_>>(),
+        "source_md": source_md,
+        "sprite": {"url": sprite_url, "width": tw, "height": th, "columns": SPRITE_COLUMNS.min(clip.len() as u32)},
+    });
+    *st.video.open.lock().unwrap_or_else(|p| p.into_inner()) =
+        Some(Arc::new(Opened { name, clip, analysis, source_md }));
+    Ok(out)
+}
+
+#[derive(Deserialize)]
+pub struct GenerateRequest {
+    /// Start frame (source index).
+    #[serde(default)]
+    pub start: usize,
+    /// Frames of the new order (default: the source's length).
+    pub length: Option<usize>,
+    /// End on a frame that returns to the start.
+    #[serde(default, rename = "loop")]
+    pub loop_close: bool,
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// `POST /api/video/generate`: a new order from the analysed clip.
+pub async fn generate(State(st): State<Arc<AppState>>, Json(req): Json<GenerateRequest>) -> Result<Json<Value>> {
+    let open = st.video.open.lock().unwrap_or_else(|p| p.into_inner()).clone();
+    let state = st.clone();
+    let id = st.jobs.spawn("video-generate", move |job| {
+        let o = open.ok_or_else(|| StudioError::BadRequest("open a clip first".into()))?;
+        let n = o.clip.len();
+        if req.start >= n {
+            return Err(StudioError::BadRequest(format!(
+                "start frame {} is outside the clip (frames 0..{})",
+                req.start,
+                n - 1
+            )));
+        }
+        job.progress("SDPF walk", 0.1);
+        let params =
+            SdpfParams { length: req.length, loop_close: req.loop_close, seed: req.seed, ..SdpfParams::default() };
+        let limits = ResequenceConfig::default().limits;
+        let (paths, walk_s) =
+            resequence(&o.analysis, req.start, &params, 1, &limits).map_err(|e| StudioError::Engine(e.to_string()))?;
+        let path = paths.into_iter().next().ok_or_else(|| StudioError::Engine("no path from this start".into()))?;
+        let order = path.frames.clone();
+        // Each step that is not the next source frame, with the engine's words for it. Steps inside a
+        // repeating loop (after a loop back the path's frames repeat without new transitions) point
+        // to the step they repeat.
+        let mut jumps = Vec::new();
+        let mut first_at: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
+        for p in 1..order.len() {
+            let (from, to) = (order[p - 1], order[p]);
+            if to == from + 1 {
+                continue;
+            }
+            let (kind, text) = match path.transitions.get(p - 1).filter(|t| t.from == from && t.chosen == Some(to)) {
+                Some(t) => {
+                    let kind = match t.kind {
+                        StepKind::Distilled if to < from => "back",
+                        StepKind::Distilled => "jump",
+                        StepKind::Cut { .. } => "cut",
+                        StepKind::LoopBack { .. } => "loop",
+                    };
+                    (kind, explain_step(t))
+                }
+                None => {
+                    let q = first_at.get(&(from, to)).copied().unwrap_or(p);
+                    ("repeat", format!("frame {from} → {to}: the loop repeats the step at position {q}"))
+                }
+            };
+            first_at.entry((from, to)).or_insert(p);
+            jumps.push(json!({"position": p, "from": from, "to": to, "kind": kind, "text": text}));
+        }
+        let closing = path.closing.as_ref().map(|t| json!({"from": t.from, "to": t.chosen, "text": explain_step(t)}));
+        let md = stability_md(&o.clip.frames, &order);
+        let v = state.video.next_version();
+        let (mp4, gif) = export(&state, &o, &order, v);
+        let msg = format!(
+            "SDPF from frame {}: {} frames ({:?}), {} jumps, M_D {md:.4} (source {:.4}), walk {:.0} ms",
+            req.start,
+            order.len(),
+            path.stop,
+            jumps.len(),
+            o.source_md,
+            walk_s * 1e3
+        );
+        Ok(json!({
+            "ok": true,
+            "message": msg,
+            "order": order,
+            "jumps": jumps,
+            "md": md,
+            "source_md": o.source_md,
+            "closes_loop": path.closes_loop,
+            "closing": closing,
+            "walk_ms": walk_s * 1e3,
+            "files": {"mp4": mp4, "gif": gif},
+        }))
+    });
+    Ok(Json(answer(&st.jobs, id).await))
+}
+
+/// MP4 and GIF of the new order, written on first download through the engine's writer.
+fn export(st: &AppState, o: &Arc<Opened>, order: &[usize], v: u64) -> (String, String) {
+    let stem = Path::new(&o.name).file_stem().and_then(|s| s.to_str()).unwrap_or("clip").replace(':', "-");
+    let mut urls = Vec::new();
+    for (ext, ctype) in [("mp4", "video/mp4"), ("gif", "image/gif")] {
+        let (o, order) = (o.clone(), order.to_vec());
+        urls.push(st.put_lazy(
+            &format!("video/{stem}-new.{ext}"),
+            ctype,
+            move || {
+                let Ok(dir) = tempfile::tempdir() else { return Vec::new() };
+                let path = dir.path().join(format!("new.{ext}"));
+                match write_clip(&path, &reorder(&o.clip, &order)) {
+                    Ok(()) => std::fs::read(&path).unwrap_or_default(),
+                    Err(_) => Vec::new(),
+                }
+            },
+            v,
+        ));
+    }
+    let gif = urls.pop().unwrap_or_default();
+    (urls.pop().unwrap_or_default(), gif)
+}
