@@ -54,8 +54,12 @@ pub struct BenchArgs {
 #[derive(Args)]
 pub struct GenerateArgs {
     /// Scene JSON (characters' root and shoulder positions per frame).
-    #[arg(long)]
-    pub scene: PathBuf,
+    #[arg(long, required_unless_present = "characters", conflicts_with = "characters")]
+    pub scene: Option<PathBuf>,
+    /// Two mocap takes (BVH, or ASF+AMC as .amc with its .asf beside it) as the scene's characters:
+    /// roots from their hips, shoulders from their upper-arm joints, metres, Y up.
+    #[arg(long, num_args = 2, value_names = ["A", "B"])]
+    pub characters: Vec<PathBuf>,
     /// Keyframes JSON: {"keys": [{"frame", "camera": {"pa", "pb", "theta", "phi"}, "targets"?, "velocity"?}], "main"?}.
     #[arg(long)]
     pub keys: PathBuf,
@@ -195,14 +199,25 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
     let limits = GenerateLimits { max_frames: a.max_frames, max_keys: a.max_keys };
     let w = load_weights(a.weights.as_deref())?;
-    let scene = Scene::load(&a.scene)?;
-    LimitExceeded::check_count(
-        a.scene.display().to_string(),
-        scene.num_frames(),
-        limits.max_frames,
-        "frames",
-        "max_frames",
-    )?;
+    let (scene, scene_name) = match &a.scene {
+        Some(p) => (Scene::load(p)?, p.display().to_string()),
+        None => {
+            let motions = a
+                .characters
+                .iter()
+                .map(|p| inbetween_io::load_motion(p).map_err(anyhow::Error::from))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let names: Vec<String> = a.characters.iter().map(|p| p.display().to_string()).collect();
+            let takes: Vec<(&str, &inbetween_core::Motion)> =
+                names.iter().map(String::as_str).zip(motions.iter()).collect();
+            let (scene, notes) = inbetween_camera::dataset::scene_from_motions(&takes).map_err(anyhow::Error::msg)?;
+            for line in notes.lines {
+                println!("  {line}");
+            }
+            (scene, names.join(" + "))
+        }
+    };
+    LimitExceeded::check_count(scene_name, scene.num_frames(), limits.max_frames, "frames", "max_frames")?;
     let keys = Keys::load(&a.keys)?;
     let options = GenerateOptions {
         exact_keys: !a.no_exact_keys,

@@ -226,3 +226,48 @@ fn camera_limits_and_time_limits_name_their_flags_and_write_nothing() {
     assert!(err.contains("raise it with --max-frames"), "{err}");
     assert!(!d.join("big").exists());
 }
+
+#[test]
+fn generate_takes_two_bvh_takes_as_the_characters() {
+    use inbetween_core::procedural::{gait, GaitParams};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (a, b) = (d.join("a.bvh"), d.join("b.bvh"));
+    std::fs::write(&a, inbetween_io::to_bvh_string(&gait(&GaitParams { frames: 90, ..GaitParams::walk() }))).unwrap();
+    std::fs::write(&b, inbetween_io::to_bvh_string(&gait(&GaitParams { frames: 120, ..GaitParams::walk() }))).unwrap();
+    let keys = d.join("keys.json");
+    std::fs::write(
+        &keys,
+        r#"{"keys":[{"frame":0,"camera":{"pa":[-0.3,0.0],"pb":[0.3,0.0],"theta":1.0,"phi":0.2}},
+                    {"frame":80,"camera":{"pa":[-0.2,0.1],"pb":[0.35,0.0],"theta":1.5,"phi":0.3}}]}"#,
+    )
+    .unwrap();
+    let cam = d.join("cam.json");
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--characters",
+        s(&a),
+        s(&b),
+        "--keys",
+        s(&keys),
+        "--style",
+        "orbit",
+        "-o",
+        s(&cam),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("a.bvh: root Hips, shoulders LeftArm / RightArm"), "{text}");
+    assert!(text.contains("moved 1.5 m"), "two takes at one spot are set apart: {text}");
+    let track: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&cam).unwrap()).unwrap();
+    assert_eq!(track["frames"].as_array().unwrap().len(), 81);
+    // A take without shoulders is refused, naming it; --scene and --characters exclude each other.
+    std::fs::write(&b, std::fs::read_to_string(&a).unwrap().replace("LeftArm", "Wing").replace("LeftShoulder", "Fin"))
+        .unwrap();
+    let err =
+        fails(&inbetween(&["camera", "generate", "--characters", s(&a), s(&b), "--keys", s(&keys), "-o", s(&cam)]));
+    assert!(err.contains("b.bvh: no left/right shoulder joints found"), "{err}");
+    let err = fails(&inbetween(&["camera", "generate", "--keys", s(&keys), "-o", s(&cam)]));
+    assert!(err.contains("--scene") || err.contains("--characters"), "{err}");
+}

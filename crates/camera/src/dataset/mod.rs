@@ -2,9 +2,11 @@
 //! character and per-scene parameter variation (§4.5). Seeded, fast (pure geometry) and serialisable.
 
 pub mod behaviours;
+pub mod from_motion;
 pub mod scene;
 
 pub use behaviours::{film, Behaviour, BehaviourParams, BEHAVIOURS};
+pub use from_motion::{scene_from_motions, SceneNotes};
 pub use scene::Scene;
 
 use crate::features::{encode_camera, encode_character, CharacterFeatures, CAM_DIM, CHAR_ENC};

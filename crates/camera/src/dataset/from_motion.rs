@@ -1,0 +1,168 @@
+//! A scene from two (or more) mocap takes (issue 24): each character's root is its hips joint and its
+//! shoulders its upper-arm (or shoulder, clavicle) joints, in metres (the length unit inferred per
+//! file, as elsewhere), Y up as in BVH. Takes at other frame rates are resampled to the first one's;
+//! the scene lasts as long as the shortest take.
+
+use glam::DVec3;
+use inbetween_core::units::UnitChoice;
+use inbetween_core::{positions_clip, Motion};
+
+use super::scene::{CharacterTrack, Scene};
+
+/// Joint names (lower case, letters and digits only) tried for each shoulder, best first: the
+/// upper-arm joint sits at the shoulder; a clavicle or collar joint is a fallback.
+const LEFT: [&str; 11] = [
+    "leftarm",
+    "leftupperarm",
+    "lupperarm",
+    "ccbaselupperarm",
+    "lhumerus",
+    "larm",
+    "leftshoulder",
+    "lshoulder",
+    "ccbaselclavicle",
+    "lclavicle",
+    "leftcollar",
+];
+const RIGHT: [&str; 11] = [
+    "rightarm",
+    "rightupperarm",
+    "rupperarm",
+    "ccbaserupperarm",
+    "rhumerus",
+    "rarm",
+    "rightshoulder",
+    "rshoulder",
+    "ccbaserclavicle",
+    "rclavicle",
+    "rightcollar",
+];
+
+/// Hip joint names (same normalisation); the root joint when none matches (some rigs root at a
+/// ground bone, such as iClone's `RL_BoneRoot`).
+const HIPS: [&str; 5] = ["hips", "hip", "ccbasehip", "pelvis", "ccbasepelvis"];
+
+fn key(name: &str) -> String {
+    name.chars().filter(|c| c.is_ascii_alphanumeric()).map(|c| c.to_ascii_lowercase()).collect()
+}
+
+/// The joint of `motion` best matching `names` (first name wins).
+fn find(motion: &Motion, names: &[&str]) -> Option<usize> {
+    let keys: Vec<String> = motion.skeleton.joints().iter().map(|j| key(&j.name)).collect();
+    names.iter().find_map(|n| keys.iter().position(|k| k == n))
+}
+
+/// What [`scene_from_motions`] did beyond the obvious, for the user to read.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SceneNotes {
+    pub lines: Vec<String>,
+}
+
+/// A scene of `takes` (name shown to the user, motion). Errors name the take and what was expected.
+pub fn scene_from_motions(takes: &[(&str, &Motion)]) -> Result<(Scene, SceneNotes), String> {
+    if takes.len() < 2 {
+        return Err(format!("a camera scene needs two characters, got {}", takes.len()));
+    }
+    let fps = takes[0].1.fps();
+    let duration =
+        takes.iter().map(|(_, m)| (m.num_frames().saturating_sub(1)) as f64 / m.fps()).fold(f64::INFINITY, f64::min);
+    let frames = (duration * fps).floor() as usize + 1;
+    if frames < 2 {
+        return Err(format!("the shortest take lasts {duration:.3} s: a scene needs at least 2 frames"));
+    }
+    let mut notes = SceneNotes::default();
+    let mut characters = Vec::new();
+    for (name, motion) in takes {
+        let (l, r) = match (find(motion, &LEFT), find(motion, &RIGHT)) {
+            (Some(l), Some(r)) => (l, r),
+            _ => {
+                return Err(format!(
+                    "{name}: no left/right shoulder joints found; expected joints named like LeftArm / RightArm, \
+                     LeftShoulder / RightShoulder, lhumerus / rhumerus or CC_Base_L_Upperarm / CC_Base_R_Upperarm"
+                ))
+            }
+        };
+        let hips = find(motion, &HIPS).unwrap_or(0);
+        let unit = UnitChoice::resolve(None, &motion.skeleton);
+        let m = unit.cm_per_unit() / 100.0;
+        let pos = positions_clip(motion);
+        let at = |f: usize, j: usize| pos[f][j] * m;
+        // Position of joint `j` at scene frame `f`: linear between the take's frames around that time.
+        let sample = |f: usize, j: usize| -> DVec3 {
+            let x = f as f64 / fps * motion.fps();
+            let (i0, w) = (x.floor() as usize, x - x.floor());
+            let i0 = i0.min(motion.num_frames() - 1);
+            let i1 = (i0 + 1).min(motion.num_frames() - 1);
+            at(i0, j).lerp(at(i1, j), w)
+        };
+        notes.lines.push(format!(
+            "{name}: root {}, shoulders {} / {}; {}",
+            motion.skeleton.joint(hips).name,
+            motion.skeleton.joint(l).name,
+            motion.skeleton.joint(r).name,
+            unit
+        ));
+        characters.push(CharacterTrack {
+            name: name.to_string(),
+            root: (0..frames).map(|f| sample(f, hips)).collect(),
+            shoulder_l: (0..frames).map(|f| sample(f, l)).collect(),
+            shoulder_r: (0..frames).map(|f| sample(f, r)).collect(),
+        });
+    }
+    // Two takes recorded at the same spot would stand inside each other: the framing needs two
+    // distinct targets, so the second steps aside (said in the notes).
+    let mean_gap =
+        (0..frames).map(|f| characters[0].frame(f).target().distance(characters[1].frame(f).target())).sum::<f64>()
+            / frames as f64;
+    if mean_gap < 0.5 {
+        let shift = DVec3::new(1.5, 0.0, 0.0);
+        let c = &mut characters[1];
+        for v in c.root.iter_mut().chain(c.shoulder_l.iter_mut()).chain(c.shoulder_r.iter_mut()) {
+            *v += shift;
+        }
+        notes.lines.push(format!(
+            "the two takes stand {mean_gap:.2} m apart on average: {} moved 1.5 m along +X so that both can be framed",
+            characters[1].name
+        ));
+    }
+    if takes.iter().any(|(_, m)| (m.fps() - fps).abs() > 1e-6) {
+        notes.lines.push(format!("takes resampled to {fps:.3} fps (the first take's rate)"));
+    }
+    let scene = Scene { fps, characters };
+    scene.validate()?;
+    Ok((scene, notes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use inbetween_core::procedural::{gait, GaitParams};
+
+    #[test]
+    fn two_walks_make_a_valid_scene_with_shoulders_at_shoulder_height() {
+        let a = gait(&GaitParams { frames: 60, ..GaitParams::walk() });
+        let b = gait(&GaitParams { frames: 90, ..GaitParams::walk() });
+        let (scene, notes) = scene_from_motions(&[("a.bvh", &a), ("b.bvh", &b)]).unwrap();
+        assert_eq!(scene.characters.len(), 2);
+        assert_eq!(scene.num_frames(), 60, "the shortest take");
+        let f = scene.characters[0].frame(10);
+        assert!(f.shoulder_l.y > f.root.y, "shoulders above the hips: {f:?}");
+        assert!((f.shoulder_l - f.shoulder_r).length() > 0.1, "two distinct shoulders");
+        // Same spot: the second character is moved aside, and the notes say so.
+        assert!(notes.lines.iter().any(|l| l.contains("moved 1.5 m")), "{notes:?}");
+        assert!(scene.characters[0].frame(0).target().distance(scene.characters[1].frame(0).target()) > 1.0);
+    }
+
+    #[test]
+    fn a_take_without_shoulders_is_refused_naming_it() {
+        let mut a = gait(&GaitParams { frames: 20, ..GaitParams::walk() });
+        let mut joints = a.skeleton.joints().to_vec();
+        for (i, j) in joints.iter_mut().enumerate() {
+            j.name = format!("bone{i}");
+        }
+        a.skeleton = inbetween_core::Skeleton::new(joints).unwrap();
+        let b = gait(&GaitParams { frames: 20, ..GaitParams::walk() });
+        let err = scene_from_motions(&[("odd.bvh", &a), ("b.bvh", &b)]).unwrap_err();
+        assert!(err.starts_with("odd.bvh: no left/right shoulder joints"), "{err}");
+    }
+}
