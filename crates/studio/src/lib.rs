@@ -1,5 +1,6 @@
 //! `inbetween studio`: a local web studio where a story or a mocap take is run, seen in 3D and
-//! edited (issue 23), a face capture is masked and refilled, and a clip is resequenced (issue 24). The server is axum on tokio; every job calls an engine's public library
+//! edited (issue 23), a face capture is masked and refilled, a clip is resequenced and a camera is keyed between two
+//! characters (issue 24). The server is axum on tokio; every job calls an engine's public library
 //! API (the script engine's [`inbetween_script::animate::incremental::StorySession`], the mocap
 //! engine's key selectors and `.ibk` codec) on a blocking thread; results reach the page as JSON,
 //! glTF and BVH (forms three.js reads), progress as server-sent events.
@@ -8,8 +9,9 @@
 //! - [`safety`]: Host (DNS rebinding) and Origin (cross-site writes) checks, the upload cap, paths
 //!   only under `--root`;
 //! - [`jobs`]: job registry with progress events and cancellation;
-//! - [`script_panel`], [`mocap_panel`], [`face_panel`], [`video_panel`]: the panels' jobs (the
-//!   face engine's `EditJob`, the video engine's analysis and SDPF walks: issue 24);
+//! - [`script_panel`], [`mocap_panel`], [`face_panel`], [`video_panel`], [`camera_panel`]: the
+//!   panels' jobs (the face engine's `EditJob`, the video engine's analysis and SDPF walks, the
+//!   camera engine's `GenerateJob`: issue 24);
 //! - [`assets`]: the embedded front-end (our files and three.js installed by `build.rs`);
 //! - [`browser`], [`bench`]: headless Chromium for the browser tests and `inbetween studio bench`.
 
@@ -19,6 +21,7 @@
 pub mod assets;
 pub mod bench;
 pub mod browser;
+pub mod camera_panel;
 pub mod error;
 pub mod face_panel;
 pub mod jobs;

@@ -20,7 +20,7 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::Jobs;
-use crate::{assets, face_panel, mocap_panel, safety, script_panel, video_panel};
+use crate::{assets, camera_panel, face_panel, mocap_panel, safety, script_panel, video_panel};
 
 /// Default `--max-upload`: 512 MB.
 pub const DEFAULT_MAX_UPLOAD: u64 = 512 * 1000 * 1000;
@@ -88,6 +88,7 @@ pub struct AppState {
     pub mocap: mocap_panel::MocapState,
     pub face: face_panel::FaceState,
     pub video: video_panel::VideoState,
+    pub camera: camera_panel::CameraState,
 }
 
 impl AppState {
@@ -179,7 +180,13 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/video/corpus", get(video_panel::corpus))
         .route("/api/video/open", post(video_panel::open_path))
         .route("/api/video/upload", post(video_panel::upload))
-        .route("/api/video/generate", post(video_panel::generate));
+        .route("/api/video/generate", post(video_panel::generate))
+        .route("/api/camera/open", post(camera_panel::open))
+        .route("/api/camera/upload", post(camera_panel::upload))
+        .route("/api/camera/reference", post(camera_panel::reference))
+        .route("/api/camera/key_at", post(camera_panel::key_at))
+        .route("/api/camera/toric", post(camera_panel::toric))
+        .route("/api/camera/generate", post(camera_panel::generate));
     if state.config.test_routes {
         app = app.route("/api/test/panic", post(test_panic));
     }
@@ -352,6 +359,7 @@ fn state(config: StudioConfig, bound: SocketAddr) -> Arc<AppState> {
         mocap: mocap_panel::MocapState::default(),
         face: face_panel::FaceState::default(),
         video: video_panel::VideoState::default(),
+        camera: camera_panel::CameraState::default(),
     })
 }
 

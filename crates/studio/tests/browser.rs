@@ -544,3 +544,134 @@ fn video_panel_in_headless_chromium() {
     assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
     assert_eq!(error_text(&b), "");
 }
+
+#[test]
+fn camera_panel_in_headless_chromium() {
+    let (chromium, driver) = match available() {
+        Ok(found) => found,
+        Err(why) => {
+            println!("skipped: {why}");
+            return;
+        }
+    };
+    if inbetween_studio::assets::missing().is_some() {
+        println!("skipped: the studio was built without three.js (no Node at build time)");
+        return;
+    }
+    let data = inbetween_io::shared_data_dir();
+    let studio = Studio::start(StudioConfig { port: 0, ..StudioConfig::default() }).expect("start");
+    let b = Browser::launch(&chromium, &driver, 1280, 800).expect("launch chromium");
+    b.goto(&studio.url()).unwrap();
+    b.eval("window.inbetweenStudio.ready()").unwrap();
+    b.eval("(document.querySelector('[data-testid=nav-camera]').click(), true)").unwrap();
+    assert_eq!(state(&b)["panel"], "camera");
+
+    // Two CMU takes as the characters (the built-in procedural pair without data).
+    let takes = data.as_ref().ok().map(|d| {
+        let dir = d.join("mocap/cmu/iclone_cc");
+        (dir.join("007_12.bvh"), dir.join("002_01.bvh"))
+    });
+    let real = takes.as_ref().is_some_and(|(a, c)| a.is_file() && c.is_file());
+    let wait_for_job = |n: u64| {
+        b.eval(&format!(
+            "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
+               window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
+               : Date.now() - t0 > 20000 ? fail(new Error('no job started')) : setTimeout(poll, 20); poll(); }})"
+        ))
+        .unwrap();
+    };
+    if real {
+        let (a, c) = takes.as_ref().unwrap();
+        let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
+        b.set_files(&sel("camera-characters"), &[a.as_path(), c.as_path()]).unwrap();
+        wait_for_job(n);
+    } else {
+        println!(
+            "skipped: no data at {} (CMU takes; using the built-in pair)",
+            data.as_ref().map_or_else(|e| e.display().to_string(), |d| d.display().to_string())
+        );
+        b.eval("(s => { s.value = 'builtin:pair'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('camera-scene'))").unwrap();
+    }
+    let st = state(&b);
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["kind"], "camera-scene", "{}", st["lastJob"]);
+    let frames = st["frames"].as_u64().unwrap();
+    assert!(frames > 100, "{st}");
+    assert_eq!(st["characters"].as_array().unwrap().len(), 2, "{st}");
+    assert_eq!(st["camera"]["keys"].as_array().unwrap().len(), 3, "three starting keys: {}", st["camera"]);
+
+    // A key at the playhead.
+    b.eval("window.inbetweenStudio.seek(60)").unwrap();
+    let st = click_and_wait(&b, "camera-add-key");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let key_frames: Vec<u64> =
+        st["camera"]["keys"].as_array().unwrap().iter().map(|k| k["frame"].as_u64().unwrap()).collect();
+    assert_eq!(key_frames.len(), 4);
+    assert!(key_frames.contains(&60), "{key_frames:?}");
+    assert!(key_frames.windows(2).all(|w| w[0] < w[1]), "keys in time order: {key_frames:?}");
+
+    // Every style at once, each through every key.
+    let st = click_and_wait(&b, "camera-generate");
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let trajectories = st["camera"]["trajectories"].as_array().unwrap();
+    let styles: Vec<&str> = trajectories.iter().map(|t| t["style"].as_str().unwrap()).collect();
+    assert_eq!(styles, ["direct", "relative", "side", "orbit"]);
+    for t in trajectories {
+        assert!(t["key_hit_error"].as_f64().unwrap() < 1e-6, "every key hit: {t}");
+        assert_eq!(t["frames"].as_u64().unwrap(), key_frames[3] - key_frames[0] + 1, "{t}");
+    }
+    let children = b.eval(&format!("{}.children.length", js_sel("camera-trajectories"))).unwrap();
+    assert_eq!(children, 4, "one listed trajectory per style");
+    let status = st["lastJob"]["message"].as_str().unwrap().to_string();
+    assert!(status.contains("key hit error"), "{status}");
+
+    // Pick orbit and look through its camera: the view shows the scene.
+    b.eval("(document.querySelector('#camera-trajectories [data-style=orbit]').click(), true)").unwrap();
+    b.eval(&format!("({}.click(), true)", js_sel("camera-shot"))).unwrap();
+    b.eval("window.inbetweenStudio.seek(80)").unwrap();
+    let st = state(&b);
+    assert_eq!(st["camera"]["selected"], "orbit");
+    assert_eq!(st["camera"]["shot"], true);
+    let covered = viewport_coverage(&b);
+    assert!(covered > 0.02, "the shot camera's view looks blank: {covered:.3}");
+
+    // The selected key takes the Toric pose of a camera placed in the viewport.
+    b.eval(&format!("({}.click(), true)", js_sel("camera-shot"))).unwrap();
+    let st = b
+        .eval("(document.getElementById('camera-key-from-view').click(), window.inbetweenStudio.ready())")
+        .map(|_| state(&b))
+        .unwrap();
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert!(st["lastJob"]["message"].as_str().unwrap().contains("set from the view"), "{}", st["lastJob"]);
+
+    // Export: the track as JSON.
+    let track = b.eval("fetch(document.querySelector('#camera-export a').href).then(r => r.json())").unwrap();
+    assert!(
+        track["frames"].as_array().is_some_and(|f| !f.is_empty()),
+        "{}",
+        &track.to_string()[..200.min(track.to_string().len())]
+    );
+
+    // A garbage take: its error names it; the next generation still works.
+    let dir = tempfile::tempdir().unwrap();
+    let (junk, good) = (dir.path().join("garbage.bvh"), dir.path().join("walk.bvh"));
+    std::fs::write(&junk, "HIERARCHY\nROOT Hips\n{\n  OFFSET nope\n").unwrap();
+    std::fs::write(
+        &good,
+        inbetween_io::to_bvh_string(&inbetween_core::procedural::gait(&inbetween_core::procedural::GaitParams {
+            frames: 60,
+            ..inbetween_core::procedural::GaitParams::walk()
+        })),
+    )
+    .unwrap();
+    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
+    // WebDriver adds files to a `multiple` input: empty it first, as a new pick would.
+    b.eval("(document.getElementById('camera-characters').value = '', true)").unwrap();
+    b.set_files(&sel("camera-characters"), &[good.as_path(), junk.as_path()]).unwrap();
+    wait_for_job(n);
+    let err = error_text(&b);
+    assert!(err.contains("garbage.bvh:"), "the error should name the file and line: {err:?}");
+    let st = click_and_wait(&b, "camera-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+}
