@@ -55,7 +55,7 @@ enum Command {
     /// Script engine: text → semantic scene graph → furnished scene (Write-An-Animation).
     #[command(subcommand)]
     Script(cmd_script::ScriptCommand),
-    /// Local web studio (script and mocap panels): serves http://127.0.0.1:7878/ until Ctrl-C.
+    /// Local web studio (script, mocap, camera, face and video panels): serves http://127.0.0.1:7878/ until Ctrl-C.
     Studio(cmd_studio::StudioArgs),
 }
 

@@ -2,7 +2,8 @@
 //! under `--root`, or a built-in procedural clip with a scene cut), analyse it once (optical flows,
 //! RSFNet trained on the clip or read from its cache, graph, shots: the video engine's [`analyse`]),
 //! then generate new orders from a start frame with SDPF ([`resequence`]) as often as asked: each
-//! regeneration reuses the analysis. The page draws frames from one JPEG sprite of the clip, so a new
+//! regeneration reuses the analysis (and its cache of motion distances, warmed by one walk when the
+//! clip opens). The page draws frames from one JPEG sprite of the clip, so a new
 //! order costs only its indices; each jump (a step that is not the next source frame) carries the
 //! engine's explanation of that step. Export writes MP4 and GIF through the engine's writer.
 
@@ -16,7 +17,7 @@ use image::{imageops, RgbImage};
 use inbetween_io::Progress;
 use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, ProceduralKind, ReadOptions};
 use inbetween_video::pipeline::{analyse, reorder, resequence, Analysis, ResequenceConfig};
-use inbetween_video::sdpf::{explain_step, stability_md, SdpfParams, StepKind};
+use inbetween_video::sdpf::{explain_step, frame_rms, stability_md, SdpfParams, StepKind};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -32,6 +33,27 @@ struct Opened {
     clip: Clip,
     analysis: Analysis,
     source_md: f64,
+    /// `D` of Eq. 21 per transition already measured (most steps of every order are the next
+    /// source frame, so later orders reuse nearly all of them).
+    rms: Mutex<std::collections::HashMap<(usize, usize), f64>>,
+}
+
+impl Opened {
+    /// M_D (Eq. 21) of `order`, the same value as `stability_md`, each transition's RMS cached.
+    fn md(&self, order: &[usize]) -> f64 {
+        if order.len() < 2 {
+            return 0.0;
+        }
+        let mut rms = self.rms.lock().unwrap_or_else(|p| p.into_inner());
+        let mut sum = 0.0;
+        for w in order.windows(2) {
+            let d = *rms.entry((w[0], w[1])).or_insert_with(|| {
+                frame_rms(&self.clip.frames[w[0]], &self.clip.frames[w[1]], w[0], w[1]).unwrap_or(f64::NAN)
+            });
+            sum += d;
+        }
+        sum / (order.len() - 1) as f64
+    }
 }
 
 /// The panel's clip.
@@ -186,6 +208,14 @@ fn opened(st: &AppState, job: &Job, name: String, clip: Clip) -> Result<Value> {
     if job.is_cancelled() {
         return Err(StudioError::Engine("cancelled".into()));
     }
+    // One walk from the first frame fills the analysis's PMSM cache (most pairs any later order
+    // needs), so a Generate after opening asks the network for few new pairs.
+    job.progress("warming the motion-distance cache (one walk from frame 0)", 0.75);
+    let limits = ResequenceConfig::default().limits;
+    resequence(&analysis, 0, &SdpfParams::default(), 1, &limits).map_err(|e| StudioError::Engine(e.to_string()))?;
+    if job.is_cancelled() {
+        return Err(StudioError::Engine("cancelled".into()));
+    }
     job.progress("frame sprite for the page", 0.9);
     let (jpeg, tw, th) = sprite(&clip)?;
     let v = st.video.next_version();
@@ -219,7 +249,7 @@ fn opened(st: &AppState, job: &Job, name: String, clip: Clip) -> Result<Value> {
         "sprite": {"url": sprite_url, "width": tw, "height": th, "columns": SPRITE_COLUMNS.min(clip.len() as u32)},
     });
     *st.video.open.lock().unwrap_or_else(|p| p.into_inner()) =
-        Some(Arc::new(Opened { name, clip, analysis, source_md }));
+        Some(Arc::new(Opened { name, clip, analysis, source_md, rms: Mutex::default() }));
     Ok(out)
 }
 
@@ -288,7 +318,7 @@ pub async fn generate(State(st): State<Arc<AppState>>, Json(req): Json<GenerateR
             jumps.push(json!({"position": p, "from": from, "to": to, "kind": kind, "text": text}));
         }
         let closing = path.closing.as_ref().map(|t| json!({"from": t.from, "to": t.chosen, "text": explain_step(t)}));
-        let md = stability_md(&o.clip.frames, &order);
+        let md = o.md(&order);
         let v = state.video.next_version();
         let (mp4, gif) = export(&state, &o, &order, v);
         let msg = format!(

@@ -178,6 +178,38 @@ pub struct Analysis {
     pub metric_note: String,
     /// The token of the [`ResequenceConfig`] that made this analysis; [`resequence`] checks it.
     pub cancel: Cancel,
+    /// PMSM distances already computed on this clip, shared by every later [`resequence`] on this
+    /// analysis: a regeneration with another start, seed or length asks the network only for pairs
+    /// no earlier walk needed. The distance of a pair is a pure function of the flows and the
+    /// embedder, so the cache never changes a result. A clone starts with an empty cache (a clone
+    /// may be given another embedder, as the bench's "w/o L_d" ablation does).
+    pub pmsm_memo: PmsmMemo,
+}
+
+/// The cache of [`Analysis::pmsm_memo`]: motion distances per `(from, to)` pair and the rotated floor
+/// per frame. Cloning gives an empty cache.
+#[derive(Default, Debug)]
+pub struct PmsmMemo {
+    pairs: std::sync::Mutex<std::collections::HashMap<(usize, usize), f32>>,
+    floors: std::sync::Mutex<std::collections::HashMap<usize, f32>>,
+}
+
+impl Clone for PmsmMemo {
+    fn clone(&self) -> Self {
+        PmsmMemo::default()
+    }
+}
+
+impl PmsmMemo {
+    /// Pairs cached so far.
+    pub fn len(&self) -> usize {
+        self.pairs.lock().unwrap_or_else(|p| p.into_inner()).len()
+    }
+
+    /// Whether nothing is cached yet.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 /// Flows, metric, graph and shots of `clip`, after checking it against `cfg.limits`.
@@ -238,6 +270,7 @@ pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Resu
         stages,
         metric_note,
         cancel: cancel.clone(),
+        pmsm_memo: Default::default(),
     })
 }
 
@@ -245,6 +278,8 @@ pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Resu
 pub struct Pmsm<'a> {
     pub backward: &'a [Flow],
     pub embedder: &'a Embedder,
+    /// Distances computed before (by this or an earlier walk on the same analysis).
+    pub memo: Option<&'a PmsmMemo>,
 }
 
 impl Pmsm<'_> {
@@ -278,18 +313,45 @@ impl MotionDistance for Pmsm<'_> {
     }
 
     fn rotated_floor(&self, c: usize) -> f32 {
+        if let Some(v) = self.memo.and_then(|m| m.floors.lock().unwrap_or_else(|p| p.into_inner()).get(&c).copied()) {
+            return v;
+        }
         let fc = &self.backward[c];
         let a1 = rotate_flow(fc, std::f32::consts::FRAC_PI_2);
         let a2 = rotate_flow(fc, -std::f32::consts::FRAC_PI_2);
-        self.pair_distances(fc, &[&a1, &a2], self.min_count(c)).into_iter().fold(f32::INFINITY, f32::min)
+        let v = self.pair_distances(fc, &[&a1, &a2], self.min_count(c)).into_iter().fold(f32::INFINITY, f32::min);
+        if let Some(m) = self.memo {
+            m.floors.lock().unwrap_or_else(|p| p.into_inner()).insert(c, v);
+        }
+        v
     }
 
     fn distances(&self, c: usize, ks: &[usize]) -> Vec<f32> {
         if ks.is_empty() {
             return Vec::new();
         }
-        let fks: Vec<&Flow> = ks.iter().map(|&k| &self.backward[k]).collect();
-        self.pair_distances(&self.backward[c], &fks, self.min_count(c))
+        let Some(memo) = self.memo else {
+            let fks: Vec<&Flow> = ks.iter().map(|&k| &self.backward[k]).collect();
+            return self.pair_distances(&self.backward[c], &fks, self.min_count(c));
+        };
+        let mut out: Vec<Option<f32>> = {
+            let pairs = memo.pairs.lock().unwrap_or_else(|p| p.into_inner());
+            ks.iter().map(|&k| pairs.get(&(c, k)).copied()).collect()
+        };
+        let missing: Vec<usize> = ks.iter().zip(&out).filter(|(_, v)| v.is_none()).map(|(&k, _)| k).collect();
+        if !missing.is_empty() {
+            let fks: Vec<&Flow> = missing.iter().map(|&k| &self.backward[k]).collect();
+            let d = self.pair_distances(&self.backward[c], &fks, self.min_count(c));
+            let mut pairs = memo.pairs.lock().unwrap_or_else(|p| p.into_inner());
+            for (&k, &v) in missing.iter().zip(&d) {
+                pairs.insert((c, k), v);
+            }
+            let mut fresh = d.into_iter();
+            for v in out.iter_mut().filter(|v| v.is_none()) {
+                *v = fresh.next();
+            }
+        }
+        out.into_iter().map(|v| v.unwrap_or(f32::NAN)).collect()
     }
 }
 
@@ -304,7 +366,8 @@ pub fn resequence(
 ) -> Result<(Vec<SdpfPath>, f64), VideoError> {
     limits.check_request(params.length, analysis.graph.n, count)?;
     let t = Instant::now();
-    let pmsm = Pmsm { backward: &analysis.motion.backward, embedder: &analysis.embedder };
+    let pmsm =
+        Pmsm { backward: &analysis.motion.backward, embedder: &analysis.embedder, memo: Some(&analysis.pmsm_memo) };
     let paths = several_with(&analysis.graph, &analysis.info, &pmsm, start, params, count, &analysis.cancel)?;
     Ok((paths, t.elapsed().as_secs_f64()))
 }
@@ -362,6 +425,35 @@ mod tests {
         assert_eq!(resequence(&b, 4, &params, 2, &VideoLimits::default()).unwrap().0[0].frames, *order);
         let r = reorder(&clip, order);
         assert_eq!(r.frames[1], clip.frames[order[1]]);
+    }
+
+    #[test]
+    fn the_pmsm_cache_makes_later_walks_ask_less_and_changes_no_order() {
+        let dir = tempfile::tempdir().unwrap();
+        let clip = procedural_clip(ProceduralKind::Pendulum, 24, 64, 48, 3);
+        let cfg = quick_config(dir.path());
+        let limits = VideoLimits::default();
+        let walk = |a: &Analysis, start, seed| {
+            resequence(a, start, &SdpfParams { seed, ..SdpfParams::default() }, 1, &limits).unwrap().0[0].frames.clone()
+        };
+        // Each order from a fresh analysis (empty cache) …
+        let fresh: Vec<Vec<usize>> = [(4, 5), (9, 1), (0, 8)]
+            .iter()
+            .map(|&(start, seed)| walk(&analyse(&clip, &cfg, &Progress::hidden()).unwrap(), start, seed))
+            .collect();
+        // … equals the same order from one analysis whose cache earlier walks filled.
+        let shared = analyse(&clip, &cfg, &Progress::hidden()).unwrap();
+        assert!(shared.pmsm_memo.is_empty());
+        let first = walk(&shared, 4, 5);
+        let cached = shared.pmsm_memo.len();
+        assert!(cached > 0);
+        assert_eq!(first, fresh[0]);
+        assert_eq!(walk(&shared, 9, 1), fresh[1]);
+        assert_eq!(walk(&shared, 0, 8), fresh[2]);
+        assert_eq!(walk(&shared, 4, 5), fresh[0], "a repeat needs no new pair");
+        assert!(shared.pmsm_memo.len() >= cached);
+        // A clone starts empty: it may get another embedder.
+        assert!(shared.clone().pmsm_memo.is_empty());
     }
 
     /// Every step of `order` but loop backs and cuts (the jumps an editor makes at a dead end, marked
