@@ -162,3 +162,89 @@ fn mocap_jobs_on_the_builtin_walk() {
     let ibk = get(s.addr(), r["files"]["ibk"].as_str().unwrap());
     assert_eq!(ibk.body.len() as u64, r["bytes"].as_u64().unwrap());
 }
+
+/// The face, video and camera panels (issue 24) refuse what they cannot use with a message, and a
+/// malformed or random body on any route gets a 4xx answer while the server keeps serving.
+#[test]
+fn new_panels_refuse_bad_requests_and_keep_serving() {
+    let s = studio(1_000_000, None);
+    let a = s.addr();
+    let ct = [("Content-Type", "application/json")];
+    let failed = |path: &str, body: &[u8]| {
+        let (event, data) = run_job(a, path, &ct, body);
+        assert_eq!(event, "failed", "{path}: {data}");
+        data["error"].as_str().unwrap().to_string()
+    };
+    // Nothing open yet.
+    assert!(failed("/api/face/edit", br#"{"start_s":1,"end_s":2}"#).contains("open a face take first"));
+    assert!(failed("/api/video/generate", b"{}").contains("open a clip first"));
+    assert!(failed("/api/camera/generate", br#"{"keys":{"keys":[]}}"#).contains("open a scene first"));
+    assert_eq!(request(a, "POST", "/api/face/history", &ct, br#"{"step":"undo"}"#).status, 400);
+    assert_eq!(request(a, "POST", "/api/camera/key_at", &ct, br#"{"frame":3}"#).status, 400);
+    // Bad files name themselves.
+    let e = failed("/api/face/upload?name=junk.csv", b"Timecode,BlendshapeCount,EyeBlinkLeft\n00:00:00:00.000,1,x\n");
+    assert!(e.contains("junk.csv"), "{e}");
+    assert!(failed("/api/face/upload?name=take.txt", b"hello").contains("take.txt: expected a Live Link Face CSV"));
+    assert!(failed("/api/face/upload?name=bytes.csv", &[0xff, 0xfe, 0x00]).contains("bytes.csv:1"));
+    assert!(failed("/api/video/upload?name=clip.avi", b"RIFF").contains("clip.avi: expected an .mp4"));
+    assert!(failed("/api/video/upload?name=bad.mp4", b"\0\0\0\x18ftypisom junk").contains("bad.mp4"));
+    assert!(failed("/api/camera/upload?name=b.bvh&slot=1", b"HIERARCHY").contains("b.bvh"));
+    assert!(failed("/api/camera/reference?name=ref.json", b"{\"characters\": [").contains("ref.json:1:"));
+    // A face take, then edits the engine refuses.
+    let (event, take) = run_job(a, "/api/face/open", &ct, br#"{"path":"builtin:procedural"}"#);
+    assert_eq!(event, "result", "{take}");
+    assert!(failed("/api/face/edit", br#"{"start_s":1,"end_s":2,"constraint":"mime"}"#).contains("expected none, keys"));
+    assert!(failed("/api/face/edit", br#"{"start_s":1,"end_s":2,"method":"magic"}"#).contains("expected auto"));
+    assert!(failed("/api/face/edit", br#"{"start_s":1,"end_s":2,"groups":"ears"}"#).contains("ears"));
+    assert!(failed("/api/face/edit", br#"{"start_s":11,"end_s":40}"#).contains("runs past the clip's end"));
+    let e = failed(
+        "/api/face/edit",
+        br#"{"start_s":1,"end_s":2,"constraint":"keys","keys":[{"time_s":1.5,"shapes":{"Nose":1}}]}"#,
+    );
+    assert!(e.contains("'Nose' is not an ARKit blendshape name"), "{e}");
+    assert!(failed("/api/face/edit", br#"{"start_s":1,"end_s":2,"constraint":"noisy"}"#).contains("needs its file"));
+    let (event, r) = run_job(a, "/api/face/edit", &ct, br#"{"start_s":1,"end_s":2}"#);
+    assert_eq!(event, "result", "{r}");
+    // A camera scene, then keys the engine refuses.
+    let (event, scene) = run_job(a, "/api/camera/open", &ct, br#"{"path":"builtin:pair"}"#);
+    assert_eq!(event, "result", "{scene}");
+    let e = failed(
+        "/api/camera/generate",
+        br#"{"keys":{"keys":[{"frame":900,"camera":{"pa":[-0.3,0],"pb":[0.3,0],"theta":1,"phi":0.2}}]}}"#,
+    );
+    assert!(e.contains("frame 900"), "{e}");
+    assert!(failed("/api/camera/generate", br#"{"keys":{"keys":[]},"styles":["noir"]}"#).contains("noir"));
+    assert_eq!(
+        request(a, "POST", "/api/camera/toric", &ct, br#"{"frame":5000,"position":[0,1,5],"rotation":[0,0,0,1]}"#)
+            .status,
+        400
+    );
+    // Malformed and random bodies on every POST route: a 4xx or a failed job, never a dead server.
+    let routes = [
+        "/api/face/open",
+        "/api/face/edit",
+        "/api/face/history",
+        "/api/video/open",
+        "/api/video/generate",
+        "/api/camera/open",
+        "/api/camera/key_at",
+        "/api/camera/toric",
+        "/api/camera/generate",
+    ];
+    let mut seed = 12345u64;
+    for route in routes {
+        for body in [&b"{"[..], b"[1,2,3]", b"{\"start_s\": \"x\"}", b"null"] {
+            let r = request(a, "POST", route, &ct, body);
+            assert!((400..500).contains(&r.status) || r.status == 200, "{route}: {} {}", r.status, r.text());
+        }
+        let noise: Vec<u8> = (0..64)
+            .map(|_| {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (seed >> 56) as u8
+            })
+            .collect();
+        let r = request(a, "POST", route, &ct, &noise);
+        assert!((400..500).contains(&r.status), "{route}: {} {}", r.status, r.text());
+    }
+    assert_eq!(get(a, "/api/info").status, 200);
+}
