@@ -10,12 +10,14 @@
 //! frames), takes a detour around the others' standing spots (A* on its grid with those spots
 //! blocked), or both, the earliest arrival that keeps the distance from the start of that wait
 //! until its next walk starts (or, after its last walk, for good). The character is rebuilt with
-//! that choice and the next conflict is repaired; each repair clears every frame up to the end of
+//! that choice from the action that makes the changed walk on ([`super::plan::rebuild`]: the
+//! timeline before it is kept, so a repair costs the rest of the story, not all of it) and the next
+//! conflict is repaired; each repair clears every frame up to the end of
 //! its window, so the loop ends. A conflict no choice solves (a character standing where another
 //! must go) stays, and a note gives the pair, the frame and the distance.
 
 use super::action::walk::{route, WalkCache};
-use super::plan::{build_character, CharacterInput, CharacterPlan, Ctx};
+use super::plan::{rebuild, CharacterInput, CharacterPlan, Ctx};
 use super::{Animation, PASSING_DISTANCE};
 use crate::motion::rig::{Rig, FPS};
 use crate::motion::WalkParams;
@@ -171,7 +173,8 @@ pub(crate) fn separate(
         match fix {
             Some((x, choices)) => {
                 let input = CharacterInput { name: names[x].clone(), choices, ..plans[x].input.clone() };
-                plans[x] = build_character(ctx, input, cache);
+                // Only the walk choices change: the build resumes at the first changed walk.
+                plans[x] = rebuild(ctx, &plans[x], input, cache);
                 resolved[x] = true;
                 builds[x] += 1;
                 accepted.retain(|&(p, q, _, _)| p != x && q != x);

@@ -83,6 +83,23 @@ pub(crate) struct CharacterPlan {
     /// Every spot it stands or sits at (start, walk ends, seats): later characters' stand points
     /// keep clear of them.
     pub spots: Vec<[f32; 2]>,
+    /// The poses `track.motion` was made from, the seats sat on, and the builder's state before
+    /// each action: what [`rebuild`] resumes from.
+    pub poses: Vec<inbetween_core::Pose>,
+    pub seats: Vec<[f32; 2]>,
+    pub checkpoints: Vec<Checkpoint>,
+}
+
+/// The builder's state before one action (its timeline only grows, so lengths locate it).
+#[derive(Debug, Clone)]
+pub(crate) struct Checkpoint {
+    st: super::builder::State,
+    frames: usize,
+    segments: usize,
+    walks: usize,
+    seats: usize,
+    props: usize,
+    notes: usize,
 }
 
 /// What [`animate_planned`] returns.
@@ -205,10 +222,56 @@ fn start_spot(
 /// Builds one character's timeline from its input: each action read once ([`Step::read`]) and
 /// played by its module of [`super::action`].
 pub(crate) fn build_character(ctx: &Ctx, input: CharacterInput, cache: &mut WalkCache) -> CharacterPlan {
+    build(ctx, input, cache, None)
+}
+
+/// `old` rebuilt with other walk choices (`input` is `old.input` with only `choices` changed, as
+/// [`crowd::separate`] makes it): the actions before the one that makes the first changed walk
+/// read no changed choice, so the build resumes there from `old`'s checkpoint and reuses its
+/// frames, converted channels and root track; the result equals [`build_character`]'s.
+pub(crate) fn rebuild(ctx: &Ctx, old: &CharacterPlan, input: CharacterInput, cache: &mut WalkCache) -> CharacterPlan {
+    let n = old.input.choices.len().max(input.choices.len());
+    let choice = |c: &[WalkChoice], w: usize| c.get(w).cloned().unwrap_or_default();
+    let first_changed = (0..n).find(|&w| choice(&old.input.choices, w) != choice(&input.choices, w));
+    let resume = first_changed.and_then(|w| old.checkpoints.iter().rposition(|cp| cp.walks <= w));
+    match resume {
+        Some(k) if old.checkpoints.len() == input.actions.len() => build(ctx, input, cache, Some((old, k))),
+        _ => build(ctx, input, cache, None),
+    }
+}
+
+fn build(
+    ctx: &Ctx,
+    input: CharacterInput,
+    cache: &mut WalkCache,
+    resume: Option<(&CharacterPlan, usize)>,
+) -> CharacterPlan {
     let (scene, query, rig) = (ctx.scene, ctx.query, &ctx.rig);
-    let mut marks = Vec::new();
     let mut b = Builder::new(ctx, &input.name, &input.grid, &input.avoid, &input.choices, input.start, cache);
-    for (sentence, a) in &input.actions {
+    let (mut marks, mut checkpoints, first, prefix) = match resume {
+        Some((old, k)) => {
+            let cp = &old.checkpoints[k];
+            b.st = cp.st;
+            b.frames = old.poses[..cp.frames].to_vec();
+            b.segments = old.track.segments[..cp.segments].to_vec();
+            b.walks = old.walks[..cp.walks].to_vec();
+            b.seats = old.seats[..cp.seats].to_vec();
+            b.props = old.track.props[..cp.props].to_vec();
+            b.notes = old.notes[..cp.notes].to_vec();
+            (old.marks[..k].to_vec(), old.checkpoints[..k].to_vec(), k, cp.frames)
+        }
+        None => (Vec::new(), Vec::new(), 0, 0),
+    };
+    for (sentence, a) in input.actions.iter().skip(first) {
+        checkpoints.push(Checkpoint {
+            st: b.st,
+            frames: b.frames.len(),
+            segments: b.segments.len(),
+            walks: b.walks.len(),
+            seats: b.seats.len(),
+            props: b.props.len(),
+            notes: b.notes.len(),
+        });
         marks.push((*sentence, b.frames.len()));
         let obj = a.target.and_then(|t| object_of_node(scene, query, t));
         if a.target.is_some() && obj.is_none() {
@@ -228,13 +291,79 @@ pub(crate) fn build_character(ctx: &Ctx, input: CharacterInput, cache: &mut Walk
     if let Some((_, s, _)) = st.seated {
         end_spots.push([s[0], s[2]]);
     }
-    let motion = crate::motion::rig::clip(rig, &b.frames);
-    let traj: Vec<[f32; 2]> =
-        b.frames.iter().map(|p| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32]).collect();
-    let Builder { segments, props, walks, seats, notes, .. } = b;
+    let root = |p: &inbetween_core::Pose| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32];
+    // Channels and root track: the resumed prefix as it was, the rest converted now (both are per
+    // frame, so the result is the same as converting everything).
+    let (motion, traj) = match resume {
+        Some((old, _)) if prefix > 0 && prefix <= b.frames.len() => {
+            let nc = old.track.motion.num_channels();
+            let mut data = old.track.motion.data()[..prefix * nc].to_vec();
+            if b.frames.len() > prefix {
+                data.extend_from_slice(crate::motion::rig::clip(rig, &b.frames[prefix..]).data());
+            }
+            let motion = inbetween_core::Motion::new(rig.skeleton.clone(), 1.0 / FPS, data)
+                .expect("poses fit the standard skeleton");
+            let mut traj = old.traj[..prefix].to_vec();
+            traj.extend(b.frames[prefix..].iter().map(root));
+            (motion, traj)
+        }
+        _ => (crate::motion::rig::clip(rig, &b.frames), b.frames.iter().map(root).collect()),
+    };
+    let Builder { segments, props, walks, seats, notes, frames, .. } = b;
     let track = CharacterTrack { name: input.name.clone(), motion, segments, props };
     let mut spots = vec![input.start];
     spots.extend(walks.iter().filter_map(|w| traj.get(w.end.saturating_sub(1)).copied()));
     spots.extend(seats.iter().copied());
-    CharacterPlan { input, track, traj, walks, marks, notes, end_spots, spots }
+    CharacterPlan { input, track, traj, walks, marks, notes, end_spots, spots, poses: frames, seats, checkpoints }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catalogue::builtin::builtin;
+    use crate::compose::{compose, ComposeConfig, ComposeInput};
+    use crate::database::SceneDatabase;
+    use crate::parse::parse_script;
+
+    /// A resumed rebuild equals a full build with the same choices, whichever walk changes.
+    #[test]
+    fn rebuild_from_the_changed_walk_equals_a_full_build() {
+        let cat = builtin();
+        let db = SceneDatabase::builtin(&cat, 2, 7);
+        let text = format!(
+            "{}Eve walks to the sofa.\nTom walks to the desk.\nEve walks to the bookshelf.\n",
+            crate::stories::DEMO
+        );
+        let parsed = parse_script(&text, &cat);
+        let comp = compose(
+            &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
+            &ComposeConfig::default(),
+        );
+        let lib = MotionLibrary::procedural(0);
+        let cfg = AnimateConfig::default();
+        let mut cache = WalkCache::default();
+        let planned = animate_planned(&comp.scene, &comp.query, &cat, &lib, &cfg, &mut cache, &HashMap::new());
+        let ctx = Ctx { scene: &comp.scene, query: &comp.query, cat: &cat, lib: &lib, cfg: &cfg, rig: Rig::standard() };
+        let mut checked = 0;
+        for plan in &planned.plans {
+            for w in 0..plan.walks.len() {
+                let mut choices = plan.input.choices.clone();
+                choices.resize(plan.walks.len().max(choices.len()), WalkChoice::default());
+                choices[w].wait += 20;
+                let input = CharacterInput { choices, ..plan.input.clone() };
+                let full = build_character(&ctx, input.clone(), &mut cache);
+                let resumed = rebuild(&ctx, plan, input, &mut cache);
+                assert_eq!(resumed.track.motion.data(), full.track.motion.data(), "{} walk {w}", plan.input.name);
+                assert_eq!(resumed.traj, full.traj);
+                assert_eq!(resumed.walks, full.walks);
+                assert_eq!(resumed.marks, full.marks);
+                assert_eq!(resumed.notes, full.notes);
+                assert_eq!(resumed.spots, full.spots);
+                assert_eq!(resumed.end_spots, full.end_spots);
+                assert_eq!(resumed.track.segments.len(), full.track.segments.len());
+                checked += 1;
+            }
+        }
+        assert!(checked >= 4, "walks rebuilt: {checked}");
+    }
 }
