@@ -15,6 +15,7 @@ const THREE_FILES: &[&str] = &[
     "build/three.module.js",
     "build/three.core.js",
     "examples/jsm/controls/OrbitControls.js",
+    "examples/jsm/controls/TransformControls.js",
     "examples/jsm/loaders/GLTFLoader.js",
     "examples/jsm/utils/BufferGeometryUtils.js",
     "examples/jsm/utils/SkeletonUtils.js",

@@ -215,6 +215,28 @@ pub async fn toric(State(st): State<Arc<AppState>>, Json(req): Json<ToricRequest
 }
 
 #[derive(Deserialize)]
+pub struct PoseRequest {
+    pub frame: usize,
+    pub camera: inbetween_camera::toric::Toric,
+    pub targets: Option<[usize; 2]>,
+}
+
+/// `POST /api/camera/pose`: the world pose of a key's Toric camera (where the viewport's gizmo
+/// starts).
+pub async fn pose(State(st): State<Arc<AppState>>, Json(req): Json<PoseRequest>) -> Result<Json<Value>> {
+    let scene = st.camera.scene()?;
+    let [i, j] = req.targets.unwrap_or([0, 1]);
+    if req.frame >= scene.num_frames() || i >= scene.characters.len() || j >= scene.characters.len() || i == j {
+        return Err(StudioError::BadRequest("frame or targets outside the scene".into()));
+    }
+    let (a, b) = (scene.characters[i].frame(req.frame).target(), scene.characters[j].frame(req.frame).target());
+    let p = inbetween_camera::toric::to_pose(&req.camera, a, b, &Lens::default())
+        .map_err(|e| StudioError::Engine(format!("key at frame {}: {e}", req.frame)))?;
+    let q = p.rotation;
+    Ok(Json(json!({"position": v3(p.position), "rotation": [q.x, q.y, q.z, q.w], "look_at": v3((a + b) * 0.5)})))
+}
+
+#[derive(Deserialize)]
 pub struct GenerateRequest {
     pub keys: Keys,
     /// Styles to generate (`direct`, `relative`, `side`, `orbit`, `reference`); empty: all.

@@ -186,6 +186,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/camera/reference", post(camera_panel::reference))
         .route("/api/camera/key_at", post(camera_panel::key_at))
         .route("/api/camera/toric", post(camera_panel::toric))
+        .route("/api/camera/pose", post(camera_panel::pose))
         .route("/api/camera/generate", post(camera_panel::generate));
     if state.config.test_routes {
         app = app.route("/api/test/panic", post(test_panic));

@@ -645,6 +645,16 @@ fn camera_panel_in_headless_chromium() {
     assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
     assert!(st["lastJob"]["message"].as_str().unwrap().contains("set from the view"), "{}", st["lastJob"]);
 
+    // The gizmo: the selected key's camera dragged in the viewport gets new Toric coordinates.
+    let before = st["camera"]["keys"].clone();
+    let st = b
+        .eval("window.inbetweenStudio.cameraGizmoMove(0.6, 0.4, 0.3).then(() => window.inbetweenStudio.ready())")
+        .map(|_| state(&b))
+        .unwrap();
+    assert_eq!(st["lastJob"]["kind"], "camera-gizmo", "{}", st["lastJob"]);
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert_ne!(st["camera"]["keys"], before, "the dragged key changed");
+
     // Export: the track as JSON.
     let track = b.eval("fetch(document.querySelector('#camera-export a').href).then(r => r.json())").unwrap();
     assert!(

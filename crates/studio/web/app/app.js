@@ -2,6 +2,7 @@
 // Test hooks (crates/studio/README.md): data-testid attributes and window.inbetweenStudio.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 
 const $ = (id) => document.getElementById(id);
@@ -154,6 +155,8 @@ function showPanel(name) {
   groups.script.visible = name === 'script';
   groups.mocap.visible = name === 'mocap';
   groups.camera.visible = name === 'camera';
+  gizmo.getHelper().visible = name === 'camera';
+  gizmo.enabled = name === 'camera';
   canvas.hidden = name === 'face' || name === 'video';
   $('face-view').hidden = name !== 'face';
   $('video-view').hidden = name !== 'video';
@@ -980,7 +983,7 @@ function drawCameraScene(r) {
   S.frame = 0; seek(0); drawTimeline();
 }
 
-function renderCameraKeys() {
+function renderCameraKeys(moveGizmo = true) {
   const c = S.camera, ul = $('camera-keys');
   c.keys.sort((a, b) => a.frame - b.frame);
   ul.innerHTML = '';
@@ -1000,6 +1003,7 @@ function renderCameraKeys() {
     $('ck-vel').checked = !!k.velocity; if (k.velocity) $('ck-velocity').value = k.velocity.join(',');
   }
   drawTimeline();
+  if (moveGizmo && S.panel === 'camera') placeGizmo().catch((e) => showError(e.message));
 }
 for (const id of ['ck-frame', 'ck-theta', 'ck-phi', 'ck-pax', 'ck-pay', 'ck-pbx', 'ck-pby', 'ck-vel', 'ck-velocity']) {
   $(id).addEventListener('change', () => {
@@ -1160,6 +1164,52 @@ $('timeline').addEventListener('contextmenu', (e) => {
   const i = cameraKeyNear(e); if (i < 0) return;
   e.preventDefault(); S.camera.keys.splice(i, 1); S.camera.selKey = Math.min(S.camera.selKey, S.camera.keys.length - 1); renderCameraKeys();
 });
+
+
+// The gizmo: the selected key's camera as a small body the user drags in the viewport
+// (three.js TransformControls); on release the camera looks at the pair and the server turns that
+// pose into the key's Toric coordinates.
+const gizmo = new TransformControls(orbitCam, canvas);
+gizmo.setMode('translate');
+gizmo.setSize(0.8);
+scene.add(gizmo.getHelper());
+gizmo.addEventListener('dragging-changed', (e) => { controls.enabled = !e.value; });
+gizmo.addEventListener('change', () => requestRender());
+gizmo.addEventListener('mouseUp', () => { if (S.camera.proxy) start('camera-gizmo', gizmoMoved); });
+function cameraProxy() {
+  const g = new THREE.Group();
+  const mat = new THREE.MeshStandardMaterial({ color: 0xffd84d, roughness: 0.5 });
+  const body = new THREE.Mesh(new THREE.BoxGeometry(0.22, 0.16, 0.3), mat);
+  const lens = new THREE.Mesh(new THREE.ConeGeometry(0.09, 0.16, 12), mat);
+  lens.rotation.x = Math.PI / 2; lens.position.z = -0.22;
+  g.add(body, lens);
+  return g;
+}
+// Places the gizmo on the selected key's camera (the server poses its Toric coordinates).
+async function placeGizmo() {
+  const c = S.camera, k = c.keys[c.selKey];
+  if (!c.scene || !k) { gizmo.detach(); if (c.proxy) c.proxy.visible = false; return; }
+  const r = await post('/api/camera/pose', { frame: k.frame, camera: k.camera });
+  if (!c.proxy) { c.proxy = cameraProxy(); groups.camera.add(c.proxy); }
+  c.proxy.visible = true;
+  c.proxy.position.fromArray(r.position);
+  c.proxy.quaternion.set(...r.rotation);
+  c.lookAt = r.look_at;
+  gizmo.attach(c.proxy);
+  requestRender();
+}
+async function gizmoMoved() {
+  const c = S.camera, k = c.keys[c.selKey];
+  if (!k || !c.proxy) throw new Error('select a key first');
+  const look = new THREE.PerspectiveCamera();
+  look.position.copy(c.proxy.position);
+  look.lookAt(v3(c.lookAt));
+  c.proxy.quaternion.copy(look.quaternion);
+  const q = look.quaternion;
+  const r = await post('/api/camera/toric', { frame: k.frame, position: c.proxy.position.toArray(), rotation: [q.x, q.y, q.z, q.w] });
+  k.camera = r.camera; renderCameraKeys(false);
+  return { ok: true, kind: 'camera-gizmo', message: `key at frame ${k.frame} placed in the viewport: θ ${r.camera.theta.toFixed(2)}, φ ${r.camera.phi.toFixed(2)}` };
+}
 
 // ---------------------------------------------------------------- playback
 function seek(frame) {
@@ -1374,6 +1424,8 @@ window.inbetweenStudio = {
   // The last story drawn: ms of its request (job included), to fetch its GLB, to parse it, to
   // build the view (for the bench).
   drawTimes: () => S.drawTimes || null,
+  // Moves the camera gizmo by (dx, dy, dz) metres and releases it, as a drag in the viewport does.
+  cameraGizmoMove: (dx, dy, dz) => { const p = S.camera.proxy; if (!p) return Promise.reject(new Error('no gizmo')); p.position.add(new THREE.Vector3(dx, dy, dz)); return start('camera-gizmo', gizmoMoved); },
   // The face take's row times, seconds from its first row.
   faceTimes: () => (S.face.take ? S.face.take.times : []),
   // Adds a face key as a click on a curve would (keyframes constraint).
