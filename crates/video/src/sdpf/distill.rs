@@ -165,15 +165,28 @@ impl<'a> Ctx<'a> {
     }
 
     /// S2 was empty: the cut an editor would make, to the unvisited frame of another shot closest
-    /// in content to `from` (C_r's replay test still applies); `None` when no other shot has
-    /// unvisited frames.
+    /// in content to `from` (C_r's replay test still applies), preferring a frame the walk can go
+    /// on from: one followed by [`MIN_LOOP`] unvisited frames of its shot, else by one; a cut into
+    /// a shot's last frames has no way forward and cuts straight back (issue 26's ping-pong).
+    /// `None` when no other shot has unvisited frames.
     pub fn cut(&self, from: usize, visited: &[bool]) -> Option<(usize, f32)> {
         let shot = self.motion.shot_of(from);
-        (0..self.graph.n)
+        let n = self.graph.n;
+        let candidates: Vec<(usize, f32)> = (0..n)
             .filter(|&k| !visited[k] && self.motion.shot_of(k) != shot && !self.forbids(from, k))
             .map(|k| (k, self.edge(from, k)))
             .filter(|(_, e)| !e.is_nan())
-            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .collect();
+        // Unvisited frames after `k` in its shot, up to MIN_LOOP.
+        let run = |k: usize| {
+            (k + 1..n.min(k + 1 + MIN_LOOP))
+                .take_while(|&j| !visited[j] && self.motion.shot_of(j) == self.motion.shot_of(k))
+                .count()
+        };
+        let closest = |min_run: usize| {
+            candidates.iter().copied().filter(|&(k, _)| run(k) >= min_run).min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        closest(MIN_LOOP).or_else(|| closest(1)).or_else(|| closest(0))
     }
 
     /// S2 was empty and no cut is left: the position in `path` to loop back to, the one whose

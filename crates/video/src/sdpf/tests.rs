@@ -593,3 +593,38 @@ fn delta_o_counts_the_source_transitions_kept() {
     assert_eq!(overlap_delta_o(&[3], 5), 0.0);
     assert_eq!(overlap_delta_o(&[], 0), 0.0);
 }
+
+#[test]
+fn a_cut_enters_the_other_shot_where_the_walk_can_go_on() {
+    // Two shots: frames 0–4 and 5–9 on a line. From frame 2, frame 9 (the other shot's last frame)
+    // is no closer than 5 in content, but only 5 has four unvisited frames after it in its shot;
+    // frame 8 is the closest with one, frame 9 the closest with none.
+    let g = Graph::from_fn(10, |i, j| {
+        if i == j {
+            0.0
+        } else if (i == 2 && j == 9) || (i == 9 && j == 2) {
+            0.5
+        } else {
+            (i as f32 - j as f32).abs()
+        }
+    });
+    let motion = MotionInfo {
+        tendency: vec![None; 10],
+        lms: vec![false; 10],
+        shot: [0; 5].into_iter().chain([1; 5]).collect(),
+        directed: vec![false, false],
+    };
+    let p = SdpfParams { use_cr: false, ..SdpfParams::default() };
+    let ctx = Ctx::new(&g, &motion, &NoMotion, &p);
+    let mut visited = vec![false; 10];
+    visited[2] = true;
+    assert_eq!(ctx.cut(2, &visited).map(|c| c.0), Some(5), "the frame with a way forward, not the closest (9)");
+    // With 6 and 7 used, no frame of the other shot has four unvisited successors: one will do.
+    visited[6] = true;
+    visited[7] = true;
+    assert_eq!(ctx.cut(2, &visited).map(|c| c.0), Some(8));
+    // With 9 alone left, it is taken.
+    visited[5] = true;
+    visited[8] = true;
+    assert_eq!(ctx.cut(2, &visited).map(|c| c.0), Some(9));
+}
