@@ -66,7 +66,7 @@ pub struct GenerateArgs {
     /// A behaviour's style code: direct, relative, side or orbit.
     #[arg(long, conflicts_with_all = ["reference", "all_styles"])]
     pub style: Option<String>,
-    /// Extract the style from a reference clip (JSON with per-frame "characters" features and "camera" toric).
+    /// Extract the style from a reference clip: JSON with per-frame "characters" features and "camera" toric, or a glTF / GLB camera animation over this scene's characters.
     #[arg(long, conflicts_with = "all_styles")]
     pub reference: Option<PathBuf>,
     /// One track per style (the paper's UI flow): writes OUT with the style name inserted.
@@ -184,8 +184,16 @@ fn behaviour_style(w: &CameraWeights, behaviour: Behaviour) -> anyhow::Result<St
     w.style(behaviour).with_context(|| format!("the weights card has no style code for `{}`", behaviour.name()))
 }
 
-fn reference_style(w: &CameraWeights, path: &Path) -> anyhow::Result<Style> {
-    let clip: ReferenceClip = inbetween_camera::read_json(path)?;
+/// The style of a reference clip: our JSON, or a glTF / GLB camera animation over `scene`'s characters.
+fn reference_style(w: &CameraWeights, path: &Path, scene: &Scene) -> anyhow::Result<Style> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    let clip: ReferenceClip = if matches!(ext.as_deref(), Some("gltf" | "glb")) {
+        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        inbetween_camera::infer::reference_from_gltf(&bytes, &path.display().to_string(), scene, &Default::default())
+            .map_err(anyhow::Error::msg)?
+    } else {
+        inbetween_camera::read_json(path)?
+    };
     Ok(Style { name: format!("reference:{}", path.display()), code: clip.style(&w.model, path)? })
 }
 
@@ -232,7 +240,7 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
             .map(|b| Ok((behaviour_style(&w, *b)?, with_suffix(&a.out, b.name()))))
             .collect::<anyhow::Result<_>>()?
     } else if let Some(r) = &a.reference {
-        vec![(reference_style(&w, r)?, a.out.clone())]
+        vec![(reference_style(&w, r, &scene)?, a.out.clone())]
     } else {
         let name = a.style.clone().unwrap_or_else(|| "relative".into());
         let b = Behaviour::parse(&name)

@@ -262,6 +262,25 @@ fn generate_takes_two_bvh_takes_as_the_characters() {
     assert!(text.contains("moved 1.5 m"), "two takes at one spot are set apart: {text}");
     let track: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&cam).unwrap()).unwrap();
     assert_eq!(track["frames"].as_array().unwrap().len(), 81);
+    // The glTF written beside it is a style reference: its camera animation over the same takes.
+    let again = d.join("again.json");
+    let out = inbetween(&[
+        "camera",
+        "generate",
+        "--characters",
+        s(&a),
+        s(&b),
+        "--keys",
+        s(&keys),
+        "--reference",
+        s(&cam.with_extension("gltf")),
+        "-o",
+        s(&again),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let track: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&again).unwrap()).unwrap();
+    assert!(track["style"].as_str().unwrap().starts_with("reference:"), "{}", track["style"]);
+    assert_eq!(track["frames"].as_array().unwrap().len(), 81);
     // A take without shoulders is refused, naming it; --scene and --characters exclude each other.
     std::fs::write(&b, std::fs::read_to_string(&a).unwrap().replace("LeftArm", "Wing").replace("LeftShoulder", "Fin"))
         .unwrap();

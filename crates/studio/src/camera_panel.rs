@@ -106,12 +106,25 @@ pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body
     Ok(Json(answer(&st.jobs, id).await))
 }
 
-/// `POST /api/camera/reference?name=…`: a reference clip (our JSON: per-frame character features and
-/// Toric camera) whose style the extractor computes; it joins the generated styles.
+/// `POST /api/camera/reference?name=…`: a reference clip whose style the extractor computes; it
+/// joins the generated styles. Our JSON (per-frame character features and Toric camera), or a glTF /
+/// GLB camera animation over the open scene's two characters.
 pub async fn reference(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
     let name = q.name.clone();
     let state = st.clone();
     let id = st.jobs.spawn("camera-reference", move |_| {
+        let lower = name.to_ascii_lowercase();
+        if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+            // A camera animation over the open scene's characters.
+            let scene = state.camera.scene()?;
+            let clip = inbetween_camera::infer::reference_from_gltf(&body, &name, &scene, &Lens::default())
+                .map_err(StudioError::Engine)?;
+            let w = state.camera.weights()?;
+            let code = clip.style(&w.model, Path::new(&name)).map_err(|e| StudioError::Engine(e.to_string()))?;
+            *state.camera.reference.lock().unwrap_or_else(|p| p.into_inner()) =
+                Some(Style { name: format!("reference {name}"), code });
+            return Ok(json!({"ok": true, "message": format!("style extracted from the camera animation in {name}: it joins the styles of the next Generate")}));
+        }
         let text = utf8(&name, &body)?;
         let clip: ReferenceClip = serde_json::from_str(&text).map_err(|e| {
             StudioError::Engine(format!(

@@ -655,6 +655,27 @@ fn camera_panel_in_headless_chromium() {
     assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
     assert_ne!(st["camera"]["keys"], before, "the dragged key changed");
 
+    // The chosen trajectory's glTF, opened as the style reference: a fifth style is generated.
+    let gltf = b
+        .eval("fetch([...document.querySelectorAll('#camera-export a')].find(a => a.textContent.endsWith('.gltf')).href).then(r => r.text())")
+        .unwrap();
+    let dir0 = tempfile::tempdir().unwrap();
+    let reference = dir0.path().join("orbit.gltf");
+    std::fs::write(&reference, gltf.as_str().unwrap()).unwrap();
+    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
+    b.set_files(&sel("camera-reference"), &[reference.as_path()]).unwrap();
+    wait_for_job(n);
+    assert_eq!(error_text(&b), "");
+    let st = click_and_wait(&b, "camera-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let styles: Vec<String> = st["camera"]["trajectories"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["style"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(styles, ["reference orbit.gltf"], "the style select says reference: {styles:?}");
+
     // Export: the track as JSON.
     let track = b.eval("fetch(document.querySelector('#camera-export a').href).then(r => r.json())").unwrap();
     assert!(
