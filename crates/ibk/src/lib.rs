@@ -324,6 +324,11 @@ pub struct Clip<'a> {
     rest: Vec<f32>,
     /// Per track: joint and whether it is a rotation, and the constant value when constant.
     tracks: Vec<(usize, bool, Option<[f32; 3]>)>,
+    /// Joints whose rotation has an animated component: the only ones whose quaternion a decoded
+    /// frame recomputes.
+    animated_rot: Vec<usize>,
+    /// Quaternion of every joint's rest (or constant) rotation vector.
+    rest_rot: Vec<[f32; 4]>,
 }
 
 impl<'a> Clip<'a> {
@@ -493,6 +498,10 @@ impl<'a> Clip<'a> {
         if r.pos != body.len() {
             return format_err(format!("{} bytes after the segment data (at byte {})", body.len() - r.pos, r.pos));
         }
+        let mut animated_rot: Vec<usize> = slot.iter().filter(|&&s| s % 6 < 3).map(|&s| s / 6).collect();
+        animated_rot.sort_unstable();
+        animated_rot.dedup();
+        let rest_rot = (0..joints.len()).map(|j| exp_map([rest[6 * j], rest[6 * j + 1], rest[6 * j + 2]])).collect();
         Ok(Clip {
             data,
             joints,
@@ -508,6 +517,8 @@ impl<'a> Clip<'a> {
             slot,
             rest,
             tracks,
+            animated_rot,
+            rest_rot,
         })
     }
 
@@ -570,12 +581,13 @@ impl<'a> Clip<'a> {
         self.decode_frame(f.min(self.num_frames - 1), out);
     }
 
-    /// Decodes frame `f` into a slot of `ctx` (values, then quaternions).
+    /// Decodes frame `f` into a slot of `ctx` (values, then quaternions). Joints with a constant
+    /// rotation keep the quaternion [`Context::bind`] set from the rest values.
     fn fill(&self, f: usize, slot: &mut Frame) {
         self.decode_frame(f, &mut slot.vals);
-        for (j, q) in slot.rot.iter_mut().enumerate() {
+        for &j in &self.animated_rot {
             let v = &slot.vals[6 * j..6 * j + 3];
-            *q = exp_map([v[0], v[1], v[2]]);
+            slot.rot[j] = exp_map([v[0], v[1], v[2]]);
         }
         slot.frame = f;
     }
@@ -681,7 +693,7 @@ impl Context {
                 f.vals.clear();
                 f.vals.extend_from_slice(&clip.rest);
                 f.rot.clear();
-                f.rot.resize(clip.joints.len(), [0.0, 0.0, 0.0, 1.0]);
+                f.rot.extend_from_slice(&clip.rest_rot);
             }
         }
     }
