@@ -243,19 +243,13 @@ fn generate_takes_two_bvh_takes_as_the_characters() {
     )
     .unwrap();
     let cam = d.join("cam.json");
-    let out = inbetween(&[
-        "camera",
-        "generate",
-        "--characters",
-        s(&a),
-        s(&b),
-        "--keys",
-        s(&keys),
-        "--style",
-        "orbit",
-        "-o",
-        s(&cam),
-    ]);
+    // `camera generate` on the two takes with the keys, then `extra`.
+    let generate = |extra: &[&str]| {
+        let mut args = vec!["camera", "generate", "--characters", s(&a), s(&b), "--keys", s(&keys)];
+        args.extend_from_slice(extra);
+        inbetween(&args)
+    };
+    let out = generate(&["--style", "orbit", "-o", s(&cam)]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(text.contains("a.bvh: root Hips, shoulders LeftArm / RightArm"), "{text}");
@@ -264,19 +258,8 @@ fn generate_takes_two_bvh_takes_as_the_characters() {
     assert_eq!(track["frames"].as_array().unwrap().len(), 81);
     // The glTF written beside it is a style reference: its camera animation over the same takes.
     let again = d.join("again.json");
-    let out = inbetween(&[
-        "camera",
-        "generate",
-        "--characters",
-        s(&a),
-        s(&b),
-        "--keys",
-        s(&keys),
-        "--reference",
-        s(&cam.with_extension("gltf")),
-        "-o",
-        s(&again),
-    ]);
+    let reference = cam.with_extension("gltf");
+    let out = generate(&["--reference", s(&reference), "-o", s(&again)]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let track: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&again).unwrap()).unwrap();
     assert!(track["style"].as_str().unwrap().starts_with("reference:"), "{}", track["style"]);

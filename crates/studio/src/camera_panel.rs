@@ -198,6 +198,19 @@ pub async fn key_at(State(st): State<Arc<AppState>>, Json(req): Json<KeyAtReques
     Ok(Json(json!({"key": keys.keys[0]})))
 }
 
+/// The framing targets of characters `targets` (default the first two) at `frame`.
+fn targets_at(scene: &Scene, frame: usize, targets: Option<[usize; 2]>) -> Result<(DVec3, DVec3)> {
+    let [i, j] = targets.unwrap_or([0, 1]);
+    let n = scene.characters.len();
+    if frame >= scene.num_frames() || i >= n || j >= n || i == j {
+        return Err(StudioError::BadRequest(format!(
+            "frame {frame} or targets [{i}, {j}] outside the scene ({} frames, {n} characters)",
+            scene.num_frames()
+        )));
+    }
+    Ok((scene.characters[i].frame(frame).target(), scene.characters[j].frame(frame).target()))
+}
+
 #[derive(Deserialize)]
 pub struct ToricRequest {
     pub frame: usize,
@@ -211,11 +224,7 @@ pub struct ToricRequest {
 /// `POST /api/camera/toric`: the Toric coordinates of a camera placed in the viewport.
 pub async fn toric(State(st): State<Arc<AppState>>, Json(req): Json<ToricRequest>) -> Result<Json<Value>> {
     let scene = st.camera.scene()?;
-    let [i, j] = req.targets.unwrap_or([0, 1]);
-    if req.frame >= scene.num_frames() || i >= scene.characters.len() || j >= scene.characters.len() || i == j {
-        return Err(StudioError::BadRequest("frame or targets outside the scene".into()));
-    }
-    let (a, b) = (scene.characters[i].frame(req.frame).target(), scene.characters[j].frame(req.frame).target());
+    let (a, b) = targets_at(&scene, req.frame, req.targets)?;
     let q = req.rotation;
     let pose = CameraPose {
         position: DVec3::from_array(req.position),
@@ -238,11 +247,7 @@ pub struct PoseRequest {
 /// starts).
 pub async fn pose(State(st): State<Arc<AppState>>, Json(req): Json<PoseRequest>) -> Result<Json<Value>> {
     let scene = st.camera.scene()?;
-    let [i, j] = req.targets.unwrap_or([0, 1]);
-    if req.frame >= scene.num_frames() || i >= scene.characters.len() || j >= scene.characters.len() || i == j {
-        return Err(StudioError::BadRequest("frame or targets outside the scene".into()));
-    }
-    let (a, b) = (scene.characters[i].frame(req.frame).target(), scene.characters[j].frame(req.frame).target());
+    let (a, b) = targets_at(&scene, req.frame, req.targets)?;
     let p = inbetween_camera::toric::to_pose(&req.camera, a, b, &Lens::default())
         .map_err(|e| StudioError::Engine(format!("key at frame {}: {e}", req.frame)))?;
     let q = p.rotation;

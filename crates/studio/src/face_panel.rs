@@ -33,7 +33,7 @@ use serde_json::{json, Value};
 use crate::error::{Result, StudioError};
 use crate::jobs::answer;
 use crate::mocap_panel::{utf8, UploadQuery};
-use crate::safety::resolve_under_root;
+use crate::safety::{extension_of, list_under_root, resolve_under_root, Folder};
 use crate::server::AppState;
 
 /// The layout the take was read in, which export writes back.
@@ -100,37 +100,16 @@ pub const BUILTIN: (&str, f64) = ("builtin:procedural", 12.0);
 /// `GET /api/face/corpus`: face captures under `--root` (CSV and JSON files below a folder named
 /// `face`) and the built-in take.
 pub async fn corpus(State(st): State<Arc<AppState>>) -> Json<Value> {
-    let mut files = Vec::new();
-    if let Some(root) = &st.config.root {
-        list(root, root, 0, &mut files);
-    }
-    files.sort();
+    let in_face = |rel: &str| rel.split('/').any(|c| c == "face");
+    let files = st.config.root.as_deref().map_or_else(Vec::new, |root| {
+        let keep = |rel: &str| matches!(extension_of(rel).as_str(), "csv" | "json") && in_face(rel);
+        list_under_root(root, 2000, keep, |_, _| Folder::Descend)
+    });
     Json(json!({
         "root": st.config.root.as_ref().map(|p| p.display().to_string()),
         "files": files,
         "builtin": [BUILTIN.0],
     }))
-}
-
-fn list(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        if out.len() >= 2000 {
-            return;
-        }
-        let p = e.path();
-        let Ok(kind) = e.file_type() else { continue };
-        if kind.is_dir() && depth < 6 {
-            list(root, &p, depth + 1, out);
-        } else if kind.is_file() {
-            let ext = p.extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
-            let Ok(rel) = p.strip_prefix(root) else { continue };
-            let rel = rel.to_string_lossy().replace('\\', "/");
-            if matches!(ext.as_deref(), Some("csv" | "json")) && rel.split('/').any(|c| c == "face") {
-                out.push(rel);
-            }
-        }
-    }
 }
 
 #[derive(Deserialize)]

@@ -27,7 +27,7 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::{answer, Job};
-use crate::safety::resolve_under_root;
+use crate::safety::{extension_of, list_under_root, resolve_under_root, Folder};
 use crate::server::AppState;
 
 /// The open take, with what every keys job needs computed once when it opens (so a K change
@@ -74,38 +74,15 @@ pub const BUILTIN: &[(&str, usize)] = &[("builtin:walk", 240), ("builtin:walk-10
 
 /// `GET /api/mocap/corpus`: BVH and AMC files under `--root` (relative paths) and the built-ins.
 pub async fn corpus(State(st): State<Arc<AppState>>) -> Json<Value> {
-    let mut files = Vec::new();
-    if let Some(root) = &st.config.root {
-        list(root, root, 0, &mut files);
-    }
-    files.sort();
+    // Motion files under `--root`, at most 6 folders deep and 5000 files.
+    let files = st.config.root.as_deref().map_or_else(Vec::new, |root| {
+        list_under_root(root, 5000, |rel| matches!(extension_of(rel).as_str(), "bvh" | "amc"), |_, _| Folder::Descend)
+    });
     Json(json!({
         "root": st.config.root.as_ref().map(|p| p.display().to_string()),
         "files": files,
         "builtin": BUILTIN.iter().map(|b| b.0).collect::<Vec<_>>(),
     }))
-}
-
-/// Motion files under `dir`, at most 6 folders deep and 5000 files.
-fn list(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        if out.len() >= 5000 {
-            return;
-        }
-        let p = e.path();
-        let Ok(kind) = e.file_type() else { continue };
-        if kind.is_dir() && depth < 6 {
-            list(root, &p, depth + 1, out);
-        } else if kind.is_file() {
-            let ext = p.extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
-            if matches!(ext.as_deref(), Some("bvh" | "amc")) {
-                if let Ok(rel) = p.strip_prefix(root) {
-                    out.push(rel.to_string_lossy().replace('\\', "/"));
-                }
-            }
-        }
-    }
 }
 
 #[derive(Deserialize)]

@@ -91,6 +91,63 @@ pub fn resolve_under_root(root: Option<&Path>, relative: &str) -> Result<PathBuf
     Ok(real)
 }
 
+/// What [`list_under_root`] does with a folder it meets.
+pub enum Folder {
+    /// List it as one entry (a clip stored as a folder of frames), not what is inside.
+    Take,
+    /// Look inside.
+    Descend,
+}
+
+/// Files (and folders `folder` says to take) under `root`, as paths relative to it with `/`
+/// separators, sorted: at most six folders deep and `max` entries. `keep` gets the relative path of
+/// every file; `folder` the path of every folder (relative, and on disk).
+pub fn list_under_root(
+    root: &Path,
+    max: usize,
+    keep: impl Fn(&str) -> bool,
+    folder: impl Fn(&str, &Path) -> Folder,
+) -> Vec<String> {
+    fn walk(
+        root: &Path,
+        dir: &Path,
+        depth: usize,
+        max: usize,
+        keep: &dyn Fn(&str) -> bool,
+        folder: &dyn Fn(&str, &Path) -> Folder,
+        out: &mut Vec<String>,
+    ) {
+        let Ok(entries) = std::fs::read_dir(dir) else { return };
+        for e in entries.flatten() {
+            if out.len() >= max {
+                return;
+            }
+            let p = e.path();
+            let Ok(kind) = e.file_type() else { continue };
+            let Ok(rel) = p.strip_prefix(root) else { continue };
+            let rel = rel.to_string_lossy().replace('\\', "/");
+            if kind.is_dir() {
+                match folder(&rel, &p) {
+                    Folder::Take => out.push(format!("{rel}/")),
+                    Folder::Descend if depth < 6 => walk(root, &p, depth + 1, max, keep, folder, out),
+                    Folder::Descend => {}
+                }
+            } else if kind.is_file() && keep(&rel) {
+                out.push(rel);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(root, root, 0, max, &keep, &folder, &mut out);
+    out.sort();
+    out
+}
+
+/// The lower-case extension of a relative path ("" when none).
+pub fn extension_of(rel: &str) -> String {
+    Path::new(rel).extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase()).unwrap_or_default()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -24,7 +24,7 @@ use serde_json::{json, Value};
 use crate::error::{Result, StudioError};
 use crate::jobs::{answer, Job};
 use crate::mocap_panel::UploadQuery;
-use crate::safety::resolve_under_root;
+use crate::safety::{extension_of, list_under_root, resolve_under_root, Folder};
 use crate::server::AppState;
 
 /// The open clip and its analysis.
@@ -80,46 +80,24 @@ pub const SPRITE_COLUMNS: u32 = 12;
 /// `GET /api/video/corpus`: MP4 and GIF files and folders of PNG/JPEG frames under `--root` (below a
 /// folder named `video`), and the built-in clip.
 pub async fn corpus(State(st): State<Arc<AppState>>) -> Json<Value> {
-    let mut files = Vec::new();
-    if let Some(root) = &st.config.root {
-        list(root, root, 0, &mut files);
-    }
-    files.sort();
+    let in_video = |rel: &str| rel.split('/').any(|c| c == "video");
+    let files = st.config.root.as_deref().map_or_else(Vec::new, |root| {
+        let keep = |rel: &str| matches!(extension_of(rel).as_str(), "mp4" | "m4v" | "mov" | "gif") && in_video(rel);
+        // A folder of PNG/JPEG frames under `video` is one clip.
+        let folder = |rel: &str, dir: &Path| {
+            let images = std::fs::read_dir(dir).is_ok_and(|rd| {
+                rd.flatten()
+                    .any(|f| matches!(extension_of(&f.file_name().to_string_lossy()).as_str(), "png" | "jpg" | "jpeg"))
+            });
+            if images && in_video(rel) {
+                Folder::Take
+            } else {
+                Folder::Descend
+            }
+        };
+        list_under_root(root, 2000, keep, folder)
+    });
     Json(json!({ "files": files, "builtin": [BUILTIN.0] }))
-}
-
-fn list(root: &Path, dir: &Path, depth: usize, out: &mut Vec<String>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        if out.len() >= 2000 {
-            return;
-        }
-        let p = e.path();
-        let Ok(kind) = e.file_type() else { continue };
-        let Ok(rel) = p.strip_prefix(root) else { continue };
-        let rel = rel.to_string_lossy().replace('\\', "/");
-        let in_video = rel.split('/').any(|c| c == "video");
-        if kind.is_dir() {
-            let images = std::fs::read_dir(&p)
-                .map(|rd| {
-                    rd.flatten().any(|f| {
-                        let n = f.file_name().to_string_lossy().to_ascii_lowercase();
-                        n.ends_with(".png") || n.ends_with(".jpg") || n.ends_with(".jpeg")
-                    })
-                })
-                .unwrap_or(false);
-            if images && in_video {
-                out.push(format!("{rel}/"));
-            } else if depth < 6 {
-                list(root, &p, depth + 1, out);
-            }
-        } else if kind.is_file() && in_video {
-            let ext = p.extension().and_then(|x| x.to_str()).map(|x| x.to_ascii_lowercase());
-            if matches!(ext.as_deref(), Some("mp4" | "m4v" | "mov" | "gif")) {
-                out.push(rel);
-            }
-        }
-    }
 }
 
 #[derive(Deserialize)]

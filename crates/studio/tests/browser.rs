@@ -257,18 +257,19 @@ fn rows_inside(times: &[f64], a: f64, b: f64) -> Vec<usize> {
     (0..times.len()).filter(|&i| times[i] >= a && times[i] <= b).collect()
 }
 
-#[test]
-fn face_panel_in_headless_chromium() {
+/// A studio (files under the shared data when present) and headless Chromium on its page, showing
+/// `panel`; None (after printing why) when Chromium or the built page is missing.
+fn open_panel(panel: &str) -> Option<(Studio, Browser, Result<std::path::PathBuf, std::path::PathBuf>)> {
     let (chromium, driver) = match available() {
         Ok(found) => found,
         Err(why) => {
             println!("skipped: {why}");
-            return;
+            return None;
         }
     };
     if inbetween_studio::assets::missing().is_some() {
         println!("skipped: the studio was built without three.js (no Node at build time)");
-        return;
+        return None;
     }
     let data = inbetween_io::shared_data_dir();
     let studio =
@@ -276,8 +277,29 @@ fn face_panel_in_headless_chromium() {
     let b = Browser::launch(&chromium, &driver, 1280, 800).expect("launch chromium");
     b.goto(&studio.url()).unwrap();
     b.eval("window.inbetweenStudio.ready()").unwrap();
-    b.eval("(document.querySelector('[data-testid=nav-face]').click(), true)").unwrap();
-    assert_eq!(state(&b)["panel"], "face");
+    b.eval(&format!("(document.querySelector('[data-testid=nav-{panel}]').click(), true)")).unwrap();
+    assert_eq!(state(&b)["panel"], panel);
+    Some((studio, b, data))
+}
+
+/// Opens a garbage file `name` through the visible panel's file input: its error names the file and
+/// the job fails; then `recover` (a button) succeeds and clears the error: the server kept serving.
+fn garbage_then_recover(b: &Browser, name: &str, bytes: &[u8], recover: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join(name);
+    std::fs::write(&junk, bytes).unwrap();
+    open_files(b, &[junk.as_path()]);
+    let err = error_text(b);
+    assert!(err.contains(name), "the error should name the file: {err:?}");
+    assert_eq!(state(b)["lastJob"]["ok"], false);
+    let st = click_and_wait(b, recover);
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert_eq!(error_text(b), "");
+}
+
+#[test]
+fn face_panel_in_headless_chromium() {
+    let Some((_studio, b, data)) = open_panel("face") else { return };
 
     // A real capture from the corpus (the built-in procedural take without data).
     let real = "face/neurosync/livelink/Fearful/MySlate_162_iPhone_cal.csv";
@@ -401,40 +423,17 @@ fn face_panel_in_headless_chromium() {
     }
     assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), frames + 1);
 
-    // A garbage file: its error names it; the server keeps serving.
-    let dir = tempfile::tempdir().unwrap();
-    let junk = dir.path().join("garbage.csv");
-    std::fs::write(&junk, "Timecode,BlendShapeCount,EyeBlinkLeft\n00:00:00:00.000,1,banana\n").unwrap();
-    open_files(&b, &[junk.as_path()]);
-    let err = error_text(&b);
-    assert!(err.contains("garbage.csv"), "the error should name the file: {err:?}");
-    assert_eq!(state(&b)["lastJob"]["ok"], false);
-    let st = click_and_wait(&b, "face-generate");
-    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
-    assert_eq!(error_text(&b), "");
+    garbage_then_recover(
+        &b,
+        "garbage.csv",
+        b"Timecode,BlendShapeCount,EyeBlinkLeft\n00:00:00:00.000,1,banana\n",
+        "face-generate",
+    );
 }
 
 #[test]
 fn video_panel_in_headless_chromium() {
-    let (chromium, driver) = match available() {
-        Ok(found) => found,
-        Err(why) => {
-            println!("skipped: {why}");
-            return;
-        }
-    };
-    if inbetween_studio::assets::missing().is_some() {
-        println!("skipped: the studio was built without three.js (no Node at build time)");
-        return;
-    }
-    let data = inbetween_io::shared_data_dir();
-    let studio =
-        Studio::start(StudioConfig { port: 0, root: data.clone().ok(), ..StudioConfig::default() }).expect("start");
-    let b = Browser::launch(&chromium, &driver, 1280, 800).expect("launch chromium");
-    b.goto(&studio.url()).unwrap();
-    b.eval("window.inbetweenStudio.ready()").unwrap();
-    b.eval("(document.querySelector('[data-testid=nav-video]').click(), true)").unwrap();
-    assert_eq!(state(&b)["panel"], "video");
+    let Some((_studio, b, data)) = open_panel("video") else { return };
 
     // Real footage with a scene cut: the corpus has no clip with one, so the test joins 40 frames of
     // two of its clips (Big Buck Bunny, then the carphone sequence) into one GIF and opens it as a
@@ -533,38 +532,12 @@ fn video_panel_in_headless_chromium() {
     assert_eq!(gif[1], "GIF8", "{gif}");
     assert!(gif[0].as_u64().unwrap() > 1000, "{gif}");
 
-    // A garbage file: its error names it; the server keeps serving.
-    let junk = dir.path().join("garbage.mp4");
-    std::fs::write(&junk, b"\0\0\0\x18ftypisom this is not a movie").unwrap();
-    open_files(&b, &[junk.as_path()]);
-    let err = error_text(&b);
-    assert!(err.contains("garbage.mp4"), "the error should name the file: {err:?}");
-    assert_eq!(state(&b)["lastJob"]["ok"], false);
-    let st = click_and_wait(&b, "video-generate");
-    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
-    assert_eq!(error_text(&b), "");
+    garbage_then_recover(&b, "garbage.mp4", b"\0\0\0\x18ftypisom this is not a movie", "video-generate");
 }
 
 #[test]
 fn camera_panel_in_headless_chromium() {
-    let (chromium, driver) = match available() {
-        Ok(found) => found,
-        Err(why) => {
-            println!("skipped: {why}");
-            return;
-        }
-    };
-    if inbetween_studio::assets::missing().is_some() {
-        println!("skipped: the studio was built without three.js (no Node at build time)");
-        return;
-    }
-    let data = inbetween_io::shared_data_dir();
-    let studio = Studio::start(StudioConfig { port: 0, ..StudioConfig::default() }).expect("start");
-    let b = Browser::launch(&chromium, &driver, 1280, 800).expect("launch chromium");
-    b.goto(&studio.url()).unwrap();
-    b.eval("window.inbetweenStudio.ready()").unwrap();
-    b.eval("(document.querySelector('[data-testid=nav-camera]').click(), true)").unwrap();
-    assert_eq!(state(&b)["panel"], "camera");
+    let Some((_studio, b, data)) = open_panel("camera") else { return };
 
     // Two CMU takes as the characters (the built-in procedural pair without data).
     let takes = data.as_ref().ok().map(|d| {

@@ -63,6 +63,11 @@ impl Mask {
         m
     }
 
+    /// Every channel erased on frames `start..end`.
+    pub fn span(frames: usize, start: usize, end: usize) -> Mask {
+        Mask::from_segments(frames, &[Segment { start, end }], &[true; NUM_ARKIT])
+    }
+
     /// The whole clip erased (the Table 4 protocol and generation from scratch).
     pub fn all(frames: usize) -> Mask {
         Mask { frames, erased: vec![true; frames * NUM_ARKIT] }

@@ -404,7 +404,7 @@ mod tests {
     }
 
     fn gap(n: usize, a: usize, b: usize) -> Mask {
-        Mask::from_segments(n, &[Segment { start: a, end: b }], &[true; NUM_ARKIT])
+        Mask::span(n, a, b)
     }
 
     #[test]

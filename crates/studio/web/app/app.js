@@ -460,20 +460,19 @@ faceCorpus.addEventListener('change', () => {
   if (path) start('face-open', async () => { const r = await job('/api/face/open', { path }); drawFaceTake(r); return r; });
 });
 const uploadCheck = (f) => { if (f.size > maxUpload) throw new Error(`${f.name}: ${(f.size / 1e6).toFixed(1)} MB is larger than this studio's upload cap of ${(maxUpload / 1e6).toFixed(0)} MB (start it with --max-upload SIZE)`); };
+// Sends file `f` to `url` (its name in the query, `extra` appended) as a job.
+function uploadJob(url, f, extra = '') {
+  uploadCheck(f);
+  return job(`${url}?name=${encodeURIComponent(f.name)}${extra}`, f, { 'content-type': 'application/octet-stream' });
+}
 $('face-file').addEventListener('change', (e) => {
   const f = e.target.files[0];
-  if (f) start('face-open', async () => {
-    uploadCheck(f);
-    const r = await job(`/api/face/upload?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
-    drawFaceTake(r);
-    return r;
-  });
+  if (f) start('face-open', async () => { const r = await uploadJob('/api/face/upload', f); drawFaceTake(r); return r; });
 });
 $('face-guide').addEventListener('change', (e) => {
   const f = e.target.files[0];
   if (f) start('face-guide', async () => {
-    uploadCheck(f);
-    const r = await job(`/api/face/guide?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
+    const r = await uploadJob('/api/face/guide', f);
     $('face-constraint').value = r.phonemes ? 'visemes' : 'noisy';
     return r;
   });
@@ -765,12 +764,7 @@ videoCorpus.addEventListener('change', () => {
 });
 $('video-file').addEventListener('change', (e) => {
   const f = e.target.files[0];
-  if (f) start('video-open', async () => {
-    uploadCheck(f);
-    const r = await job(`/api/video/upload?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
-    await drawVideoClip(r);
-    return r;
-  });
+  if (f) start('video-open', async () => { const r = await uploadJob('/api/video/upload', f); await drawVideoClip(r); return r; });
 });
 
 function loadImage(url) {
@@ -911,10 +905,7 @@ $('camera-characters').addEventListener('change', (e) => {
   start('camera-scene', async () => {
     if (files.length !== 2) throw new Error(`pick two BVH takes together (got ${files.length})`);
     let r;
-    for (const [slot, f] of files.entries()) {
-      uploadCheck(f);
-      r = await job(`/api/camera/upload?name=${encodeURIComponent(f.name)}&slot=${slot}`, f, { 'content-type': 'application/octet-stream' });
-    }
+    for (const [slot, f] of files.entries()) r = await uploadJob('/api/camera/upload', f, `&slot=${slot}`);
     drawCameraScene(r);
     return r;
   });
@@ -922,8 +913,7 @@ $('camera-characters').addEventListener('change', (e) => {
 $('camera-reference').addEventListener('change', (e) => {
   const f = e.target.files[0];
   if (f) start('camera-reference', async () => {
-    uploadCheck(f);
-    const r = await job(`/api/camera/reference?name=${encodeURIComponent(f.name)}`, f, { 'content-type': 'application/octet-stream' });
+    const r = await uploadJob('/api/camera/reference', f);
     $('camera-style').value = 'reference';
     return r;
   });
