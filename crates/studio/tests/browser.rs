@@ -297,6 +297,23 @@ fn garbage_then_recover(b: &Browser, name: &str, bytes: &[u8], recover: &str) {
     assert_eq!(error_text(b), "");
 }
 
+/// Without the shared data (`what` names what was missing): picks `value` in the select `select_id`
+/// instead and waits for its job.
+fn open_builtin(
+    b: &Browser,
+    data: &Result<std::path::PathBuf, std::path::PathBuf>,
+    what: &str,
+    select_id: &str,
+    value: &str,
+) {
+    let at = data.as_ref().map_or_else(|e| e.display().to_string(), |d| d.display().to_string());
+    println!("skipped: no data at {at} ({what}; using {value})");
+    b.eval(&format!(
+        "(s => {{ s.value = {value:?}; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); }})(document.getElementById({select_id:?}))"
+    ))
+    .unwrap();
+}
+
 #[test]
 fn face_panel_in_headless_chromium() {
     let Some((_studio, b, data)) = open_panel("face") else { return };
@@ -321,7 +338,7 @@ fn face_panel_in_headless_chromium() {
     assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
     assert_eq!(st["lastJob"]["kind"], "face-open", "{}", st["lastJob"]);
     let frames = st["frames"].as_u64().unwrap() as usize;
-    assert!(frames > 500, "{}", st["lastJob"]);
+    assert!(frames >= 300, "{}", st["lastJob"]);
     let original = edited(&st);
     assert_eq!(original.len(), 52);
     assert_eq!(col(&original, "JawOpen").len(), frames, "one value per input row");
@@ -461,11 +478,7 @@ fn video_panel_in_headless_chromium() {
     if have_real {
         open_files(&b, &[joined.as_path()]);
     } else {
-        println!(
-            "skipped: no data at {} (real clips; using the built-in one)",
-            data.as_ref().map_or_else(|e| e.display().to_string(), |d| d.display().to_string())
-        );
-        b.eval("(s => { s.value = 'builtin:mixed'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('video-corpus'))").unwrap();
+        open_builtin(&b, &data, "real clips", "video-corpus", "builtin:mixed");
     }
     let st = state(&b);
     assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
@@ -559,11 +572,7 @@ fn camera_panel_in_headless_chromium() {
         b.set_files(&sel("camera-characters"), &[a.as_path(), c.as_path()]).unwrap();
         wait_for_job(n);
     } else {
-        println!(
-            "skipped: no data at {} (CMU takes; using the built-in pair)",
-            data.as_ref().map_or_else(|e| e.display().to_string(), |d| d.display().to_string())
-        );
-        b.eval("(s => { s.value = 'builtin:pair'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('camera-scene'))").unwrap();
+        open_builtin(&b, &data, "CMU takes", "camera-scene", "builtin:pair");
     }
     let st = state(&b);
     assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
