@@ -546,6 +546,14 @@ fn video_panel_in_headless_chromium() {
     assert!(gif[0].as_u64().unwrap() > 1000, "{gif}");
 
     garbage_then_recover(&b, "garbage.mp4", b"\0\0\0\x18ftypisom this is not a movie", "video-generate");
+
+    // A folder of PNG frames from the corpus opens as one clip.
+    if have_real {
+        b.eval("(s => { s.value = 'video/bbb_png_seq/'; s.dispatchEvent(new Event('change')); return window.inbetweenStudio.ready(); })(document.getElementById('video-corpus'))").unwrap();
+        let st = state(&b);
+        assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+        assert_eq!(st["frames"].as_u64().unwrap(), 24, "{}", st["lastJob"]);
+    }
 }
 
 #[test]
@@ -626,6 +634,20 @@ fn camera_panel_in_headless_chromium() {
         .unwrap();
     assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
     assert!(st["lastJob"]["message"].as_str().unwrap().contains("set from the view"), "{}", st["lastJob"]);
+
+    // A velocity at the selected key shows as an arrow in the viewport; swapping A and B at a key
+    // still generates through every key.
+    b.eval("(() => { const v = document.getElementById('ck-vel'); v.checked = true; v.dispatchEvent(new Event('change')); return true; })()").unwrap();
+    let st = b.eval("new Promise(ok => setTimeout(ok, 300)).then(() => window.inbetweenStudio.state())").unwrap();
+    assert_eq!(st["camera"]["arrow"], true, "{}", st["camera"]);
+    b.eval("(() => { const s = document.querySelector('[data-testid=camera-swap]'); s.checked = true; s.dispatchEvent(new Event('change')); return true; })()").unwrap();
+    let st = click_and_wait(&b, "camera-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    let keys = st["camera"]["keys"].as_array().unwrap();
+    assert!(keys.iter().any(|k| k["targets"].is_array() && !k["velocity"].is_null()), "{}", st["camera"]);
+    for t in st["camera"]["trajectories"].as_array().unwrap() {
+        assert!(t["key_hit_error"].as_f64().unwrap() < 1e-6, "every key hit: {t}");
+    }
 
     // The gizmo: the selected key's camera dragged in the viewport gets new Toric coordinates.
     let before = st["camera"]["keys"].clone();

@@ -991,11 +991,12 @@ function renderCameraKeys(moveGizmo = true) {
     $('ck-pax').value = k.camera.pa[0].toFixed(3); $('ck-pay').value = k.camera.pa[1].toFixed(3);
     $('ck-pbx').value = k.camera.pb[0].toFixed(3); $('ck-pby').value = k.camera.pb[1].toFixed(3);
     $('ck-vel').checked = !!k.velocity; if (k.velocity) $('ck-velocity').value = k.velocity.join(',');
+    $('ck-swap').checked = !!k.targets;
   }
   drawTimeline();
   if (moveGizmo && S.panel === 'camera') placeGizmo().catch((e) => showError(e.message));
 }
-for (const id of ['ck-frame', 'ck-theta', 'ck-phi', 'ck-pax', 'ck-pay', 'ck-pbx', 'ck-pby', 'ck-vel', 'ck-velocity']) {
+for (const id of ['ck-frame', 'ck-theta', 'ck-phi', 'ck-pax', 'ck-pay', 'ck-pbx', 'ck-pby', 'ck-vel', 'ck-velocity', 'ck-swap']) {
   $(id).addEventListener('change', () => {
     const c = S.camera, k = c.keys[c.selKey]; if (!k) return;
     const num = (x) => parseFloat($(x).value);
@@ -1003,6 +1004,8 @@ for (const id of ['ck-frame', 'ck-theta', 'ck-phi', 'ck-pax', 'ck-pay', 'ck-pbx'
     k.camera = { pa: [num('ck-pax'), num('ck-pay')], pb: [num('ck-pbx'), num('ck-pby')], theta: num('ck-theta'), phi: num('ck-phi') };
     const vel = $('ck-velocity').value.split(',').map(Number);
     k.velocity = $('ck-vel').checked && vel.length === 6 && vel.every(Number.isFinite) ? vel : null;
+    const names = c.scene.characters.map((x) => x.name);
+    k.targets = $('ck-swap').checked ? [names[1], names[0]] : null;
     const keep = k; renderCameraKeys(); S.camera.selKey = S.camera.keys.indexOf(keep); renderCameraKeys();
   });
 }
@@ -1035,7 +1038,7 @@ function runCamera() {
     const c = S.camera;
     if (!c.scene) throw new Error('open a scene first');
     const style = $('camera-style').value;
-    const keys = { main: c.scene.keys.main, keys: c.keys.map((k) => ({ frame: k.frame, camera: k.camera, ...(k.velocity ? { velocity: k.velocity } : {}) })) };
+    const keys = { main: c.scene.keys.main, keys: c.keys.map((k) => ({ frame: k.frame, camera: k.camera, ...(k.velocity ? { velocity: k.velocity } : {}), ...(k.targets ? { targets: k.targets } : {}) })) };
     const r = await job('/api/camera/generate', { keys, styles: style ? [style] : [] });
     c.trajectories = r.trajectories;
     for (const ch of [...c.paths.children]) disposeTree(ch);
@@ -1179,8 +1182,21 @@ function cameraProxy() {
 async function placeGizmo() {
   const c = S.camera, k = c.keys[c.selKey];
   if (!c.scene || !k) { gizmo.detach(); if (c.proxy) c.proxy.visible = false; return; }
-  const r = await post('/api/camera/pose', { frame: k.frame, camera: k.camera });
+  const targets = k.targets ? [1, 0] : null;
+  const r = await post('/api/camera/pose', { frame: k.frame, camera: k.camera, targets });
   if (!c.proxy) { c.proxy = cameraProxy(); groups.camera.add(c.proxy); }
+  // The velocity at the key (Fig. 6): where the camera would be a quarter second later at that
+  // Toric velocity, drawn as an arrow from the key's camera.
+  if (c.arrow) { groups.camera.remove(c.arrow); c.arrow.dispose(); c.arrow = null; }
+  if (k.velocity) {
+    const dt = 0.25, v = k.velocity;
+    const later = { pa: [k.camera.pa[0] + v[0] * dt, k.camera.pa[1] + v[1] * dt], pb: [k.camera.pb[0] + v[2] * dt, k.camera.pb[1] + v[3] * dt], theta: k.camera.theta + v[4] * dt, phi: k.camera.phi + v[5] * dt };
+    const r2 = await post('/api/camera/pose', { frame: k.frame, camera: later, targets }).catch(() => null);
+    if (r2) {
+      const from = v3(r.position), d = v3(r2.position).sub(from), len = d.length();
+      if (len > 1e-4) { c.arrow = new THREE.ArrowHelper(d.normalize(), from, Math.max(0.3, len * 4), 0xff5a5a, 0.15, 0.1); groups.camera.add(c.arrow); }
+    }
+  }
   c.proxy.visible = true;
   c.proxy.position.fromArray(r.position);
   c.proxy.quaternion.set(...r.rotation);
@@ -1196,7 +1212,7 @@ async function gizmoMoved() {
   look.lookAt(v3(c.lookAt));
   c.proxy.quaternion.copy(look.quaternion);
   const q = look.quaternion;
-  const r = await post('/api/camera/toric', { frame: k.frame, position: c.proxy.position.toArray(), rotation: [q.x, q.y, q.z, q.w] });
+  const r = await post('/api/camera/toric', { frame: k.frame, position: c.proxy.position.toArray(), rotation: [q.x, q.y, q.z, q.w], targets: k.targets ? [1, 0] : null });
   k.camera = r.camera; renderCameraKeys(false);
   return { ok: true, kind: 'camera-gizmo', message: `key at frame ${k.frame} placed in the viewport: θ ${r.camera.theta.toFixed(2)}, φ ${r.camera.phi.toFixed(2)}` };
 }
@@ -1392,7 +1408,8 @@ function state() {
     characters = cs.scene.characters.map((c) => ({ name: c.name, joints: 3, frames: cs.frames }));
     camera = {
       ...camera, shot: $('camera-shot').checked,
-      keys: cs.keys.map((k) => ({ frame: k.frame, camera: k.camera, velocity: k.velocity ?? null })),
+      keys: cs.keys.map((k) => ({ frame: k.frame, camera: k.camera, velocity: k.velocity ?? null, targets: k.targets ?? null })),
+      arrow: !!cs.arrow,
       trajectories: cs.trajectories.map((t) => ({ style: t.style, first_frame: t.first_frame, frames: t.position.length, key_hit_error: t.key_hit_error, network_key_miss: t.network_key_miss, ms: t.ms })),
       selected: cs.selected,
     };
