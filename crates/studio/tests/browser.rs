@@ -344,6 +344,7 @@ fn face_panel_in_headless_chromium() {
     assert_eq!(col(&original, "JawOpen").len(), frames, "one value per input row");
     let times: Vec<f64> = serde_json::from_value(b.eval("window.inbetweenStudio.faceTimes()").unwrap()).unwrap();
     assert_eq!(times.len(), frames);
+    let fps = (frames - 1) as f64 / times[frames - 1];
 
     // A 2 s unguided span: the frames inside change, the ones outside do not.
     set_value(&b, "face-mask-start", "4");
@@ -380,6 +381,13 @@ fn face_panel_in_headless_chromium() {
     assert_eq!(edited(&st), original, "undo");
     let st = click_and_wait(&b, "face-redo");
     assert_eq!(edited(&st), first, "redo");
+
+    // A drag on the timeline sets the span (seconds of the file's own time).
+    b.eval(&format!("window.inbetweenStudio.dragTimeline({}, {})", (3.0 * fps).round(), (5.0 * fps).round())).unwrap();
+    let mask: Vec<f64> = serde_json::from_value(state(&b)["face"]["mask"].clone()).unwrap();
+    assert!((mask[0] - 3.0).abs() < 0.05 && (mask[1] - 5.0).abs() < 0.05, "{mask:?}");
+    set_value(&b, "face-mask-start", "4");
+    set_value(&b, "face-mask-end", "6");
 
     // Keyframes: a key inside the span is hit.
     set_value(&b, "face-constraint", "keys");
@@ -589,6 +597,13 @@ fn camera_panel_in_headless_chromium() {
     assert!(frames > 100, "{st}");
     assert_eq!(st["characters"].as_array().unwrap().len(), 2, "{st}");
     assert_eq!(st["camera"]["keys"].as_array().unwrap().len(), 3, "three starting keys: {}", st["camera"]);
+
+    // Dragging a key's triangle on the timeline moves it in time.
+    let mid = st["camera"]["keys"][1]["frame"].as_u64().unwrap();
+    b.eval(&format!("window.inbetweenStudio.dragTimeline({mid}, {})", mid + 20)).unwrap();
+    let moved: Vec<u64> =
+        state(&b)["camera"]["keys"].as_array().unwrap().iter().map(|k| k["frame"].as_u64().unwrap()).collect();
+    assert!(moved.contains(&(mid + 20)) && !moved.contains(&mid), "{moved:?} (dragged {mid} → {})", mid + 20);
 
     // A key at the playhead.
     b.eval("window.inbetweenStudio.seek(60)").unwrap();

@@ -57,6 +57,9 @@ const S = {
 const panelState = () => S[S.panel];
 
 function setStatus(text) { $('status').textContent = text; }
+// Keeps a drag's pointer events on `el` (a pointer the browser does not know, as in a scripted
+// test, just goes without capture).
+function capture(el, e) { try { el.setPointerCapture(e.pointerId); } catch { /* no such pointer */ } }
 function showError(msg) { $('error').textContent = msg; }
 function clearError() { $('error').textContent = ''; }
 
@@ -722,13 +725,13 @@ faceCv.addEventListener('pointerdown', (e) => {
   if (!hit) return;
   if (e.button === 2) return;
   const near = nearestKey(hit);
-  if (near) { dragKey = near; faceCv.setPointerCapture(e.pointerId); return; }
+  if (near) { dragKey = near; capture(faceCv, e); return; }
   if ($('face-constraint').value !== 'keys') { seek(faceLayout.rowOf(hit.t)); return; }
   const [a, b] = faceMask();
   if (hit.t < a || hit.t > b) { showError(`a key at ${hit.t.toFixed(2)} s lies outside the span ${a.toFixed(2)}–${b.toFixed(2)} s; keys guide the edit only inside it`); return; }
   clearError();
   const k = { time_s: Math.round(hit.t * 100) / 100, shape: hit.shape, value: Math.round(hit.value * 1000) / 1000 };
-  S.face.keys.push(k); dragKey = k; faceCv.setPointerCapture(e.pointerId);
+  S.face.keys.push(k); dragKey = k; capture(faceCv, e);
   updateKeysCount(); drawFaceView();
 });
 faceCv.addEventListener('pointermove', (e) => {
@@ -1143,7 +1146,7 @@ $('timeline').addEventListener('pointerdown', (e) => {
   e.stopImmediatePropagation();
   if (e.button === 2) return;
   S.camera.selKey = i; draggingKey = i; renderCameraKeys();
-  $('timeline').setPointerCapture(e.pointerId);
+  capture($('timeline'), e);
 }, true);
 $('timeline').addEventListener('pointermove', (e) => {
   if (draggingKey < 0) return;
@@ -1375,7 +1378,7 @@ const scrub = (e) => {
 // On the face panel a drag sets the span (seconds of the file's own time); a click seeks.
 let dragFrom = null;
 const tlFrame = (e) => { const st = panelState(); const n = Math.max(1, st.frames); const r = tl.getBoundingClientRect(); return Math.max(0, Math.min(n - 1, (e.clientX - r.left - 40) / (r.width - 50) * (n - 1))); };
-tl.addEventListener('pointerdown', (e) => { scrubbing = true; tl.setPointerCapture(e.pointerId); dragFrom = { x: e.clientX, f: tlFrame(e) }; scrub(e); });
+tl.addEventListener('pointerdown', (e) => { scrubbing = true; capture(tl, e); dragFrom = { x: e.clientX, f: tlFrame(e) }; scrub(e); });
 tl.addEventListener('pointermove', (e) => {
   if (!scrubbing) return;
   if (S.panel === 'face' && S.face.take && dragFrom && Math.abs(e.clientX - dragFrom.x) > 4) {
@@ -1431,6 +1434,14 @@ window.inbetweenStudio = {
   // The last story drawn: ms of its request (job included), to fetch its GLB, to parse it, to
   // build the view (for the bench).
   drawTimes: () => S.drawTimes || null,
+  // Drags on the timeline from frame `a` to frame `b` with pointer events, as a mouse would.
+  dragTimeline: (a, b) => {
+    const r = tl.getBoundingClientRect(), n = Math.max(1, panelState().frames);
+    const x = (f) => r.left + 40 + (r.width - 50) * f / Math.max(1, n - 1);
+    const ev = (type, f) => tl.dispatchEvent(new PointerEvent(type, { clientX: x(f), clientY: r.top + 39, bubbles: true, pointerId: 1, button: 0 }));
+    ev('pointerdown', a); for (let k = 1; k <= 4; k++) ev('pointermove', a + (b - a) * k / 4); ev('pointerup', b);
+    return true;
+  },
   // Moves the camera gizmo by (dx, dy, dz) metres and releases it, as a drag in the viewport does.
   cameraGizmoMove: (dx, dy, dz) => { const p = S.camera.proxy; if (!p) return Promise.reject(new Error('no gizmo')); p.position.add(new THREE.Vector3(dx, dy, dz)); return start('camera-gizmo', gizmoMoved); },
   // The face take's row times, seconds from its first row.
