@@ -410,6 +410,31 @@ fn face_panel_in_headless_chromium() {
     assert_eq!(col(&before, "EyeBlinkLeft"), col(&after, "EyeBlinkLeft"), "the eyes changed under groups mouth,jaw");
     assert_ne!(col(&before, "JawOpen"), col(&after, "JawOpen"));
 
+    // Phonemes from a TextGrid file (MFA's phones tier) guide the span.
+    let tg_dir = tempfile::tempdir().unwrap();
+    let tg = tg_dir.path().join("align.TextGrid");
+    std::fs::write(
+        &tg,
+        "File type = \"ooTextFile\"\nObject class = \"TextGrid\"\n\nxmin = 0\nxmax = 6\ntiers? <exists>\nsize = 1\nitem []:\n\
+         item [1]:\nclass = \"IntervalTier\"\nname = \"phones\"\nxmin = 0\nxmax = 6\nintervals: size = 4\n\
+         intervals [1]:\nxmin = 0\nxmax = 4.2\ntext = \"\"\nintervals [2]:\nxmin = 4.2\nxmax = 4.8\ntext = \"HH\"\n\
+         intervals [3]:\nxmin = 4.8\nxmax = 5.5\ntext = \"AA1\"\nintervals [4]:\nxmin = 5.5\nxmax = 6\ntext = \"\"\n",
+    )
+    .unwrap();
+    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
+    b.set_files(&sel("face-guide"), &[tg.as_path()]).unwrap();
+    b.eval(&format!(
+        "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
+           window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
+           : Date.now() - t0 > 20000 ? fail(new Error('no job started')) : setTimeout(poll, 20); poll(); }})"
+    ))
+    .unwrap();
+    assert_eq!(error_text(&b), "");
+    assert_eq!(b.eval(&format!("{}.value", js_sel("face-constraint"))).unwrap(), "visemes");
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert!(st["lastJob"]["message"].as_str().unwrap().starts_with("network fill"), "{}", st["lastJob"]);
+
     // A noisy guide file: the take itself stands in for a second tracker's take.
     set_value(&b, "face-groups", "all");
     let guide = match &data {
@@ -694,6 +719,11 @@ fn camera_panel_in_headless_chromium() {
         .map(|t| t["style"].as_str().unwrap().to_string())
         .collect();
     assert_eq!(styles, ["reference orbit.gltf"], "the style select says reference: {styles:?}");
+
+    // Delete the selected key.
+    let before = state(&b)["camera"]["keys"].as_array().unwrap().len();
+    b.eval("(document.getElementById('camera-delete-key').click(), true)").unwrap();
+    assert_eq!(state(&b)["camera"]["keys"].as_array().unwrap().len(), before - 1);
 
     // Export: the track as JSON.
     let track = b.eval("fetch(document.querySelector('#camera-export a').href).then(r => r.json())").unwrap();
