@@ -577,6 +577,14 @@ fn video_panel_in_headless_chromium() {
         .unwrap();
     assert_eq!(gif[1], "GIF8", "{gif}");
     assert!(gif[0].as_u64().unwrap() > 1000, "{gif}");
+    let mp4 = b
+        .eval(
+            "fetch([...document.querySelectorAll('#video-export a')].find(a => a.textContent.endsWith('.mp4')).href)\
+             .then(r => r.arrayBuffer()).then(b => { const u = new Uint8Array(b); return [u.length, String.fromCharCode(...u.slice(4, 8))]; })",
+        )
+        .unwrap();
+    assert_eq!(mp4[1], "ftyp", "{mp4}");
+    assert!(mp4[0].as_u64().unwrap() > 1000, "{mp4}");
 
     garbage_then_recover(&b, "garbage.mp4", b"\0\0\0\x18ftypisom this is not a movie", "video-generate");
 
