@@ -305,7 +305,7 @@ fn retrieval_library(files: &[PathBuf], max_rows: usize) -> anyhow::Result<Motio
     let mut lib = MotionLibrary::default();
     for f in files {
         let clip = read_clip_limited(f, max_rows)?.resample(MODEL_FPS).with_context(|| format!("{}", f.display()))?;
-        lib.push((0..clip.num_frames()).map(|i| std::array::from_fn(|c| clip.arkit(i)[c])).collect());
+        lib.push(clip.arkit_frames());
     }
     Ok(lib)
 }

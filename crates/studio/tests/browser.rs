@@ -28,8 +28,13 @@ fn click_and_wait(b: &Browser, testid: &str) -> Value {
 
 /// Sets the visible panel's file input and waits for the job its change event starts.
 fn open_files(b: &Browser, files: &[&Path]) {
+    set_files_and_wait(b, "file-input", files);
+}
+
+/// Sets the visible panel's file input `testid` and waits for the job its change event starts.
+fn set_files_and_wait(b: &Browser, testid: &str, files: &[&Path]) {
     let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
-    b.set_files(&sel("file-input"), files).unwrap();
+    b.set_files(&sel(testid), files).unwrap();
     b.eval(&format!(
         "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
            window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
@@ -421,14 +426,7 @@ fn face_panel_in_headless_chromium() {
          intervals [3]:\nxmin = 4.8\nxmax = 5.5\ntext = \"AA1\"\nintervals [4]:\nxmin = 5.5\nxmax = 6\ntext = \"\"\n",
     )
     .unwrap();
-    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
-    b.set_files(&sel("face-guide"), &[tg.as_path()]).unwrap();
-    b.eval(&format!(
-        "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
-           window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
-           : Date.now() - t0 > 20000 ? fail(new Error('no job started')) : setTimeout(poll, 20); poll(); }})"
-    ))
-    .unwrap();
+    set_files_and_wait(&b, "face-guide", &[tg.as_path()]);
     assert_eq!(error_text(&b), "");
     assert_eq!(b.eval(&format!("{}.value", js_sel("face-constraint"))).unwrap(), "visemes");
     let st = click_and_wait(&b, "face-generate");
@@ -451,14 +449,7 @@ fn face_panel_in_headless_chromium() {
             p
         }
     };
-    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
-    b.set_files(&sel("face-guide"), &[guide.as_path()]).unwrap();
-    b.eval(&format!(
-        "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
-           window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
-           : Date.now() - t0 > 20000 ? fail(new Error('no job started')) : setTimeout(poll, 20); poll(); }})"
-    ))
-    .unwrap();
+    set_files_and_wait(&b, "face-guide", &[guide.as_path()]);
     assert_eq!(error_text(&b), "");
     assert_eq!(b.eval(&format!("{}.value", js_sel("face-constraint"))).unwrap(), "noisy");
     let st = click_and_wait(&b, "face-generate");
@@ -607,19 +598,9 @@ fn camera_panel_in_headless_chromium() {
         (dir.join("007_12.bvh"), dir.join("002_01.bvh"))
     });
     let real = takes.as_ref().is_some_and(|(a, c)| a.is_file() && c.is_file());
-    let wait_for_job = |n: u64| {
-        b.eval(&format!(
-            "new Promise((ok, fail) => {{ const t0 = Date.now(); const poll = () => \
-               window.inbetweenStudio.started() > {n} ? ok(window.inbetweenStudio.ready()) \
-               : Date.now() - t0 > 20000 ? fail(new Error('no job started')) : setTimeout(poll, 20); poll(); }})"
-        ))
-        .unwrap();
-    };
     if real {
         let (a, c) = takes.as_ref().unwrap();
-        let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
-        b.set_files(&sel("camera-characters"), &[a.as_path(), c.as_path()]).unwrap();
-        wait_for_job(n);
+        set_files_and_wait(&b, "camera-characters", &[a.as_path(), c.as_path()]);
     } else {
         open_builtin(&b, &data, "CMU takes", "camera-scene", "builtin:pair");
     }
@@ -714,9 +695,7 @@ fn camera_panel_in_headless_chromium() {
     let dir0 = tempfile::tempdir().unwrap();
     let reference = dir0.path().join("orbit.gltf");
     std::fs::write(&reference, gltf.as_str().unwrap()).unwrap();
-    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
-    b.set_files(&sel("camera-reference"), &[reference.as_path()]).unwrap();
-    wait_for_job(n);
+    set_files_and_wait(&b, "camera-reference", &[reference.as_path()]);
     assert_eq!(error_text(&b), "");
     let st = click_and_wait(&b, "camera-generate");
     assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
@@ -753,11 +732,9 @@ fn camera_panel_in_headless_chromium() {
         })),
     )
     .unwrap();
-    let n = b.eval("window.inbetweenStudio.started()").unwrap().as_u64().unwrap();
     // WebDriver adds files to a `multiple` input: empty it first, as a new pick would.
     b.eval("(document.getElementById('camera-characters').value = '', true)").unwrap();
-    b.set_files(&sel("camera-characters"), &[good.as_path(), junk.as_path()]).unwrap();
-    wait_for_job(n);
+    set_files_and_wait(&b, "camera-characters", &[good.as_path(), junk.as_path()]);
     let err = error_text(&b);
     assert!(err.contains("garbage.bvh:"), "the error should name the file and line: {err:?}");
     let st = click_and_wait(&b, "camera-generate");

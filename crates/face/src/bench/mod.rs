@@ -144,17 +144,6 @@ impl Acc {
     }
 }
 
-/// Model-rate frames of a clip.
-fn frames_of(clip: &BlendshapeClip) -> Vec<Frame> {
-    (0..clip.num_frames())
-        .map(|f| {
-            let mut x = [0.0; NUM_ARKIT];
-            x.copy_from_slice(&clip.arkit(f)[..NUM_ARKIT]);
-            x
-        })
-        .collect()
-}
-
 /// A 25 fps clip of the given frames (times from 0).
 pub fn clip_of(frames: &[Frame]) -> BlendshapeClip {
     let times = (0..frames.len()).map(|f| f as f64 / MODEL_FPS).collect();
@@ -222,7 +211,7 @@ pub struct Library {
 pub fn libraries(cfg: &FaceBenchConfig) -> Result<Vec<Library>, FaceError> {
     let mut real = MotionLibrary::default();
     for f in TRAIN_FILES {
-        real.push(frames_of(&read_live_link(&cfg.captures.join(f))?.resample(MODEL_FPS)?));
+        real.push(read_live_link(&cfg.captures.join(f))?.resample(MODEL_FPS)?.arkit_frames());
     }
     Ok(vec![
         Library { label: "real split".into(), library: real },
@@ -260,7 +249,7 @@ fn edit(
 /// The guide recomposed into the gap (the "use the noisy take as is" baseline).
 fn guide_as_is(truth: &[Frame], mask: &Mask, guide: &Guide) -> Vec<Frame> {
     let Guide::Noisy(g) = guide else { return truth.to_vec() };
-    crate::model::input::recompose(truth, mask, &frames_of(g))
+    crate::model::input::recompose(truth, mask, &g.arkit_frames())
 }
 
 type Cells = Vec<((ConstraintKind, f64, String), Acc)>;
@@ -286,7 +275,7 @@ fn evaluate_clip(
     cells: &mut Cells,
     progress: &Progress,
 ) -> Result<(), FaceError> {
-    let truth = frames_of(truth_clip);
+    let truth = truth_clip.arkit_frames();
     let n = truth.len();
     for (gi, gap_s) in GAPS_S.iter().enumerate() {
         let len = (gap_s * MODEL_FPS).round() as usize;
@@ -457,7 +446,7 @@ fn plausibility_tables(
     let mut cells: PCells = Vec::new();
     let real_label = "real capture".to_string();
     for (ci, (_, clip)) in tests.iter().enumerate() {
-        let truth = frames_of(clip);
+        let truth = clip.arkit_frames();
         let n = truth.len();
         let margin = 2 * MODEL_FPS as usize;
         for (gi, gap_s) in PLAUSIBILITY_GAPS_S.iter().enumerate() {
@@ -605,7 +594,7 @@ fn table4(
                    kind: ConstraintKind,
                    s: u64|
      -> Result<(), FaceError> {
-        let all = frames_of(truth_clip);
+        let all = truth_clip.arkit_frames();
         for (w, chunk) in all.chunks_exact(window).enumerate() {
             let truth = chunk.to_vec();
             let clip = clip_of(&truth);
@@ -684,7 +673,7 @@ fn table3(
         } else {
             (tests[0].1.clone(), None)
         };
-        let truth = frames_of(&clip);
+        let truth = clip.arkit_frames();
         let start = truth.len() / 2 - frames / 2;
         let seg = Segment { start, end: start + frames };
         let mask = Mask::from_segments(truth.len(), &[seg], &[true; NUM_ARKIT]);

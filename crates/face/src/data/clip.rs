@@ -178,6 +178,11 @@ impl BlendshapeClip {
         &self.frame(f)[..NUM_ARKIT]
     }
 
+    /// The 52 ARKit weights of every frame.
+    pub fn arkit_frames(&self) -> Vec<[f32; NUM_ARKIT]> {
+        (0..self.num_frames()).map(|f| self.arkit(f).try_into().expect("52 ARKit values")).collect()
+    }
+
     /// The 9 head/eye rotations of one frame, when present.
     pub fn head_eye(&self, f: usize) -> Option<&[f32]> {
         self.head_eye.then(|| &self.frame(f)[NUM_ARKIT..NUM_ARKIT + NUM_HEAD_EYE])

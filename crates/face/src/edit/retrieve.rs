@@ -39,10 +39,8 @@ impl MotionLibrary {
     /// `seconds` of procedural faces (blinks, speech, expressions, gaze) in 20 s clips, drawn with `seed`.
     pub fn procedural(seconds: f64, seed: u64) -> Self {
         let n = (seconds / 20.0).ceil().max(1.0) as usize;
-        let clips = crate::procedural::generate_corpus(n, 20.0, seed)
-            .into_iter()
-            .map(|p| (0..p.clip.num_frames()).map(|f| frame_of(p.clip.arkit(f))).collect())
-            .collect();
+        let clips =
+            crate::procedural::generate_corpus(n, 20.0, seed).into_iter().map(|p| p.clip.arkit_frames()).collect();
         MotionLibrary { clips }
     }
 
@@ -60,12 +58,6 @@ impl MotionLibrary {
     pub fn clips(&self) -> &[Vec<Frame>] {
         &self.clips
     }
-}
-
-fn frame_of(values: &[f32]) -> Frame {
-    let mut f = [0.0; NUM_ARKIT];
-    f.copy_from_slice(&values[..NUM_ARKIT]);
-    f
 }
 
 /// How segments are scored, drawn and joined.

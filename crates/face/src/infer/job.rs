@@ -260,7 +260,7 @@ impl EditJob<'_> {
         self.cancel.check()?;
         let model = self.clip.resample(MODEL_FPS)?;
         self.cancel.check()?;
-        let before: Vec<Frame> = (0..model.num_frames()).map(|f| frame_of(model.arkit(f))).collect();
+        let before: Vec<Frame> = model.arkit_frames();
         let n = before.len();
         let segments = self.segments(n);
         let mask = Mask::from_segments(n, &segments, &self.channels);
@@ -329,7 +329,7 @@ impl EditJob<'_> {
                 let g0 = guide.times()[0];
                 let times: Vec<f64> = (0..n).map(|f| g0 + f as f64 / MODEL_FPS).collect();
                 let g = guide.resample_at(&times, MODEL_FPS)?;
-                Constraint::Noisy((0..n).map(|f| frame_of(g.arkit(f))).collect())
+                Constraint::Noisy(g.arkit_frames())
             }
             Guide::Visemes(spans) => Constraint::Visemes(
                 (0..n)
@@ -427,12 +427,6 @@ fn generate_in_window(
     let mut out = before.to_vec();
     out[w0..w1].copy_from_slice(&net.generate(&x, w1 - w0));
     out
-}
-
-fn frame_of(values: &[f32]) -> Frame {
-    let mut f = [0.0; NUM_ARKIT];
-    f.copy_from_slice(&values[..NUM_ARKIT]);
-    f
 }
 
 /// Cubic Hermite across each run of `inside` frames for the head/eye channels, from the values and

@@ -247,28 +247,16 @@ impl<'a, R: Rng> Solver<'a, R> {
             if !inside_room(&self.p.room, &obj) || self.collides(i, &obj) {
                 continue;
             }
-            let unmet = live
-                .iter()
-                .filter(|c| {
-                    let (a, b) = if c.active == i {
-                        (&obj, self.poses[c.anchor].as_ref().expect("live"))
-                    } else {
-                        (self.poses[c.active].as_ref().expect("live"), &obj)
-                    };
-                    !relation_holds(c.relation, a, b)
-                })
-                .count();
-            let loose = live
-                .iter()
-                .filter(|c| {
-                    let (a, b) = if c.active == i {
-                        (&obj, self.poses[c.anchor].as_ref().expect("live"))
-                    } else {
-                        (self.poses[c.active].as_ref().expect("live"), &obj)
-                    };
-                    !strictly_holds(c.relation, a, b)
-                })
-                .count();
+            // The constraint's (active, anchor) objects with the candidate in its place.
+            let pair = |c: &LayoutConstraint| {
+                if c.active == i {
+                    (&obj, self.poses[c.anchor].as_ref().expect("live"))
+                } else {
+                    (self.poses[c.active].as_ref().expect("live"), &obj)
+                }
+            };
+            let unmet = live.iter().filter(|c| !relation_holds(c.relation, pair(c).0, pair(c).1)).count();
+            let loose = live.iter().filter(|c| !strictly_holds(c.relation, pair(c).0, pair(c).1)).count();
             // The authored pose is kept whenever the shared definitions hold there.
             let tidy = if pose.penalty < 0.0 { 0.0 } else { 2.0 * loose as f32 };
             let mut score = 100.0 * unmet as f32 + tidy + pose.penalty;
