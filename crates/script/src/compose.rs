@@ -273,6 +273,7 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
                 origin: Origin::Script { sentence: o.sentence, node },
                 hint: if k == 0 { hint_of.get(&node).cloned() } else { None },
                 pinned: None,
+                seat: c.is_seat(),
             });
             item_keys.push(key);
         }
@@ -311,6 +312,7 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
                 origin: Origin::Database { scene: scene.name.clone(), node: n },
                 hint: Some(hint_in_room(&scene.placements[n], &scene.room, &room)),
                 pinned: None,
+                seat: c.is_seat(),
             });
         }
         for mut e in extra {

@@ -9,7 +9,9 @@ use crate::database::SceneDatabase;
 use crate::error::Diagnostic;
 use crate::limits::ScriptLimits;
 use crate::output;
+use crate::scene::Scene;
 use crate::session::Session;
+use crate::ssg::Ssg;
 use crate::story::StorySession;
 use crate::ScriptError;
 
@@ -79,24 +81,24 @@ fn script_catalogue(text: &str, job: &SceneJob) -> Result<(Catalogue, Vec<Diagno
     }
 }
 
-/// Writes the scene outputs (scene.json, ssg.json, scene.gltf, previews) of a composition.
-fn write_scene(composition: &Composition, cat: &Catalogue, job: &SceneJob) -> Result<Vec<PathBuf>, ScriptError> {
+/// Writes the scene outputs (scene.json, ssg.json, scene.gltf, previews) of `scene` composed
+/// from `query` (a story passes its optimised scene, so every output shows one layout).
+fn write_scene(scene: &Scene, query: &Ssg, cat: &Catalogue, job: &SceneJob) -> Result<Vec<PathBuf>, ScriptError> {
     let dir = &job.out_dir;
     std::fs::create_dir_all(dir).map_err(|e| ScriptError::io(dir, e))?;
     let mut files = Vec::new();
     let json = dir.join("scene.json");
-    output::write_json(&json, &composition.scene)?;
+    output::write_json(&json, scene, cat)?;
     files.push(json);
     let ssg = dir.join("ssg.json");
-    let ssg_text = serde_json::to_vec_pretty(&composition.query).map_err(|e| ScriptError::Invalid(e.to_string()))?;
+    let ssg_text = serde_json::to_vec_pretty(query).map_err(|e| ScriptError::Invalid(e.to_string()))?;
     inbetween_io::write_atomic(&ssg, &ssg_text).map_err(|e| ScriptError::io(&ssg, e))?;
     files.push(ssg);
     let gltf = dir.join("scene.gltf");
-    output::write_gltf(&gltf, &composition.scene, cat)?;
+    output::write_gltf(&gltf, scene, cat)?;
     files.push(gltf);
-    let view =
-        job.view.clone().or_else(|| composition.scene.camera.last().cloned()).unwrap_or_else(|| "front".to_string());
-    files.extend(output::write_previews(dir, &composition.scene, cat, &view)?);
+    let view = job.view.clone().or_else(|| scene.camera.last().cloned()).unwrap_or_else(|| "front".to_string());
+    files.extend(output::write_previews(dir, scene, cat, &view)?);
     Ok(files)
 }
 
@@ -112,7 +114,7 @@ pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneRepor
     let mut session = Session::new(cat, db, ComposeConfig { seed: job.seed, ..job.config.clone() });
     let update = session.update(text);
     let composition = update.composition;
-    let files = write_scene(&composition, session.catalogue(), job)?;
+    let files = write_scene(&composition.scene, &composition.query, session.catalogue(), job)?;
     let diagnostics = notes.into_iter().chain(composition.diagnostics.iter().cloned()).collect();
     Ok(SceneReport { files, diagnostics, composition, seconds: update.seconds })
 }
@@ -196,7 +198,8 @@ pub fn run_story_in(
     let u = session.update(text);
     let cat = session.catalogue();
     job.scene.limits.check_animation(&name, u.animation.frames(), u.animation.fps)?;
-    let scene_files = write_scene(&u.scene.composition, cat, &job.scene)?;
+    // One layout per run: the scene files show the optimised scene the story plays in.
+    let scene_files = write_scene(&u.animation.scene, &u.scene.composition.query, cat, &job.scene)?;
     let mut files = scene_files.clone();
     let dir = &job.scene.out_dir;
     if let Some(curves) = &u.curves {

@@ -60,6 +60,20 @@ impl PlacedObject {
     }
 }
 
+/// How an object is held up (`mount` in scene.json).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mount {
+    /// Stands on the floor.
+    Floor,
+    /// Rests on the top of its support object.
+    On,
+    /// Hangs on a wall.
+    Wall,
+    /// Hangs from the ceiling.
+    Ceiling,
+}
+
 /// The furnished scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Scene {

@@ -128,3 +128,90 @@ pub fn all() -> Vec<(&'static str, &'static str)> {
         ("night-of-the-living-dead", NIGHT_OF_THE_LIVING_DEAD),
     ]
 }
+
+/// Room kinds, furniture, small things, names and directions [`random_story`] draws from (all of
+/// them words the parser and the motion library know).
+const RANDOM_ROOMS: &[&str] = &["office", "bedroom", "living room", "room", "kitchen"];
+const RANDOM_FURNITURE: &[&str] =
+    &["desk", "table", "chair", "sofa", "bed", "wardrobe", "bookcase", "armchair", "stool", "cabinet"];
+const RANDOM_SMALL: &[&str] = &["cup", "book", "lamp", "laptop", "phone", "vase", "bottle"];
+const RANDOM_SEATS: &[&str] = &["chair", "sofa", "armchair", "stool", "bed"];
+const RANDOM_RELATIONS: &[&str] = &["near", "next to", "in front of", "behind"];
+const RANDOM_NAMES: &[&str] = &["Tom", "Eve", "Anna", "Ben"];
+const RANDOM_VIEWS: &[&str] = &["front", "back", "left", "right", "close", "wide", "top"];
+
+/// A random story (deterministic in `seed`) in the style of the built-in texts: a room with two to
+/// four pieces of furniture related to each other, a small thing on one of them, a camera
+/// command, and one or two characters walking, sitting, standing up, picking things up and acting
+/// on them. The property tests of issue 27 check every invariant on such stories.
+pub fn random_story(seed: u64) -> String {
+    use rand::seq::IndexedRandom;
+    use rand::Rng;
+    let mut rng = inbetween_core::seed::rng(seed);
+    fn pick<R: Rng>(rng: &mut R, from: &[&'static str]) -> &'static str {
+        from.choose(rng).expect("non-empty")
+    }
+    let mut lines = Vec::new();
+    let n = rng.random_range(2..=4usize);
+    let mut furniture: Vec<&'static str> = Vec::new();
+    while furniture.len() < n {
+        let f = pick(&mut rng, RANDOM_FURNITURE);
+        if !furniture.contains(&f) {
+            furniture.push(f);
+        }
+    }
+    let a = |w: &str| if w.starts_with(['a', 'e', 'i', 'o', 'u']) { format!("an {w}") } else { format!("a {w}") };
+    let room = pick(&mut rng, RANDOM_ROOMS);
+    lines.push(format!(
+        "In the {room}, {} is {} {}$",
+        a(furniture[0]),
+        pick(&mut rng, RANDOM_RELATIONS),
+        a(furniture[1])
+    ));
+    for k in 2..furniture.len() {
+        let anchor = furniture[rng.random_range(0..k)];
+        let what = a(furniture[k]);
+        lines.push(format!(
+            "{}{} is {} the {anchor}$",
+            what[..1].to_uppercase(),
+            &what[1..],
+            pick(&mut rng, RANDOM_RELATIONS)
+        ));
+    }
+    let surfaces: Vec<&'static str> =
+        furniture.iter().copied().filter(|f| matches!(*f, "desk" | "table" | "cabinet")).collect();
+    let small = pick(&mut rng, RANDOM_SMALL);
+    if let Some(s) = surfaces.choose(&mut rng) {
+        let what = a(small);
+        lines.push(format!("{}{} is on the {s}$", what[..1].to_uppercase(), &what[1..]));
+    }
+    lines.push(format!("camera {}", pick(&mut rng, RANDOM_VIEWS)));
+    let characters = rng.random_range(1..=2usize);
+    let mut seats: Vec<&'static str> = furniture.iter().copied().filter(|f| RANDOM_SEATS.contains(f)).collect();
+    for c in 0..characters {
+        let name = RANDOM_NAMES[(seed as usize + c) % RANDOM_NAMES.len()];
+        let mut seated = false;
+        for _ in 0..rng.random_range(1..=3usize) {
+            let target = pick(&mut rng, &furniture);
+            let line = match rng.random_range(0..8u32) {
+                0 | 1 if !seated => format!("{name} walks to the {target}."),
+                2 if !seated && !seats.is_empty() => {
+                    seated = true;
+                    // One character per seat.
+                    let seat = seats.remove(rng.random_range(0..seats.len()));
+                    format!("{name} walks to the {seat} and sits on it.")
+                }
+                3 if seated => {
+                    seated = false;
+                    format!("{name} gets up.")
+                }
+                4 if !surfaces.is_empty() => format!("{name} picks up the {small}."),
+                5 => format!("{name} looks at the {target}."),
+                6 if !seated => format!("{name} runs to the {target}."),
+                _ => format!("{name} {}.", pick(&mut rng, &["waves", "thinks", "points at the window", "turns left"])),
+            };
+            lines.push(line);
+        }
+    }
+    lines.join("\n") + "\n"
+}

@@ -30,11 +30,14 @@ fn session() -> StorySession {
     )
 }
 
-/// The demo with Tom's sentence changed: he walks to the table first, then sits on the sofa.
+/// The demo with Tom's sentence changed: he walks to the bookshelf first, then sits on the sofa.
+/// (Walking to the table instead puts him on Eve's way to her chair in this layout for longer
+/// than he may wait, a conflict only Eve can solve, and the crowd repair then rightly changes her
+/// too.)
 fn edited() -> String {
     let old = "Tom walks slowly to the sofa and sits on it.";
     assert!(DEMO.contains(old));
-    DEMO.replace(old, "Tom walks to the table and sits on the sofa.")
+    DEMO.replace(old, "Tom walks to the bookshelf and sits on the sofa.")
 }
 
 #[test]
@@ -89,26 +92,38 @@ fn editing_one_characters_sentence_re_solves_only_that_character_and_its_objects
         u.animation.characters.iter().find(|c| c.name == "Eve").unwrap().clone()
     };
     assert!(eve(&first).motion == eve(&second).motion, "Eve's motion changed");
-    // Tom now walks to the table first.
+    // Tom now walks to the bookshelf first.
     let tom = second.animation.characters.iter().find(|c| c.name == "Tom").unwrap();
-    assert_eq!(tom.segments.first().and_then(|s| s.target.as_deref()), Some("table"));
+    assert_eq!(tom.segments.first().and_then(|s| s.target.as_deref()), Some("bookshelf"));
     // The optimisation ran only over Tom's objects: the sofa he sits on (and what relates to it),
     // none of Eve's.
     assert!(second.resolved_objects.iter().any(|l| l == "sofa"), "{:?}", second.resolved_objects);
     for l in ["desk", "chair", "laptop"] {
         assert!(!second.resolved_objects.iter().any(|r| r == l), "{l} is Eve's, yet re-optimised");
     }
-    // Every other object keeps its exact pose from the previous run.
+    // Every other object keeps its exact pose from the previous run, but what rests on a
+    // re-optimised object, which moves with it.
+    let objects = &second.animation.scene.objects;
+    let rests_on_resolved = |mut i: usize| {
+        while let Some(s) = objects[i].support {
+            if second.resolved_objects.contains(&objects[s].label) {
+                return true;
+            }
+            i = s;
+        }
+        false
+    };
     let mut kept = 0;
-    for o in &second.animation.scene.objects {
-        if second.resolved_objects.contains(&o.label) {
+    for (i, o) in objects.iter().enumerate() {
+        if second.resolved_objects.contains(&o.label) || rests_on_resolved(i) {
             continue;
         }
         let before = first.animation.scene.find(&o.label).expect("no object was added");
         assert_eq!((o.position, o.yaw, o.size), (before.position, before.yaw, before.size), "{} moved", o.label);
         kept += 1;
     }
-    assert!(kept >= first.animation.scene.objects.len() - second.resolved_objects.len());
+    let carried = (0..objects.len()).filter(|&i| rests_on_resolved(i)).count();
+    assert!(kept >= first.animation.scene.objects.len() - second.resolved_objects.len() - carried);
 }
 
 #[test]

@@ -31,6 +31,7 @@ fn database_scenes_lay_out_cleanly_from_their_hints() {
                     origin: Origin::Database { scene: s.name.clone(), node: k },
                     hint: Some(p.clone()),
                     pinned: None,
+                    seat: c.is_seat(),
                 }
             })
             .collect();

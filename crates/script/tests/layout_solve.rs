@@ -25,6 +25,7 @@ fn item(label: &str, size: [f32; 3], support: Support, surface: bool) -> LayoutI
         origin: Origin::Script { sentence: 0, node: 0 },
         hint: None,
         pinned: None,
+        seat: false,
     }
 }
 
@@ -35,10 +36,10 @@ fn table() -> LayoutItem {
     item("table", [1.2, 0.75, 0.8], Support::Floor, true)
 }
 fn chair() -> LayoutItem {
-    item("chair", [0.5, 0.9, 0.5], Support::Floor, false)
+    LayoutItem { seat: true, ..item("chair", [0.5, 0.9, 0.5], Support::Floor, false) }
 }
 fn stool() -> LayoutItem {
-    item("stool", [0.4, 0.45, 0.4], Support::Floor, false)
+    LayoutItem { seat: true, ..item("stool", [0.4, 0.45, 0.4], Support::Floor, false) }
 }
 fn lamp() -> LayoutItem {
     item("lamp", [0.2, 0.45, 0.2], Support::Surface, false)

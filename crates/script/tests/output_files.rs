@@ -32,11 +32,27 @@ fn scene() -> Scene {
 }
 
 #[test]
-fn json_round_trips() {
+fn json_round_trips_and_says_what_holds_each_object_up() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("sub/scene.json");
-    write_json(&p, &scene()).unwrap();
+    write_json(&p, &scene(), &builtin()).unwrap();
     assert_eq!(read_json(&p).unwrap(), scene());
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    let mounts: Vec<(&str, &str)> = v["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| (o["label"].as_str().unwrap(), o["mount"].as_str().unwrap()))
+        .collect();
+    let scene = scene();
+    for (o, (label, mount)) in scene.objects.iter().zip(&mounts) {
+        let want = match (o.support, o.category.as_str()) {
+            (Some(_), _) => "on",
+            (None, "oilpainting") => "wall",
+            _ => "floor",
+        };
+        assert_eq!((*label, *mount), (o.label.as_str(), want));
+    }
 }
 
 #[test]

@@ -146,10 +146,13 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let gltf_ms = t_gltf.elapsed().as_secs_f64() * 1000.0;
     let t_rest = std::time::Instant::now();
     let scene = anim.scene.clone();
+    let mounts = inbetween_script::invariants::mounts(&scene, cat);
     let scene_url = st.put_lazy(
         "script/scene.json",
         "application/json",
-        move || serde_json::to_vec_pretty(&scene).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}").into_bytes()),
+        move || {
+            output::scene_json_bytes(&scene, &mounts).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}").into_bytes())
+        },
         v,
     );
     let mut characters = Vec::new();

@@ -11,7 +11,7 @@ use super::action::walk::WalkCache;
 use super::plan::Ctx;
 use super::{CarriedProp, JointContact, Segment, WalkChoice, WalkInfo};
 use crate::layout::grid::Grid;
-use crate::motion::ik::{solve_limb, Limb};
+use crate::motion::ik::{ground_feet, solve_limb, Limb};
 use crate::motion::locomotion::place_clip_on;
 use crate::motion::procedural::SEAT_HEIGHT;
 use crate::motion::MotionLibrary;
@@ -114,6 +114,9 @@ impl<'a> Builder<'a> {
                 let w = smooth((k + 1) as f64 / (n + 1) as f64);
                 *p = interpolate_pose(&last, p, w);
             }
+        }
+        for p in &mut poses {
+            ground_feet(&self.ctx.rig, p);
         }
         self.frames.extend(poses);
     }

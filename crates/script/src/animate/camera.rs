@@ -9,7 +9,9 @@ use inbetween_core::fk::forward;
 use inbetween_core::toric::{to_pose, Lens, Toric};
 
 use super::{Animation, CameraShot};
+use crate::layout::geom;
 use crate::motion::rig::Rig;
+use crate::scene::PlacedObject;
 use crate::ssg::{Command, Ssg};
 
 /// The shots: each camera command holds from the first action written after it (the last command
@@ -68,7 +70,9 @@ pub fn view_at(anim: &Animation, frame: usize) -> &str {
         .unwrap_or("front")
 }
 
-/// Camera for a frame: (eye, target, vertical field of view in degrees). With two or more
+/// The framing a camera command asks for at a frame, ignoring furniture (the outputs use
+/// [`camera_track`], which also keeps the characters in sight): (eye, target, vertical field of
+/// view in degrees). With two or more
 /// characters, a Toric two-shot when one fits in the room (see the module doc). Otherwise the target is the first
 /// character's chest (the room's centre at chest height without characters); the eye sits 3 m
 /// from it towards the named side of the room (front: +z, the door wall; back: −z; left: −x;
@@ -82,11 +86,14 @@ pub fn camera_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) 
     room_pose(anim, frame, chest_at(anim, frame))
 }
 
-/// [`camera_pose`] for every frame of the animation (at least one), the same values, with each
-/// character's forward kinematics run once per frame instead of once per frame and neighbour.
+/// The camera of every frame of the animation (at least one), what the outputs show:
+/// [`camera_pose`]'s framing (each character's forward kinematics run once per frame instead of
+/// once per frame and neighbour), moved where furniture would block the view of whom it frames
+/// (see [`keep_in_sight`]; equal to [`camera_pose`] in a scene without objects).
 /// [`CameraTrack::pose`] answers any frame from it (past its end through [`camera_pose`]).
 pub fn camera_track(anim: &Animation) -> CameraTrack<'_> {
-    CameraTrack { anim, poses: camera_poses(anim) }
+    let (poses, framed) = camera_poses(anim);
+    CameraTrack { anim, poses, framed }
 }
 
 /// The camera of every frame of an animation, computed once.
@@ -94,6 +101,9 @@ pub struct CameraTrack<'a> {
     anim: &'a Animation,
     /// (eye, target, vertical field of view in degrees) per frame.
     pub poses: Vec<([f32; 3], [f32; 3], f32)>,
+    /// How many characters (the first ones) each frame's camera keeps in sight: two in a
+    /// two-shot, one where furniture stands between the pair (see [`keep_in_sight`]).
+    pub framed: Vec<usize>,
 }
 
 impl CameraTrack<'_> {
@@ -106,10 +116,14 @@ impl CameraTrack<'_> {
     }
 }
 
-fn camera_poses(anim: &Animation) -> Vec<([f32; 3], [f32; 3], f32)> {
-    let heads: Vec<Option<Vec<DVec3>>> = anim.characters.iter().take(2).map(head_positions).collect();
+type Framing = ([f32; 3], [f32; 3], f32);
+
+fn camera_poses(anim: &Animation) -> (Vec<Framing>, Vec<usize>) {
+    let bodies: Vec<Option<Vec<[DVec3; 2]>>> = anim.characters.iter().take(2).map(body_points).collect();
+    let heads: Vec<Option<Vec<DVec3>>> =
+        bodies.iter().map(|b| b.as_ref().map(|b| b.iter().map(|p| p[0]).collect())).collect();
     let chest = chest_positions(anim);
-    (0..anim.frames().max(1))
+    let framing: Vec<Framing> = (0..anim.frames().max(1))
         .map(|frame| {
             let head = |c: usize| heads[c].as_deref().map(|h| smoothed(h, frame));
             if let Some(shot) = two_shot(anim, frame, head) {
@@ -121,7 +135,181 @@ fn camera_poses(anim: &Animation) -> Vec<([f32; 3], [f32; 3], f32)> {
             };
             room_pose(anim, frame, chest)
         })
+        .collect();
+    keep_in_sight(anim, &bodies, framing)
+}
+
+/// Head and hips of a character at every frame (None off the common rig or without frames).
+fn body_points(track: &super::CharacterTrack) -> Option<Vec<[DVec3; 2]>> {
+    let n = track.motion.num_frames();
+    if n == 0 {
+        return None;
+    }
+    let rig = Rig::try_of(track.motion.skeleton.clone()).ok()?;
+    Some(
+        (0..n)
+            .map(|k| {
+                let g = forward(&rig.skeleton, &track.motion.pose(k));
+                [g.positions[rig.head], g.positions[rig.hips]]
+            })
+            .collect(),
+    )
+}
+
+/// Hips lower than this (metres) are seated or crouched: hidden by a desk or a seat back is
+/// fine, so only the head must be seen.
+const SEATED_HIPS: f64 = 0.75;
+/// A line of sight ends this short of the joint it aims at (the head's radius), metres.
+pub(crate) const SIGHT_END_MARGIN: f64 = 0.1;
+/// Frames the command's own camera must stay clear before a moved camera goes back to it.
+const RETURN_AFTER: usize = 30;
+
+/// How many characters a shot frames at a frame: the first two in a two-shot-able view (two or
+/// more characters, not "top" or "wide"), else the first.
+pub(crate) fn framed_count(anim: &Animation, frame: usize) -> usize {
+    let view = view_at(anim, frame);
+    if anim.characters.len() >= 2 && view != "top" && view != "wide" {
+        2
+    } else {
+        1
+    }
+}
+
+/// The points a shot must see at a frame: the head of each of the first `framed` characters and
+/// their hips while standing or walking. `bodies[c]`: [`body_points`] of character `c`.
+pub(crate) fn sight_targets(bodies: &[Option<Vec<[DVec3; 2]>>], frame: usize, framed: usize) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for b in bodies.iter().take(framed).flatten() {
+        let [head, hips] = b[frame.min(b.len() - 1)];
+        out.push(head);
+        if hips.y >= SEATED_HIPS {
+            out.push(hips);
+        }
+    }
+    out
+}
+
+/// Whether a camera at `eye` sees every target past the obstacles' boxes (and is not inside one);
+/// a box holding the target itself does not hide it.
+pub(crate) fn sees(obstacles: &[&PlacedObject], eye: DVec3, targets: &[DVec3]) -> bool {
+    if obstacles.iter().any(|o| geom::point_in_box(o, eye)) {
+        return false;
+    }
+    targets.iter().all(|&t| {
+        let d = t - eye;
+        let len = d.length();
+        len <= SIGHT_END_MARGIN || {
+            let end = eye + d * ((len - SIGHT_END_MARGIN) / len);
+            // The box a joint is in is the seat it sits in (the armchair round the hips).
+            !obstacles.iter().any(|o| !geom::point_in_box(o, t) && geom::segment_hits_box(o, eye, end))
+        }
+    })
+}
+
+/// The objects that can block a view: every object but the carried props.
+pub(crate) fn obstacles(anim: &Animation) -> Vec<&PlacedObject> {
+    (0..anim.scene.objects.len())
+        .filter(|&i| super::carried_from(anim, i).is_none())
+        .map(|i| &anim.scene.objects[i])
         .collect()
+}
+
+/// Other places for a blocked camera, best first: (turn about the target in degrees, distance
+/// factor, metres raised). The first is the command's own camera.
+const MOVES: [(f64, f64, f64); 28] = [
+    (0.0, 1.0, 0.0),
+    (0.0, 1.0, 0.5),
+    (20.0, 1.0, 0.0),
+    (-20.0, 1.0, 0.0),
+    (0.0, 0.7, 0.0),
+    (20.0, 1.0, 0.5),
+    (-20.0, 1.0, 0.5),
+    (0.0, 0.7, 0.6),
+    (40.0, 1.0, 0.0),
+    (-40.0, 1.0, 0.0),
+    (40.0, 0.8, 0.6),
+    (-40.0, 0.8, 0.6),
+    (0.0, 0.5, 0.3),
+    (0.0, 1.0, 1.2),
+    (60.0, 0.8, 0.3),
+    (-60.0, 0.8, 0.3),
+    (90.0, 0.7, 0.5),
+    (-90.0, 0.7, 0.5),
+    (0.0, 0.4, 0.8),
+    (180.0, 0.7, 0.5),
+    // Over the furniture, looking down.
+    (30.0, 0.8, 1.4),
+    (-30.0, 0.8, 1.4),
+    (90.0, 0.8, 1.3),
+    (-90.0, 0.8, 1.3),
+    (180.0, 0.8, 1.3),
+    (0.0, 0.5, 1.6),
+    (135.0, 0.6, 1.5),
+    (-135.0, 0.6, 1.5),
+];
+
+/// The camera `eye` moved by `MOVES[k]` about `target`, kept inside the room.
+fn moved(anim: &Animation, k: usize, eye: [f32; 3], target: [f32; 3]) -> [f32; 3] {
+    let (turn, scale, raise) = MOVES[k];
+    if k == 0 {
+        return eye;
+    }
+    let t = DVec3::new(target[0] as f64, target[1] as f64, target[2] as f64);
+    let v = DVec3::new(eye[0] as f64, eye[1] as f64, eye[2] as f64) - t;
+    let v = glam::DQuat::from_rotation_y(turn.to_radians()) * v * scale;
+    let e = t + v + DVec3::Y * raise;
+    let room = &anim.scene.room;
+    let m = 0.05;
+    [
+        (e.x as f32).clamp(m, room.width - m),
+        (e.y as f32).clamp(0.1, room.height - m),
+        (e.z as f32).clamp(m, room.depth - m),
+    ]
+}
+
+/// The command's cameras (`framing`, per frame) moved where furniture would block the view
+/// (issue 27): while the camera in use sees its targets it stays; when it is blocked the first
+/// of [`MOVES`] that sees them takes over (a cut), and the command's own camera comes back after
+/// it has been clear for [`RETURN_AFTER`] frames. Where no move sees both characters of a
+/// two-shot (furniture stands between them) the shot keeps the first in sight; where no move
+/// sees even that, the command's camera stays. Returns the cameras and how many characters each
+/// frame keeps in sight.
+fn keep_in_sight(
+    anim: &Animation,
+    bodies: &[Option<Vec<[DVec3; 2]>>],
+    framing: Vec<Framing>,
+) -> (Vec<Framing>, Vec<usize>) {
+    let obstacles = obstacles(anim);
+    let counts: Vec<usize> = (0..framing.len()).map(|f| framed_count(anim, f)).collect();
+    if obstacles.is_empty() || anim.characters.is_empty() {
+        return (framing, counts);
+    }
+    let v3 = |p: [f32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+    let (mut current, mut clear_run) = (0usize, 0usize);
+    let mut framed = Vec::with_capacity(framing.len());
+    let poses = framing
+        .into_iter()
+        .enumerate()
+        .map(|(f, (eye, target, fov))| {
+            let mut n = counts[f];
+            let mut targets = sight_targets(bodies, f, n);
+            let ok = |k: usize, targets: &[DVec3]| sees(&obstacles, v3(moved(anim, k, eye, target)), targets);
+            if n > 1 && !(0..MOVES.len()).any(|k| ok(k, &targets)) {
+                n = 1;
+                targets = sight_targets(bodies, f, n);
+            }
+            clear_run = if ok(0, &targets) { clear_run + 1 } else { 0 };
+            if current != 0 && clear_run >= RETURN_AFTER {
+                current = 0;
+            }
+            if !ok(current, &targets) {
+                current = (0..MOVES.len()).find(|&k| ok(k, &targets)).unwrap_or(0);
+            }
+            framed.push(n);
+            (moved(anim, current, eye, target), target, fov)
+        })
+        .collect();
+    (poses, framed)
 }
 
 /// Vertical field of view of two-shots (degrees) and the preview's aspect ratio.
@@ -145,16 +333,6 @@ fn smoothed_head(track: &super::CharacterTrack, frame: usize) -> Option<DVec3> {
     let count = range.clone().count() as f64;
     let sum: DVec3 = range.map(|k| forward(&rig.skeleton, &track.motion.pose(k)).positions[rig.head]).sum();
     Some(sum / count)
-}
-
-/// A character's head at every frame (None where [`smoothed_head`] gives None).
-fn head_positions(track: &super::CharacterTrack) -> Option<Vec<DVec3>> {
-    let n = track.motion.num_frames();
-    if n == 0 {
-        return None;
-    }
-    let rig = Rig::try_of(track.motion.skeleton.clone()).ok()?;
-    Some((0..n).map(|k| forward(&rig.skeleton, &track.motion.pose(k)).positions[rig.head]).collect())
 }
 
 /// [`smoothed_head`] from the heads of every frame (the same sum in the same order).

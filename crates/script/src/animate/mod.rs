@@ -42,14 +42,14 @@
 
 pub(crate) mod action;
 pub(crate) mod builder;
-mod camera;
+pub(crate) mod camera;
 pub mod crowd;
 pub(crate) mod plan;
 mod props;
 pub(crate) mod spots;
 
 pub(crate) use action::walk::WalkCache;
-pub use camera::{camera_pose, camera_shots, camera_track, CameraTrack};
+pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
 pub use crowd::{min_clearance, Clearance};
 pub(crate) use crowd::{WalkChoice, WalkInfo};
 pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan};

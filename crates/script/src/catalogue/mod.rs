@@ -69,6 +69,24 @@ pub struct Category {
     pub model: Option<String>,
 }
 
+/// Whether objects of this category hold things on shelves inside their box (a bookshelf).
+pub fn has_shelves(category: &str) -> bool {
+    category == "bookshelf"
+}
+
+impl Category {
+    /// Whether things rest on its shelves, inside its box, as well as on its top.
+    pub fn has_shelves(&self) -> bool {
+        has_shelves(&self.name)
+    }
+
+    /// Whether people sit on it (it has a seat contact): placed "in front of" something, a seat
+    /// turns to face it.
+    pub fn is_seat(&self) -> bool {
+        self.contacts.iter().any(|p| p.kind == ContactKind::Seat)
+    }
+}
+
 /// A room kind: "office", "bedroom", ... with its default size and the objects it usually holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RoomKind {

@@ -1,6 +1,8 @@
 //! Footprint geometry shared by the relation tests, the solver and the occupancy grid: oriented
 //! rectangles on the floor plane (x, z), in metres.
 
+use glam::DVec3;
+
 use crate::scene::PlacedObject;
 
 /// Slack for "touching" tests: placements computed in f32 land a hair off exact contact.
@@ -10,6 +12,21 @@ pub const EPS: f32 = 0.02;
 pub fn forward(yaw: f32) -> [f32; 2] {
     [yaw.sin(), yaw.cos()]
 }
+
+/// Angle (degrees, 0–180) between `active`'s front and the direction from it to `anchor`'s
+/// centre (0 when the centres coincide).
+pub fn facing_angle(active: &PlacedObject, anchor: &PlacedObject) -> f32 {
+    let to = [anchor.position[0] - active.position[0], anchor.position[2] - active.position[2]];
+    let len = to[0].hypot(to[1]);
+    if len < 1e-3 {
+        return 0.0;
+    }
+    let f = forward(active.yaw);
+    ((f[0] * to[0] + f[1] * to[1]) / len).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// Largest [`facing_angle`] at which "in front of X" counts as facing X, degrees.
+pub const FACING_TOLERANCE_DEG: f32 = 45.0;
 
 /// A point given in an object's frame (lx along its width, lz towards its front) in world x, z.
 pub fn to_world(center: [f32; 2], yaw: f32, local: [f32; 2]) -> [f32; 2] {
@@ -110,4 +127,41 @@ pub fn footprints_overlap(a: &PlacedObject, b: &PlacedObject) -> bool {
 /// Whether the vertical extents of two objects overlap by more than [`EPS`].
 pub fn heights_overlap(a: &PlacedObject, b: &PlacedObject) -> bool {
     a.top().min(b.top()) - a.position[1].max(b.position[1]) > EPS
+}
+
+/// Whether the point `p` (world metres) lies inside the object's box.
+pub fn point_in_box(o: &PlacedObject, p: DVec3) -> bool {
+    let l = to_local(center(o), o.yaw, [p.x as f32, p.z as f32]);
+    let y = p.y as f32;
+    l[0].abs() <= o.size[0] / 2.0 && l[1].abs() <= o.size[2] / 2.0 && y >= o.position[1] && y <= o.top()
+}
+
+/// Whether the segment `a`–`b` passes through the object's box (slab test in its frame).
+pub fn segment_hits_box(o: &PlacedObject, a: DVec3, b: DVec3) -> bool {
+    let la = to_local(center(o), o.yaw, [a.x as f32, a.z as f32]);
+    let lb = to_local(center(o), o.yaw, [b.x as f32, b.z as f32]);
+    let p0 = [la[0], a.y as f32, la[1]];
+    let p1 = [lb[0], b.y as f32, lb[1]];
+    let lo = [-o.size[0] / 2.0, o.position[1], -o.size[2] / 2.0];
+    let hi = [o.size[0] / 2.0, o.top(), o.size[2] / 2.0];
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for k in 0..3 {
+        let d = p1[k] - p0[k];
+        if d.abs() < 1e-9 {
+            if p0[k] < lo[k] || p0[k] > hi[k] {
+                return false;
+            }
+            continue;
+        }
+        let (mut ta, mut tb) = ((lo[k] - p0[k]) / d, (hi[k] - p0[k]) / d);
+        if ta > tb {
+            std::mem::swap(&mut ta, &mut tb);
+        }
+        t0 = t0.max(ta);
+        t1 = t1.min(tb);
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
 }

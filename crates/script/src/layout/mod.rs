@@ -32,6 +32,11 @@ pub const NEXT_TO_GAP: f32 = 0.3;
 pub const FRONT_GAP: f32 = 1.5;
 /// Thickness left for a table top: an object under a table keeps its top this far below.
 pub const UNDER_CLEARANCE: f32 = 0.03;
+/// Depth kept free in front of a seat, metres: a person stands there to sit down. Tables and
+/// desks (surfaces, legs room beneath) and anything lower than [`SEAT_FRONT_LOW`] may reach in.
+pub const SEAT_FRONT: f32 = 0.45;
+/// Objects lower than this (rugs) do not block a seat's front, metres.
+pub const SEAT_FRONT_LOW: f32 = 0.1;
 /// Height of the centre of wall objects (paintings, boards), metres.
 pub const WALL_CENTER_HEIGHT: f32 = 1.5;
 
@@ -51,6 +56,10 @@ pub struct LayoutItem {
     pub hint: Option<Placement>,
     /// Keep exactly here (position, yaw): incremental edits keep unchanged objects in place.
     pub pinned: Option<([f32; 3], f32)>,
+    /// A seat: it keeps [`SEAT_FRONT`] free in front of it (where a person stands to sit down),
+    /// and one the script puts "in front of" something turns to face it (a chair in front of a
+    /// desk faces the desk; database poses already face where they should).
+    pub seat: bool,
 }
 
 /// `items[active]` stands in `relation` to `items[anchor]`.
@@ -153,6 +162,35 @@ fn exempt(objects: &[PlacedObject], relations: &[(Relation, usize, usize)], i: u
     objects[i].support == Some(j)
         || objects[j].support == Some(i)
         || relations.iter().any(|&(r, a, b)| stacking(r) && ((a, b) == (i, j) || (a, b) == (j, i)))
+}
+
+/// The floor area in front of a seat that must stay free ([`SEAT_FRONT`] deep, the seat's
+/// width), as a box from the floor to 1.2 m.
+pub fn seat_front(o: &PlacedObject) -> PlacedObject {
+    let c = geom::to_world(geom::center(o), o.yaw, [0.0, o.size[2] / 2.0 + SEAT_FRONT / 2.0]);
+    PlacedObject {
+        label: format!("front of {}", o.label),
+        position: [c[0], 0.0, c[1]],
+        size: [o.size[0], 1.2, SEAT_FRONT],
+        support: None,
+        ..o.clone()
+    }
+}
+
+/// Whether `other` stands in the free front of seat `seat` (`legroom`: a surface, or what the seat
+/// is in front of; what rests on something, and anything lower than [`SEAT_FRONT_LOW`], may reach
+/// in).
+pub fn blocks_seat(seat: &PlacedObject, other: &PlacedObject, legroom: bool) -> bool {
+    !legroom && other.support.is_none() && other.top() > SEAT_FRONT_LOW && interpenetrate(&seat_front(seat), other)
+}
+
+/// Whether `o` rests on `support`: its base on the support's top, or on a shelf inside a shelf
+/// unit ([`crate::catalogue::has_shelves`]), with its centre inside the support's footprint.
+pub fn rests_on(o: &PlacedObject, support: &PlacedObject) -> bool {
+    let y = o.position[1];
+    let level = (support.top() - y).abs() <= EPS
+        || (crate::catalogue::has_shelves(&support.category) && y > support.position[1] && y < support.top());
+    level && geom::center_inside(o, support)
 }
 
 /// Whether two objects interpenetrate (footprints and heights both overlap by more than 2 cm).

@@ -26,29 +26,64 @@ pub fn solve(problem: &LayoutProblem, seed: u64) -> LayoutOutcome {
 /// Restarts of the constructive search (each with its own derived seed).
 pub const ATTEMPTS: usize = 6;
 
-/// Pinned items first, then anchors before their actives (longest anchor chain), floor objects
-/// before wall, ceiling and surface ones, bigger footprints first.
+/// Pinned items first, then supports before what rests on them, anchors before their actives
+/// (longest anchor chain), floor objects before wall, ceiling and surface ones, bigger footprints
+/// first.
 fn placement_order(p: &LayoutProblem) -> Vec<usize> {
     let n = p.items.len();
-    let mut depth = vec![0usize; n];
-    // Longest chain of anchors, relaxed n times so cycles stay bounded.
-    for _ in 0..n {
-        let mut changed = false;
-        for c in &p.relations {
-            if c.active < n
-                && c.anchor < n
-                && c.active != c.anchor
-                && depth[c.active] < depth[c.anchor] + 1
-                && depth[c.anchor] < n
-            {
-                depth[c.active] = depth[c.anchor] + 1;
-                changed = true;
+    // Longest chain of `edges` (active, anchor) above each item, relaxed n times so cycles stay
+    // bounded.
+    let chain = |edges: &[(usize, usize)]| {
+        let mut depth = vec![0usize; n];
+        for _ in 0..n {
+            let mut changed = false;
+            for &(active, anchor) in edges {
+                if active < n
+                    && anchor < n
+                    && active != anchor
+                    && depth[active] < depth[anchor] + 1
+                    && depth[anchor] < n
+                {
+                    depth[active] = depth[anchor] + 1;
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
             }
         }
-        if !changed {
-            break;
+        depth
+    };
+    // Supports first: what stands on something ("On", or a database pose resting on another's
+    // top: a lamp whose hint stands on the nightstand's) comes after it, so its pose finds its
+    // support. Resting goes strictly upwards, so these chains have no cycles.
+    let mut supports: Vec<(usize, usize)> =
+        p.relations.iter().filter(|c| c.relation == Relation::On).map(|c| (c.active, c.anchor)).collect();
+    let object = |i: usize, h: &crate::database::Placement| PlacedObject {
+        label: String::new(),
+        category: p.items[i].category.clone(),
+        attributes: Vec::new(),
+        position: h.position,
+        yaw: h.yaw,
+        size: h.size,
+        support: None,
+        origin: p.items[i].origin.clone(),
+    };
+    for (a, ia) in p.items.iter().enumerate() {
+        let Some(ha) = ia.hint.as_ref().filter(|h| h.position[1] > EPS) else { continue };
+        let oa = object(a, ha);
+        for (b, ib) in p.items.iter().enumerate() {
+            let Some(hb) = ib.hint.as_ref().filter(|_| a != b && ib.surface) else { continue };
+            let ob = object(b, hb);
+            if (oa.position[1] - ob.top()).abs() <= EPS && geom::center_inside(&oa, &ob) {
+                supports.push((a, b));
+            }
         }
     }
+    let support_depth = chain(&supports);
+    // Then anchors before their actives.
+    let edges: Vec<(usize, usize)> = p.relations.iter().map(|c| (c.active, c.anchor)).collect();
+    let depth = chain(&edges);
     let rank = |s: Support| match s {
         Support::Floor => 0,
         Support::Wall => 1,
@@ -59,8 +94,8 @@ fn placement_order(p: &LayoutProblem) -> Vec<usize> {
     order.sort_by(|&a, &b| {
         let (ia, ib) = (&p.items[a], &p.items[b]);
         let area = |i: &LayoutItem| i.size[0] * i.size[2];
-        (ia.pinned.is_none(), depth[a], rank(ia.support))
-            .cmp(&(ib.pinned.is_none(), depth[b], rank(ib.support)))
+        (ia.pinned.is_none(), support_depth[a], depth[a], rank(ia.support))
+            .cmp(&(ib.pinned.is_none(), support_depth[b], depth[b], rank(ib.support)))
             .then(area(ib).total_cmp(&area(ia)))
             .then(a.cmp(&b))
     });
@@ -244,7 +279,10 @@ impl<'a, R: Rng> Solver<'a, R> {
         let mut scored: Vec<(f32, PlacedObject)> = Vec::with_capacity(cands.len());
         for pose in cands.drain(..) {
             let obj = self.object(i, &pose);
-            if !inside_room(&self.p.room, &obj) || self.collides(i, &obj) {
+            if !inside_room(&self.p.room, &obj)
+                || self.collides(i, &obj)
+                || !self.rests(i, obj.position, obj.yaw, obj.support)
+            {
                 continue;
             }
             // The constraint's (active, anchor) objects with the candidate in its place.
@@ -259,7 +297,13 @@ impl<'a, R: Rng> Solver<'a, R> {
             let loose = live.iter().filter(|c| !strictly_holds(c.relation, pair(c).0, pair(c).1)).count();
             // The authored pose is kept whenever the shared definitions hold there.
             let tidy = if pose.penalty < 0.0 { 0.0 } else { 2.0 * loose as f32 };
-            let mut score = 100.0 * unmet as f32 + tidy + pose.penalty;
+            // "In front of X" faces X (a chair in front of a desk is turned to it).
+            let turned_away = live
+                .iter()
+                .filter(|c| c.relation == Relation::InFrontOf && self.faces(c.active))
+                .filter(|c| geom::facing_angle(pair(c).0, pair(c).1) > geom::FACING_TOLERANCE_DEG)
+                .count();
+            let mut score = 100.0 * unmet as f32 + tidy + pose.penalty + 10.0 * turned_away as f32;
             if grid::blocks_walking(&obj) && self.in_door_zone(&obj) {
                 score += 20.0;
             }
@@ -311,7 +355,14 @@ impl<'a, R: Rng> Solver<'a, R> {
         geom::box_penetration(geom::center(o), o.half_extents_xz(), c, [DOOR_ZONE[0], DOOR_ZONE[1] / 2.0]) > 0.0
     }
 
-    /// Whether `obj` (for item `i`) interpenetrates a placed item it is not stacked with.
+    /// Whether item `i` turns to face what the script puts it in front of (a seat the script names).
+    fn faces(&self, i: usize) -> bool {
+        let it = &self.p.items[i];
+        it.seat && matches!(it.origin, Origin::Script { .. })
+    }
+
+    /// Whether `obj` (for item `i`) interpenetrates a placed item it is not stacked with, or
+    /// stands in the free front of a seat (or, as a seat, has something in its own).
     fn collides(&self, i: usize, obj: &PlacedObject) -> bool {
         self.poses.iter().enumerate().any(|(j, o)| {
             let Some(o) = o else { return false };
@@ -320,7 +371,18 @@ impl<'a, R: Rng> Solver<'a, R> {
                 || self.p.relations.iter().any(|c| {
                     stacking(c.relation) && ((c.active, c.anchor) == (i, j) || (c.active, c.anchor) == (j, i))
                 });
-            !linked && interpenetrate(obj, o)
+            let (me, them) = (&self.p.items[i], &self.p.items[j]);
+            // A seat placed in front of something is there to use it (a stool at a piano): the
+            // user's knees go under it, as under a table.
+            let uses = |seat: usize, other: usize| {
+                self.p
+                    .relations
+                    .iter()
+                    .any(|c| c.relation == Relation::InFrontOf && (c.active, c.anchor) == (seat, other))
+            };
+            let front = (me.seat && obj.support.is_none() && blocks_seat(obj, o, them.surface || uses(i, j)))
+                || (them.seat && o.support.is_none() && blocks_seat(o, obj, me.surface || uses(j, i)));
+            !linked && (interpenetrate(obj, o) || front)
         })
     }
 
@@ -335,25 +397,39 @@ impl<'a, R: Rng> Solver<'a, R> {
             .iter()
             .enumerate()
             .filter(|&(j, _)| j != i)
-            .find(|(_, o)| {
-                o.as_ref().is_some_and(|o| (o.top() - position[1]).abs() <= EPS && geom::center_inside(&probe, o))
-            })
+            .find(|(_, o)| o.as_ref().is_some_and(|o| rests_on(&probe, o)))
             .map(|(j, _)| j)
     }
 
     fn candidates(&mut self, i: usize, live: &[LayoutConstraint]) -> Vec<Pose> {
         let item = &self.p.items[i];
         let mut out = Vec::new();
-        if let Some(h) = &item.hint {
-            let support = self.support_at(i, h.position, h.yaw);
-            out.push(Pose { position: h.position, yaw: h.yaw, support, penalty: -1.0 });
-            for _ in 0..8 {
-                let d = [self.rng.random_range(-0.4..0.4), self.rng.random_range(-0.4..0.4)];
+        if let Some(h) = item.hint.clone() {
+            // The database pose, and a few near it, where something holds them up here (a
+            // keyboard at desk height is no use where this room has no desk).
+            for k in 0..9 {
+                let d = if k == 0 {
+                    [0.0, 0.0]
+                } else {
+                    [self.rng.random_range(-0.4..0.4), self.rng.random_range(-0.4..0.4)]
+                };
                 let position = [h.position[0] + d[0], h.position[1], h.position[2] + d[1]];
                 let support = self.support_at(i, position, h.yaw);
-                out.push(Pose { position, yaw: h.yaw, support, penalty: 2.0 * (d[0].hypot(d[1])) });
+                if self.rests(i, position, h.yaw, support) {
+                    let penalty = if k == 0 { -1.0 } else { 2.0 * (d[0].hypot(d[1])) };
+                    out.push(Pose { position, yaw: h.yaw, support, penalty });
+                    // The same place turned to whatever the item stands in front of.
+                    let faces =
+                        live.iter().filter(|c| c.active == i && c.relation == Relation::InFrontOf && self.faces(i));
+                    for c in faces {
+                        let Some(a) = &self.poses[c.anchor] else { continue };
+                        let face = (a.position[0] - position[0]).atan2(a.position[2] - position[2]);
+                        out.push(Pose { position, yaw: face, support, penalty: penalty + 0.5 });
+                    }
+                }
             }
         }
+        let item = &self.p.items[i];
         for c in live {
             if c.active == i {
                 let anchor = self.poses[c.anchor].clone().expect("live relation");
@@ -409,11 +485,46 @@ impl<'a, R: Rng> Solver<'a, R> {
                 p.penalty += 1.0;
             }
         }
+        // A seat the script puts in front of something may stand anywhere it fits, turned to it.
+        if let Some(a) = live.iter().find(|c| c.active == i && c.relation == Relation::InFrontOf && self.faces(i)) {
+            if let Some(anchor) = &self.poses[a.anchor] {
+                let turned: Vec<Pose> = out
+                    .iter()
+                    .map(|p| {
+                        let face = (anchor.position[0] - p.position[0]).atan2(anchor.position[2] - p.position[2]);
+                        Pose { yaw: face, penalty: p.penalty + 0.5, ..*p }
+                    })
+                    .collect();
+                out.extend(turned);
+            }
+        }
         // Tiny seeded jitter breaks ties differently per attempt.
         for p in &mut out {
             p.penalty += self.rng.random_range(0.0..0.01);
         }
         out
+    }
+
+    /// Whether item `i` at `position` (turned by `yaw`) is held up: by `support`, else by the
+    /// floor (floor and surface items at height 0), a wall (its footprint touching one) or the
+    /// ceiling (its top at it).
+    fn rests(&self, i: usize, position: [f32; 3], yaw: f32, support: Option<usize>) -> bool {
+        if support.is_some() {
+            return true;
+        }
+        let it = &self.p.items[i];
+        let r = &self.p.room;
+        match it.support {
+            Support::Floor | Support::Surface => position[1].abs() <= EPS,
+            Support::Wall => {
+                let probe =
+                    PlacedObject { position, yaw, ..self.object(i, &Pose { position, yaw, support, penalty: 0.0 }) };
+                let [hx, hz] = probe.half_extents_xz();
+                let [x, _, z] = position;
+                position[1] > 0.0 && [x - hx, r.width - x - hx, z - hz, r.depth - z - hz].iter().any(|g| g.abs() <= EPS)
+            }
+            Support::Ceiling => (r.height - position[1] - it.size[1]).abs() <= EPS,
+        }
     }
 
     /// The base height an item gets when it is not stacked: floor, wall height or under the ceiling.
@@ -610,12 +721,24 @@ impl<'a, R: Rng> Solver<'a, R> {
             }
             Relation::InFrontOf | Relation::Behind => {
                 let sign = if rel == Relation::InFrontOf { 1.0 } else { -1.0 };
-                // In front: facing the anchor; behind: facing the same way.
-                let yaw = if rel == Relation::InFrontOf { anchor.yaw + HALF } else { anchor.yaw };
+                // In front: facing the anchor; behind: facing the same way (a seat behind
+                // something turns its back to it, so its own front stays free).
+                let yaw = if rel == Relation::InFrontOf || item.seat { anchor.yaw + HALF } else { anchor.yaw };
                 for k in 0..24 {
                     let g = if k == 0 { 0.1 } else { self.rng.random_range(0.05..FRONT_GAP - 0.1) };
                     let lx = if k < 3 { 0.0 } else { self.rng.random_range(-0.5..=0.5) * aw };
                     push(at([lx, sign * (ad + d / 2.0 + g)]), base, yaw, None, 0.3 * (g - 0.4).abs());
+                }
+                if rel == Relation::InFrontOf && self.faces(i) {
+                    // Off to one side of the front, turned to face the anchor (when the space
+                    // straight in front is taken).
+                    for _ in 0..12 {
+                        let g = self.rng.random_range(0.05..FRONT_GAP - 0.1);
+                        let lx = self.rng.random_range(-1.0..=1.0) * (aw + 0.3);
+                        let p = at([lx, ad + d / 2.0 + g]);
+                        let face = (ac[0] - p[0]).atan2(ac[1] - p[1]);
+                        push(p, base, face, None, 0.3 * (g - 0.4).abs() + 0.5);
+                    }
                 }
             }
             Relation::Above => {
@@ -634,11 +757,11 @@ impl<'a, R: Rng> Solver<'a, R> {
                     for (yaw, p) in walls {
                         push(p, y, yaw, None, 0.0);
                     }
+                } else if item.support == Support::Ceiling {
+                    push(ac, (self.p.room.height - h).max(anchor.top()), anchor.yaw, None, 0.0);
                 } else {
-                    let y = if item.support == Support::Ceiling { self.p.room.height - h } else { anchor.top() + 0.3 };
-                    push(ac, y.max(anchor.top()), anchor.yaw, None, 0.0);
-                    let y = (self.p.room.height - h).max(anchor.top());
-                    push(ac, y, anchor.yaw, None, 0.1);
+                    // Nothing holds a floor or surface object in the air: it rests on the anchor.
+                    push(ac, anchor.top(), anchor.yaw, Some(j), 0.0);
                 }
             }
         }

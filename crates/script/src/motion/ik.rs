@@ -118,6 +118,73 @@ pub fn solve_limb(rig: &Rig, pose: &mut Pose, limb: Limb, target: DVec3, pole: O
     solve_chain(&rig.skeleton, pose, limb.chain(rig), target, pole, limb.default_bend())
 }
 
+/// How far the heel lies behind the ankle joint, metres (the heel point is straight under the
+/// ankle at rest height, this far back).
+pub const HEEL_BACK: f64 = 0.03;
+/// How far under the floor a sole point may be before [`ground_feet`] moves it, metres.
+const SOLE_SLACK: f64 = 1e-4;
+
+/// The foot's yaw alone: `q` with its pitch and roll removed (forward projected on the floor).
+pub(crate) fn flat_of(q: DQuat) -> DQuat {
+    let f = q * DVec3::Z;
+    let h = DVec3::new(f.x, 0.0, f.z);
+    if h.length_squared() < 1e-12 {
+        return DQuat::IDENTITY;
+    }
+    DQuat::from_rotation_y(h.x.atan2(h.z))
+}
+
+/// Feet on the floor (issue 27): no point of a sole (heel, toe base, toe tip) ends under the
+/// floor. A foot that reaches under it is turned towards flat (its yaw kept, toes straightened)
+/// just as far as clears it, so a foot pitched toe-down on a planted ankle lies flat and one
+/// rolling over its toes keeps them on the floor; when even flat does not clear it, the ankle is
+/// lifted with the leg's two-bone IK. A foot above the floor is left as it is. Works on one
+/// pose, so every frame a timeline appends goes through it.
+pub fn ground_feet(rig: &Rig, pose: &mut Pose) {
+    let s = &rig.skeleton;
+    for leg in rig.legs {
+        let [_, knee, foot, toe] = leg;
+        let g = forward(s, pose);
+        let ankle = g.positions[foot];
+        let own = g.rotations[foot];
+        let flat = flat_of(own);
+        let toe_local = pose.rotations[toe];
+        let toe_offset = s.joint(toe).offset;
+        let tip_offset = s.joint(toe).end_site.unwrap_or(DVec3::ZERO);
+        // Lowest sole point for a foot rotation `r` (toe keeping its local rotation) at `at`.
+        let heel = DVec3::new(0.0, -rig.ankle_height, -HEEL_BACK);
+        let lowest = |r: DQuat, toe_rot: DQuat, at: DVec3| -> f64 {
+            let toe_pos = at + r * toe_offset;
+            let tip = toe_pos + (r * toe_rot) * tip_offset;
+            (at + r * heel).y.min(toe_pos.y).min(tip.y)
+        };
+        if lowest(own, toe_local, ankle) >= -SOLE_SLACK {
+            continue;
+        }
+        // The least turn towards flat that clears the floor (all the way when none does).
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        if lowest(flat, DQuat::IDENTITY, ankle) >= -SOLE_SLACK {
+            for _ in 0..12 {
+                let mid = 0.5 * (lo + hi);
+                if lowest(own.slerp(flat, mid), toe_local.slerp(DQuat::IDENTITY, mid), ankle) >= -SOLE_SLACK {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+        }
+        let (r, toe_rot) = (own.slerp(flat, hi), toe_local.slerp(DQuat::IDENTITY, hi));
+        let lift = -lowest(r, toe_rot, ankle);
+        if lift > SOLE_SLACK {
+            let limb = if leg == rig.legs[0] { Limb::LeftLeg } else { Limb::RightLeg };
+            solve_limb(rig, pose, limb, ankle + DVec3::Y * lift, None);
+        }
+        let knee_global = forward(s, pose).rotations[knee];
+        pose.rotations[foot] = local_from_global(knee_global, r);
+        pose.rotations[toe] = toe_rot.normalize();
+    }
+}
+
 /// Height of the pelvis contact (midpoint of the hip joints) above the seat surface when sitting.
 pub const PELVIS_ABOVE_SEAT: f64 = 0.09;
 

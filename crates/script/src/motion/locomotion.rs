@@ -5,11 +5,11 @@
 //! and decelerates to a stop followed by a settle step into the idle stance, and stance feet are
 //! locked to the floor with two-bone leg IK ([`lock_feet`]; skate measured by [`foot_skate`]).
 
-use super::ik::{solve_limb, Limb};
+use super::ik::{flat_of, solve_limb, Limb};
 use super::library::MotionLibrary;
-use super::rig::{clip, heading_of, wrap, yaw, Rig, FPS};
+use super::rig::{clip, heading_of, local_from_global, wrap, yaw, Rig, FPS};
 use crate::error::ScriptError;
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use inbetween_core::fk::{forward, forward_clip};
 use inbetween_core::motion::interpolate_pose;
 use inbetween_core::{Motion, Pose};
@@ -211,7 +211,11 @@ pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &Wa
             .filter(|c| c.motion.skeleton == rig.skeleton)
             .map(|c| Cycle::new(&c.motion, &rig))
             .unwrap_or_else(|| {
-                let m = super::procedural::gait_cycle(inbetween_core::procedural::GaitParams::walk(), 2, 0.6, 0.08);
+                let walk = inbetween_core::procedural::GaitParams {
+                    cycle_hz: super::procedural::WALK_CYCLE_HZ,
+                    ..inbetween_core::procedural::GaitParams::walk()
+                };
+                let m = super::procedural::gait_cycle(walk, 2, 0.6, 0.08);
                 Cycle::new(&m, &rig)
             }),
     );
@@ -401,9 +405,10 @@ pub(crate) fn detect_contacts_on(rig: &Rig, m: &Motion, p: &LockParams) -> [Vec<
     })
 }
 
-/// Foot locking: each detected contact is pinned at the mean floor position of its ankle at rest
-/// ankle height (faded in/out over `blend_frames`), the root is lowered where a leg could not
-/// reach, and both legs are re-solved with two-bone IK (ankles keep their global orientation).
+/// Foot locking: each detected contact pins the toe base at its mean floor position (the ankle
+/// moved with it, at least at rest ankle height; faded in/out over `blend_frames`), the heel
+/// rises about the toes and then the root is lowered where a leg could not reach, and both legs
+/// are re-solved with two-bone IK (ankles keep their global orientation unless the heel rose).
 /// An error names the joint missing when `m` is not on the common rig.
 pub fn lock_feet(m: &Motion, p: &LockParams) -> Result<Motion, ScriptError> {
     Ok(lock_feet_on(&Rig::for_motion(m, "foot locking")?, m, p))
@@ -417,7 +422,13 @@ pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
     }
     let contacts = detect_contacts_on(rig, m, p);
     let a = ankles(m, rig);
-    let mut targets: Vec<[Option<DVec3>; 2]> = vec![[None, None]; n];
+    // Each contact pins the toe base (the point a foot rolls over from heel-off on) where the foot
+    // lands; the ankle is moved with it, so a heel rolling up over the toes keeps its
+    // own rise and the foot only stops sliding. `pins[f][k]`: (pin, weight) per frame and foot.
+    let toes: Vec<[DVec3; 2]> =
+        forward_clip(m).into_iter().map(|g| [g.positions[rig.legs[0][3]], g.positions[rig.legs[1][3]]]).collect();
+    let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
+    let mut pins: Vec<[Option<(DVec3, f64)>; 2]> = vec![[None, None]; n];
     for k in 0..2 {
         let c = &contacts[k];
         let mut f = 0;
@@ -428,47 +439,91 @@ pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
             }
             // A contact whose foot drifts further than `max_drift` is split into several locks.
             let start = f;
-            let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
             while f < n && c[f] && (flat(a[f][k]) - flat(a[start][k])).length() <= p.max_drift {
                 f += 1;
             }
             let end = f; // exclusive
-            let mean = (start..end).map(|i| a[i][k]).sum::<DVec3>() / (end - start) as f64;
-            let lock = DVec3::new(mean.x, rig.ankle_height, mean.z);
             let b = p.blend_frames;
-            let prev = if start > 0 && c[start - 1] { targets[start - 1][k] } else { None };
-            for (j, tgt) in targets[start..end].iter_mut().enumerate() {
-                // After a split, glide from the previous lock instead of jumping.
-                tgt[k] = Some(match prev {
+            let lock = (start..end).map(|i| flat(toes[i][k])).sum::<DVec3>() / (end - start) as f64;
+            // After a split, or a contact broken for a frame or two, glide from the previous
+            // lock instead of jumping.
+            let from =
+                (1..=3).filter(|&d| start >= d).find(|&d| c[start - d]).and_then(|d| pins[start - d][k].map(|q| q.0));
+            for (j, pin) in pins[start..end].iter_mut().enumerate() {
+                let t = match from {
                     Some(q) if j < b => q.lerp(lock, smooth01((j + 1) as f64 / (b + 1) as f64)),
                     _ => lock,
-                });
+                };
+                pin[k] = Some((t, 1.0));
             }
             // Fades: the foot keeps its lock horizontally while it is low (it lifts before it
             // swings, and lands where it will be locked), weighted by time and by height.
-            let fade = |i: usize, j: usize| -> DVec3 {
+            let fade = |i: usize, j: usize| -> (DVec3, f64) {
                 let wt = smooth01(1.0 - j as f64 / (b + 1) as f64);
                 let wh = smooth01(1.0 - (a[i][k].y - rig.ankle_height) / p.release_height);
-                let w = wt.max(wh) * smooth01(1.0 - (j as f64 - 1.0) / b as f64).max(wt);
-                let xz = DVec3::new(a[i][k].x, 0.0, a[i][k].z).lerp(DVec3::new(lock.x, 0.0, lock.z), w);
-                DVec3::new(xz.x, a[i][k].y.max(lock.y), xz.z)
+                (lock, wt.max(wh) * smooth01(1.0 - (j as f64 - 1.0) / b as f64).max(wt))
             };
             for j in 1..=b {
-                if start >= j && targets[start - j][k].is_none() {
-                    targets[start - j][k] = Some(fade(start - j, j));
+                if start >= j && pins[start - j][k].is_none() {
+                    pins[start - j][k] = Some(fade(start - j, j));
                 }
                 if end - 1 + j < n && !c[end - 1 + j] {
-                    targets[end - 1 + j][k] = Some(fade(end - 1 + j, j));
+                    pins[end - 1 + j][k] = Some(fade(end - 1 + j, j));
                 }
             }
         }
     }
+    let mut targets: Vec<[Option<DVec3>; 2]> = (0..n)
+        .map(|f| {
+            [0, 1].map(|k| {
+                pins[f][k].map(|(pin, w)| {
+                    let t = a[f][k] + (pin - flat(toes[f][k])) * w;
+                    DVec3::new(t.x, a[f][k].y.max(rig.ankle_height), t.z)
+                })
+            })
+        })
+        .collect();
     let mut poses = m.poses();
-    // Lower the root where a locked leg cannot reach, smoothed over a few frames.
     let leg_len = {
         let s = &rig.skeleton;
         (s.joint(rig.legs[0][1]).offset.length() + s.joint(rig.legs[0][2]).offset.length()) * 0.999
     };
+    // Where a locked leg cannot reach its ankle target, the heel rises first, the foot turning
+    // about its pinned toe base (as a walker's back foot does), up to MAX_HEEL_RAISE.
+    let mut raises: Vec<[Option<(DVec3, f64)>; 2]> = vec![[None, None]; n];
+    for f in 0..n {
+        let g = forward(&rig.skeleton, &poses[f]);
+        for k in 0..2 {
+            let Some(t) = targets[f][k] else { continue };
+            let hip = g.positions[rig.legs[k][0]];
+            if (t - hip).length() <= leg_len {
+                continue;
+            }
+            let toe = t + (toes[f][k] - a[f][k]);
+            let back = t - toe;
+            let axis = flat(back).cross(DVec3::Y).normalize_or_zero();
+            if axis == DVec3::ZERO {
+                continue;
+            }
+            let lifted = |ang: f64| toe + DQuat::from_axis_angle(axis, ang) * back;
+            let mut ang = MAX_HEEL_RAISE;
+            if (lifted(ang) - hip).length() <= leg_len {
+                let (mut lo, mut hi) = (0.0, MAX_HEEL_RAISE);
+                for _ in 0..14 {
+                    let mid = 0.5 * (lo + hi);
+                    if (lifted(mid) - hip).length() <= leg_len {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                ang = hi;
+            }
+            targets[f][k] = Some(lifted(ang));
+            raises[f][k] = Some((axis, ang));
+        }
+    }
+    // Lower the root where a locked leg still cannot reach, smoothed over a few frames.
     let mut drop = vec![0.0f64; n];
     for f in 0..n {
         let g = forward(&rig.skeleton, &poses[f]);
@@ -493,21 +548,52 @@ pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
         })
         .collect();
     for f in 0..n {
+        let g0 = forward(&rig.skeleton, &poses[f]);
         poses[f].translations[rig.hips].y -= smooth[f].max(0.0);
         for (k, limb) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
             if let Some(t) = targets[f][k] {
                 solve_limb(rig, &mut poses[f], limb, t, None);
+            }
+            if raises[f][k].is_none() && contacts[k][f] {
+                // A foot standing on its heel with the toes up settles flat once it has landed
+                // (a stride frozen at a stop or blended at a start would keep them up).
+                let [_, knee, foot, _] = rig.legs[k];
+                let own = g0.rotations[foot];
+                let since = (0..=f).rev().take_while(|&i| contacts[k][i]).count();
+                let w = smooth01(since as f64 / SETTLE_FRAMES);
+                if (own * DVec3::Z).y > 0.0 && w > 0.0 {
+                    let foot_global = own.slerp(flat_of(own), w).normalize();
+                    let knee_global = forward(&rig.skeleton, &poses[f]).rotations[knee];
+                    poses[f].rotations[foot] = local_from_global(knee_global, foot_global);
+                }
+            }
+            if let Some((axis, ang)) = raises[f][k] {
+                // The foot turned with its heel, the toes kept on the floor.
+                let [_, knee, foot, toe] = rig.legs[k];
+                let foot_global = (DQuat::from_axis_angle(axis, ang) * g0.rotations[foot]).normalize();
+                let knee_global = forward(&rig.skeleton, &poses[f]).rotations[knee];
+                poses[f].rotations[foot] = local_from_global(knee_global, foot_global);
+                poses[f].rotations[toe] = local_from_global(foot_global, g0.rotations[toe]);
             }
         }
     }
     Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("locked poses fit the skeleton")
 }
 
+/// Frames over which a planted foot with its toes up settles flat.
+const SETTLE_FRAMES: f64 = 2.0;
+
+/// Largest heel raise (radians of foot pitch about the toe base) foot locking uses before it
+/// lowers the hips.
+const MAX_HEEL_RAISE: f64 = 0.7;
+
 /// Ankle height above rest at or below which [`foot_skate`] counts a foot as on the floor (m).
 pub const SKATE_HEIGHT: f64 = 0.02;
 
-/// Foot skate in **cm/s**: mean horizontal ankle speed over the frames where that ankle is within
-/// [`SKATE_HEIGHT`] of its rest height (both feet pooled; 0 when no foot touches the floor).
+/// Foot skate in **cm/s**: mean horizontal speed of the toe base (the point a foot stands on
+/// from flat to toe off; the ankle itself moves when the heel rolls up) over the frames where
+/// the foot is on the floor, its ankle within [`SKATE_HEIGHT`] of its rest height (both feet
+/// pooled; 0 when no foot touches the floor).
 /// Contact is judged by height alone, so locking cannot hide skate by changing the detection.
 /// An error names the joint missing when `m` is not on the common rig.
 pub fn foot_skate(m: &Motion) -> Result<f64, ScriptError> {
@@ -516,13 +602,15 @@ pub fn foot_skate(m: &Motion) -> Result<f64, ScriptError> {
 
 /// [`foot_skate`] on a motion known to be on `rig`.
 pub(crate) fn foot_skate_on(rig: &Rig, m: &Motion) -> f64 {
-    let a = ankles(m, rig);
+    // (ankle, toe base) per frame and foot.
+    let a: Vec<[(DVec3, DVec3); 2]> =
+        forward_clip(m).into_iter().map(|g| rig.legs.map(|l| (g.positions[l[2]], g.positions[l[3]]))).collect();
+    let on = |(ankle, _): (DVec3, DVec3)| ankle.y <= rig.ankle_height + SKATE_HEIGHT;
     let (mut sum, mut count) = (0.0, 0usize);
     for f in 1..a.len() {
         for (&now, &before) in a[f].iter().zip(&a[f - 1]) {
-            let on = |p: DVec3| p.y <= rig.ankle_height + SKATE_HEIGHT;
             if on(now) && on(before) {
-                sum += hspeed(before, now, m.frame_time);
+                sum += hspeed(before.1, now.1, m.frame_time);
                 count += 1;
             }
         }

@@ -3,7 +3,7 @@
 //! standard skeleton ([`super::rig`]), 30 fps, standing at the origin facing +Z.
 
 use super::ik::{seated_pose, solve_limb, Limb};
-use super::rig::{clip, hip_height, Rig, FPS, M_PER_CMU};
+use super::rig::{clip, hip_height, local_from_global, Rig, FPS, M_PER_CMU};
 use glam::{DQuat, DVec3};
 use inbetween_core::fk::forward;
 use inbetween_core::motion::interpolate_pose;
@@ -12,6 +12,10 @@ use inbetween_core::units::scale_motion;
 use inbetween_core::{Motion, Pose};
 use rand::Rng;
 use std::f64::consts::{PI, TAU};
+
+/// Gait cycles per second of the procedural walk (core's relaxed walk takes 0.9; a slightly
+/// quicker cadence with shorter steps keeps the pelvis of our shorter-legged rig high).
+pub const WALK_CYCLE_HZ: f64 = 1.0;
 
 /// Seat height (metres) of the procedural sitting clips.
 pub const SEAT_HEIGHT: f64 = 0.45;
@@ -54,27 +58,18 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
     let s = &rig.skeleton;
     let leg = (s.joint(rig.legs[0][1]).offset.length() + s.joint(rig.legs[0][2]).offset.length()) * 0.985;
     let hip_x = s.joint(rig.legs[0][0]).offset.x.abs();
-    // Foot targets relative to the progression point, per frame and foot.
-    let targets: Vec<[DVec3; 2]> = (0..n)
+    // Foot targets relative to the progression point, per frame and foot: ankle and pitch.
+    let roll = FootRoll::of(&rig);
+    let targets: Vec<[(DVec3, f64); 2]> = (0..n)
         .map(|f| {
             let t = f as f64 / FPS;
             let centre = speed * t;
-            [0.0, 0.5]
-                .map(|off| (t * p.cycle_hz - 0.25 + off).rem_euclid(1.0))
-                .iter()
-                .zip([1.0, -1.0])
-                .map(|(&ph, side)| {
-                    let (z, y) = if ph < duty {
-                        (stride * (duty / 2.0 - ph), rig.ankle_height)
-                    } else {
-                        let u = (ph - duty) / (1.0 - duty);
-                        (stride * (-duty / 2.0 + duty * smooth(u)), rig.ankle_height + lift * (PI * u).sin())
-                    };
-                    DVec3::new(side * hip_x, y, centre + z)
-                })
-                .collect::<Vec<_>>()
-                .try_into()
-                .expect("two feet")
+            [0.0, 0.5].map(|off| {
+                let ph = (t * p.cycle_hz - 0.25 + off).rem_euclid(1.0);
+                let side = if off == 0.0 { 1.0 } else { -1.0 };
+                let (a, pitch) = roll.at(ph, duty, stride, lift);
+                (DVec3::new(side * hip_x, a.y, centre + a.z), pitch)
+            })
         })
         .collect();
     let mut poses = base.poses();
@@ -83,7 +78,7 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
         .map(|f| {
             let g = forward(s, &poses[f]);
             let mut y = poses[f].translations[rig.hips].y;
-            for (k, &t) in targets[f].iter().enumerate() {
+            for (k, &(t, _)) in targets[f].iter().enumerate() {
                 let hip = g.positions[rig.legs[k][0]];
                 let r = DVec3::new(t.x - hip.x, 0.0, t.z - hip.z).length().min(leg * 0.999);
                 let max_hip = t.y + (leg * leg - r * r).sqrt();
@@ -99,10 +94,80 @@ pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Mot
     for (f, pose) in poses.iter_mut().enumerate() {
         pose.translations[rig.hips].y = (-w..=w).map(|d| at(&low, f as i64 + d)).sum::<f64>() / (2 * w + 1) as f64;
         for (k, limb) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
-            solve_limb(&rig, pose, limb, targets[f][k], None);
+            let (target, pitch) = targets[f][k];
+            solve_limb(&rig, pose, limb, target, None);
+            let [_, knee, foot, toe] = rig.legs[k];
+            let knee_global = forward(s, pose).rotations[knee];
+            pose.rotations[foot] = local_from_global(knee_global, DQuat::from_rotation_x(pitch));
+            // Toes stay on the floor while the heel rolls over them.
+            pose.rotations[toe] = DQuat::from_rotation_x(-pitch.max(0.0));
         }
     }
     clip(&rig, &poses)
+}
+
+/// A foot rolling over the floor through one gait cycle (heel strike, flat, heel off over the
+/// toes, swing), in the frame of the progression point, facing +Z. Rolling over the toes lets
+/// the ankle rise and come forward at the end of the stance, so the pelvis stays high.
+struct FootRoll {
+    /// Toe base relative to the ankle at rest (metres).
+    toe: DVec3,
+    /// Heel point relative to the ankle at rest.
+    heel: DVec3,
+    ankle_height: f64,
+}
+
+impl FootRoll {
+    /// Pitch at heel strike (toes up), radians.
+    const HEEL_STRIKE: f64 = -0.15;
+    /// Pitch at toe off (heel up), radians.
+    const TOE_OFF: f64 = 0.6;
+    /// Fraction of the stance rolling onto the flat foot, and the fraction where the heel lifts.
+    const FLAT_FROM: f64 = 0.12;
+    const HEEL_OFF: f64 = 0.5;
+    /// The stance lies this fraction of its length behind the hips (a foot lands closer in
+    /// front of the body than it leaves behind it).
+    const BACK: f64 = 0.1;
+
+    fn of(rig: &Rig) -> FootRoll {
+        let g = forward(&rig.skeleton, &rig.standing());
+        let [_, _, foot, toe] = rig.legs[0];
+        let toe = g.positions[toe] - g.positions[foot];
+        FootRoll {
+            toe: DVec3::new(0.0, toe.y, toe.z),
+            heel: DVec3::new(0.0, -rig.ankle_height, -super::ik::HEEL_BACK),
+            ankle_height: rig.ankle_height,
+        }
+    }
+
+    /// Ankle (x = 0) and pitch (about +X; positive lifts the heel) at stance phase `s` ∈ [0, 1]
+    /// of a foot whose flat ankle would be at `z` (y = rest ankle height).
+    fn stance(&self, s: f64, z: f64) -> (DVec3, f64) {
+        let a = DVec3::new(0.0, self.ankle_height, z);
+        let (pivot, pitch) = if s < Self::FLAT_FROM {
+            (a + self.heel, Self::HEEL_STRIKE * (1.0 - smooth(s / Self::FLAT_FROM)))
+        } else if s > Self::HEEL_OFF {
+            (a + self.toe, Self::TOE_OFF * smooth((s - Self::HEEL_OFF) / (1.0 - Self::HEEL_OFF)))
+        } else {
+            (a, 0.0)
+        };
+        (pivot + DQuat::from_rotation_x(pitch) * (a - pivot), pitch)
+    }
+
+    /// Ankle (x = 0, z relative to the progression point) and pitch at cycle phase `ph` ∈ [0, 1)
+    /// of a foot planted for `duty` of a cycle of `stride` metres, lifted `lift` in swing.
+    fn at(&self, ph: f64, duty: f64, stride: f64, lift: f64) -> (DVec3, f64) {
+        let front = stride * duty * (0.5 - Self::BACK);
+        if ph < duty {
+            return self.stance(ph / duty, front - stride * ph);
+        }
+        let u = (ph - duty) / (1.0 - duty);
+        let (from, p0) = self.stance(1.0, front - stride * duty);
+        let (to, p1) = self.stance(0.0, front);
+        let w = smooth(u);
+        let a = from.lerp(to, w) + DVec3::Y * lift * (PI * u).sin();
+        (a, p0 + (p1 - p0) * w)
+    }
 }
 
 fn build(rig: &Rig, frames: usize, mut f: impl FnMut(f64, &mut Pose)) -> Motion {
@@ -167,6 +232,7 @@ pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
 
     let mut walk = GaitParams::walk();
     walk.speed *= jit.k();
+    walk.cycle_hz = WALK_CYCLE_HZ;
     add("procedural walk cycle", &["walk", "cycle", "loop", "locomotion"], gait_cycle(walk, 2, 0.6, 0.08));
     let mut run = GaitParams::run();
     run.speed *= jit.k();

@@ -319,7 +319,7 @@ fn truncated_normal(rng: &mut impl Rng, sigma: f64) -> f64 {
 }
 
 /// Moves object `k` by (dx, dz), scales its height by `s`; whatever rests on it (transitively)
-/// moves along and sits on its support's (new) top.
+/// moves along and sits on its support's (new) top, or on the same shelf of it.
 fn disturb(objects: &mut [PlacedObject], k: usize, dx: f32, dz: f32, s: f32) {
     let n = objects.len();
     let mut carried = vec![false; n];
@@ -342,14 +342,28 @@ fn disturb(objects: &mut [PlacedObject], k: usize, dx: f32, dz: f32, s: f32) {
             o.position[2] += dz;
         }
     }
+    // Where each carried object rests on its support, as a fraction of the support's height (1 on
+    // its top, less on a shelf inside it), kept as the support is scaled.
+    let level: Vec<f32> = (0..n)
+        .map(|i| match objects[i].support.filter(|&p| p < n && carried[p]) {
+            Some(p) if objects[p].size[1] > 1e-6 => {
+                (objects[i].position[1] - objects[p].position[1]) / objects[p].size[1]
+            }
+            _ => 1.0,
+        })
+        .collect();
     objects[k].size[1] *= s;
     for _ in 0..n {
         let mut changed = false;
         for i in 0..n {
             if let Some(p) = objects[i].support.filter(|&p| p < n && carried[p]) {
-                let top = objects[p].top();
-                if (objects[i].position[1] - top).abs() > 1e-6 {
-                    objects[i].position[1] = top;
+                let y = if (level[i] - 1.0).abs() < 1e-6 {
+                    objects[p].top()
+                } else {
+                    objects[p].position[1] + level[i] * objects[p].size[1]
+                };
+                if (objects[i].position[1] - y).abs() > 1e-6 {
+                    objects[i].position[1] = y;
                     changed = true;
                 }
             }

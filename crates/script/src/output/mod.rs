@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
-use crate::scene::Scene;
+use crate::scene::{Mount, Scene};
 
 pub use anim_gltf::{animated_gltf_document, story_gltf_document, write_animated_gltf, write_story_gltf};
 pub use anim_preview::{render_preview_gif, render_top_down_trails, AnimPreviewOptions};
@@ -21,10 +21,26 @@ pub use bvh_out::write_character_bvh;
 pub use gltf::{glb_bytes, gltf_document, gltf_text_bytes, write_gltf, write_gltf_with_models};
 pub use preview::{perspective, top_down, VIEWS};
 
-/// Writes the scene as pretty JSON (atomic).
-pub fn write_json(path: &Path, scene: &Scene) -> Result<(), ScriptError> {
-    let text = serde_json::to_string_pretty(scene).map_err(|e| ScriptError::Invalid(format!("scene JSON: {e}")))?;
-    inbetween_io::write_atomic(path, text.as_bytes()).map_err(|e| ScriptError::io(path, e))
+/// The scene as pretty JSON, each object with its `mount` (floor, on, wall or ceiling: what
+/// holds it up; `mounts` from [`crate::invariants::mounts`]).
+pub fn scene_json_bytes(scene: &Scene, mounts: &[Mount]) -> Result<Vec<u8>, ScriptError> {
+    let err = |e: serde_json::Error| ScriptError::Invalid(format!("scene JSON: {e}"));
+    let mut value = serde_json::to_value(scene).map_err(err)?;
+    if let Some(objects) = value.get_mut("objects").and_then(|o| o.as_array_mut()) {
+        for (o, m) in objects.iter_mut().zip(mounts) {
+            let mount = serde_json::to_value(m).map_err(err)?;
+            if let Some(map) = o.as_object_mut() {
+                map.insert("mount".into(), mount);
+            }
+        }
+    }
+    serde_json::to_vec_pretty(&value).map_err(err)
+}
+
+/// Writes [`scene_json_bytes`] (atomic).
+pub fn write_json(path: &Path, scene: &Scene, cat: &Catalogue) -> Result<(), ScriptError> {
+    let bytes = scene_json_bytes(scene, &crate::invariants::mounts(scene, cat))?;
+    inbetween_io::write_atomic(path, &bytes).map_err(|e| ScriptError::io(path, e))
 }
 
 /// Reads a scene written by [`write_json`].
