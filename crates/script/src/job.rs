@@ -195,6 +195,7 @@ pub fn run_story_in(
     }
     let name = source.display().to_string();
     job.scene.limits.check_text(text, &name, session.catalogue())?;
+    session.check_verbs(text, &name)?;
     let u = session.update(text);
     let cat = session.catalogue();
     job.scene.limits.check_animation(&name, u.animation.frames(), u.animation.fps)?;

@@ -36,6 +36,7 @@ use crate::optimize::{anneal, costs, movable_objects, optimize, CostCurves, Cost
 use crate::scene::{PlacedObject, Scene};
 use crate::session::{Session, Update};
 use crate::ssg::Ssg;
+use crate::ScriptError;
 
 /// An action compared across versions: verb, preposition, manner and the target's identity.
 type ActionSignature = (String, Option<String>, Vec<String>, Option<ObjectKey>);
@@ -105,6 +106,36 @@ impl StorySession {
         optimize: Option<OptimizeConfig>,
     ) -> StorySession {
         StorySession { session: Session::new(catalogue, database, compose), lib, animate, optimize, prev: None }
+    }
+
+    /// The motion library the characters are animated from.
+    pub fn library(&self) -> &MotionLibrary {
+        &self.lib
+    }
+
+    /// Every character verb of `text` has motion in this session's library, or an error naming
+    /// the file (`source`), line and verb of each that does not (see [`unplayable_verbs`]).
+    pub fn check_verbs(&self, text: &str, source: &str) -> Result<(), ScriptError> {
+        let parsed = crate::parse::parse_script(text, self.catalogue());
+        let bad = unplayable_verbs(&parsed, &self.lib);
+        if bad.is_empty() {
+            return Ok(());
+        }
+        let lines: Vec<String> = bad
+            .iter()
+            .map(|(at, verb)| format!("{source}:{}: \"{}\": no motion for the verb \"{verb}\"", at.line, at.text))
+            .collect();
+        let known: Vec<&str> = crate::motion::verbs::VERBS
+            .iter()
+            .map(|(tag, _)| *tag)
+            .filter(|tag| crate::animate::action::has_motion(tag, &self.lib))
+            .collect();
+        Err(ScriptError::Invalid(format!(
+            "{}\nnothing was written; verbs with motion here: {} (and their synonyms; jump, kick, dance, climb, \
+             bend and throw need captured clips: --shared-motions)",
+            lines.join("\n"),
+            known.join(", ")
+        )))
     }
 
     pub fn catalogue(&self) -> &Catalogue {
@@ -444,4 +475,24 @@ fn restricted_movable(
         k += 1;
     }
     movable_objects(&sub, relations, cat).into_iter().filter(|i| !fixed.contains(i)).collect()
+}
+
+/// The character actions of a parsed script whose verb has no motion in `lib` (no locomotion,
+/// sitting, standing, turning or lying, and no clip): the sentence and the verb as written.
+pub fn unplayable_verbs(
+    parsed: &crate::parse::ParsedScript,
+    lib: &MotionLibrary,
+) -> Vec<(crate::error::SentenceRef, String)> {
+    let mut out = Vec::new();
+    for s in &parsed.sentences {
+        for c in &s.ssg.characters {
+            for a in &c.actions {
+                let step = crate::animate::action::Step::read(a, None, lib, 0.0);
+                if !crate::animate::action::plays(&step, lib) {
+                    out.push((s.raw.at.clone(), a.verb.clone()));
+                }
+            }
+        }
+    }
+    out
 }

@@ -114,6 +114,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     }
     let live = live.as_mut().expect("a session was just made");
     job.progress("composing the scene and animating the characters", 0.15);
+    live.session.check_verbs(&req.text, "script").map_err(|e| StudioError::Engine(e.to_string()))?;
     let up = live.session.update(&req.text);
     live.version += 1;
     if job.is_cancelled() {

@@ -23,6 +23,8 @@ pub(crate) struct State {
     pub heading: f64,
     /// Seated: (stand point in front of the seat, seat point, object).
     pub seated: Option<([f32; 2], [f32; 3], usize)>,
+    /// Lying (on the seat when seated, else on the floor where it stands).
+    pub lying: bool,
 }
 
 /// Builds one character's frames: what every action of [`super::action`] reads and extends.
@@ -75,7 +77,7 @@ impl<'a> Builder<'a> {
             choices,
             cache,
             fallback: None,
-            st: State { pos: start, heading: std::f64::consts::PI, seated: None },
+            st: State { pos: start, heading: std::f64::consts::PI, seated: None, lying: false },
             frames: Vec::new(),
             segments: Vec::new(),
             walks: Vec::new(),
@@ -127,9 +129,14 @@ impl<'a> Builder<'a> {
         (0..n).map(|k| placed[k % placed.len()].clone()).collect()
     }
 
-    /// `n` frames of the lower body the character holds where it is: the seated loop when seated,
-    /// else the idle clip looped where it stands.
+    /// `n` frames of the lower body the character holds where it is: still when lying, the seated
+    /// loop when seated, else the idle clip looped where it stands.
     pub fn in_place(&mut self, n: usize) -> Vec<Pose> {
+        if self.st.lying {
+            if let Some(last) = self.frames.last() {
+                return vec![last.clone(); n];
+            }
+        }
         match self.st.seated {
             Some((at, s, _)) => self.seated(at, s, self.st.heading, n),
             None => {

@@ -224,6 +224,15 @@ pub fn contacts_of(scene: &Scene, cat: &Catalogue, obj: usize, kind: ContactKind
 /// Closest approach (metres) between two characters' roots that [`crowd::separate`] accepts.
 pub const PASSING_DISTANCE: f32 = 0.5;
 
+/// Whether a verb lemma as the parser gives it (with its particles in `manner`: "get" + "up") has
+/// motion in `lib`: locomotion, sitting, standing up, turning and lying are built, any other verb
+/// needs a clip ([`crate::story::StorySession::check_verbs`] refuses a script with one that has
+/// none).
+pub fn verb_has_motion(verb: &str, manner: &[String], lib: &MotionLibrary) -> bool {
+    let a = crate::ssg::Action { verb: verb.to_string(), preposition: None, target: None, manner: manner.to_vec() };
+    action::plays(&action::Step::read(&a, None, lib, 0.0), lib)
+}
+
 /// The animation with a walk cache (the optimiser re-animates many nearly equal scenes).
 pub(crate) fn animate_cached(
     scene: &Scene,

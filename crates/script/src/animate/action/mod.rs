@@ -5,11 +5,13 @@
 //! - [`sit`]: sitting on the target's nearest free seat (or holding the seat already taken);
 //! - [`stand_up`]: leaving the seat;
 //! - [`turn`]: turning on the spot;
+//! - [`lie`]: lying down on a bed or sofa, or on the floor;
 //! - [`pick_up`]: walking to a small prop and taking it into the right hand;
 //! - [`act`]: any other verb, an action in place over the idle or seated lower body, hands on the
 //!   target's contacts (or a small prop picked up first and used in the hand).
 
 pub(crate) mod act;
+pub(crate) mod lie;
 pub(crate) mod pick_up;
 pub(crate) mod sit;
 pub(crate) mod stand_up;
@@ -31,6 +33,8 @@ pub(crate) enum Verb {
     StandUp,
     /// "stand" and its synonyms: stands up when seated, else a standing action.
     Stand,
+    /// "lie", "lie down", "sleep": lying on the target when it has a seat, else on the floor.
+    Lie,
     /// "turn": on the spot by this many radians (left +π/2, right −π/2, else about); seated, an
     /// action in place.
     Turn(f64),
@@ -61,6 +65,7 @@ impl Verb {
             "sit" | "sit_down" => Verb::Sit,
             "stand_up" => Verb::StandUp,
             "stand" => Verb::Stand,
+            "lie" => Verb::Lie,
             "turn" => Verb::Turn(if manner.iter().any(|m| m == "right") {
                 -std::f64::consts::FRAC_PI_2
             } else if manner.iter().any(|m| m == "left") {
@@ -88,6 +93,17 @@ impl<'s> Step<'s> {
     }
 }
 
+/// Whether a step has motion: a kind with its own module, or a clip for its verb in `lib`.
+pub(crate) fn plays(step: &Step, lib: &MotionLibrary) -> bool {
+    step.kind != Verb::Act || has_motion(&step.verb, lib)
+}
+
+/// Whether a canonical verb tag has motion: locomotion, sitting, standing, turning and lying are
+/// built; any other needs a clip in `lib`.
+pub(crate) fn has_motion(tag: &str, lib: &MotionLibrary) -> bool {
+    Verb::of(tag, &[], lib) != Verb::Act || matches!(tag, "idle") || lib.retrieve(tag).is_some()
+}
+
 impl Builder<'_> {
     /// Plays one action.
     pub fn play(&mut self, step: &Step) {
@@ -95,8 +111,9 @@ impl Builder<'_> {
             Verb::Locomotion => self.walk_to(step),
             Verb::Sit => self.sit(step),
             Verb::StandUp => self.stand_up(),
-            Verb::Stand if self.st.seated.is_some() => self.stand_up(),
-            Verb::Turn(dh) if self.st.seated.is_none() => self.turn(dh, step.object),
+            Verb::Stand if self.st.seated.is_some() || self.st.lying => self.stand_up(),
+            Verb::Lie => self.lie(step),
+            Verb::Turn(dh) if self.st.seated.is_none() && !self.st.lying => self.turn(dh, step.object),
             Verb::Stand | Verb::Turn(_) | Verb::Act => self.act(step),
         }
     }

@@ -8,6 +8,7 @@ use crate::motion::procedural::SEAT_HEIGHT;
 impl Builder<'_> {
     /// Stands up from a seat (if seated): a "stand_up" segment touching the seat.
     pub fn stand_up(&mut self) {
+        self.get_up_from_lying();
         let Some((at, seat, obj)) = self.st.seated.take() else { return };
         let clip = self.named("procedural stand up");
         let mut poses = place_clip_on(&self.ctx.rig, &clip, at, self.st.heading).poses();
