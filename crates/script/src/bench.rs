@@ -170,8 +170,9 @@ pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<Pat
     progress.inc(1);
 
     std::fs::create_dir_all(dir).map_err(|e| ScriptError::io(dir, e))?;
-    let (stories, curves) = story_table(&cat, &db, &compose_cfg, cfg)?;
+    let (stories, curves, invariants) = story_table(&cat, &db, &compose_cfg, cfg)?;
     report.table(stories);
+    report.table(invariants);
     let costs_png = dir.join("fig12_costs.png");
     crate::optimize::plot_costs(&costs_png, &curves)?;
     progress.inc(1);
@@ -199,7 +200,7 @@ fn story_table(
     db: &SceneDatabase,
     compose_cfg: &ComposeConfig,
     cfg: &BenchConfig,
-) -> Result<(Table, crate::optimize::CostCurves), ScriptError> {
+) -> Result<(Table, crate::optimize::CostCurves, Table), ScriptError> {
     use crate::animate::AnimateConfig;
     use crate::motion::library::MotionLibrary;
     use crate::motion::locomotion::foot_skate;
@@ -228,6 +229,7 @@ fn story_table(
             "paper s / text",
         ],
     );
+    let mut inv = invariant_table();
     let pins = HashMap::new();
     let mut demo_curves = None;
     for (name, text) in stories::all() {
@@ -260,14 +262,64 @@ fn story_table(
         if name == "demo" {
             demo_curves = Some(o.curves.clone());
         }
+        invariant_row(&mut inv, name, &crate::invariants::check(&o.animation, cat, &c.relations));
     }
+    // Random stories from the lexicon (stories::random_story), optimised the same way.
+    let mut clean = 0;
+    for seed in 0..RANDOM_STORIES {
+        let text = stories::random_story(seed);
+        let parsed = parse_script(&text, cat);
+        let c = compose(&ComposeInput { parsed: &parsed, catalogue: cat, database: db, pins: &pins }, compose_cfg);
+        let o = optimize(&c, cat, &lib, &acfg, &ocfg);
+        let r = crate::invariants::check(&o.animation, cat, &c.relations);
+        if r.problems().is_empty() {
+            clean += 1;
+        } else {
+            invariant_row(&mut inv, &format!("random {seed}"), &r);
+        }
+    }
+    inv.note(format!(
+        "{clean} of {RANDOM_STORIES} random stories (stories::random_story, seeds 0-{}) keep every invariant; those that do not have their own row",
+        RANDOM_STORIES - 1
+    ));
+    inv.note(format!(
+        "joint under floor: any joint or toe tip more than {} m under the floor (lying exempt); planted foot: ankle slower than 0.15 m/s within {} m of its rest height, flat when its toe base is within {} m of the floor; hips: under {} of their rest height in a walk",
+        crate::invariants::FLOOR_TOLERANCE,
+        crate::invariants::FLAT_TOLERANCE,
+        crate::invariants::FLAT_TOLERANCE,
+        crate::invariants::WALK_HIP_FRACTION
+    ));
+    inv.note(format!(
+        "camera: frames where an object box cuts the line from the shot camera to a framed head (or standing hips), counted as a violation above {:.0} % of the frames, and frames with the camera inside an object; resting: every object on the floor, on its support's top or shelf (within {} m), on a wall or the ceiling; facing: seats the script puts in front of something, turned more than {}° away",
+        (1.0 - crate::invariants::SIGHT_FRACTION) * 100.0,
+        crate::invariants::REST_TOLERANCE,
+        crate::layout::geom::FACING_TOLERANCE_DEG
+    ));
     t.note(format!("seconds: compose + animate + {} annealing iterations (each re-animates), this machine; the paper: about 1 s per text for about 3 minutes of animation at 20-30 fps (Unity, NSM)", cfg.anneal_iterations));
     t.note("T in units of 1 % of the initial C (our difference on purpose); 'C after, T as printed': the same run with T = 1 - 0.002 k in absolute cost units, which accepts nearly every move");
     t.note("C = 1·C_D + 10·C_T (Eq. 1-3); contact m = C_T, the mean distance of the contact joints to their contact points; collided boxes: 0.25 m object boxes touched by the body over the animation");
-    t.note("foot skate: mean horizontal ankle speed while the ankle is within 2 cm of its rest height, mean over the characters (a text without characters shows —)");
+    t.note("foot skate: mean horizontal speed of the toe base while the ankle is within 2 cm of its rest height, mean over the characters (a text without characters shows —)");
     t.note(format!("closest characters: the least distance between two characters' roots over all frames (a character holds its last position after its track ends; — with one character); the planner keeps {} m", crate::animate::PASSING_DISTANCE));
     t.note(story_edit_note(cat, db, compose_cfg, &lib, &acfg, &ocfg));
-    Ok((t, demo_curves.unwrap_or_default()))
+    Ok((t, demo_curves.unwrap_or_default(), inv))
+}
+
+/// Random stories the invariant table checks besides the built-in texts.
+const RANDOM_STORIES: u64 = 40;
+
+/// The table of issue 27's invariants (see [`crate::invariants`]); goal 0 everywhere.
+fn invariant_table() -> Table {
+    let mut headers = vec!["script", "frames"];
+    headers.extend(crate::invariants::Report::NAMES);
+    headers.push("camera blocked %");
+    Table::new("invariants", "What a 3D client shows: violations per invariant (goal: 0)", &headers)
+}
+
+fn invariant_row(t: &mut Table, name: &str, r: &crate::invariants::Report) {
+    let mut cells = vec![name.to_string(), r.frames.to_string()];
+    cells.extend(r.counts().iter().map(|c| c.to_string()));
+    cells.push(num(100.0 * r.blocked as f64 / r.frames.max(1) as f64, 1));
+    t.row(cells);
 }
 
 /// The demo's second character's sentence, and the edit the bench makes to it.

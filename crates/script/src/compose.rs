@@ -99,6 +99,37 @@ pub struct Composition {
     pub times: ComposeTimes,
 }
 
+/// Size adjectives and the factors they scale a category's default size by (width, height,
+/// depth): within about ±30 % of the category's size, so a small table is still a table.
+pub const SIZE_WORDS: &[(&str, [f32; 3])] = &[
+    ("small", [0.75, 0.9, 0.75]),
+    ("little", [0.75, 0.9, 0.75]),
+    ("tiny", [0.7, 0.85, 0.7]),
+    ("large", [1.3, 1.05, 1.3]),
+    ("big", [1.3, 1.05, 1.3]),
+    ("huge", [1.35, 1.1, 1.35]),
+    ("tall", [1.0, 1.3, 1.0]),
+    ("high", [1.0, 1.3, 1.0]),
+    ("low", [1.0, 0.7, 1.0]),
+    ("short", [1.0, 0.75, 1.0]),
+    ("wide", [1.3, 1.0, 1.0]),
+    ("narrow", [0.75, 1.0, 1.0]),
+];
+
+/// A category's default `size` (width, height, depth, metres) scaled by the size adjectives
+/// among `attributes` ([`SIZE_WORDS`]).
+pub fn sized(size: [f32; 3], attributes: &[String]) -> [f32; 3] {
+    let mut out = size;
+    for a in attributes {
+        if let Some((_, f)) = SIZE_WORDS.iter().find(|(w, _)| w == a) {
+            for k in 0..3 {
+                out[k] *= f[k];
+            }
+        }
+    }
+    out
+}
+
 /// Builds the query SSG: every scene sentence's graph, then the objects that direction sentences
 /// target and no scene sentence names (a character walking "to the house" needs a house).
 ///
@@ -267,7 +298,7 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
                 label,
                 category: c.name.clone(),
                 attributes: o.attributes.clone(),
-                size: c.size,
+                size: sized(c.size, &o.attributes),
                 support: c.support,
                 surface: c.surface,
                 origin: Origin::Script { sentence: o.sentence, node },

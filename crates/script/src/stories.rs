@@ -142,8 +142,8 @@ const RANDOM_VIEWS: &[&str] = &["front", "back", "left", "right", "close", "wide
 
 /// A random story (deterministic in `seed`) in the style of the built-in texts: a room with two to
 /// four pieces of furniture related to each other, a small thing on one of them, a camera
-/// command, and one or two characters walking, sitting, standing up, picking things up and acting
-/// on them. The property tests of issue 27 check every invariant on such stories.
+/// command, and one or two characters walking, sitting, lying down, standing up, picking things
+/// up and acting on them. The property tests of issue 27 check every invariant on such stories.
 pub fn random_story(seed: u64) -> String {
     use rand::seq::IndexedRandom;
     use rand::Rng;
@@ -193,7 +193,7 @@ pub fn random_story(seed: u64) -> String {
         let mut seated = false;
         for _ in 0..rng.random_range(1..=3usize) {
             let target = pick(&mut rng, &furniture);
-            let line = match rng.random_range(0..8u32) {
+            let line = match rng.random_range(0..9u32) {
                 0 | 1 if !seated => format!("{name} walks to the {target}."),
                 2 if !seated && !seats.is_empty() => {
                     seated = true;
@@ -208,6 +208,13 @@ pub fn random_story(seed: u64) -> String {
                 4 if !surfaces.is_empty() => format!("{name} picks up the {small}."),
                 5 => format!("{name} looks at the {target}."),
                 6 if !seated => format!("{name} runs to the {target}."),
+                7 if !seated => match furniture.iter().find(|f| matches!(**f, "bed" | "sofa")) {
+                    Some(bed) => {
+                        seated = true;
+                        format!("{name} lies down on the {bed}.")
+                    }
+                    None => format!("{name} waves."),
+                },
                 _ => format!("{name} {}.", pick(&mut rng, &["waves", "thinks", "points at the window", "turns left"])),
             };
             lines.push(line);

@@ -124,3 +124,30 @@ fn a_story_run_writes_one_layout() {
     let r = check(&rep.animation, &builtin(), &rep.scene.composition.relations);
     assert_clean("issue 27 example", text, &r);
 }
+
+/// "A small table", "a tall bookshelf": size adjectives scale the object within its category's
+/// range (issue 27: "a small table" used to get the default 1.2 m table).
+#[test]
+fn size_words_scale_the_object() {
+    use inbetween_script::compose::{compose, ComposeInput};
+    use inbetween_script::parse::parse_script;
+    let cat = builtin();
+    let db = SceneDatabase::builtin(&cat, 2, 1);
+    let text = "In the room, a small table is near a tall bookshelf$\nA low cabinet is next to the bookshelf$\n";
+    let parsed = parse_script(text, &cat);
+    let c = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &Default::default() },
+        &ComposeConfig::default(),
+    );
+    let default = |name: &str| cat.get(name).unwrap().size;
+    let find = |cat: &str| c.scene.objects.iter().find(|o| o.category == cat).unwrap_or_else(|| panic!("no {cat}"));
+    let (small, low) = (find("table"), find("cabinet"));
+    assert!(small.size[0] < default("table")[0] * 0.8 && small.size[0] > default("table")[0] * 0.6, "{:?}", small.size);
+    assert!(
+        low.size[1] < default("cabinet")[1] * 0.8 && (low.size[0] - default("cabinet")[0]).abs() < 1e-6,
+        "{:?}",
+        low.size
+    );
+    let shelf = find("bookshelf");
+    assert!(shelf.size[1] > default("bookshelf")[1] * 1.2, "{:?}", shelf.size);
+}

@@ -34,7 +34,7 @@ pub const FRONT_GAP: f32 = 1.5;
 pub const UNDER_CLEARANCE: f32 = 0.03;
 /// Depth kept free in front of a seat, metres: a person stands there to sit down. Tables and
 /// desks (surfaces, legs room beneath) and anything lower than [`SEAT_FRONT_LOW`] may reach in.
-pub const SEAT_FRONT: f32 = 0.45;
+pub const SEAT_FRONT: f32 = 0.3;
 /// Objects lower than this (rugs) do not block a seat's front, metres.
 pub const SEAT_FRONT_LOW: f32 = 0.1;
 /// Height of the centre of wall objects (paintings, boards), metres.
@@ -56,9 +56,9 @@ pub struct LayoutItem {
     pub hint: Option<Placement>,
     /// Keep exactly here (position, yaw): incremental edits keep unchanged objects in place.
     pub pinned: Option<([f32; 3], f32)>,
-    /// A seat: it keeps [`SEAT_FRONT`] free in front of it (where a person stands to sit down),
-    /// and one the script puts "in front of" something turns to face it (a chair in front of a
-    /// desk faces the desk; database poses already face where they should).
+    /// A seat. One the script names keeps [`SEAT_FRONT`] free in front of it (where a person
+    /// stands to sit down) and, put "in front of" something, turns to face it (a chair in front
+    /// of a desk faces the desk); database seats keep their authored poses and neighbours.
     pub seat: bool,
 }
 

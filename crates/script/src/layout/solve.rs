@@ -355,14 +355,16 @@ impl<'a, R: Rng> Solver<'a, R> {
         geom::box_penetration(geom::center(o), o.half_extents_xz(), c, [DOOR_ZONE[0], DOOR_ZONE[1] / 2.0]) > 0.0
     }
 
-    /// Whether item `i` turns to face what the script puts it in front of (a seat the script names).
+    /// Whether item `i` is a seat the script names: it turns to face what the script puts it in
+    /// front of, and keeps its front free (database seats keep their authored poses and
+    /// neighbours).
     fn faces(&self, i: usize) -> bool {
         let it = &self.p.items[i];
         it.seat && matches!(it.origin, Origin::Script { .. })
     }
 
     /// Whether `obj` (for item `i`) interpenetrates a placed item it is not stacked with, or
-    /// stands in the free front of a seat (or, as a seat, has something in its own).
+    /// stands in the free front of a script seat (or, as one, has something in its own).
     fn collides(&self, i: usize, obj: &PlacedObject) -> bool {
         self.poses.iter().enumerate().any(|(j, o)| {
             let Some(o) = o else { return false };
@@ -380,8 +382,8 @@ impl<'a, R: Rng> Solver<'a, R> {
                     .iter()
                     .any(|c| c.relation == Relation::InFrontOf && (c.active, c.anchor) == (seat, other))
             };
-            let front = (me.seat && obj.support.is_none() && blocks_seat(obj, o, them.surface || uses(i, j)))
-                || (them.seat && o.support.is_none() && blocks_seat(o, obj, me.surface || uses(j, i)));
+            let front = (self.faces(i) && obj.support.is_none() && blocks_seat(obj, o, them.surface || uses(i, j)))
+                || (self.faces(j) && o.support.is_none() && blocks_seat(o, obj, me.surface || uses(j, i)));
             !linked && (interpenetrate(obj, o) || front)
         })
     }
