@@ -305,6 +305,10 @@ impl<'a, R: Rng> Solver<'a, R> {
                 .count();
             let mut score = 100.0 * unmet as f32 + tidy + pose.penalty + 10.0 * turned_away as f32;
             if grid::blocks_walking(&obj) && self.in_door_zone(&obj) {
+                // Furnishing never stands in the doorway; the script's own objects avoid it.
+                if matches!(self.p.items[i].origin, Origin::Database { .. }) {
+                    continue;
+                }
                 score += 20.0;
             }
             scored.push((score, obj));
