@@ -299,7 +299,7 @@ fn improve(
                 // A partial clear only when it gains at least a second and the plan stays short
                 // (pushing a conflict on and on would only stretch the timeline).
                 Some(t)
-                    if t >= run_end + FPS as usize
+                    if t >= run_end.saturating_add(FPS as usize)
                         && extra <= 3 * WAIT_STEP
                         && partial.as_ref().is_none_or(|(b, _)| t > *b) =>
                 {
