@@ -3,32 +3,22 @@
 //! walking, the camera sees whom it frames, every object rests on something, seats in front of
 //! something face it; and a story's outputs all show one (the optimised) layout.
 
+mod common;
+use common::run_job;
+
 use inbetween_script::animate::AnimateConfig;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::ComposeConfig;
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::invariants::{check, Report};
-use inbetween_script::job::{run_story, RunJob, SceneJob, DEFAULT_VARIATIONS};
+use inbetween_script::job::{run_story, RunJob, DEFAULT_VARIATIONS};
 use inbetween_script::motion::MotionLibrary;
 use inbetween_script::optimize::OptimizeConfig;
 use inbetween_script::stories::{all, random_story};
 use inbetween_script::story::StorySession;
 
 fn job(out: &std::path::Path) -> RunJob {
-    RunJob {
-        scene: SceneJob {
-            out_dir: out.to_path_buf(),
-            seed: 1,
-            view: None,
-            models: None,
-            config: Default::default(),
-            semantic: None,
-            limits: Default::default(),
-        },
-        optimize: true,
-        shared_motions: false,
-        gif_width: 120,
-    }
+    run_job(out, true)
 }
 
 /// A session as `script run` makes it, with a shorter annealing (the invariants must hold after

@@ -1,28 +1,18 @@
 //! Issue 27: every verb of the parser's lexicon either has motion or is refused before anything
 //! is written; "lie down" lies on the bed and "gets up" gets up again.
 
+mod common;
+use common::run_job;
+
 use inbetween_core::fk::forward;
 use inbetween_script::animate::verb_has_motion;
-use inbetween_script::job::{run_story, RunJob, SceneJob};
+use inbetween_script::job::{run_story, RunJob};
 use inbetween_script::motion::rig::Rig;
 use inbetween_script::motion::MotionLibrary;
 use inbetween_script::parse::lexicon::VERBS;
 
 fn job(out: &std::path::Path) -> RunJob {
-    RunJob {
-        scene: SceneJob {
-            out_dir: out.to_path_buf(),
-            seed: 1,
-            view: None,
-            models: None,
-            config: Default::default(),
-            semantic: None,
-            limits: Default::default(),
-        },
-        optimize: false,
-        shared_motions: false,
-        gif_width: 120,
-    }
+    run_job(out, false)
 }
 
 #[test]

@@ -1,8 +1,29 @@
-//! Fixtures and glTF read-back helpers shared by the output tests (each test binary uses a part).
+//! Fixtures and glTF read-back helpers shared by the output and story tests (each test binary uses
+//! a part).
 #![allow(dead_code)]
 
+use inbetween_script::job::{RunJob, SceneJob};
 use inbetween_script::scene::{Origin, PlacedObject};
 use serde_json::Value;
+
+/// A story job as `inbetween script run` makes it (seed 1, procedural motions, small GIF) writing
+/// into `out`.
+pub fn run_job(out: &std::path::Path, optimize: bool) -> RunJob {
+    RunJob {
+        scene: SceneJob {
+            out_dir: out.to_path_buf(),
+            seed: 1,
+            view: None,
+            models: None,
+            config: Default::default(),
+            semantic: None,
+            limits: Default::default(),
+        },
+        optimize,
+        shared_motions: false,
+        gif_width: 120,
+    }
+}
 
 /// An object placed by the script's first sentence, with no attributes and no support.
 pub fn obj(label: &str, category: &str, position: [f32; 3], yaw: f32, size: [f32; 3]) -> PlacedObject {
