@@ -141,3 +141,30 @@ fn size_words_scale_the_object() {
     let shelf = find("bookshelf");
     assert!(shelf.size[1] > default("bookshelf")[1] * 1.2, "{:?}", shelf.size);
 }
+
+/// "A chair is at the desk": the chair stands in front of the desk, turned to it (issue 27: "at"
+/// was an unknown relation).
+#[test]
+fn a_chair_at_the_desk_faces_it() {
+    use inbetween_script::compose::{compose, ComposeInput};
+    use inbetween_script::layout::geom::{facing_angle, FACING_TOLERANCE_DEG};
+    use inbetween_script::parse::parse_script;
+    use inbetween_script::ssg::Relation;
+    let cat = builtin();
+    let db = SceneDatabase::builtin(&cat, 2, 1);
+    let text = "In the office, a desk is near the window$. A chair is at the desk$.\nTom looks at the window.\n";
+    let parsed = parse_script(text, &cat);
+    assert!(parsed.diagnostics.is_empty(), "{:?}", parsed.diagnostics);
+    let rel = parsed.sentences.iter().flat_map(|s| &s.ssg.relations).find(|r| r.sentence == 1).expect("a relation");
+    assert_eq!(rel.relation, Relation::InFrontOf);
+    // "looks at" keeps its preposition.
+    let look = parsed.sentences.iter().flat_map(|s| &s.ssg.characters).flat_map(|c| &c.actions).next().unwrap();
+    assert_eq!(look.preposition.as_deref(), Some("at"));
+    let c = compose(
+        &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &Default::default() },
+        &ComposeConfig::default(),
+    );
+    let (chair, desk) = (c.scene.find("chair").unwrap(), c.scene.find("desk").unwrap());
+    assert!(facing_angle(chair, desk) <= FACING_TOLERANCE_DEG, "{chair:?}\n{desk:?}");
+    assert!(inbetween_script::layout::relation_holds(Relation::InFrontOf, chair, desk));
+}

@@ -50,6 +50,8 @@ const RELATION_PHRASES: &[(&[&str], Relation)] = &[
     (&["alongside"], Relation::NextTo),
     (&["against"], Relation::NextTo),
     (&["before"], Relation::InFrontOf),
+    // "A chair is at the desk": where one sits or stands to use it, facing it.
+    (&["at"], Relation::InFrontOf),
     (&["under"], Relation::Under),
     (&["underneath"], Relation::Under),
     (&["beneath"], Relation::Under),
@@ -81,6 +83,7 @@ const RELATION_WORDS: &[&str] = &[
     "over",
     "inside",
     "against",
+    "at",
 ];
 
 /// A matched relation phrase.
@@ -103,6 +106,7 @@ fn relation_at(t: &[Tagged], i: usize) -> Option<RelMatch> {
             }
             let dangling = words.last() == Some(&"front") || words.last() == Some(&"back");
             let prep = match (rel, n) {
+                (Relation::InFrontOf, 1) if words[0] == "at" => "at",
                 (Relation::InFrontOf, _) => "in front of",
                 (Relation::On, 3) => "on",
                 (_, 1) => match words[0] {
