@@ -469,7 +469,7 @@ impl<'a, R: Rng> Solver<'a, R> {
                 let mut floor = Vec::new();
                 self.wall_candidates(i, 0.0, 6, 0.0, &mut floor);
                 self.interior_candidates(i, 10, 0.0, &mut floor);
-                out.extend(floor.into_iter().map(|p| Pose { penalty: p.penalty + 30.0, ..p }));
+                out.extend(floor);
             }
             Support::Wall => {
                 let h = item.size[1];
@@ -502,6 +502,14 @@ impl<'a, R: Rng> Solver<'a, R> {
                     })
                     .collect();
                 out.extend(turned);
+            }
+        }
+        // Small things belong on a surface: the floor is a last resort, for database furnishing
+        // even at the cost of a relation (a laptop or a pillow on the floor looks lost).
+        if item.support == Support::Surface {
+            let floor = if matches!(item.origin, Origin::Database { .. }) { 150.0 } else { 30.0 };
+            for p in out.iter_mut().filter(|p| p.support.is_none()) {
+                p.penalty += floor;
             }
         }
         // Tiny seeded jitter breaks ties differently per attempt.
