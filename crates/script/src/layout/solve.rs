@@ -305,11 +305,12 @@ impl<'a, R: Rng> Solver<'a, R> {
                 .count();
             let mut score = 100.0 * unmet as f32 + tidy + pose.penalty + 10.0 * turned_away as f32;
             if grid::blocks_walking(&obj) && self.in_door_zone(&obj) {
-                // Furnishing never stands in the doorway; the script's own objects avoid it.
+                // Furnishing never stands in the doorway; the script's own objects only when no
+                // other place meets their relations.
                 if matches!(self.p.items[i].origin, Origin::Database { .. }) {
                     continue;
                 }
-                score += 20.0;
+                score += 150.0;
             }
             scored.push((score, obj));
         }
