@@ -45,12 +45,12 @@ impl Builder<'_> {
                     self.sit_on(o, s, 10, step.speed);
                 }
                 let b = &scene.objects[o];
-                let ψ = b.yaw as f64;
+                let bed_yaw = b.yaw as f64;
                 // Head towards the far end of the longer side: a bed's head (−z), a sofa's left (−x).
                 let head = if b.size[2] >= b.size[0] {
-                    DVec3::new(-ψ.sin(), 0.0, -ψ.cos())
+                    DVec3::new(-bed_yaw.sin(), 0.0, -bed_yaw.cos())
                 } else {
-                    DVec3::new(-ψ.cos(), 0.0, ψ.sin())
+                    DVec3::new(-bed_yaw.cos(), 0.0, bed_yaw.sin())
                 };
                 let mid = DVec3::new(b.position[0] as f64, b.top() as f64, b.position[2] as f64);
                 self.lying_pose(mid - head * HIPS_FROM_MIDDLE, head)
