@@ -35,6 +35,7 @@ if [ -d "$DATA/mocap/cmu" ]; then
         run script run builtin:demo -o story-demo-models --models "$DATA/assets/kenney_furniture" --gif-width 160
     fi
 fi
-# Logs and reports that print wall-clock times differ from run to run.
-find . \( -name '*.log' -o -name 'report.txt' -o -name 'report.md' -o -name 'costs.png' \) -delete
+# Logs and reports that print wall-clock times differ from run to run (the video metric's cache
+# records its training seconds too).
+find . \( -name '*.log' -o -name 'report.txt' -o -name 'report.md' -o -name 'costs.png' -o -path '*/video-cache/*' \) -delete
 echo "snapshot: $(find . -type f | wc -l) files in $OUT"

@@ -271,6 +271,33 @@ impl Clip {
         Pose { rotations: self.key_rotations(k).to_vec(), translations: self.key_translations(k).to_vec() }
     }
 
+    /// The pose at frame `f` (a key copied, a frame between keys interpolated, the last frame
+    /// held past the end): what [`Motion::pose`] gives for a BVH-form clip, without decoding.
+    pub fn pose(&self, f: usize) -> Pose {
+        let mut p = Pose::rest(&self.skeleton);
+        self.pose_into(f, &mut p);
+        p
+    }
+
+    /// [`Clip::pose`] into a pose the caller owns (no allocation once it has the skeleton's size).
+    pub fn pose_into(&self, f: usize, out: &mut Pose) {
+        match self.key_frames.get(f) {
+            Some(&k) if k == f => self.copy_key_resized(f, out),
+            _ => self.sample_frame(f as f64, &mut SamplingContext::default(), out),
+        }
+    }
+
+    /// Global (world) transforms of every frame, by forward kinematics.
+    pub fn globals(&self) -> Vec<crate::fk::GlobalPose> {
+        let mut pose = Pose::rest(&self.skeleton);
+        (0..self.num_frames())
+            .map(|f| {
+                self.pose_into(f, &mut pose);
+                crate::fk::forward(&self.skeleton, &pose)
+            })
+            .collect()
+    }
+
     /// The pose of every frame (keys copied, frames between them interpolated).
     pub fn poses(&self) -> Vec<Pose> {
         let mut ctx = SamplingContext::default();
@@ -341,6 +368,13 @@ impl Clip {
         };
         ctx.segment = k;
         k
+    }
+
+    fn copy_key_resized(&self, k: usize, out: &mut Pose) {
+        let n = self.skeleton.len();
+        out.rotations.resize(n, DQuat::IDENTITY);
+        out.translations.resize(n, DVec3::ZERO);
+        self.copy_key(k, out);
     }
 
     fn copy_key(&self, k: usize, out: &mut Pose) {

@@ -240,7 +240,7 @@ fn story_table(
         let secs = start.elapsed().as_secs_f64();
         let printed = optimize(&c, cat, &lib, &acfg, &OptimizeConfig { relative_temperature: None, ..ocfg.clone() });
         let frames = o.animation.frames();
-        let skate: Vec<f64> = o.animation.characters.iter().filter_map(|ch| foot_skate(&ch.motion).ok()).collect();
+        let skate: Vec<f64> = o.animation.characters.iter().filter_map(|ch| foot_skate(&ch.clip).ok()).collect();
         let skate = if skate.is_empty() { f64::NAN } else { skate.iter().sum::<f64>() / skate.len() as f64 };
         t.row([
             name.to_string(),

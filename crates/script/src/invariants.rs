@@ -203,15 +203,15 @@ pub fn check(anim: &Animation, cat: &Catalogue, relations: &[(Relation, usize, u
     // Head and hips per frame of each character, for the line of sight.
     let mut bodies: Vec<Option<Vec<[DVec3; 2]>>> = Vec::new();
     for c in &anim.characters {
-        let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else {
+        let Ok(rig) = Rig::try_of(c.clip.skeleton().clone()) else {
             bodies.push(None);
             continue;
         };
-        let n = c.motion.num_frames();
+        let n = c.clip.num_frames();
         let mut g = GlobalPose { positions: Vec::new(), rotations: Vec::new() };
         let mut all = Vec::with_capacity(n);
         for f in 0..n {
-            forward_into(&rig.skeleton, &c.motion.pose(f), &mut g);
+            forward_into(&rig.skeleton, &c.clip.pose(f), &mut g);
             all.push(g.clone());
         }
         body(&mut r, &rig, c, &all, anim.fps);

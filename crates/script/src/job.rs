@@ -209,8 +209,8 @@ pub fn run_story_in(
         files.push(plot);
     }
     let animation = u.animation;
-    let chars: Vec<(&str, &inbetween_core::Motion)> =
-        animation.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &inbetween_core::clip::Clip)> =
+        animation.characters.iter().map(|c| (c.name.as_str(), &c.clip)).collect();
     let track = camera_track(&animation);
     let cam = |f: usize| track.pose(f);
     let gltf = dir.join("story.gltf");
@@ -219,7 +219,7 @@ pub fn run_story_in(
     for c in &animation.characters {
         let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
         let bvh = dir.join(format!("{safe}.bvh"));
-        output::write_character_bvh(&bvh, &c.motion)?;
+        output::write_character_bvh(&bvh, &c.clip)?;
         files.push(bvh);
     }
     let gif = dir.join("story.gif");

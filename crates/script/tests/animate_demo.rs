@@ -35,8 +35,8 @@ fn demo_characters_move_continuously_and_reach_their_targets() {
     let names: Vec<&str> = anim.characters.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["Eve", "Tom"]);
     for c in &anim.characters {
-        let rig = Rig::of(c.motion.skeleton.clone());
-        let poses = c.motion.poses();
+        let rig = Rig::of(c.clip.skeleton().clone());
+        let poses = c.clip.poses();
         assert!(poses.len() > 60, "{}: {} frames", c.name, poses.len());
         for f in 1..poses.len() {
             let d = (poses[f].translations[rig.hips] - poses[f - 1].translations[rig.hips]).length();
@@ -65,11 +65,11 @@ fn sitting_puts_the_pelvis_on_the_seat() {
     let (_comp, anim) = demo();
     let mut sat = 0;
     for c in &anim.characters {
-        let rig = Rig::of(c.motion.skeleton.clone());
+        let rig = Rig::of(c.clip.skeleton().clone());
         for s in c.segments.iter().filter(|s| s.verb == "sit") {
             for jc in &s.contacts {
                 let f = (jc.start + jc.end) / 2;
-                let g = forward(&rig.skeleton, &c.motion.pose(f));
+                let g = forward(&rig.skeleton, &c.clip.pose(f));
                 let pelvis = (g.positions[rig.legs[0][0]] + g.positions[rig.legs[1][0]]) * 0.5;
                 let seat_y = jc.point[1] as f64 - PELVIS_ABOVE_SEAT;
                 let obj = &anim.scene.objects[s.object.unwrap()];
@@ -93,10 +93,10 @@ fn sitting_puts_the_pelvis_on_the_seat() {
 fn walking_roots_stay_out_of_floor_objects() {
     let (_comp, anim) = demo();
     for c in &anim.characters {
-        let rig = Rig::of(c.motion.skeleton.clone());
+        let rig = Rig::of(c.clip.skeleton().clone());
         for s in c.segments.iter().filter(|s| s.verb == "walk") {
             for f in s.start..s.end {
-                let r = c.motion.pose(f).translations[rig.hips];
+                let r = c.clip.pose(f).translations[rig.hips];
                 for (i, o) in anim.scene.objects.iter().enumerate() {
                     if o.support.is_some() || !blocks_walking(o) || s.touching.contains(&i) {
                         continue;
@@ -179,8 +179,8 @@ fn every_builtin_story_animates() {
         );
         assert!(!anim.camera.is_empty());
         for c in &anim.characters {
-            let rig = Rig::of(c.motion.skeleton.clone());
-            let poses = c.motion.poses();
+            let rig = Rig::of(c.clip.skeleton().clone());
+            let poses = c.clip.poses();
             for f in 1..poses.len() {
                 let d = (poses[f].translations[rig.hips] - poses[f - 1].translations[rig.hips]).length();
                 assert!(d < 0.1, "{name} {}: root jumps {d:.3} m at frame {f}", c.name);

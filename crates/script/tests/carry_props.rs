@@ -48,7 +48,7 @@ fn fig1_eve_fetches_the_microphone_and_sings_with_it_in_her_hand() {
     let rig = Rig::standard();
     let grip = contacts_of(&anim.scene, &cat, mic, ContactKind::Grip)[0];
     let grip = DVec3::new(grip[0] as f64, grip[1] as f64, grip[2] as f64);
-    let at_grab = forward(&eve.motion.skeleton, &eve.motion.pose(prop.from)).positions[rig.arms[1][3]];
+    let at_grab = forward(eve.clip.skeleton(), &eve.clip.pose(prop.from)).positions[rig.arms[1][3]];
     let gap = (at_grab - grip).length();
     eprintln!("hand {gap:.3} m from the microphone's grip at the grab (frame {})", prop.from);
     assert!(gap < 0.05, "{gap:.3} m");
@@ -64,9 +64,9 @@ fn fig1_eve_fetches_the_microphone_and_sings_with_it_in_her_hand() {
     };
     let seg = &eve.segments[sing];
     let mut moved: f64 = 0.0;
-    for f in (prop.from..eve.motion.num_frames()).step_by(7) {
+    for f in (prop.from..eve.clip.num_frames()).step_by(7) {
         let (p, q) = object_pose(&anim, mic, f);
-        let hand = forward(&eve.motion.skeleton, &eve.motion.pose(f)).positions[rig.arms[1][3]];
+        let hand = forward(eve.clip.skeleton(), &eve.clip.pose(f)).positions[rig.arms[1][3]];
         assert!((p + q * local - hand).length() < 1e-6, "frame {f}: the microphone left the hand");
         moved = moved.max((p - rest).length());
     }
@@ -122,8 +122,8 @@ fn the_preview_draws_a_moving_object_where_it_is() {
     let cat = builtin();
     let anim = animated("A microphone is on a table$.\nEve waves.\n");
     let table = anim.scene.objects.iter().position(|o| o.category == "table").unwrap();
-    let chars: Vec<(&str, &inbetween_core::Motion)> =
-        anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &inbetween_core::clip::Clip)> =
+        anim.characters.iter().map(|c| (c.name.as_str(), &c.clip)).collect();
     let cam = |f: usize| inbetween_script::animate::camera_pose(&anim, f);
     let base =
         inbetween_script::output::AnimPreviewOptions { width: 160, max_frames: 2, labels: false, ..Default::default() };

@@ -91,7 +91,7 @@ fn editing_one_characters_sentence_re_solves_only_that_character_and_its_objects
     let eve = |u: &inbetween_script::story::StoryUpdate| {
         u.animation.characters.iter().find(|c| c.name == "Eve").unwrap().clone()
     };
-    assert!(eve(&first).motion == eve(&second).motion, "Eve's motion changed");
+    assert!(eve(&first).clip == eve(&second).clip, "Eve's motion changed");
     // Tom now walks to the bookshelf first.
     let tom = second.animation.characters.iter().find(|c| c.name == "Tom").unwrap();
     assert_eq!(tom.segments.first().and_then(|s| s.target.as_deref()), Some("bookshelf"));
@@ -136,7 +136,7 @@ fn an_unchanged_text_re_solves_nothing() {
     assert!(again.resolved_objects.is_empty(), "{:?}", again.resolved_objects);
     assert!(again.character_builds.iter().all(|(_, b)| *b == 0), "{:?}", again.character_builds);
     for (a, b) in again.animation.characters.iter().zip(&first.animation.characters) {
-        assert!(a.motion == b.motion, "{}'s motion changed", a.name);
+        assert!(a.clip == b.clip, "{}'s motion changed", a.name);
     }
     let moved: Vec<&str> = again
         .animation
@@ -166,7 +166,7 @@ fn an_unchanged_text_re_solves_nothing() {
     );
     assert!(third.scene.changed_sentences.is_empty());
     for (a, b) in third.animation.characters.iter().zip(&second.animation.characters) {
-        assert!(a.motion == b.motion, "{}'s motion changed", a.name);
+        assert!(a.clip == b.clip, "{}'s motion changed", a.name);
     }
     assert!(third.animation == second.animation, "saving the edit again gives another Animation");
 }

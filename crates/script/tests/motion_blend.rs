@@ -14,7 +14,7 @@ fn blend_keeps_lower_body_from_locomotion_and_upper_body_from_action() {
     let rig = Rig::standard();
     let mask = rig.upper_body_mask();
     let walk = walk_route(&[[0.0, 0.0], [0.0, 4.0]], &lib, &WalkParams::default());
-    let action = &lib.retrieve("call").unwrap().motion;
+    let action = &lib.retrieve("call").unwrap().clip;
     let params = BlendParams { start: 20, end: Some(80), blend_in: 6, blend_out: 6, looping: true, action_offset: 0 };
     let out = blend_upper(&walk, action, &params).unwrap();
     assert_eq!(out.num_frames(), walk.num_frames());
@@ -43,7 +43,7 @@ fn blend_keeps_lower_body_from_locomotion_and_upper_body_from_action() {
         }
     }
     // With the action at full weight the right hand is up at the head (calling), not swinging low.
-    let g = forward(&out.skeleton, &out.pose(50));
+    let g = forward(out.skeleton(), &out.pose(50));
     let hand = g.positions[rig.arms[1][3]];
     let head = g.positions[rig.head];
     assert!((hand - head).length() < 0.25, "hand {hand:?} head {head:?}");
@@ -67,10 +67,10 @@ fn seated_typing_meets_the_keyboard() {
     let lib = MotionLibrary::procedural(0);
     let rig = Rig::standard();
     // Sit on a chair at (2, 1) facing +X, type on a keyboard 0.38 m in front at desk height.
-    let sit = place_clip(&lib.retrieve("sit").unwrap().motion, [2.0, 1.0], std::f64::consts::FRAC_PI_2).unwrap();
-    let typing = &lib.retrieve("type").unwrap().motion;
+    let sit = place_clip(&lib.retrieve("sit").unwrap().clip, [2.0, 1.0], std::f64::consts::FRAC_PI_2).unwrap();
+    let typing = &lib.retrieve("type").unwrap().clip;
     let blended = blend_upper(&sit, typing, &BlendParams::default()).unwrap();
-    let g0 = forward(&blended.skeleton, &blended.pose(0));
+    let g0 = forward(blended.skeleton(), &blended.pose(0));
     let pelvis = g0.positions[rig.hips];
     let keys = [DVec3::new(pelvis.x + 0.38, 0.72, pelvis.z + 0.12), DVec3::new(pelvis.x + 0.38, 0.72, pelvis.z - 0.12)];
     let window = BlendParams { start: 0, end: None, blend_in: 1, blend_out: 0, ..BlendParams::default() };
@@ -81,12 +81,12 @@ fn seated_typing_meets_the_keyboard() {
     let (out, worst) = reach_contacts(&blended, &contacts).unwrap();
     assert!(worst < 1e-6, "hands miss the keyboard by {worst}");
     for f in [0, 20, 45, out.num_frames() - 1] {
-        let g = forward(&out.skeleton, &out.pose(f));
+        let g = forward(out.skeleton(), &out.pose(f));
         assert!((g.positions[rig.arms[0][3]] - keys[1]).length() < 1e-6);
         assert!((g.positions[rig.arms[1][3]] - keys[0]).length() < 1e-6);
         // The seated lower body is untouched.
         assert!(
-            (g.positions[rig.legs[0][2]] - forward(&sit.skeleton, &sit.pose(f)).positions[rig.legs[0][2]]).length()
+            (g.positions[rig.legs[0][2]] - forward(sit.skeleton(), &sit.pose(f)).positions[rig.legs[0][2]]).length()
                 < 1e-9
         );
     }

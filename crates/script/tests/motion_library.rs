@@ -1,7 +1,6 @@
 //! Template-action library (§3.2): procedural clips without files, retrieval by verb lemma and
 //! synonyms, CMU tagging and loading on the real corpus when present.
 
-use inbetween_core::fk::forward_clip;
 use inbetween_script::motion::{walk_route_stats, ClipSource, MotionLibrary, Rig, WalkParams};
 
 #[test]
@@ -11,10 +10,10 @@ fn procedural_library_needs_no_files_and_stands_on_the_floor() {
     assert!(lib.clips.len() >= 14, "{} clips", lib.clips.len());
     for c in &lib.clips {
         assert_eq!(c.source, ClipSource::Procedural);
-        assert_eq!(c.motion.skeleton, rig.skeleton, "{}", c.name);
-        assert!((c.motion.fps() - 30.0).abs() < 1e-9);
-        assert!(c.motion.num_frames() >= 30, "{}", c.name);
-        let g = forward_clip(&c.motion);
+        assert_eq!(c.clip.skeleton(), &rig.skeleton, "{}", c.name);
+        assert!((c.clip.fps() - 30.0).abs() < 1e-9);
+        assert!(c.clip.num_frames() >= 30, "{}", c.name);
+        let g = c.clip.globals();
         let low = g
             .iter()
             .map(|p| p.positions[rig.legs[0][2]].y.min(p.positions[rig.legs[1][2]].y))
@@ -96,8 +95,8 @@ fn cmu_index_is_tagged_and_cgspeed_clips_load() {
         let captured: Vec<_> = lib.clips.iter().filter(|c| c.is_captured()).collect();
         assert!(!captured.is_empty());
         for c in &captured {
-            assert_eq!(c.motion.skeleton, rig.skeleton);
-            let g = forward_clip(&c.motion);
+            assert_eq!(c.clip.skeleton(), &rig.skeleton);
+            let g = c.clip.globals();
             // Grounded: the 5th percentile of the lowest toe is at the floor (uneven-terrain and
             // climbing trials go below and above it elsewhere).
             let mut toes: Vec<f64> =
@@ -117,7 +116,7 @@ fn cmu_index_is_tagged_and_cgspeed_clips_load() {
         }
         // The iClone/Character Creator conversions retarget too: a CMU walk walks forward.
         if let Some(walk) = lib.clips.iter().find(|c| c.name.starts_with("cmu 02_01")) {
-            let g = forward_clip(&walk.motion);
+            let g = walk.clip.globals();
             let end = g.last().unwrap().positions[0];
             assert!(end.z > 2.0 && end.x.abs() < 1.0, "02_01 ends at {end:?}");
             let hips = g.iter().map(|p| p.positions[0].y).sum::<f64>() / g.len() as f64;
@@ -170,7 +169,7 @@ fn kenney_characters_add_clips_when_present() {
         assert_eq!(lib.retrieve("walk").unwrap().source, ClipSource::Procedural);
         // Orientation: the right kick swings the right foot forward (+Z), above the floor.
         let rig = Rig::standard();
-        let g = forward_clip(&kick.motion);
+        let g = kick.clip.globals();
         let (mut fwd, mut up): (f64, f64) = (0.0, 0.0);
         let side = if kick.name.contains("right") { 1 } else { 0 };
         for p in &g {
@@ -196,7 +195,7 @@ fn captured_walks_give_locomotion_its_cycle() {
         let cycle = lib.cycle("walk").expect("a walk cycle");
         assert!(cycle.is_captured(), "{}", cycle.name);
         assert!(cycle.has_tag("cycle") && cycle.has_tag("cmu"));
-        let seconds = cycle.motion.num_frames() as f64 * cycle.motion.frame_time;
+        let seconds = cycle.clip.num_frames() as f64 * cycle.clip.frame_time();
         assert!((0.8..=1.6).contains(&seconds), "{}: {seconds} s", cycle.name);
         // Walking an L-shaped route on captured steps: locking keeps skate low.
         let route = [[0.0, 0.0], [0.0, 3.0], [2.5, 3.0]];

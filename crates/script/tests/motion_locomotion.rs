@@ -1,7 +1,6 @@
 //! Walking a route (§4.3): arc-length timing, eased start and stop, limited turn rate, and foot
 //! locking that removes foot skate.
 
-use inbetween_core::fk::forward_clip;
 use inbetween_script::motion::locomotion::{heading_at, place_clip};
 use inbetween_script::motion::{
     foot_skate, lock_feet, walk_route, walk_route_stats, LockParams, MotionLibrary, Rig, WalkParams,
@@ -16,7 +15,7 @@ fn arc_route() -> Vec<[f32; 2]> {
         .collect()
 }
 
-fn root_xz(m: &inbetween_core::Motion, f: usize) -> [f64; 2] {
+fn root_xz(m: &inbetween_core::clip::Clip, f: usize) -> [f64; 2] {
     let r = m.pose(f).translations[0];
     [r.x, r.z]
 }
@@ -37,7 +36,7 @@ fn straight_route_starts_and_stops_at_rest_and_arrives() {
         ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt() * 30.0
     };
     let cycle_speed = {
-        let c = &lib.cycle("walk").unwrap().motion;
+        let c = &lib.cycle("walk").unwrap().clip;
         let (a, b) = (c.pose(0).translations[0], c.pose(c.num_frames() - 1).translations[0]);
         (b.z - a.z) / c.duration()
     };
@@ -69,7 +68,8 @@ fn foot_locking_removes_skate_on_a_curved_route() {
     assert!(after < 0.35 * before, "locking must cut skate by two thirds: {before} -> {after}");
     // Locking keeps feet out of the floor and the root on the route.
     let rig = Rig::standard();
-    let low = forward_clip(&locked)
+    let low = locked
+        .globals()
         .iter()
         .map(|g| g.positions[rig.legs[0][2]].y.min(g.positions[rig.legs[1][2]].y))
         .fold(f64::INFINITY, f64::min);
@@ -131,7 +131,7 @@ fn walking_is_deterministic_and_run_is_faster() {
     let run = walk_route(&route, &lib, &WalkParams { verb: "run".into(), ..WalkParams::default() });
     assert!(run.num_frames() < a.num_frames());
     // A library clip can be placed in the world.
-    let sit = &lib.retrieve("sit").unwrap().motion;
+    let sit = &lib.retrieve("sit").unwrap().clip;
     let placed = place_clip(sit, [2.0, 3.0], 1.0).unwrap();
     let r = placed.pose(0).translations[0];
     let r0 = sit.pose(0).translations[0];
@@ -169,7 +169,8 @@ fn walks_an_astar_route_around_an_obstacle() {
 
 #[test]
 fn a_foreign_skeleton_gives_an_error_naming_the_missing_joint_not_a_panic() {
-    use inbetween_core::{Motion, Pose};
+    use inbetween_core::clip::Clip;
+    use inbetween_core::Pose;
     use inbetween_script::animate::crowd::root_track;
     use inbetween_script::motion::locomotion::detect_contacts;
     use inbetween_script::motion::{blend_upper, reach_contacts, BlendParams, Contact, Limb};
@@ -179,7 +180,7 @@ fn a_foreign_skeleton_gives_an_error_naming_the_missing_joint_not_a_panic() {
     assert!(sk.find("LeftToeBase").is_none() && sk.find("LeftFoot").is_some());
     let mut pose = Pose::rest(&sk);
     pose.translations[0].y = 0.9;
-    let m = Motion::from_poses(sk.clone(), 1.0 / 30.0, &[pose.clone(), pose]).unwrap();
+    let m = Clip::from_poses(sk.clone(), 1.0 / 30.0, &[pose.clone(), pose]).unwrap();
     let contact =
         Contact { limb: Limb::RightArm, target: glam::DVec3::new(0.3, 1.0, 0.3), window: BlendParams::default() };
     let errors = [

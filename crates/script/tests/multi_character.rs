@@ -51,7 +51,7 @@ fn dist(a: [f32; 2], b: [f32; 2]) -> f32 {
 
 /// The smallest root distance over every frame, every pair (each holds its last position).
 fn closest(anim: &Animation) -> f32 {
-    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().map(|c| root_track(&c.motion).unwrap()).collect();
+    let trajs: Vec<Vec<[f32; 2]>> = anim.characters.iter().map(|c| root_track(&c.clip).unwrap()).collect();
     let frames = trajs.iter().map(Vec::len).max().unwrap();
     let at = |t: &Vec<[f32; 2]>, f: usize| t[f.min(t.len() - 1)];
     let mut best = f32::INFINITY;
@@ -93,7 +93,7 @@ fn three_characters_crossing_the_room_keep_their_distance_at_every_frame() {
     // Everyone still gets where they were sent.
     for (ch, target) in anim.characters.iter().zip(["table", "desk", "bookshelf"]) {
         let o = anim.scene.find(target).unwrap();
-        let end = *root_track(&ch.motion).unwrap().last().unwrap();
+        let end = *root_track(&ch.clip).unwrap().last().unwrap();
         let gap = dist(end, [o.position[0], o.position[2]]);
         assert!(gap < 1.2, "{} ends {gap:.2} m from the {target}", ch.name);
     }
@@ -108,8 +108,8 @@ fn a_character_standing_still_is_not_walked_through() {
         vec![object("bookshelf", "bookshelf", 0.8, 4.6, std::f32::consts::PI), object("table", "table", 4.5, 1.5, 0.0)];
     let anim = animate_in(objects, "Eve walks to the bookshelf.\nTom waves.\n");
     eprintln!("notes: {:?}", anim.notes);
-    let eve = root_track(&anim.characters[0].motion).unwrap();
-    let tom = root_track(&anim.characters[1].motion).unwrap();
+    let eve = root_track(&anim.characters[0].clip).unwrap();
+    let tom = root_track(&anim.characters[1].clip).unwrap();
     let tom_spot = tom[0];
     // Tom never moves from his spot (the wave is in place).
     assert!(tom.iter().all(|p| dist(*p, tom_spot) < 0.1), "Tom stays where he started");

@@ -9,8 +9,8 @@ use std::path::Path;
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 use image::AnimationDecoder;
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
-use inbetween_core::Motion;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::motion::{walk_route, MotionLibrary, WalkParams};
 use inbetween_script::output::anim_gltf::{animation_frames, ANIMATION_NAME, CHARACTER_COLORS};
@@ -41,7 +41,7 @@ fn scene() -> Scene {
 }
 
 /// A straight walk across the room (procedural library, no shared data needed).
-fn walk() -> Motion {
+fn walk() -> Clip {
     walk_route(&[[0.6, 3.1], [4.4, 3.1]], &MotionLibrary::procedural(0), &WalkParams::default())
 }
 
@@ -62,7 +62,7 @@ fn parents_by_node(doc: &Value) -> HashMap<usize, usize> {
 }
 
 /// Checks the animation against the motion; returns the number of key frames of the camera.
-fn check_animation(doc: &Value, bin: &[u8], name: &str, m: &Motion, fps: f64) {
+fn check_animation(doc: &Value, bin: &[u8], name: &str, m: &Clip, fps: f64) {
     check_buffers(doc, bin);
     let nodes = doc["nodes"].as_array().unwrap();
     let parent = parents_by_node(doc);
@@ -73,7 +73,7 @@ fn check_animation(doc: &Value, bin: &[u8], name: &str, m: &Motion, fps: f64) {
     // Character: a scene root named `name` whose one child is the skeleton's root joint.
     let root = *scene_roots.iter().find(|&&r| nodes[r]["name"] == name).expect("character root node");
     let hips = nodes[root]["children"][0].as_u64().unwrap() as usize;
-    let sk = &m.skeleton;
+    let sk = m.skeleton();
     assert_eq!(nodes[hips]["name"], sk.joint(0).name.as_str());
     // Joint nodes: below the character root, named by joint, parented as in the skeleton, rest offsets.
     let under = |mut k: usize| {
@@ -257,8 +257,8 @@ fn animated_gltf_rejects_bad_input() {
     assert!(animated_gltf_document(&scene(), &builtin(), &[("w", &m)], &camera, 0.0, &lookup).is_err());
     let bad_fov = |_: usize| ([0.0, 1.0, 5.0], [0.0, 1.0, 0.0], 0.0);
     assert!(animated_gltf_document(&scene(), &builtin(), &[("w", &m)], &bad_fov, 30.0, &lookup).is_err());
-    let empty = Motion::new(m.skeleton.clone(), m.frame_time, vec![]).unwrap();
-    assert!(animated_gltf_document(&scene(), &builtin(), &[("w", &empty)], &camera, 30.0, &lookup).is_err());
+    // A character without frames cannot be given: a clip has at least one.
+    assert!(Clip::from_poses(m.skeleton().clone(), m.frame_time(), &[]).is_err());
     // No characters: the static scene plus a one-key camera.
     let (doc, _, _) = animated_gltf_document(&scene(), &builtin(), &[], &camera, 30.0, &lookup).unwrap();
     assert_eq!(doc["animations"][0]["channels"].as_array().unwrap().len(), 2);
@@ -272,7 +272,9 @@ fn bvh_round_trips_within_1e6_with_unit_sidecar() {
     write_character_bvh(&p, &m).unwrap();
     let back = inbetween_io::bvh::read_bvh(&p).unwrap();
     assert_eq!(back.num_frames(), m.num_frames());
-    assert!((back.frame_time - m.frame_time).abs() < 1e-12);
+    assert!((back.frame_time - m.frame_time()).abs() < 1e-12);
+    // Channels as written (the clip's poses in each joint's Euler order) and as read back.
+    let m = m.to_motion().unwrap();
     assert_eq!(back.skeleton.len(), m.skeleton.len());
     for (j, joint) in m.skeleton.joints().iter().enumerate() {
         let k = back.skeleton.find(&joint.name).unwrap();

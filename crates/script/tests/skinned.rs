@@ -8,8 +8,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DQuat, DVec3, Mat4, Quat, Vec3};
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
-use inbetween_core::{Motion, Pose};
+use inbetween_core::Pose;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::motion::kenney::{read_character, KenneyCharacter};
 use inbetween_script::motion::rig::{clip, Rig};
@@ -151,7 +152,7 @@ fn camera(_: usize) -> ([f32; 3], [f32; 3], f32) {
 
 /// Frame 0 the bind pose at (2, y, 2); then the left knee bends to 90°, the right arm drops to the
 /// side and the body walks 0.5 m along +z and turns 90° about +Y.
-fn test_motion(rig: &Rig) -> Motion {
+fn test_motion(rig: &Rig) -> Clip {
     let (bind, _) = bind_pose(&rig.skeleton);
     let frames = 6;
     let poses: Vec<Pose> = (0..frames)
@@ -348,8 +349,8 @@ fn check_bind(ch: &KenneyCharacter, body: &SkinnedBody, rig: &Rig) {
 
 /// Document invariants (glTF 2.0 rules our readers and Blender rely on) plus the skin math on the
 /// document's own data.
-fn check_document(doc: &Value, bin: &[u8], body: &SkinnedBody, m: &Motion) {
-    let sk = &m.skeleton;
+fn check_document(doc: &Value, bin: &[u8], body: &SkinnedBody, m: &Clip) {
+    let sk = m.skeleton();
     assert_eq!(doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize, bin.len());
     for v in doc["bufferViews"].as_array().unwrap() {
         let (off, len) = (v["byteOffset"].as_u64().unwrap() as usize, v["byteLength"].as_u64().unwrap() as usize);

@@ -72,7 +72,7 @@ fn lying_down_on_the_bed_and_getting_up() {
     let lie = tom.segments.iter().find(|s| s.verb == "lie").unwrap();
     let bed = rep.animation.scene.objects.iter().find(|o| o.category == "bed").unwrap();
     let rig = Rig::standard();
-    let g = forward(&rig.skeleton, &tom.motion.pose(lie.end - 1));
+    let g = forward(&rig.skeleton, &tom.clip.pose(lie.end - 1));
     let (hips, head) = (g.positions[rig.hips], g.positions[rig.head]);
     // Lying: head and hips at about the same height, just above the bed's top, over the bed.
     assert!((head.y - hips.y).abs() < 0.2, "not lying: hips {hips:?}, head {head:?}");
@@ -87,6 +87,6 @@ fn lying_down_on_the_bed_and_getting_up() {
     };
     assert!(over(hips) && over(head), "hips {hips:?}, head {head:?} not over the bed");
     // Standing again at the end, at the desk.
-    let end = forward(&rig.skeleton, &tom.motion.pose(tom.motion.num_frames() - 1));
+    let end = forward(&rig.skeleton, &tom.clip.pose(tom.clip.num_frames() - 1));
     assert!(end.positions[rig.head].y > 1.4, "{:?}", end.positions[rig.head]);
 }

@@ -133,7 +133,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     // One document, sent as GLB to the viewer and offered as .gltf for download: every character
     // a skinned Kenney blocky character when those models are in the shared data, the engine's
     // joint hierarchy with bone boxes otherwise.
-    let skeletons: Vec<inbetween_core::Skeleton> = anim.characters.iter().map(|c| c.motion.skeleton.clone()).collect();
+    let skeletons: Vec<inbetween_core::Skeleton> = anim.characters.iter().map(|c| c.clip.skeleton().clone()).collect();
     if live.bodies.as_ref().is_none_or(|(s, _, _)| *s != skeletons) {
         live.bodies = output::skinned::skinned_bodies(anim, None).ok().map(|(b, n)| (skeletons, b, n));
     }
@@ -159,13 +159,17 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let mut characters = Vec::new();
     for c in &anim.characters {
         let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
-        let motion = c.motion.clone();
-        let bvh = move || inbetween_io::to_bvh_string(&motion).into_bytes();
+        let clip = c.clip.clone();
+        // Euler channels only when the file is asked for.
+        let bvh = move || match clip.to_motion() {
+            Ok(motion) => inbetween_io::to_bvh_string(&motion).into_bytes(),
+            Err(e) => format!("error: {e}").into_bytes(),
+        };
         let url = st.put_lazy(&format!("script/{safe}.bvh"), "text/plain; charset=utf-8", bvh, v);
         characters.push(json!({
             "name": c.name,
-            "joints": c.motion.skeleton.len(),
-            "frames": c.motion.num_frames(),
+            "joints": c.clip.skeleton().len(),
+            "frames": c.clip.num_frames(),
             "bvh": url,
             "segments": c.segments.iter().map(|s| json!({
                 "verb": s.verb, "start": s.start, "end": s.end, "target": s.target,

@@ -3,16 +3,17 @@
 //! cache, its notes, and the timeline built so far (frames, segments, walks, seats, props), with
 //! the pieces the actions share: clips by name, looping, cross-fading, lifting onto a seat.
 
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
 use inbetween_core::motion::interpolate_pose;
-use inbetween_core::{Motion, Pose};
+use inbetween_core::Pose;
 
 use super::action::walk::WalkCache;
 use super::plan::Ctx;
 use super::{CarriedProp, JointContact, Segment, WalkChoice, WalkInfo};
 use crate::layout::grid::Grid;
 use crate::motion::ik::{ground_feet, solve_limb, Limb};
-use crate::motion::locomotion::place_clip_on;
+use crate::motion::locomotion::place_clip;
 use crate::motion::procedural::SEAT_HEIGHT;
 use crate::motion::MotionLibrary;
 
@@ -88,23 +89,23 @@ impl<'a> Builder<'a> {
     }
 
     /// A clip of the library on the common rig, by exact name, else from the procedural library.
-    pub fn named(&mut self, name: &str) -> Motion {
-        if let Some(c) = self.ctx.lib.get(name).filter(|c| c.motion.skeleton == self.ctx.rig.skeleton) {
-            return c.motion.clone();
+    pub fn named(&mut self, name: &str) -> Clip {
+        if let Some(c) = self.ctx.lib.get(name).filter(|c| c.clip.skeleton() == &self.ctx.rig.skeleton) {
+            return c.clip.clone();
         }
         let proc = self.fallback.get_or_insert_with(|| MotionLibrary::procedural(0));
-        proc.get(name).expect("procedural clip").motion.clone()
+        proc.get(name).expect("procedural clip").clip.clone()
     }
 
     /// The library clip retrieved for `verb` on the common rig, else the procedural clip `name`.
-    pub fn retrieved_or(&mut self, verb: &str, name: &str) -> Motion {
-        match self.ctx.lib.retrieve(verb).filter(|c| c.motion.skeleton == self.ctx.rig.skeleton) {
-            Some(c) => c.motion.clone(),
+    pub fn retrieved_or(&mut self, verb: &str, name: &str) -> Clip {
+        match self.ctx.lib.retrieve(verb).filter(|c| c.clip.skeleton() == &self.ctx.rig.skeleton) {
+            Some(c) => c.clip.clone(),
             None => self.named(name),
         }
     }
 
-    pub fn idle_clip(&mut self) -> Motion {
+    pub fn idle_clip(&mut self) -> Clip {
         self.retrieved_or("idle", "procedural idle")
     }
 
@@ -124,8 +125,8 @@ impl<'a> Builder<'a> {
     }
 
     /// `n` frames of a looped clip with its origin placed at `at`, facing `heading`.
-    pub fn looped(&self, clip: &Motion, at: [f32; 2], heading: f64, n: usize) -> Vec<Pose> {
-        let placed = place_clip_on(&self.ctx.rig, clip, at, heading).poses();
+    pub fn looped(&self, clip: &Clip, at: [f32; 2], heading: f64, n: usize) -> Vec<Pose> {
+        let placed = placed(clip, at, heading);
         (0..n).map(|k| placed[k % placed.len()].clone()).collect()
     }
 
@@ -198,3 +199,12 @@ impl<'a> Builder<'a> {
         (self.ctx.cfg.min_action_seconds * crate::motion::rig::FPS).round() as usize
     }
 }
+
+/// The poses of a clip on the common rig placed at `at` facing `heading` ([`place_clip`]).
+pub(crate) fn placed(clip: &Clip, at: [f32; 2], heading: f64) -> Vec<Pose> {
+    place_clip(clip, at, heading).expect(ON_RIG).poses()
+}
+
+/// Why the motion helpers cannot fail on the builder's clips (they are built on, or filtered to,
+/// [`super::plan::Ctx::rig`]).
+pub(crate) const ON_RIG: &str = "the builder's clips are on the common rig";

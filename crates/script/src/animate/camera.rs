@@ -141,15 +141,15 @@ fn camera_poses(anim: &Animation) -> (Vec<Framing>, Vec<usize>) {
 
 /// Head and hips of a character at every frame (None off the common rig or without frames).
 fn body_points(track: &super::CharacterTrack) -> Option<Vec<[DVec3; 2]>> {
-    let n = track.motion.num_frames();
+    let n = track.clip.num_frames();
     if n == 0 {
         return None;
     }
-    let rig = Rig::try_of(track.motion.skeleton.clone()).ok()?;
+    let rig = Rig::try_of(track.clip.skeleton().clone()).ok()?;
     Some(
         (0..n)
             .map(|k| {
-                let g = forward(&rig.skeleton, &track.motion.pose(k));
+                let g = forward(&rig.skeleton, &track.clip.pose(k));
                 [g.positions[rig.head], g.positions[rig.hips]]
             })
             .collect(),
@@ -323,15 +323,15 @@ const MIN_PAIR_DISTANCE: f64 = 0.3;
 
 /// A character's head at a frame, averaged over ±[`TARGET_SMOOTHING`] frames.
 fn smoothed_head(track: &super::CharacterTrack, frame: usize) -> Option<DVec3> {
-    let n = track.motion.num_frames();
+    let n = track.clip.num_frames();
     if n == 0 {
         return None;
     }
-    let rig = Rig::try_of(track.motion.skeleton.clone()).ok()?;
+    let rig = Rig::try_of(track.clip.skeleton().clone()).ok()?;
     let f = frame.min(n - 1);
     let range = f.saturating_sub(TARGET_SMOOTHING)..=(f + TARGET_SMOOTHING).min(n - 1);
     let count = range.clone().count() as f64;
-    let sum: DVec3 = range.map(|k| forward(&rig.skeleton, &track.motion.pose(k)).positions[rig.head]).sum();
+    let sum: DVec3 = range.map(|k| forward(&rig.skeleton, &track.clip.pose(k)).positions[rig.head]).sum();
     Some(sum / count)
 }
 
@@ -346,19 +346,19 @@ fn smoothed(heads: &[DVec3], frame: usize) -> DVec3 {
 
 /// The first character's chest at a frame (None without characters or frames).
 fn chest_at(anim: &Animation, frame: usize) -> Option<DVec3> {
-    let c = anim.characters.first().filter(|c| c.motion.num_frames() > 0)?;
-    let f = frame.min(c.motion.num_frames() - 1);
-    Some(match Rig::try_of(c.motion.skeleton.clone()) {
-        Ok(rig) => forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1],
-        Err(_) => c.motion.pose(f).translations[0] + DVec3::Y * 0.3,
+    let c = anim.characters.first().filter(|c| c.clip.num_frames() > 0)?;
+    let f = frame.min(c.clip.num_frames() - 1);
+    Some(match Rig::try_of(c.clip.skeleton().clone()) {
+        Ok(rig) => forward(&rig.skeleton, &c.clip.pose(f)).positions[rig.spine1],
+        Err(_) => c.clip.pose(f).translations[0] + DVec3::Y * 0.3,
     })
 }
 
 /// [`chest_at`] for every frame of the first character.
 fn chest_positions(anim: &Animation) -> Option<Vec<DVec3>> {
     let c = anim.characters.first()?;
-    let rig = Rig::try_of(c.motion.skeleton.clone()).ok()?;
-    Some((0..c.motion.num_frames()).map(|f| forward(&rig.skeleton, &c.motion.pose(f)).positions[rig.spine1]).collect())
+    let rig = Rig::try_of(c.clip.skeleton().clone()).ok()?;
+    Some((0..c.clip.num_frames()).map(|f| forward(&rig.skeleton, &c.clip.pose(f)).positions[rig.spine1]).collect())
 }
 
 /// The Toric framing of a view (A: the first character, B: the second): both heads in the upper
@@ -459,15 +459,15 @@ mod tests {
     use crate::animate::{CameraShot, CharacterTrack};
     use crate::motion::rig::{yaw, FPS};
     use crate::scene::{Room, Scene};
+    use inbetween_core::clip::Clip;
     use inbetween_core::toric::CameraPose;
-    use inbetween_core::Motion;
 
-    fn standing_at(rig: &Rig, x: f64, z: f64, heading: f64, frames: usize) -> Motion {
+    fn standing_at(rig: &Rig, x: f64, z: f64, heading: f64, frames: usize) -> Clip {
         let mut p = rig.standing();
         p.translations[rig.hips].x += x;
         p.translations[rig.hips].z += z;
         p.rotations[rig.hips] = (yaw(heading) * p.rotations[rig.hips]).normalize();
-        Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, &vec![p; frames]).unwrap()
+        Clip::from_poses(rig.skeleton.clone(), 1.0 / FPS, &vec![p; frames]).unwrap()
     }
 
     fn two_people(view: &str) -> Animation {
@@ -475,7 +475,7 @@ mod tests {
         let room = Room { name: "room".into(), width: 6.0, depth: 5.0, height: 2.8 };
         let track = |name: &str, x: f64| CharacterTrack {
             name: name.into(),
-            motion: standing_at(&rig, x, 2.5, 0.0, 40),
+            clip: standing_at(&rig, x, 2.5, 0.0, 40),
             segments: Vec::new(),
             props: Vec::new(),
         };
@@ -490,7 +490,7 @@ mod tests {
 
     fn head(anim: &Animation, c: usize, f: usize) -> DVec3 {
         let rig = Rig::standard();
-        forward(&rig.skeleton, &anim.characters[c].motion.pose(f)).positions[rig.head]
+        forward(&rig.skeleton, &anim.characters[c].clip.pose(f)).positions[rig.head]
     }
 
     /// Screen positions of both heads for the returned (eye, target), in the two-shot lens.
@@ -511,12 +511,12 @@ mod tests {
                 let rig = Rig::standard();
                 let poses: Vec<_> = (0..40)
                     .map(|f| {
-                        let mut p = track.motion.pose(f);
+                        let mut p = track.clip.pose(f);
                         p.translations[rig.hips].x += 0.02 * f as f64 * (c as f64 - 0.5);
                         p
                     })
                     .collect();
-                track.motion = Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, &poses).unwrap();
+                track.clip = Clip::from_poses(rig.skeleton.clone(), 1.0 / FPS, &poses).unwrap();
             }
             let track = camera_track(&anim);
             assert_eq!(track.poses.len(), anim.frames());

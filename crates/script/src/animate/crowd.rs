@@ -74,14 +74,21 @@ fn dist(a: [f32; 2], b: [f32; 2]) -> f32 {
 
 /// Root (x, z) of every frame of a motion; an error names the joint missing when it is not on the
 /// common rig.
-pub fn root_track(m: &inbetween_core::Motion) -> Result<Vec<[f32; 2]>, crate::ScriptError> {
-    let rig = Rig::for_motion(m, "a root track")?;
-    Ok((0..m.num_frames())
+pub fn root_track(m: &inbetween_core::clip::Clip) -> Result<Vec<[f32; 2]>, crate::ScriptError> {
+    let rig = Rig::for_clip(m, "a root track")?;
+    Ok(hip_track(m, rig.hips))
+}
+
+/// Joint `hips`' (x, z) at every frame of a clip.
+fn hip_track(m: &inbetween_core::clip::Clip, hips: usize) -> Vec<[f32; 2]> {
+    let mut p = inbetween_core::Pose::rest(m.skeleton());
+    (0..m.num_frames())
         .map(|f| {
-            let r = m.pose(f).translations[rig.hips];
+            m.pose_into(f, &mut p);
+            let r = p.translations[hips];
             [r.x as f32, r.z as f32]
         })
-        .collect())
+        .collect()
 }
 
 /// The minimum distance between any two characters' roots over every frame of the animation
@@ -89,7 +96,7 @@ pub fn root_track(m: &inbetween_core::Motion) -> Result<Vec<[f32; 2]>, crate::Sc
 /// character not on the common rig has no root track and is left out).
 pub fn min_clearance(anim: &Animation) -> Option<Clearance> {
     let trajs: Vec<Vec<[f32; 2]>> =
-        anim.characters.iter().filter_map(|c| root_track(&c.motion).ok()).filter(|t| !t.is_empty()).collect();
+        anim.characters.iter().filter_map(|c| root_track(&c.clip).ok()).filter(|t| !t.is_empty()).collect();
     closest(&trajs, &[])
 }
 
@@ -208,14 +215,7 @@ pub(crate) fn separate(
 
 /// Root (x, z) per frame of a walk along `route`.
 fn walk_roots(ctx: &Ctx, cache: &mut WalkCache, route: &[[f32; 2]], params: &WalkParams) -> Vec<[f32; 2]> {
-    let m = cache.walk(route, ctx.lib, params);
-    let hips = ctx.rig.hips;
-    (0..m.num_frames())
-        .map(|k| {
-            let r = m.pose(k).translations[hips];
-            [r.x as f32, r.z as f32]
-        })
-        .collect()
+    hip_track(&cache.walk(route, ctx.lib, params), ctx.rig.hips)
 }
 
 /// New walk choices for character `x` that clear its conflict at frame `f` (see the module

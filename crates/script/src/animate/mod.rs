@@ -57,7 +57,7 @@ pub use props::{carried_from, object_pose, CarriedProp};
 
 use std::collections::HashMap;
 
-use inbetween_core::Motion;
+use inbetween_core::clip::Clip;
 
 use crate::catalogue::{Catalogue, ContactKind};
 use crate::compose::Composition;
@@ -111,8 +111,9 @@ pub struct JointContact {
 #[derive(Debug, Clone, PartialEq)]
 pub struct CharacterTrack {
     pub name: String,
-    /// Common rig skeleton, metres, world placement, [`crate::motion::rig::FPS`].
-    pub motion: Motion,
+    /// Common rig skeleton, metres, world placement, [`crate::motion::rig::FPS`]; at least one
+    /// frame. Written out as BVH channels only at the file boundary ([`crate::output`]).
+    pub clip: Clip,
     pub segments: Vec<Segment>,
     /// Small props the character picks up and carries (see [`CarriedProp`]).
     pub props: Vec<CarriedProp>,
@@ -141,7 +142,7 @@ pub struct Animation {
 impl Animation {
     /// Frames of the longest character track (at least 1).
     pub fn frames(&self) -> usize {
-        self.characters.iter().map(|c| c.motion.num_frames()).max().unwrap_or(0).max(1)
+        self.characters.iter().map(|c| c.clip.num_frames()).max().unwrap_or(0).max(1)
     }
 }
 

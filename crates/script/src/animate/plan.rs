@@ -83,9 +83,8 @@ pub(crate) struct CharacterPlan {
     /// Every spot it stands or sits at (start, walk ends, seats): later characters' stand points
     /// keep clear of them.
     pub spots: Vec<[f32; 2]>,
-    /// The poses `track.motion` was made from, the seats sat on, and the builder's state before
-    /// each action: what [`rebuild`] resumes from.
-    pub poses: Vec<inbetween_core::Pose>,
+    /// The seats sat on and the builder's state before each action: with `track.clip`'s frames,
+    /// what [`rebuild`] resumes from.
     pub seats: Vec<[f32; 2]>,
     pub checkpoints: Vec<Checkpoint>,
 }
@@ -252,7 +251,7 @@ fn build(
         Some((old, k)) => {
             let cp = &old.checkpoints[k];
             b.st = cp.st;
-            b.frames = old.poses[..cp.frames].to_vec();
+            b.frames = (0..cp.frames).map(|f| old.track.clip.pose(f)).collect();
             b.segments = old.track.segments[..cp.segments].to_vec();
             b.walks = old.walks[..cp.walks].to_vec();
             b.seats = old.seats[..cp.seats].to_vec();
@@ -292,29 +291,23 @@ fn build(
         end_spots.push([s[0], s[2]]);
     }
     let root = |p: &inbetween_core::Pose| [p.translations[rig.hips].x as f32, p.translations[rig.hips].z as f32];
-    // Channels and root track: the resumed prefix as it was, the rest converted now (both are per
-    // frame, so the result is the same as converting everything).
-    let (motion, traj) = match resume {
+    // Root track: the resumed prefix as it was, the rest read now (per frame, so the result is
+    // the same as reading everything).
+    let traj = match resume {
         Some((old, _)) if prefix > 0 && prefix <= b.frames.len() => {
-            let nc = old.track.motion.num_channels();
-            let mut data = old.track.motion.data()[..prefix * nc].to_vec();
-            if b.frames.len() > prefix {
-                data.extend_from_slice(crate::motion::rig::clip(rig, &b.frames[prefix..]).data());
-            }
-            let motion = inbetween_core::Motion::new(rig.skeleton.clone(), 1.0 / FPS, data)
-                .expect("poses fit the standard skeleton");
             let mut traj = old.traj[..prefix].to_vec();
             traj.extend(b.frames[prefix..].iter().map(root));
-            (motion, traj)
+            traj
         }
-        _ => (crate::motion::rig::clip(rig, &b.frames), b.frames.iter().map(root).collect()),
+        _ => b.frames.iter().map(root).collect(),
     };
-    let Builder { segments, props, walks, seats, notes, frames, .. } = b;
-    let track = CharacterTrack { name: input.name.clone(), motion, segments, props };
+    let clip = crate::motion::rig::clip(rig, &b.frames);
+    let Builder { segments, props, walks, seats, notes, .. } = b;
+    let track = CharacterTrack { name: input.name.clone(), clip, segments, props };
     let mut spots = vec![input.start];
     spots.extend(walks.iter().filter_map(|w| traj.get(w.end.saturating_sub(1)).copied()));
     spots.extend(seats.iter().copied());
-    CharacterPlan { input, track, traj, walks, marks, notes, end_spots, spots, poses: frames, seats, checkpoints }
+    CharacterPlan { input, track, traj, walks, marks, notes, end_spots, spots, seats, checkpoints }
 }
 
 #[cfg(test)]
@@ -353,7 +346,7 @@ mod tests {
                 let input = CharacterInput { choices, ..plan.input.clone() };
                 let full = build_character(&ctx, input.clone(), &mut cache);
                 let resumed = rebuild(&ctx, plan, input, &mut cache);
-                assert_eq!(resumed.track.motion.data(), full.track.motion.data(), "{} walk {w}", plan.input.name);
+                assert_eq!(resumed.track.clip, full.track.clip, "{} walk {w}", plan.input.name);
                 assert_eq!(resumed.traj, full.traj);
                 assert_eq!(resumed.walks, full.walks);
                 assert_eq!(resumed.marks, full.marks);

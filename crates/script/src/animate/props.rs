@@ -29,11 +29,11 @@ impl CarriedProp {
     /// The prop's base point (world metres) and rotation at `frame` of the carrying `track`, None
     /// before it is picked up.
     pub fn pose_at(&self, track: &CharacterTrack, frame: usize) -> Option<(DVec3, DQuat)> {
-        let n = track.motion.num_frames();
-        if frame < self.from || n == 0 || self.joint >= track.motion.skeleton.len() {
+        let n = track.clip.num_frames();
+        if frame < self.from || n == 0 || self.joint >= track.clip.skeleton().len() {
             return None;
         }
-        let g = forward(&track.motion.skeleton, &track.motion.pose(frame.min(n - 1)));
+        let g = forward(track.clip.skeleton(), &track.clip.pose(frame.min(n - 1)));
         let (p, q) = (g.positions[self.joint], g.rotations[self.joint]);
         Some((p + q * self.offset, (q * self.rotation).normalize()))
     }

@@ -7,8 +7,8 @@ use super::ik::{solve_limb, Limb};
 use super::rig::{heading_of, local_from_global, yaw, Rig};
 use crate::error::ScriptError;
 use glam::DVec3;
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
-use inbetween_core::Motion;
 
 /// When and how the action plays over the locomotion (frames of the locomotion clip).
 #[derive(Clone, Debug, PartialEq)]
@@ -69,20 +69,15 @@ impl BlendParams {
 /// joints take the action's local rotations. Both clips must be on the same skeleton and rate;
 /// the result has the locomotion's length. An error says when the skeletons differ or names the
 /// joint of the common rig missing.
-pub fn blend_upper(locomotion: &Motion, action: &Motion, params: &BlendParams) -> Result<Motion, ScriptError> {
-    if locomotion.skeleton != action.skeleton {
+pub fn blend_upper(locomotion: &Clip, action: &Clip, params: &BlendParams) -> Result<Clip, ScriptError> {
+    if locomotion.skeleton() != action.skeleton() {
         return Err(ScriptError::Invalid(format!(
             "blending an action over locomotion needs both clips on one skeleton (the locomotion has {} joints, the action {})",
-            locomotion.skeleton.len(),
-            action.skeleton.len()
+            locomotion.skeleton().len(),
+            action.skeleton().len()
         )));
     }
-    let rig = Rig::for_motion(locomotion, "blending an action over locomotion")?;
-    Ok(blend_upper_on(&rig, locomotion, action, params))
-}
-
-/// [`blend_upper`] for two clips known to be on `rig`.
-pub(crate) fn blend_upper_on(rig: &Rig, locomotion: &Motion, action: &Motion, params: &BlendParams) -> Motion {
+    let rig = Rig::for_clip(locomotion, "blending an action over locomotion")?;
     let mask = rig.upper_body_mask();
     let n = locomotion.num_frames();
     let na = action.num_frames();
@@ -94,8 +89,8 @@ pub(crate) fn blend_upper_on(rig: &Rig, locomotion: &Motion, action: &Motion, pa
                 return p;
             }
             let a = action.pose(params.action_frame(f, na));
-            let ga = forward(&action.skeleton, &a);
-            let gl = forward(&locomotion.skeleton, &p);
+            let ga = forward(action.skeleton(), &a);
+            let gl = forward(locomotion.skeleton(), &p);
             // Upper-body root: heading-relative global orientation of the action.
             let rel = yaw(-heading_of(a.rotations[rig.hips])) * ga.rotations[rig.lower_back];
             let want = yaw(heading_of(p.rotations[rig.hips])) * rel;
@@ -110,8 +105,8 @@ pub(crate) fn blend_upper_on(rig: &Rig, locomotion: &Motion, action: &Motion, pa
             p
         })
         .collect();
-    Motion::from_poses(locomotion.skeleton.clone(), locomotion.frame_time, &poses)
-        .expect("blended poses fit the skeleton")
+    Ok(Clip::from_poses(locomotion.skeleton().clone(), locomotion.frame_time(), &poses)
+        .expect("blended poses fit the skeleton"))
 }
 
 /// A hand (or foot) contact: the end of `limb` goes to `target` (world metres) over a window of
@@ -127,12 +122,8 @@ pub struct Contact {
 /// at each frame the limb end moves from where the motion puts it towards the contact by the
 /// window's weight. Returns the clip and the largest remaining distance at full weight (m); an
 /// error names the joint missing when `m` is not on the common rig.
-pub fn reach_contacts(m: &Motion, contacts: &[Contact]) -> Result<(Motion, f64), ScriptError> {
-    Ok(reach_contacts_on(&Rig::for_motion(m, "reaching contacts")?, m, contacts))
-}
-
-/// [`reach_contacts`] on a motion known to be on `rig`.
-pub(crate) fn reach_contacts_on(rig: &Rig, m: &Motion, contacts: &[Contact]) -> (Motion, f64) {
+pub fn reach_contacts(m: &Clip, contacts: &[Contact]) -> Result<(Clip, f64), ScriptError> {
+    let rig = &Rig::for_clip(m, "reaching contacts")?;
     let n = m.num_frames();
     let mut worst: f64 = 0.0;
     let poses: Vec<_> = (0..n)
@@ -153,5 +144,5 @@ pub(crate) fn reach_contacts_on(rig: &Rig, m: &Motion, contacts: &[Contact]) -> 
             p
         })
         .collect();
-    (Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("IK poses fit the skeleton"), worst)
+    Ok((Clip::from_poses(m.skeleton().clone(), m.frame_time(), &poses).expect("IK poses fit the skeleton"), worst))
 }

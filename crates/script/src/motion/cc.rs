@@ -7,6 +7,7 @@
 
 use super::rig::{local_from_global, Rig, FPS};
 use glam::{DMat3, DQuat, DVec3};
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
 use inbetween_core::{Motion, Pose, Skeleton};
 
@@ -56,7 +57,7 @@ fn frame(a: DVec3, b: DVec3) -> Option<DMat3> {
 /// Retargets a Character Creator clip; `up_z` converts a source whose world is Z up (the
 /// `iclone_cc` files are Y up after their root rotation: pass false). Drops the prepended
 /// T-pose frame when `drop_first`.
-pub fn retarget_cc(src: &Motion, rig: &Rig, up_z: bool, drop_first: bool) -> Result<Motion, String> {
+pub fn retarget_cc(src: &Motion, rig: &Rig, up_z: bool, drop_first: bool) -> Result<Clip, String> {
     let s = &src.skeleton;
     let t = &rig.skeleton;
     let map: Vec<Option<usize>> =

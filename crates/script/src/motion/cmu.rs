@@ -6,6 +6,7 @@ use super::rig::{arc, local_from_global, Rig, FPS};
 use super::verbs::tags_of_description;
 use crate::ScriptError;
 use glam::{DQuat, DVec3};
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
 use inbetween_core::{Motion, Pose, Skeleton};
 use std::path::Path;
@@ -143,7 +144,7 @@ fn leg_length(s: &Skeleton, up: &str, leg: &str, foot: &str) -> Option<f64> {
 /// source's times the rest-pose correction that maps the target bone onto the source bone; the
 /// root path is scaled by the leg-length ratio (which also converts units to metres), resampled to
 /// 30 fps, grounded (feet on y = 0) and normalised to start at the origin facing +Z.
-pub fn retarget(src: &Motion, rig: &Rig) -> Result<Motion, String> {
+pub fn retarget(src: &Motion, rig: &Rig) -> Result<Clip, String> {
     let s = &src.skeleton;
     let max_style = s.find("LeftCollar").is_some() || s.find("LeftHip").is_some();
     let names: Vec<String> = s.joints().iter().map(|j| standard_name(&j.name, max_style)).collect();
@@ -188,7 +189,7 @@ pub fn retarget(src: &Motion, rig: &Rig) -> Result<Motion, String> {
 
 /// Reads a CMU BVH and retargets it: cgspeed layouts with [`retarget`], Character Creator
 /// (iClone) layouts with [`super::cc::retarget_cc`] (its first frame, a T-pose, dropped).
-pub fn load_bvh(path: &Path, rig: &Rig) -> Result<Motion, ScriptError> {
+pub fn load_bvh(path: &Path, rig: &Rig) -> Result<Clip, ScriptError> {
     let m =
         inbetween_io::read_bvh(path).map_err(|e| ScriptError::Asset { path: path.into(), message: e.to_string() })?;
     let result = if m.skeleton.find("CC_Base_Hip").is_some() {

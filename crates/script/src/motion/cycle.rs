@@ -8,7 +8,8 @@
 
 use super::rig::{heading_of, wrap, yaw, Rig, FPS};
 use glam::{DQuat, DVec3};
-use inbetween_core::{Motion, Pose};
+use inbetween_core::clip::Clip;
+use inbetween_core::Pose;
 
 /// Shortest and longest gait cycle considered, seconds (people walk at about 1 s per cycle).
 const PERIOD_SECONDS: (f64, f64) = (0.8, 1.6);
@@ -57,10 +58,10 @@ fn seam_distance(rig: &Rig, a: &Pose, b: &Pose) -> f64 {
 
 /// The best-looping gait cycle of a walk clip on the common rig, or None when no window walks
 /// straight enough, fast enough and loops closely enough.
-pub fn find_cycle(m: &Motion, rig: &Rig) -> Option<CycleCut> {
+pub fn find_cycle(m: &Clip, rig: &Rig) -> Option<CycleCut> {
     let poses = m.poses();
     let n = poses.len();
-    let fps = 1.0 / m.frame_time;
+    let fps = m.fps();
     let (lo, hi) = ((PERIOD_SECONDS.0 * fps).round() as usize, (PERIOD_SECONDS.1 * fps).round() as usize);
     let root: Vec<DVec3> = poses.iter().map(|p| horizontal(p.translations[rig.hips])).collect();
     let heading: Vec<f64> = poses.iter().map(|p| heading_of(p.rotations[rig.hips])).collect();
@@ -92,7 +93,7 @@ pub fn find_cycle(m: &Motion, rig: &Rig) -> Option<CycleCut> {
 /// The cycle's frames as a loopable clip: travelling along +Z from the origin, the seam mismatch
 /// of every joint spread evenly over the cycle (so frame `period` would equal frame 0 again,
 /// heading drift included), resampled to the common rig's frame rate.
-pub fn cut_cycle(m: &Motion, rig: &Rig, cut: &CycleCut) -> Motion {
+pub fn cut_cycle(m: &Clip, rig: &Rig, cut: &CycleCut) -> Clip {
     let poses = m.poses();
     let (s, e) = (cut.start, cut.start + cut.period);
     let travel = horizontal(poses[e].translations[rig.hips] - poses[s].translations[rig.hips]);
@@ -121,10 +122,10 @@ pub fn cut_cycle(m: &Motion, rig: &Rig, cut: &CycleCut) -> Motion {
             p
         })
         .collect();
-    if (m.frame_time - 1.0 / FPS).abs() > 1e-9 {
-        out = resample_loop(&out, m.frame_time, travel.length());
+    if (m.frame_time() - 1.0 / FPS).abs() > 1e-9 {
+        out = resample_loop(&out, m.frame_time(), travel.length());
     }
-    Motion::from_poses(m.skeleton.clone(), 1.0 / FPS, &out).expect("poses come from the same skeleton")
+    Clip::from_poses(m.skeleton().clone(), 1.0 / FPS, &out).expect("poses come from the same skeleton")
 }
 
 /// A looping cycle sampled at another frame time, resampled to [`FPS`] (the root's forward
@@ -152,8 +153,8 @@ fn resample_loop(poses: &[Pose], frame_time: f64, stride: f64) -> Vec<Pose> {
 }
 
 /// [`find_cycle`] then [`cut_cycle`].
-pub fn extract_cycle(m: &Motion, rig: &Rig) -> Option<(Motion, CycleCut)> {
-    if m.skeleton != rig.skeleton {
+pub fn extract_cycle(m: &Clip, rig: &Rig) -> Option<(Clip, CycleCut)> {
+    if m.skeleton() != &rig.skeleton {
         return None;
     }
     let cut = find_cycle(m, rig)?;
@@ -166,9 +167,9 @@ mod tests {
     use crate::motion::locomotion::foot_skate;
 
     /// A procedural walk cycle repeated several times, turned and shifted like a capture.
-    fn captured_walk(rig: &Rig, turn: f64, loops: usize) -> (Motion, usize) {
+    fn captured_walk(rig: &Rig, turn: f64, loops: usize) -> (Clip, usize) {
         let lib = crate::motion::MotionLibrary::procedural(0);
-        let cyc = lib.cycle("walk").expect("procedural walk cycle").motion.clone();
+        let cyc = lib.cycle("walk").expect("procedural walk cycle").clip.clone();
         let one = cyc.poses();
         let n = one.len();
         let stride = one[n - 1].translations[rig.hips].z - one[0].translations[rig.hips].z;
@@ -183,7 +184,7 @@ mod tests {
                 poses.push(p);
             }
         }
-        (Motion::from_poses(cyc.skeleton.clone(), 1.0 / FPS, &poses).unwrap(), n)
+        (Clip::from_poses(cyc.skeleton().clone(), 1.0 / FPS, &poses).unwrap(), n)
     }
 
     #[test]
@@ -213,7 +214,7 @@ mod tests {
             p.rotations[rig.spine1] = (DQuat::from_rotation_x(0.2 * w) * p.rotations[rig.spine1]).normalize();
             p.translations[rig.hips].y += 0.03 * w;
         }
-        let walk = Motion::from_poses(walk.skeleton.clone(), 1.0 / FPS, &poses).unwrap();
+        let walk = Clip::from_poses(walk.skeleton().clone(), 1.0 / FPS, &poses).unwrap();
         let (cycle, cut) = extract_cycle(&walk, &rig).expect("a cycle");
         assert!(cut.seam > 0.01, "the drift makes a seam: {cut:?}");
         // Closed seam: looping from the last frame back to the first changes the spine and the
@@ -239,7 +240,7 @@ mod tests {
     fn standing_still_has_no_cycle() {
         let rig = Rig::standard();
         let stand = vec![rig.standing(); 90];
-        let m = Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, &stand).unwrap();
+        let m = Clip::from_poses(rig.skeleton.clone(), 1.0 / FPS, &stand).unwrap();
         assert!(find_cycle(&m, &rig).is_none());
     }
 }

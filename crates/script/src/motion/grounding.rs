@@ -4,12 +4,13 @@
 
 use super::rig::{heading_of, yaw, Rig, FPS};
 use glam::DVec3;
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
-use inbetween_core::{Motion, Pose, Skeleton};
+use inbetween_core::{Pose, Skeleton};
 
 /// Retargeted poses made into a clip that starts at the origin facing +Z, with its lowest foot
 /// points (5th percentile, so a stumble does not lift the floor) at y = 0.
-pub(crate) fn grounded(rig: &Rig, t: &Skeleton, mut poses: Vec<Pose>) -> Result<Motion, String> {
+pub(crate) fn grounded(rig: &Rig, t: &Skeleton, mut poses: Vec<Pose>) -> Result<Clip, String> {
     if poses.is_empty() {
         return Err("no frames".into());
     }
@@ -33,5 +34,5 @@ pub(crate) fn grounded(rig: &Rig, t: &Skeleton, mut poses: Vec<Pose>) -> Result<
         p.translations[rig.hips] = turn * d;
         p.rotations[rig.hips] = (turn * p.rotations[rig.hips]).normalize();
     }
-    Motion::from_poses(t.clone(), 1.0 / FPS, &poses).map_err(|e| e.to_string())
+    Clip::from_poses(t.clone(), 1.0 / FPS, &poses).map_err(|e| e.to_string())
 }

@@ -6,7 +6,8 @@
 use super::rig::{clip, hip_height, Rig, FPS};
 use crate::ScriptError;
 use glam::{DQuat, DVec3};
-use inbetween_core::{Motion, Pose};
+use inbetween_core::clip::Clip;
+use inbetween_core::Pose;
 use serde_json::Value;
 use std::path::Path;
 
@@ -82,7 +83,7 @@ fn sample_track(times: &[f32], values: &[f32], comps: usize, t: f64, step: bool)
 
 /// Every named animation of a Kenney blocky character, retargeted onto the common skeleton at
 /// 30 fps (name, clip).
-pub fn read_animations(path: &Path) -> Result<Vec<(String, Motion)>, ScriptError> {
+pub fn read_animations(path: &Path) -> Result<Vec<(String, Clip)>, ScriptError> {
     let (json, bin) = read_glb(path)?;
     let rig = Rig::standard();
     let nodes: Vec<String> = json["nodes"]

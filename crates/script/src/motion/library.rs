@@ -7,7 +7,7 @@ use super::procedural;
 use super::rig::Rig;
 use super::verbs::canonical;
 use crate::ScriptError;
-use inbetween_core::Motion;
+use inbetween_core::clip::Clip;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -28,7 +28,7 @@ pub enum ClipSource {
 pub struct LibraryClip {
     pub name: String,
     pub tags: Vec<String>,
-    pub motion: Motion,
+    pub clip: Clip,
     pub source: ClipSource,
 }
 
@@ -72,7 +72,7 @@ impl MotionLibrary {
     pub fn procedural(seed: u64) -> MotionLibrary {
         let clips = procedural::clips(seed)
             .into_iter()
-            .map(|(name, tags, motion)| LibraryClip { name, tags, motion, source: ClipSource::Procedural })
+            .map(|(name, tags, clip)| LibraryClip { name, tags, clip, source: ClipSource::Procedural })
             .collect();
         MotionLibrary { clips, ..Default::default() }
     }
@@ -106,13 +106,13 @@ impl MotionLibrary {
                 continue;
             }
             match load_bvh(&path, &rig) {
-                Ok(motion) => {
+                Ok(clip) => {
                     let mut tags = trial.tags.clone();
                     tags.push("cmu".into());
                     lib.clips.push(LibraryClip {
                         name: format!("cmu {} {}", trial.clip_id, trial.description),
                         tags,
-                        motion,
+                        clip,
                         source: ClipSource::Cmu {
                             clip_id: trial.clip_id.clone(),
                             description: trial.description.clone(),
@@ -139,13 +139,13 @@ impl MotionLibrary {
                 .clips
                 .iter()
                 .filter(|c| c.is_captured() && c.tags.first().is_some_and(|t| t == verb))
-                .filter_map(|c| super::cycle::extract_cycle(&c.motion, rig).map(|(m, cut)| (c, m, cut)))
+                .filter_map(|c| super::cycle::extract_cycle(&c.clip, rig).map(|(m, cut)| (c, m, cut)))
                 .min_by(|a, b| a.2.seam.total_cmp(&b.2.seam));
-            let Some((clip, motion, cut)) = best else { continue };
-            let name = format!("{} {verb} cycle (frames {}–{})", clip.name, cut.start, cut.start + cut.period);
-            let source = clip.source.clone();
+            let Some((from, clip, cut)) = best else { continue };
+            let name = format!("{} {verb} cycle (frames {}–{})", from.name, cut.start, cut.start + cut.period);
+            let source = from.source.clone();
             let tags = [verb, "cycle", "loop", "locomotion", "cmu"].map(String::from).to_vec();
-            self.clips.push(LibraryClip { name, tags, motion, source });
+            self.clips.push(LibraryClip { name, tags, clip, source });
             added += 1;
         }
         added
@@ -164,7 +164,7 @@ impl MotionLibrary {
         let t0 = Instant::now();
         let mut added = 0;
         for path in files {
-            for (animation, motion) in kenney::read_animations(&path)? {
+            for (animation, clip) in kenney::read_animations(&path)? {
                 let tags = kenney::tags_of_name(&animation);
                 let seen = self
                     .clips
@@ -179,7 +179,7 @@ impl MotionLibrary {
                 self.clips.push(LibraryClip {
                     name: format!("kenney {stem} {animation}"),
                     tags,
-                    motion,
+                    clip,
                     source: ClipSource::Kenney { animation, path: path.clone() },
                 });
                 added += 1;

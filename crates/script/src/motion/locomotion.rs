@@ -10,9 +10,10 @@ use super::library::MotionLibrary;
 use super::rig::{clip, heading_of, local_from_global, wrap, yaw, Rig, FPS};
 use crate::error::ScriptError;
 use glam::{DQuat, DVec3};
-use inbetween_core::fk::{forward, forward_clip};
+use inbetween_core::clip::Clip;
+use inbetween_core::fk::forward;
 use inbetween_core::motion::interpolate_pose;
-use inbetween_core::{Motion, Pose};
+use inbetween_core::Pose;
 
 /// How to walk a route.
 #[derive(Clone, Debug, PartialEq)]
@@ -127,7 +128,7 @@ struct Cycle {
 }
 
 impl Cycle {
-    fn new(m: &Motion, rig: &Rig) -> Cycle {
+    fn new(m: &Clip, rig: &Rig) -> Cycle {
         let n = m.num_frames().max(1);
         let mut poses = m.poses();
         let r0 = poses[0].translations[rig.hips];
@@ -138,7 +139,7 @@ impl Cycle {
             let r = p.translations[rig.hips] - trend * f as f64;
             p.translations[rig.hips] = DVec3::new(r.x - r0.x, r.y, r.z - r0.z);
         }
-        let speed = trend.length() / m.frame_time;
+        let speed = trend.length() / m.frame_time();
         let ankles: Vec<[DVec3; 2]> = poses
             .iter()
             .map(|p| {
@@ -170,11 +171,11 @@ impl Cycle {
 }
 
 fn idle_cycle(lib: &MotionLibrary, rig: &Rig) -> Cycle {
-    match lib.retrieve("idle").filter(|c| c.motion.skeleton == rig.skeleton) {
+    match lib.retrieve("idle").filter(|c| c.clip.skeleton() == &rig.skeleton) {
         Some(c) => {
-            let mut cyc = Cycle::new(&c.motion, rig);
+            let mut cyc = Cycle::new(&c.clip, rig);
             // An idle has no progression: keep the root where it stands.
-            for (p, q) in cyc.poses.iter_mut().zip(c.motion.poses()) {
+            for (p, q) in cyc.poses.iter_mut().zip(c.clip.poses()) {
                 p.translations[rig.hips] = q.translations[rig.hips];
             }
             cyc
@@ -195,12 +196,12 @@ fn place(rig: &Rig, mut p: Pose, at: DVec3, h: f64) -> Pose {
 /// Walks `route` (points on the floor, metres, `[x, z]`) with the library's cycle for
 /// `params.verb`: see the module comment. Returns a 30 fps clip on the common skeleton in world
 /// metres. A route of one point (or of zero length) gives an idle at that point.
-pub fn walk_route(route: &[[f32; 2]], library: &MotionLibrary, params: &WalkParams) -> Motion {
+pub fn walk_route(route: &[[f32; 2]], library: &MotionLibrary, params: &WalkParams) -> Clip {
     walk_route_stats(route, library, params).0
 }
 
 /// [`walk_route`] plus measurements (foot skate before/after locking, route error).
-pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &WalkParams) -> (Motion, WalkStats) {
+pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &WalkParams) -> (Clip, WalkStats) {
     let rig = Rig::standard();
     let path = Path::new(if route.is_empty() { &[[0.0, 0.0]] } else { route });
     // The library's cycle for the verb, else its walk, else the built-in procedural walk.
@@ -208,8 +209,8 @@ pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &Wa
         library
             .cycle(&params.verb)
             .or_else(|| library.cycle("walk"))
-            .filter(|c| c.motion.skeleton == rig.skeleton)
-            .map(|c| Cycle::new(&c.motion, &rig))
+            .filter(|c| c.clip.skeleton() == &rig.skeleton)
+            .map(|c| Cycle::new(&c.clip, &rig))
             .unwrap_or_else(|| {
                 let walk = inbetween_core::procedural::GaitParams {
                     cycle_hz: super::procedural::WALK_CYCLE_HZ,
@@ -314,14 +315,15 @@ pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &Wa
         push(&mut frames, &mut t, l, path.at(len), h);
     }
     let raw = clip(&rig, &frames);
-    let before = foot_skate_on(&rig, &raw);
-    let out = if params.lock_feet { lock_feet_on(&rig, &raw, &LockParams::default()) } else { raw };
+    let on_rig = "a walk is on the common rig";
+    let before = foot_skate(&raw).expect(on_rig);
+    let out = if params.lock_feet { lock_feet(&raw, &LockParams::default()).expect(on_rig) } else { raw };
     let stats = WalkStats {
         length: len,
         frames: out.num_frames(),
         seconds: out.duration(),
         skate_before: before,
-        skate_after: foot_skate_on(&rig, &out),
+        skate_after: foot_skate(&out).expect(on_rig),
         max_route_error: route_err,
     };
     (out, stats)
@@ -359,8 +361,8 @@ impl Default for LockParams {
     }
 }
 
-fn ankles(m: &Motion, rig: &Rig) -> Vec<[DVec3; 2]> {
-    forward_clip(m).into_iter().map(|g| [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]]).collect()
+fn ankles(m: &Clip, rig: &Rig) -> Vec<[DVec3; 2]> {
+    m.globals().into_iter().map(|g| [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]]).collect()
 }
 
 fn hspeed(a: DVec3, b: DVec3, dt: f64) -> f64 {
@@ -370,16 +372,12 @@ fn hspeed(a: DVec3, b: DVec3, dt: f64) -> f64 {
 /// Foot contacts (left, right) per frame by ankle height and horizontal speed, with runs
 /// shorter than `min_frames` removed.
 /// An error names the joint missing when `m` is not on the common rig.
-pub fn detect_contacts(m: &Motion, p: &LockParams) -> Result<[Vec<bool>; 2], ScriptError> {
-    Ok(detect_contacts_on(&Rig::for_motion(m, "foot-contact detection")?, m, p))
-}
-
-/// [`detect_contacts`] on a motion known to be on `rig`.
-pub(crate) fn detect_contacts_on(rig: &Rig, m: &Motion, p: &LockParams) -> [Vec<bool>; 2] {
+pub fn detect_contacts(m: &Clip, p: &LockParams) -> Result<[Vec<bool>; 2], ScriptError> {
+    let rig = &Rig::for_clip(m, "foot-contact detection")?;
     let a = ankles(m, rig);
     let n = a.len();
-    let dt = m.frame_time;
-    [0, 1].map(|k| {
+    let dt = m.frame_time();
+    Ok([0, 1].map(|k| {
         let mut c: Vec<bool> = (0..n)
             .map(|f| {
                 let (f0, f1) = (f.saturating_sub(1), (f + 1).min(n - 1));
@@ -402,7 +400,7 @@ pub(crate) fn detect_contacts_on(rig: &Rig, m: &Motion, p: &LockParams) -> [Vec<
             }
         }
         c
-    })
+    }))
 }
 
 /// Foot locking: each detected contact pins the toe base at its mean floor position (the ankle
@@ -410,23 +408,16 @@ pub(crate) fn detect_contacts_on(rig: &Rig, m: &Motion, p: &LockParams) -> [Vec<
 /// rises about the toes and then the root is lowered where a leg could not reach, and both legs
 /// are re-solved with two-bone IK (ankles keep their global orientation unless the heel rose).
 /// An error names the joint missing when `m` is not on the common rig.
-pub fn lock_feet(m: &Motion, p: &LockParams) -> Result<Motion, ScriptError> {
-    Ok(lock_feet_on(&Rig::for_motion(m, "foot locking")?, m, p))
-}
-
-/// [`lock_feet`] on a motion known to be on `rig`.
-pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
+pub fn lock_feet(m: &Clip, p: &LockParams) -> Result<Clip, ScriptError> {
+    let contacts = detect_contacts(m, p)?;
+    let rig = &Rig::for_clip(m, "foot locking")?;
     let n = m.num_frames();
-    if n == 0 {
-        return m.clone();
-    }
-    let contacts = detect_contacts_on(rig, m, p);
     let a = ankles(m, rig);
     // Each contact pins the toe base (the point a foot rolls over from heel-off on) where the foot
     // lands; the ankle is moved with it, so a heel rolling up over the toes keeps its
     // own rise and the foot only stops sliding. `pins[f][k]`: (pin, weight) per frame and foot.
     let toes: Vec<[DVec3; 2]> =
-        forward_clip(m).into_iter().map(|g| [g.positions[rig.legs[0][3]], g.positions[rig.legs[1][3]]]).collect();
+        m.globals().into_iter().map(|g| [g.positions[rig.legs[0][3]], g.positions[rig.legs[1][3]]]).collect();
     let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
     let mut pins: Vec<[Option<(DVec3, f64)>; 2]> = vec![[None, None]; n];
     for k in 0..2 {
@@ -577,7 +568,7 @@ pub(crate) fn lock_feet_on(rig: &Rig, m: &Motion, p: &LockParams) -> Motion {
             }
         }
     }
-    Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("locked poses fit the skeleton")
+    Ok(Clip::from_poses(m.skeleton().clone(), m.frame_time(), &poses).expect("locked poses fit the skeleton"))
 }
 
 /// Frames over which a planted foot with its toes up settles flat.
@@ -596,41 +587,29 @@ pub const SKATE_HEIGHT: f64 = 0.02;
 /// pooled; 0 when no foot touches the floor).
 /// Contact is judged by height alone, so locking cannot hide skate by changing the detection.
 /// An error names the joint missing when `m` is not on the common rig.
-pub fn foot_skate(m: &Motion) -> Result<f64, ScriptError> {
-    Ok(foot_skate_on(&Rig::for_motion(m, "foot skate")?, m))
-}
-
-/// [`foot_skate`] on a motion known to be on `rig`.
-pub(crate) fn foot_skate_on(rig: &Rig, m: &Motion) -> f64 {
+pub fn foot_skate(m: &Clip) -> Result<f64, ScriptError> {
+    let rig = &Rig::for_clip(m, "foot skate")?;
     // (ankle, toe base) per frame and foot.
     let a: Vec<[(DVec3, DVec3); 2]> =
-        forward_clip(m).into_iter().map(|g| rig.legs.map(|l| (g.positions[l[2]], g.positions[l[3]]))).collect();
+        m.globals().into_iter().map(|g| rig.legs.map(|l| (g.positions[l[2]], g.positions[l[3]]))).collect();
     let on = |(ankle, _): (DVec3, DVec3)| ankle.y <= rig.ankle_height + SKATE_HEIGHT;
     let (mut sum, mut count) = (0.0, 0usize);
     for f in 1..a.len() {
         for (&now, &before) in a[f].iter().zip(&a[f - 1]) {
             if on(now) && on(before) {
-                sum += hspeed(before.1, now.1, m.frame_time);
+                sum += hspeed(before.1, now.1, m.frame_time());
                 count += 1;
             }
         }
     }
-    if count == 0 {
-        0.0
-    } else {
-        100.0 * sum / count as f64
-    }
+    Ok(if count == 0 { 0.0 } else { 100.0 * sum / count as f64 })
 }
 
 /// A library clip placed in the world: its first frame's root moved to floor point `at` and
 /// turned to heading `heading` (the clip starts facing +Z at the origin).
 /// An error names the joint missing when `m` is not on the common rig.
-pub fn place_clip(m: &Motion, at: [f32; 2], heading: f64) -> Result<Motion, ScriptError> {
-    Ok(place_clip_on(&Rig::for_motion(m, "placing a clip")?, m, at, heading))
-}
-
-/// [`place_clip`] for a clip known to be on `rig`.
-pub(crate) fn place_clip_on(rig: &Rig, m: &Motion, at: [f32; 2], heading: f64) -> Motion {
+pub fn place_clip(m: &Clip, at: [f32; 2], heading: f64) -> Result<Clip, ScriptError> {
+    let rig = Rig::for_clip(m, "placing a clip")?;
     let q = yaw(heading);
     let off = DVec3::new(at[0] as f64, 0.0, at[1] as f64);
     let poses: Vec<Pose> = m
@@ -642,10 +621,10 @@ pub(crate) fn place_clip_on(rig: &Rig, m: &Motion, at: [f32; 2], heading: f64) -
             p
         })
         .collect();
-    Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses).expect("placed poses fit the skeleton")
+    Ok(Clip::from_poses(m.skeleton().clone(), m.frame_time(), &poses).expect("placed poses fit the skeleton"))
 }
 
 /// Heading (yaw, 0 = +Z) of a clip's root at frame `f`.
-pub fn heading_at(m: &Motion, f: usize) -> f64 {
+pub fn heading_at(m: &Clip, f: usize) -> f64 {
     heading_of(m.pose(f).rotations[0])
 }

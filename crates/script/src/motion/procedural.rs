@@ -5,11 +5,12 @@
 use super::ik::{seated_pose, solve_limb, Limb};
 use super::rig::{clip, hip_height, local_from_global, Rig, FPS, M_PER_CMU};
 use glam::{DQuat, DVec3};
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
 use inbetween_core::motion::interpolate_pose;
 use inbetween_core::procedural::{gait, GaitParams};
 use inbetween_core::units::scale_motion;
-use inbetween_core::{Motion, Pose};
+use inbetween_core::Pose;
 use rand::Rng;
 use std::f64::consts::{PI, TAU};
 
@@ -41,7 +42,7 @@ impl<R: Rng> Jitter<R> {
 /// legs are re-solved with two-bone IK so each foot is planted for `duty` of the cycle (no skate
 /// on a straight line) and lifted `lift` metres in swing; the pelvis height follows the reach of
 /// the legs.
-pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Motion {
+pub fn gait_cycle(mut p: GaitParams, cycles: usize, duty: f64, lift: f64) -> Clip {
     let period = (FPS / p.cycle_hz).round();
     let stride = p.speed / p.cycle_hz;
     p.cycle_hz = FPS / period;
@@ -170,7 +171,7 @@ impl FootRoll {
     }
 }
 
-fn build(rig: &Rig, frames: usize, mut f: impl FnMut(f64, &mut Pose)) -> Motion {
+fn build(rig: &Rig, frames: usize, mut f: impl FnMut(f64, &mut Pose)) -> Clip {
     let poses: Vec<Pose> = (0..frames)
         .map(|i| {
             let mut p = rig.standing();
@@ -192,7 +193,7 @@ fn breathe(rig: &Rig, p: &mut Pose, t: f64, amp: f64) {
 }
 
 /// Standing idle: breathing and a slight weight shift.
-fn idle(rig: &Rig, k: f64) -> Motion {
+fn idle(rig: &Rig, k: f64) -> Clip {
     build(rig, 90, |t, p| {
         breathe(rig, p, t, k);
         p.translations[rig.hips].x += 0.01 * k * (TAU * t / 3.0).sin();
@@ -222,11 +223,11 @@ fn mix(a: &Pose, b: &Pose, w: f64) -> Pose {
 }
 
 /// All procedural clips: (name, tags, clip). The first tag is the primary (canonical) one.
-pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Motion)> {
+pub fn clips(seed: u64) -> Vec<(String, Vec<String>, Clip)> {
     let rig = Rig::standard();
     let mut jit = Jitter(inbetween_core::seed::rng(seed));
-    let mut out: Vec<(String, Vec<String>, Motion)> = Vec::new();
-    let mut add = |name: &str, tags: &[&str], m: Motion| {
+    let mut out: Vec<(String, Vec<String>, Clip)> = Vec::new();
+    let mut add = |name: &str, tags: &[&str], m: Clip| {
         out.push((name.to_string(), tags.iter().map(|s| s.to_string()).collect(), m))
     };
 

@@ -3,6 +3,7 @@
 //! y = 0, facing +Z in its rest pose.
 
 use glam::{DQuat, DVec3};
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::{forward, GlobalPose};
 use inbetween_core::procedural::{standard_hip_height, standard_skeleton, CM_PER_CMU_UNIT};
 use inbetween_core::units::scale_motion;
@@ -53,10 +54,10 @@ impl Rig {
         Rig::try_of(skeleton).unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// The rig of a motion's skeleton for `what` (a helper's task, for the message), or an error
+    /// The rig of a clip's skeleton for `what` (a helper's task, for the message), or an error
     /// naming the joint missing.
-    pub fn for_motion(m: &Motion, what: &str) -> Result<Rig, crate::error::ScriptError> {
-        Rig::try_of(m.skeleton.clone())
+    pub fn for_clip(c: &Clip, what: &str) -> Result<Rig, crate::error::ScriptError> {
+        Rig::try_of(c.skeleton().clone())
             .map_err(|e| crate::error::ScriptError::Invalid(format!("{what} needs the common rig's joints: {e}")))
     }
 
@@ -144,7 +145,7 @@ pub fn local_from_global(parent_global: DQuat, global: DQuat) -> DQuat {
     (parent_global.inverse() * global).normalize()
 }
 
-/// Clip from poses on the standard skeleton at [`FPS`].
-pub fn clip(rig: &Rig, poses: &[Pose]) -> Motion {
-    Motion::from_poses(rig.skeleton.clone(), 1.0 / FPS, poses).expect("poses fit the standard skeleton")
+/// Clip from poses on the rig's skeleton at [`FPS`] (at least one; unit rotations).
+pub fn clip(rig: &Rig, poses: &[Pose]) -> Clip {
+    Clip::from_poses(rig.skeleton.clone(), 1.0 / FPS, poses).expect("poses fit the standard skeleton")
 }

@@ -175,14 +175,14 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
         (0..objs.len()).map(|i| crate::animate::carried_from(anim, i).unwrap_or(usize::MAX)).collect();
     let mut spheres = Vec::new();
     for c in &anim.characters {
-        let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
+        let Ok(rig) = Rig::try_of(c.clip.skeleton().clone()) else { continue };
         let mut seg = 0;
-        for f in 0..c.motion.num_frames() {
+        for f in 0..c.clip.num_frames() {
             while seg + 1 < c.segments.len() && f >= c.segments[seg].end {
                 seg += 1;
             }
             let touching: &[usize] = c.segments.get(seg).map(|s| s.touching.as_slice()).unwrap_or(&[]);
-            let g = forward(&rig.skeleton, &c.motion.pose(f));
+            let g = forward(&rig.skeleton, &c.clip.pose(f));
             body_spheres(&rig, &g, &mut spheres);
             for (i, o) in objs.iter().enumerate() {
                 // Flat objects (rugs) are walked on, not into.
@@ -226,7 +226,7 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
 pub fn contact_cost(anim: &Animation) -> (f64, usize) {
     let (mut sum, mut count) = (0.0, 0usize);
     for c in &anim.characters {
-        let Ok(rig) = Rig::try_of(c.motion.skeleton.clone()) else { continue };
+        let Ok(rig) = Rig::try_of(c.clip.skeleton().clone()) else { continue };
         let sk = &rig.skeleton;
         let finger = |side: &str, hand: usize| {
             sk.find(&format!("{side}HandIndex1")).or_else(|| sk.find(&format!("{side}FingerBase"))).unwrap_or(hand)
@@ -235,13 +235,13 @@ pub fn contact_cost(anim: &Animation) -> (f64, usize) {
         let (lf, rf) = (finger("Left", lh), finger("Right", rh));
         for s in &c.segments {
             for jc in &s.contacts {
-                let (a, b) = (jc.start.min(c.motion.num_frames()), jc.end.min(c.motion.num_frames()));
+                let (a, b) = (jc.start.min(c.clip.num_frames()), jc.end.min(c.clip.num_frames()));
                 if a >= b {
                     continue;
                 }
                 let mut mean = DVec3::ZERO;
                 for f in a..b {
-                    let g = forward(sk, &c.motion.pose(f));
+                    let g = forward(sk, &c.clip.pose(f));
                     mean += match jc.joint {
                         ContactJoint::Hips => (g.positions[rig.legs[0][0]] + g.positions[rig.legs[1][0]]) * 0.5,
                         ContactJoint::LeftWrist => g.positions[lh],

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
-use inbetween_core::Motion;
+use inbetween_core::clip::Clip;
 use inbetween_io::gltf_buffer::{self, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
 use serde_json::{json, Value};
 
@@ -34,7 +34,7 @@ pub const ANIMATION_NAME: &str = "story";
 
 /// Frames of the story at `fps`: enough to cover the longest character clip (each clip is
 /// sampled at its own frame time), at least 1.
-pub fn animation_frames(characters: &[(&str, &Motion)], fps: f64) -> usize {
+pub fn animation_frames(characters: &[(&str, &Clip)], fps: f64) -> usize {
     let dur = characters.iter().map(|(_, m)| m.duration()).fold(0.0f64, f64::max);
     if !(fps.is_finite() && fps > 0.0) {
         return 1;
@@ -42,15 +42,11 @@ pub fn animation_frames(characters: &[(&str, &Motion)], fps: f64) -> usize {
     (dur * fps + 1e-6).floor() as usize + 1
 }
 
-/// Checks the inputs every animated writer needs.
-pub(crate) fn check_inputs(characters: &[(&str, &Motion)], fps: f64) -> Result<(), ScriptError> {
+/// Checks the inputs every animated writer needs (a character's clip has at least one frame by
+/// construction).
+pub(crate) fn check_fps(fps: f64) -> Result<(), ScriptError> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(ScriptError::Invalid(format!("animation frame rate {fps} must be a positive number")));
-    }
-    for (name, m) in characters {
-        if m.num_frames() == 0 {
-            return Err(ScriptError::Invalid(format!("character '{name}' has no frames")));
-        }
     }
     Ok(())
 }
@@ -178,12 +174,12 @@ fn continuous_quats(qs: impl Iterator<Item = Quat>) -> Vec<f32> {
 pub fn animated_gltf_document(
     scene: &Scene,
     cat: &Catalogue,
-    characters: &[(&str, &Motion)],
+    characters: &[(&str, &Clip)],
     camera: &CameraFn,
     fps: f64,
     model: &dyn Fn(&str) -> Option<PathBuf>,
 ) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
-    check_inputs(characters, fps)?;
+    check_fps(fps)?;
     let (mut doc, mut bin, notes) = gltf_document(scene, cat, model);
     let mut roots: Vec<usize> = Vec::new();
     let mut samplers: Vec<Value> = Vec::new();
@@ -207,7 +203,7 @@ pub fn animated_gltf_document(
         };
 
     for (ci, (name, m)) in characters.iter().enumerate() {
-        let sk = &m.skeleton;
+        let sk = m.skeleton();
         let n = m.num_frames();
         let color = CHARACTER_COLORS[ci % CHARACTER_COLORS.len()].map(srgb_to_linear);
         let mat = a.push(
@@ -216,7 +212,7 @@ pub fn animated_gltf_document(
         );
         let mesh = a.centred_box(&format!("{name} bone"), mat);
         let poses = m.poses();
-        let input = time_acc(&mut a, n, m.frame_time);
+        let input = time_acc(&mut a, n, m.frame_time());
         // Joint nodes first (their indices are needed for children lists), filled in below.
         let first = a.doc["nodes"].as_array().map_or(0, Vec::len);
         let mut kids: Vec<Vec<usize>> = vec![Vec::new(); sk.len()];
@@ -327,7 +323,7 @@ pub fn write_animated_gltf(
     path: &Path,
     scene: &Scene,
     cat: &Catalogue,
-    characters: &[(&str, &Motion)],
+    characters: &[(&str, &Clip)],
     camera: &CameraFn,
     fps: f64,
 ) -> Result<(), ScriptError> {
@@ -357,7 +353,7 @@ pub fn story_gltf_document(
     cat: &Catalogue,
     camera: &CameraFn,
 ) -> Result<(Value, Vec<u8>), ScriptError> {
-    let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &Clip)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.clip)).collect();
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
     let (mut doc, mut bin, _notes) = animated_gltf_document(&anim.scene, cat, &chars, camera, anim.fps, &lookup)?;
     let n = animation_frames(&chars, anim.fps);

@@ -7,13 +7,12 @@ use std::path::Path;
 
 use glam::DVec3;
 use image::RgbImage;
-use inbetween_core::fk::forward_clip;
-use inbetween_core::Motion;
+use inbetween_core::clip::Clip;
 use inbetween_render::canvas::{text_width, Camera3};
 use inbetween_render::Canvas;
 use rayon::prelude::*;
 
-use super::anim_gltf::{animation_frames, check_inputs, CameraFn, CHARACTER_COLORS};
+use super::anim_gltf::{animation_frames, check_fps, CameraFn, CHARACTER_COLORS};
 pub use super::preview::plan_pixel;
 use super::preview::{draw_object, draw_room, scale_color};
 use super::{category_color, top_down};
@@ -76,7 +75,7 @@ impl AnimPreviewOptions {
 /// Story frames shown in the GIF and the GIF's frame rate: every `step`-th frame of
 /// [`animation_frames`] so that the rate is at most `opts.max_fps` (≤ 10) and at most
 /// `opts.max_frames` frames are written.
-pub fn preview_frame_indices(characters: &[(&str, &Motion)], fps: f64, opts: &AnimPreviewOptions) -> (Vec<usize>, f64) {
+pub fn preview_frame_indices(characters: &[(&str, &Clip)], fps: f64, opts: &AnimPreviewOptions) -> (Vec<usize>, f64) {
     let n = animation_frames(characters, fps);
     let max_fps =
         if opts.max_fps.is_finite() && opts.max_fps > 0.0 { opts.max_fps.min(MAX_GIF_FPS) } else { MAX_GIF_FPS };
@@ -100,13 +99,14 @@ struct Figure {
 }
 
 impl Figure {
-    fn new(name: &str, m: &Motion, color: [u8; 3]) -> Figure {
-        let sk = &m.skeleton;
+    fn new(name: &str, m: &Clip, color: [u8; 3]) -> Figure {
+        let sk = m.skeleton();
         let mut parents: Vec<Option<usize>> = sk.joints().iter().map(|j| j.parent).collect();
         let ends: Vec<usize> = (0..sk.len()).filter(|&j| sk.joint(j).end_site.is_some()).collect();
         parents.extend(ends.iter().map(|&j| Some(j)));
         let head = sk.find("Head").and_then(|h| ends.iter().position(|&e| e == h).map(|k| (h, sk.len() + k)));
-        let frames = forward_clip(m)
+        let frames = m
+            .globals()
             .into_iter()
             .map(|g| {
                 let mut pts = g.positions.clone();
@@ -114,7 +114,7 @@ impl Figure {
                 pts
             })
             .collect();
-        Figure { parents, frames, frame_time: m.frame_time, head, name: name.to_string(), color }
+        Figure { parents, frames, frame_time: m.frame_time(), head, name: name.to_string(), color }
     }
 
     /// Points at story time `t` seconds (held at the last frame after the clip ends).
@@ -221,12 +221,12 @@ fn draw_frame(
 pub fn preview_frames(
     scene: &Scene,
     cat: &Catalogue,
-    characters: &[(&str, &Motion)],
+    characters: &[(&str, &Clip)],
     camera: &CameraFn,
     fps: f64,
     opts: &AnimPreviewOptions,
 ) -> Result<(Vec<RgbImage>, f64), ScriptError> {
-    check_inputs(characters, fps)?;
+    check_fps(fps)?;
     let (w, h) = opts.size();
     let n = animation_frames(characters, fps);
     let (idx, gif_fps) = preview_frame_indices(characters, fps, opts);
@@ -258,7 +258,7 @@ pub fn render_preview_gif(
     path: &Path,
     scene: &Scene,
     cat: &Catalogue,
-    characters: &[(&str, &Motion)],
+    characters: &[(&str, &Clip)],
     camera: &CameraFn,
     fps: f64,
     opts: &AnimPreviewOptions,
@@ -269,7 +269,7 @@ pub fn render_preview_gif(
 }
 
 /// Floor route of each character: its root joint's `[x, z]` per frame.
-pub fn root_route(m: &Motion) -> Vec<[f32; 2]> {
+pub fn root_route(m: &Clip) -> Vec<[f32; 2]> {
     (0..m.num_frames())
         .map(|f| {
             let t = m.pose(f).translations[0];
@@ -280,7 +280,7 @@ pub fn root_route(m: &Motion) -> Vec<[f32; 2]> {
 
 /// The plan ([`top_down`]) with each character's root path as a coloured polyline, a disc at its
 /// start, a square at its end and its name at the start.
-pub fn top_down_trails(scene: &Scene, cat: &Catalogue, characters: &[(&str, &Motion)]) -> RgbImage {
+pub fn top_down_trails(scene: &Scene, cat: &Catalogue, characters: &[(&str, &Clip)]) -> RgbImage {
     let mut cv = Canvas::from_image(top_down(scene, cat));
     for (i, (name, m)) in characters.iter().enumerate() {
         let color = CHARACTER_COLORS[i % CHARACTER_COLORS.len()];
@@ -328,7 +328,7 @@ pub fn render_top_down_trails(
     path: &Path,
     scene: &Scene,
     cat: &Catalogue,
-    characters: &[(&str, &Motion)],
+    characters: &[(&str, &Clip)],
 ) -> Result<(), ScriptError> {
     super::write_png(path, &top_down_trails(scene, cat, characters))
 }

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use inbetween_core::Motion;
+use inbetween_core::clip::Clip;
 use serde_json::json;
 
 use crate::error::ScriptError;
@@ -17,12 +17,11 @@ pub fn bvh_sidecar_path(path: &Path) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// Writes `motion` (the common rig in metres, see [`crate::motion::rig`]) as BVH through
-/// [`inbetween_io::bvh::write_bvh`], plus its sidecar ([`bvh_sidecar_path`]); both atomic.
-pub fn write_character_bvh(path: &Path, motion: &Motion) -> Result<(), ScriptError> {
-    if motion.num_frames() == 0 {
-        return Err(ScriptError::Invalid(format!("{}: the motion has no frames", path.display())));
-    }
+/// Writes `clip` (the common rig in metres, see [`crate::motion::rig`]) as BVH through
+/// [`inbetween_io::bvh::write_bvh`] (the file boundary where poses become Euler channels), plus
+/// its sidecar ([`bvh_sidecar_path`]); both atomic.
+pub fn write_character_bvh(path: &Path, clip: &Clip) -> Result<(), ScriptError> {
+    let motion = &clip.to_motion().map_err(|e| ScriptError::Invalid(format!("{}: {e}", path.display())))?;
     inbetween_io::bvh::write_bvh(path, motion)
         .map_err(|e| ScriptError::Asset { path: path.to_path_buf(), message: e.to_string() })?;
     let side = bvh_sidecar_path(path);

@@ -7,17 +7,18 @@
 //! up first ([`super::pick_up`]) and the action plays with it in the hand.
 
 use glam::DVec3;
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
-use inbetween_core::Motion;
 
 use super::Step;
 use crate::animate::builder::Builder;
+use crate::animate::builder::ON_RIG;
 use crate::animate::props::carries;
 use crate::animate::spots::{dist2, heading_to, stand_point};
 use crate::animate::{contacts_of, ContactJoint, JointContact};
 use crate::catalogue::{Catalogue, ContactKind};
 use crate::layout::geom;
-use crate::motion::blend::{blend_upper_on, reach_contacts_on};
+use crate::motion::blend::{blend_upper, reach_contacts};
 use crate::motion::ik::Limb;
 use crate::motion::rig::Rig;
 use crate::motion::{BlendParams, Contact};
@@ -38,7 +39,7 @@ impl Builder<'_> {
             }
         }
         let hands_on = if carried.is_some() { None } else { obj };
-        let action = ctx.lib.retrieve(verb).filter(|c| c.motion.skeleton == rig.skeleton).map(|c| c.motion.clone());
+        let action = ctx.lib.retrieve(verb).filter(|c| c.clip.skeleton() == &rig.skeleton).map(|c| c.clip.clone());
         if action.is_none() && verb != "stand" && verb != "idle" {
             self.notes.push(format!("{}: no clip for \"{}\"; standing instead", self.name, a.verb));
         }
@@ -62,12 +63,12 @@ impl Builder<'_> {
         let base = self.in_place(n);
         let base = crate::motion::rig::clip(rig, &base);
         let mut m = match &action {
-            Some(act) => blend_upper_on(
-                rig,
+            Some(act) => blend_upper(
                 &base,
                 act,
                 &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: true, action_offset: 0 },
-            ),
+            )
+            .expect(ON_RIG),
             None => base,
         };
         let start = self.frames.len();
@@ -75,7 +76,7 @@ impl Builder<'_> {
         if let (Some(o), true) = (hands_on, cfg.reach) {
             let (ik, jc) = hand_contacts(rig, &m, scene, cat, o, start);
             if !ik.is_empty() {
-                m = reach_contacts_on(rig, &m, &ik).0;
+                m = reach_contacts(&m, &ik).expect(ON_RIG).0;
             }
             contacts = jc;
         }
@@ -91,7 +92,7 @@ impl Builder<'_> {
 /// hand, a top surface both wrists ±20 cm apart.
 fn hand_contacts(
     rig: &Rig,
-    m: &Motion,
+    m: &Clip,
     scene: &Scene,
     cat: &Catalogue,
     o: usize,

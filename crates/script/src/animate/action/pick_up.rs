@@ -7,11 +7,12 @@
 use glam::{DQuat, DVec3};
 use inbetween_core::fk::forward;
 
+use crate::animate::builder::ON_RIG;
 use crate::animate::builder::{smooth, Builder};
 use crate::animate::spots::{dist2, heading_to, stand_point};
 use crate::animate::{contacts_of, CarriedProp, ContactJoint, JointContact};
 use crate::catalogue::ContactKind;
-use crate::motion::blend::{blend_upper_on, reach_contacts_on};
+use crate::motion::blend::{blend_upper, reach_contacts};
 use crate::motion::ik::Limb;
 use crate::motion::{BlendParams, Contact};
 
@@ -45,12 +46,12 @@ impl Builder<'_> {
         let n = clip.num_frames().max(30);
         let base = self.in_place(n);
         let base = crate::motion::rig::clip(rig, &base);
-        let m = blend_upper_on(
-            rig,
+        let m = blend_upper(
             &base,
             &clip,
             &BlendParams { start: 0, end: None, blend_in: 8, blend_out: 0, looping: false, action_offset: 0 },
-        );
+        )
+        .expect(ON_RIG);
         // The hand closes at frame `grab`: IK weight rises to 1 there and falls after.
         let grab = n / 2;
         let bump = |k: usize| {
@@ -87,7 +88,7 @@ impl Builder<'_> {
             action_offset: 0,
         };
         let target = DVec3::new(grip[0] as f64, grip[1] as f64, grip[2] as f64);
-        let m = reach_contacts_on(rig, &m, &[Contact { limb: Limb::RightArm, target, window }]).0;
+        let m = reach_contacts(&m, &[Contact { limb: Limb::RightArm, target, window }]).expect(ON_RIG).0;
         // The prop's grip goes to the hand joint; its rotation relative to the hand stays as it
         // was at the grab.
         let hand = rig.arms[1][3];

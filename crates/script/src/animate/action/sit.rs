@@ -4,12 +4,12 @@
 //! re-solved), then the seated loop. The "sit" segment carries the hips contact of Eq. 2.
 
 use super::Step;
+use crate::animate::builder::placed;
 use crate::animate::builder::{smooth, Builder};
 use crate::animate::spots::{dist2, SPOT_MARGIN};
 use crate::animate::{contacts_of, ContactJoint, JointContact, PASSING_DISTANCE};
 use crate::catalogue::ContactKind;
 use crate::motion::ik::PELVIS_ABOVE_SEAT;
-use crate::motion::locomotion::place_clip_on;
 use crate::motion::procedural::{seat_point, SEAT_HEIGHT};
 
 impl Builder<'_> {
@@ -63,7 +63,7 @@ impl Builder<'_> {
         self.push_segment("walk", start, Some(o), vec![o], Vec::new());
         let start = self.frames.len();
         let clip = self.named("procedural sit down");
-        let mut poses = place_clip_on(&self.ctx.rig, &clip, self.st.pos, yaw).poses();
+        let mut poses = placed(&clip, self.st.pos, yaw);
         let n = poses.len().max(2);
         let dy = s[1] as f64 - SEAT_HEIGHT;
         self.lift(&mut poses, |k| dy * smooth(k as f64 / (n - 1) as f64));

@@ -1,8 +1,8 @@
 //! Standing up from a seat: the stand-up clip placed at the stand point in front of the seat,
 //! the root lowered onto the seat's height at first and eased to standing height (legs re-solved).
 
+use crate::animate::builder::placed;
 use crate::animate::builder::{smooth, Builder};
-use crate::motion::locomotion::place_clip_on;
 use crate::motion::procedural::SEAT_HEIGHT;
 
 impl Builder<'_> {
@@ -11,7 +11,7 @@ impl Builder<'_> {
         self.get_up_from_lying();
         let Some((at, seat, obj)) = self.st.seated.take() else { return };
         let clip = self.named("procedural stand up");
-        let mut poses = place_clip_on(&self.ctx.rig, &clip, at, self.st.heading).poses();
+        let mut poses = placed(&clip, at, self.st.heading);
         let n = poses.len().max(2);
         let dy = seat[1] as f64 - SEAT_HEIGHT;
         self.lift(&mut poses, |k| dy * (1.0 - smooth(k as f64 / (n - 1) as f64)));

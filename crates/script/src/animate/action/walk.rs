@@ -5,7 +5,7 @@
 
 use std::collections::HashMap;
 
-use inbetween_core::Motion;
+use inbetween_core::clip::Clip;
 
 use super::Step;
 use crate::animate::builder::Builder;
@@ -18,11 +18,11 @@ use crate::motion::{walk_route, MotionLibrary, WalkParams};
 /// it was).
 #[derive(Default)]
 pub(crate) struct WalkCache {
-    walks: HashMap<Vec<u64>, Motion>,
+    walks: HashMap<Vec<u64>, Clip>,
 }
 
 impl WalkCache {
-    pub fn walk(&mut self, route: &[[f32; 2]], lib: &MotionLibrary, p: &WalkParams) -> Motion {
+    pub fn walk(&mut self, route: &[[f32; 2]], lib: &MotionLibrary, p: &WalkParams) -> Clip {
         let mut key: Vec<u64> = route.iter().map(|q| ((q[0].to_bits() as u64) << 32) | q[1].to_bits() as u64).collect();
         key.push(p.speed.unwrap_or(-1.0).to_bits());
         key.push(p.initial_heading.unwrap_or(9.0).to_bits());

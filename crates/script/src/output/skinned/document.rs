@@ -304,7 +304,7 @@ pub fn skinned_gltf_document(
     let mut taken = BTreeSet::new();
     let mut found = Vec::new();
     for (name, m) in characters {
-        let (root, first) = joint_nodes(&doc, name, &m.skeleton, &taken).ok_or_else(|| {
+        let (root, first) = joint_nodes(&doc, name, m.skeleton(), &taken).ok_or_else(|| {
             ScriptError::Invalid(format!("character '{name}': no joint nodes in the animated document"))
         })?;
         taken.insert(root);
@@ -312,11 +312,11 @@ pub fn skinned_gltf_document(
     }
     for ((_, m), body) in characters.iter().zip(bodies) {
         if let Some(b) = body {
-            if b.bind.len() != m.skeleton.len() {
+            if b.bind.len() != m.skeleton().len() {
                 return Err(ScriptError::Invalid(format!(
                     "a body bound to {} joints for a skeleton of {}",
                     b.bind.len(),
-                    m.skeleton.len()
+                    m.skeleton().len()
                 )));
             }
         }
@@ -327,7 +327,7 @@ pub fn skinned_gltf_document(
         if body.is_none() {
             continue;
         }
-        for j in first..first + m.skeleton.len() {
+        for j in first..first + m.skeleton().len() {
             for c in doc["nodes"][j]["children"].as_array().into_iter().flatten().filter_map(Value::as_u64) {
                 if doc["nodes"][c as usize].get("mesh").is_some() {
                     drop.insert(c as usize);

@@ -26,8 +26,9 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, Mat4, Quat, Vec3};
 use image::RgbImage;
+use inbetween_core::clip::Clip;
 use inbetween_core::fk::{forward, GlobalPose};
-use inbetween_core::{Motion, Pose, Skeleton};
+use inbetween_core::{Pose, Skeleton};
 use inbetween_io::gltf_buffer::{pad_to_4, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT};
 use inbetween_render::canvas::Camera3;
 use inbetween_render::Canvas;
@@ -163,7 +164,7 @@ pub use preview::render_skinned_frame;
 pub struct SkinnedCast<'a> {
     pub scene: &'a Scene,
     pub cat: &'a Catalogue,
-    pub characters: &'a [(&'a str, &'a Motion)],
+    pub characters: &'a [(&'a str, &'a Clip)],
     pub bodies: &'a [Option<&'a SkinnedBody>],
     pub camera: &'a CameraFn<'a>,
     pub fps: f64,
@@ -187,7 +188,7 @@ pub fn write_skinned_story(
     cat: &Catalogue,
     models: Option<&Path>,
 ) -> Result<SkinnedStory, ScriptError> {
-    let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &Clip)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.clip)).collect();
     let (bodies, notes) = skinned_bodies(anim, models)?;
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
     let track = crate::animate::camera_track(anim);
@@ -214,7 +215,7 @@ pub fn skinned_bodies(
     let mut notes = Vec::new();
     for (i, c) in anim.characters.iter().enumerate() {
         let file = character_file(&glbs, i);
-        let body = bind_body(&read_character(&file)?, &c.motion.skeleton)?;
+        let body = bind_body(&read_character(&file)?, c.clip.skeleton())?;
         notes.push(format!(
             "{} wears {} ({} triangles, {:.2} m tall)",
             c.name,
@@ -235,7 +236,7 @@ pub fn skinned_story_document(
     bodies: &[SkinnedBody],
     camera: &super::anim_gltf::CameraFn,
 ) -> Result<(Value, Vec<u8>), ScriptError> {
-    let chars: Vec<(&str, &Motion)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.motion)).collect();
+    let chars: Vec<(&str, &Clip)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.clip)).collect();
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
     let cast = SkinnedCast { scene: &anim.scene, cat, characters: &chars, bodies: &refs, camera, fps: anim.fps };

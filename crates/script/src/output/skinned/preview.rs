@@ -53,8 +53,8 @@ pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) 
     let t = frame as f64 / fps;
     for ((_, m), body) in characters.iter().zip(bodies) {
         let Some(body) = body else { continue };
-        let f = ((t / m.frame_time).round().max(0.0) as usize).min(m.num_frames().saturating_sub(1));
-        let world = joint_matrices(&forward(&m.skeleton, &m.pose(f)));
+        let f = ((t / m.frame_time()).round().max(0.0) as usize).min(m.num_frames().saturating_sub(1));
+        let world = joint_matrices(&forward(m.skeleton(), &m.pose(f)));
         let pts = skin_positions(body, &world);
         let paint = Paint::of(body);
         for tri in body.indices.chunks_exact(3) {
