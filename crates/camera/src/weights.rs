@@ -36,7 +36,7 @@ pub fn check_output(out: &Path, overwrite_committed: bool) -> Result<(), CameraE
     Err(CameraError::invalid(
         out,
         format!(
-            "refusing to overwrite the committed weights in {} (pass --overwrite-committed to replace them on purpose)",
+            "refusing to overwrite the committed weights in {} (set `overwrite_committed` to replace them on purpose)",
             committed_dir().display()
         ),
     ))
@@ -231,7 +231,7 @@ mod tests {
     fn training_output_refuses_the_committed_folder_unless_asked() {
         let inside = committed_dir().join("camera.bpk");
         let e = check_output(&inside, false).unwrap_err().to_string();
-        assert!(e.contains("--overwrite-committed"), "{e}");
+        assert!(e.contains("`overwrite_committed`"), "{e}");
         assert!(check_output(&inside, true).is_ok());
         // The same folder through a relative path with `..` is still refused.
         let sneaky = committed_dir().join("..").join("weights").join("x.bpk");

@@ -59,7 +59,7 @@ pub fn info(a: InfoArgs) -> anyhow::Result<()> {
     writeln!(out, "fps:       {:.3} (frame time {} s)", m.fps(), m.frame_time)?;
     writeln!(out, "duration:  {:.3} s", m.duration())?;
     let unit = UnitChoice::resolve(a.unit, &m.skeleton);
-    writeln!(out, "unit:      {} ({})", unit.unit.describe(), unit.reason)?;
+    writeln!(out, "unit:      {} ({})", unit.unit.describe(), crate::errors::with_flags(&unit.reason))?;
     let size = rest_pose_extent(&m.skeleton);
     writeln!(out, "rest pose: {size:.2} units = {:.1} cm tall (or wide)", size * unit.cm_per_unit())?;
     writeln!(out, "skeleton:")?;

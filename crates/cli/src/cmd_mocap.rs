@@ -309,7 +309,7 @@ fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let report = job.run(&m).with_context(|| format!("compressing {}", a.input.display()))?;
     let secs = t.elapsed().as_secs_f64();
     write_atomic(&a.output, report.bytes()).with_context(|| format!("writing {}", a.output.display()))?;
-    println!("{report}");
+    println!("{}", crate::errors::with_flags(&report.to_string()));
     println!("wrote {} in {secs:.2} s", a.output.display());
     Ok(())
 }
@@ -393,7 +393,7 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
         let out = bench::run(&a.config(), &progress);
         progress.finish();
         let out = out?;
-        print!("{}", out.report.to_text());
+        print!("{}", crate::errors::with_flags(&out.report.to_text()));
         for p in &out.written {
             println!("wrote {}", p.display());
         }
@@ -416,7 +416,7 @@ fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
     let out = bench::acl::run(&cfg, a.output.as_deref(), &progress);
     progress.finish();
     let (_, report, written) = out?;
-    print!("{}", report.to_text());
+    print!("{}", crate::errors::with_flags(&report.to_text()));
     for p in &written {
         println!("wrote {}", p.display());
     }
@@ -499,7 +499,7 @@ fn stream_send(a: SendArgs) -> anyhow::Result<()> {
     };
     let r = inbetween_mocap::stream::send(&a.addr, &m, &opts)?;
     let secs = m.duration().max(1e-9);
-    println!("{}", r.unit);
+    println!("{}", crate::errors::with_flags(&r.unit.to_string()));
     println!(
         "sent {} keys for {} frames in {:.2} s: {} bytes ({:.0} B/s) vs {} raw bytes ({:.0} B/s), {:.1}x less; added latency mean {:.0} ms, max {:.0} ms; {} reconnects",
         r.keys,

@@ -347,7 +347,15 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
     let params = if a.paper_choice { params.paper_choice() } else { params };
     let (paths, walk_s) = resequence(&analysis, a.start, &params, a.count, &limits).map_err(with_flag)?;
     if a.explain {
-        print!("{}", direction_words(&analysis.info, &analysis.direction, params.allow_reverse, params.use_cr));
+        print!(
+            "{}",
+            crate::errors::with_flags(&direction_words(
+                &analysis.info,
+                &analysis.direction,
+                params.allow_reverse,
+                params.use_cr
+            ))
+        );
     }
     let source: Vec<usize> = (0..clip.len()).collect();
     let md_source = stability_md(&clip.frames, &source);
@@ -392,7 +400,7 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
             sheet.display()
         );
         if a.explain {
-            print!("{}", explain(path));
+            print!("{}", crate::errors::with_flags(&explain(path)));
         }
     }
     set.commit().with_context(|| format!("moving the outputs into place beside {}", a.out.display()))?;

@@ -27,11 +27,33 @@ pub fn install(debug: bool) {
     }));
 }
 
-/// `error: <message>`, one `caused by:` line per cause, and the backtrace when `debug`.
+/// The options the libraries name in their messages and notes as `` `field` `` (they speak of
+/// fields; the commands own the flags), and the flag each is given with here.
+pub const OPTION_FLAGS: &[(&str, &str)] = &[
+    ("unit", "--unit"),
+    ("overwrite_committed", "--overwrite-committed"),
+    ("allow_reverse", "--allow-reverse"),
+    ("models", "--models"),
+    ("shared_motions", "--shared-motions"),
+    ("data", "--data"),
+];
+
+/// Library text with each `` `field` `` of [`OPTION_FLAGS`] written as its flag (other text,
+/// other backticked words included, unchanged).
+pub fn with_flags(text: &str) -> String {
+    let mut out = text.to_string();
+    for (field, flag) in OPTION_FLAGS {
+        out = out.replace(&format!("`{field}`"), flag);
+    }
+    out
+}
+
+/// `error: <message>`, one `caused by:` line per cause, and the backtrace when `debug`; options
+/// the message names are written as flags ([`with_flags`]).
 pub fn render(error: &anyhow::Error, debug: bool) -> String {
-    let mut out = format!("error: {error}\n");
+    let mut out = format!("error: {}\n", with_flags(&error.to_string()));
     for cause in error.chain().skip(1) {
-        let _ = writeln!(out, "  caused by: {cause}");
+        let _ = writeln!(out, "  caused by: {}", with_flags(&cause.to_string()));
     }
     if debug {
         let _ = writeln!(out, "\nbacktrace:\n{}", error.backtrace());
@@ -101,6 +123,19 @@ mod tests {
         );
         let other = name_flags(anyhow::anyhow!("disk full"), &[("max_rows", "--max-rows")]);
         assert_eq!(other.to_string(), "disk full");
+    }
+
+    #[test]
+    fn options_named_by_the_libraries_are_written_as_flags() {
+        let e = anyhow::anyhow!("refusing to overwrite w.bpk (set `overwrite_committed` to replace them on purpose)");
+        assert_eq!(
+            render(&e, false),
+            "error: refusing to overwrite w.bpk (set --overwrite-committed to replace them on purpose)\n"
+        );
+        assert_eq!(
+            with_flags("given with `unit`; build with `cargo build`"),
+            "given with --unit; build with `cargo build`"
+        );
     }
 
     #[test]

@@ -79,7 +79,7 @@ impl LengthUnit {
             return UnitChoice {
                 unit: LengthUnit::Centimetre,
                 reason: format!(
-                    "the rest pose has no size ({} units): cannot infer the unit, assuming cm (give --unit)",
+                    "the rest pose has no size ({} units): cannot infer the unit, assuming cm (give `unit`)",
                     fmt_num(size)
                 ),
             };
@@ -93,7 +93,7 @@ impl LengthUnit {
             fmt_num(size),
         );
         if cm < HUMAN_SIZE_RANGE_CM.0 || cm > HUMAN_SIZE_RANGE_CM.1 {
-            reason.push_str("; not human-sized in any unit, so this is a guess: give --unit if it is wrong");
+            reason.push_str("; not human-sized in any unit, so this is a guess: give `unit` if it is wrong");
         }
         UnitChoice { unit, reason }
     }
@@ -165,9 +165,9 @@ impl UnitChoice {
         }
     }
 
-    /// A unit the user gave (`--unit`).
+    /// A unit the user gave (the `unit` option; the CLI's `--unit`).
     pub fn given(unit: LengthUnit) -> UnitChoice {
-        UnitChoice { unit, reason: "given with --unit".into() }
+        UnitChoice { unit, reason: "given with `unit`".into() }
     }
 
     pub fn cm_per_unit(&self) -> f64 {
@@ -264,7 +264,7 @@ mod tests {
         }
         let cmu = LengthUnit::infer(&sk);
         assert!(cmu.reason.starts_with("rest-pose height 26.7 units ≈ 151 cm in CMU units"), "{}", cmu.reason);
-        assert_eq!(UnitChoice::resolve(Some(LengthUnit::Inch), &sk).reason, "given with --unit");
+        assert_eq!(UnitChoice::resolve(Some(LengthUnit::Inch), &sk).reason, "given with `unit`");
     }
 
     #[test]
@@ -276,7 +276,7 @@ mod tests {
         assert_eq!(g.unit, LengthUnit::Centimetre);
         assert!(g.reason.contains("cannot infer"), "{}", g.reason);
         let giant = scale_motion(&gait(&GaitParams { frames: 2, ..GaitParams::walk() }), 1e4);
-        assert!(LengthUnit::infer(&giant.skeleton).reason.contains("give --unit"));
+        assert!(LengthUnit::infer(&giant.skeleton).reason.contains("give `unit`"));
     }
 
     #[test]

@@ -107,7 +107,7 @@ pub fn check_output(out: &Path, overwrite_committed: bool) -> Result<(), FaceErr
     };
     if same && !overwrite_committed {
         return Err(FaceError::Invalid(format!(
-            "{} is in the committed weights folder; pass --overwrite-committed to replace the committed weights on purpose",
+            "{} is in the committed weights folder; set `overwrite_committed` to replace the committed weights on purpose",
             out.display()
         )));
     }

@@ -302,7 +302,7 @@ mod tests {
         // --unit overrides the inference; a sub-folder alone is a plain folder too.
         let given = load(dir.path(), Some(LengthUnit::Metre)).unwrap();
         assert!(given.clips.iter().all(|c| c.cm_per_unit == 100.0));
-        assert_eq!(given.unit_notes(), ["3 bvh takes: length unit: m (given with --unit)"]);
+        assert_eq!(given.unit_notes(), ["3 bvh takes: length unit: m (given with `unit`)"]);
         assert_eq!(cmu_corpus(&dir.path().join("sub")).unwrap()[0].name, "deeper/cm");
     }
 

@@ -132,7 +132,7 @@ impl StorySession {
             .collect();
         Err(ScriptError::Invalid(format!(
             "{}\nnothing was written; verbs with motion here: {} (and their synonyms; jump, kick, dance, climb, \
-             bend and throw need captured clips: --shared-motions)",
+             bend and throw need captured clips: `shared_motions`)",
             lines.join("\n"),
             known.join(", ")
         )))

@@ -124,7 +124,7 @@ pub fn data_dir(data: Option<&Path>) -> Result<PathBuf> {
     match data {
         Some(d) => Ok(d.to_path_buf()),
         None => inbetween_io::data::shared_data_dir()
-            .map_err(|p| MocapError::Invalid(format!("no data at {} (give --data DIR)", p.display()))),
+            .map_err(|p| MocapError::Invalid(format!("no data at {} (give `data`)", p.display()))),
     }
 }
 

@@ -104,7 +104,7 @@ fn candidate(c: &Candidate) -> String {
 fn cr_words(t: &Transition) -> String {
     match t.cr {
         CrState::Disabled => "off".into(),
-        CrState::AllowedUndirected => "skipped, the shot's motion is judged undirected (--allow-reverse)".into(),
+        CrState::AllowedUndirected => "skipped, the shot's motion is judged undirected (`allow_reverse`)".into(),
         CrState::Active => format!(
             "removes steps that play the motion backwards (replays of the previous source frames, or frames closer to frame {}'s past than to its future); removed {}",
             t.from,

@@ -71,9 +71,9 @@ pub fn direction_words(info: &MotionInfo, judged: &[(bool, f32)], allow_reverse:
         } else if directed {
             "steps that play it backwards are removed (C_r)"
         } else if allow_reverse {
-            "steps that play it backwards are allowed (--allow-reverse)"
+            "steps that play it backwards are allowed (`allow_reverse`)"
         } else {
-            "steps that play it backwards are still removed (C_r; --allow-reverse would allow them here)"
+            "steps that play it backwards are still removed (C_r; `allow_reverse` would allow them here)"
         };
         out.push_str(&format!(
             "shot {s} ({frames} frames): motion judged {verdict}, {:.0} % LMS frames (directed from {:.0} %); {rule}\n",

@@ -79,7 +79,7 @@ pub fn first_character_dir(dirs: &[PathBuf]) -> Result<PathBuf, ScriptError> {
     }
     let looked: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
     Err(ScriptError::Invalid(format!(
-        "skinned characters need the Kenney blocky characters (character-a.glb …); none found in: {} (set INBETWEEN_DATA to the shared data folder, or pass --models <data>/assets/kenney_furniture)",
+        "skinned characters need the Kenney blocky characters (character-a.glb …); none found in: {} (set INBETWEEN_DATA to the shared data folder, or give `models` = <data>/assets/kenney_furniture)",
         looked.join(", ")
     )))
 }
