@@ -352,10 +352,17 @@ fn check_bind(ch: &KenneyCharacter, body: &SkinnedBody, rig: &Rig) {
 fn check_document(doc: &Value, bin: &[u8], body: &SkinnedBody, m: &Clip) {
     let sk = m.skeleton();
     assert_eq!(doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize, bin.len());
+    // Views lie in the buffer, 4-byte aligned, and cover all of it but the alignment padding:
+    // nothing was written only to be dropped (the bone boxes are never built for a skinned body).
+    let mut covered = 0;
     for v in doc["bufferViews"].as_array().unwrap() {
         let (off, len) = (v["byteOffset"].as_u64().unwrap() as usize, v["byteLength"].as_u64().unwrap() as usize);
         assert!(off % 4 == 0 && off + len <= bin.len(), "{v}");
+        covered += len.next_multiple_of(4);
     }
+    assert_eq!(covered, bin.len(), "bytes no view uses");
+    let mesh_names: Vec<&str> = doc["meshes"].as_array().unwrap().iter().filter_map(|m| m["name"].as_str()).collect();
+    assert!(mesh_names.iter().all(|n| !n.ends_with(" bone")), "no bone box mesh: {mesh_names:?}");
     let sizes = |a: &Value| {
         let c = match a["componentType"].as_u64().unwrap() {
             5121 => 1,
@@ -376,7 +383,7 @@ fn check_document(doc: &Value, bin: &[u8], body: &SkinnedBody, m: &Clip) {
         assert!(sizes(a) <= v["byteLength"].as_u64().unwrap() as usize, "{a}");
     }
     let nodes = doc["nodes"].as_array().unwrap();
-    assert!(nodes.iter().all(|n| !n["name"].as_str().unwrap_or("").ends_with(" bone")), "bone boxes removed");
+    assert!(nodes.iter().all(|n| !n["name"].as_str().unwrap_or("").ends_with(" bone")), "no bone boxes");
     for n in nodes {
         for key in ["mesh", "skin", "camera"] {
             if let Some(i) = n[key].as_u64() {

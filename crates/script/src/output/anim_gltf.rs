@@ -179,7 +179,47 @@ pub fn animated_gltf_document(
     fps: f64,
     model: &dyn Fn(&str) -> Option<PathBuf>,
 ) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
+    let bodies = vec![Body::Boxes; characters.len()];
+    let out = animated_document(scene, cat, characters, &bodies, camera, fps, model)?;
+    Ok((out.doc, out.bin, out.notes))
+}
+
+/// How a character's body is drawn in an animated document.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Body {
+    /// A box along every bone (the stick figure), children of the joint nodes.
+    Boxes,
+    /// None here: the caller skins a mesh onto the joint nodes ([`super::skinned`]).
+    Skinned,
+}
+
+/// An animated document under construction and where each character's joint nodes are.
+pub(crate) struct AnimatedDocument {
+    pub doc: Value,
+    pub bin: Vec<u8>,
+    pub notes: Vec<String>,
+    /// Per character, the node index of its root joint; its other joints follow in skeleton order.
+    pub first_joint: Vec<usize>,
+}
+
+/// [`animated_gltf_document`] with each character's body chosen up front (`bodies[c]`), so a
+/// skinned character never gets bone boxes. The buffer is padded but `buffers` is left for the
+/// caller to set when it adds no more data.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn animated_document(
+    scene: &Scene,
+    cat: &Catalogue,
+    characters: &[(&str, &Clip)],
+    bodies: &[Body],
+    camera: &CameraFn,
+    fps: f64,
+    model: &dyn Fn(&str) -> Option<PathBuf>,
+) -> Result<AnimatedDocument, ScriptError> {
     check_fps(fps)?;
+    if bodies.len() != characters.len() {
+        return Err(ScriptError::Invalid(format!("{} bodies for {} characters", bodies.len(), characters.len())));
+    }
+    let mut first_joint = Vec::with_capacity(characters.len());
     let (mut doc, mut bin, notes) = gltf_document(scene, cat, model);
     let mut roots: Vec<usize> = Vec::new();
     let mut samplers: Vec<Value> = Vec::new();
@@ -202,19 +242,22 @@ pub fn animated_gltf_document(
             channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
         };
 
-    for (ci, (name, m)) in characters.iter().enumerate() {
+    for (ci, ((name, m), body)) in characters.iter().zip(bodies).enumerate() {
         let sk = m.skeleton();
         let n = m.num_frames();
-        let color = CHARACTER_COLORS[ci % CHARACTER_COLORS.len()].map(srgb_to_linear);
-        let mat = a.push(
-            "materials",
-            json!({"name": format!("{name} body"), "pbrMetallicRoughness": {"baseColorFactor": [color[0], color[1], color[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.7}}),
-        );
-        let mesh = a.centred_box(&format!("{name} bone"), mat);
+        let mesh = (*body == Body::Boxes).then(|| {
+            let color = CHARACTER_COLORS[ci % CHARACTER_COLORS.len()].map(srgb_to_linear);
+            let mat = a.push(
+                "materials",
+                json!({"name": format!("{name} body"), "pbrMetallicRoughness": {"baseColorFactor": [color[0], color[1], color[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.7}}),
+            );
+            a.centred_box(&format!("{name} bone"), mat)
+        });
         let poses = m.poses();
         let input = time_acc(&mut a, n, m.frame_time());
         // Joint nodes first (their indices are needed for children lists), filled in below.
         let first = a.doc["nodes"].as_array().map_or(0, Vec::len);
+        first_joint.push(first);
         let mut kids: Vec<Vec<usize>> = vec![Vec::new(); sk.len()];
         for (j, joint) in sk.joints().iter().enumerate() {
             let t = poses[0].translations[j];
@@ -228,6 +271,7 @@ pub fn animated_gltf_document(
             }
         }
         for (j, joint) in sk.joints().iter().enumerate() {
+            let Some(mesh) = mesh else { break };
             if let Some(p) = joint.parent {
                 if let Some(b) =
                     bone_node(format!("{} bone", joint.name), mesh, joint.offset, bone_thickness(&joint.name))
@@ -311,7 +355,7 @@ pub fn animated_gltf_document(
     }
     doc["buffers"] = json!([{"byteLength": bin.len()}]);
     doc["asset"]["generator"] = json!("inbetween script (animated)");
-    Ok((doc, bin, notes))
+    Ok(AnimatedDocument { doc, bin, notes, first_joint })
 }
 
 /// Writes the animated scene (see the module comment) as `.glb` (by extension) or `.gltf` with an

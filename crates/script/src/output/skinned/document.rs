@@ -1,5 +1,5 @@
-//! The skinned glTF document: the animated document with its bone boxes removed and a skinned
-//! mesh per character added on the joint nodes.
+//! The skinned glTF document: the animated document built without bone boxes for the characters
+//! that have a body, and a skinned mesh per such character added on its joint nodes.
 
 use super::*;
 
@@ -12,213 +12,6 @@ impl Appender<'_> {
         let view = self.view(bytes, target);
         self.push("accessors", json!({"bufferView": view, "componentType": component, "count": count, "type": kind}))
     }
-}
-
-/// Indices of a character's joint nodes in an animated document: the node named `name` whose only
-/// child is the skeleton's root joint; its joints follow that child in skeleton order.
-fn joint_nodes(doc: &Value, name: &str, skeleton: &Skeleton, taken: &BTreeSet<usize>) -> Option<(usize, usize)> {
-    let nodes = doc["nodes"].as_array()?;
-    let root_name = skeleton.joint(0).name.as_str();
-    nodes.iter().enumerate().find_map(|(i, n)| {
-        if taken.contains(&i) || n["name"].as_str() != Some(name) {
-            return None;
-        }
-        let first = n["children"].as_array().filter(|c| c.len() == 1)?[0].as_u64()? as usize;
-        let ok = skeleton
-            .joints()
-            .iter()
-            .enumerate()
-            .all(|(j, jt)| nodes.get(first + j).is_some_and(|x| x["name"].as_str() == Some(jt.name.as_str())));
-        (ok && nodes[first]["name"].as_str() == Some(root_name)).then_some((i, first))
-    })
-}
-
-/// Removes nodes (and meshes and materials nothing uses any more), re-indexing every reference:
-/// node children, scene roots, animation targets, skins and mesh/material indices.
-fn remove_nodes(doc: &mut Value, drop: &BTreeSet<usize>) {
-    let n = doc["nodes"].as_array().map_or(0, Vec::len);
-    let map: Vec<Option<usize>> = {
-        let mut k = 0;
-        (0..n)
-            .map(|i| {
-                if drop.contains(&i) {
-                    None
-                } else {
-                    k += 1;
-                    Some(k - 1)
-                }
-            })
-            .collect()
-    };
-    let re = |v: &Value| v.as_u64().and_then(|i| map.get(i as usize).copied().flatten()).map(|i| json!(i));
-    let old: Vec<Value> = doc["nodes"].as_array().cloned().unwrap_or_default();
-    let mut nodes: Vec<Value> =
-        old.into_iter().enumerate().filter(|(i, _)| !drop.contains(i)).map(|(_, v)| v).collect();
-    for node in &mut nodes {
-        if let Some(c) = node["children"].as_array() {
-            let kids: Vec<Value> = c.iter().filter_map(&re).collect();
-            if kids.is_empty() {
-                if let Some(o) = node.as_object_mut() {
-                    o.remove("children");
-                }
-            } else {
-                node["children"] = json!(kids);
-            }
-        }
-    }
-    doc["nodes"] = json!(nodes);
-    for scene in doc["scenes"].as_array_mut().into_iter().flatten() {
-        let roots: Vec<Value> = scene["nodes"].as_array().into_iter().flatten().filter_map(&re).collect();
-        scene["nodes"] = json!(roots);
-    }
-    for anim in doc["animations"].as_array_mut().into_iter().flatten() {
-        for ch in anim["channels"].as_array_mut().into_iter().flatten() {
-            if let Some(t) = re(&ch["target"]["node"]) {
-                ch["target"]["node"] = t;
-            }
-        }
-    }
-    for skin in doc["skins"].as_array_mut().into_iter().flatten() {
-        let joints: Vec<Value> = skin["joints"].as_array().into_iter().flatten().filter_map(&re).collect();
-        skin["joints"] = json!(joints);
-        if let Some(s) = re(&skin["skeleton"]) {
-            skin["skeleton"] = s;
-        }
-    }
-    compact(
-        doc,
-        "meshes",
-        |d| d["nodes"].as_array().into_iter().flatten().filter_map(|n| n["mesh"].as_u64()).collect(),
-        |d, m| {
-            for node in d["nodes"].as_array_mut().into_iter().flatten() {
-                if let Some(i) = node["mesh"].as_u64() {
-                    node["mesh"] = json!(m[i as usize]);
-                }
-            }
-        },
-    );
-    let used_materials = |d: &Value| -> BTreeSet<u64> {
-        d["meshes"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .flat_map(|m| m["primitives"].as_array().into_iter().flatten().filter_map(|p| p["material"].as_u64()))
-            .collect()
-    };
-    compact(doc, "materials", used_materials, |d, m| {
-        for mesh in d["meshes"].as_array_mut().into_iter().flatten() {
-            for p in mesh["primitives"].as_array_mut().into_iter().flatten() {
-                if let Some(i) = p["material"].as_u64() {
-                    p["material"] = json!(m[i as usize]);
-                }
-            }
-        }
-    });
-    compact(
-        doc,
-        "accessors",
-        |d| accessor_refs(d).iter().filter_map(|r| r.as_u64()).collect(),
-        |d, m| {
-            for r in accessor_refs_mut(d) {
-                if let Some(i) = r.as_u64() {
-                    *r = json!(m[i as usize]);
-                }
-            }
-        },
-    );
-    // Buffer views of the dropped accessors (their bytes stay in the buffer, unreferenced).
-    let view_users = ["accessors", "images"];
-    let used_views = |d: &Value| -> BTreeSet<u64> {
-        view_users
-            .iter()
-            .flat_map(|k| d[*k].as_array().into_iter().flatten().filter_map(|x| x["bufferView"].as_u64()))
-            .collect()
-    };
-    compact(doc, "bufferViews", used_views, |d, m| {
-        for k in view_users {
-            for x in d[k].as_array_mut().into_iter().flatten() {
-                if let Some(i) = x["bufferView"].as_u64() {
-                    x["bufferView"] = json!(m[i as usize]);
-                }
-            }
-        }
-    });
-}
-
-/// Every accessor reference of a document (before skins exist: mesh attributes and indices,
-/// animation sampler inputs and outputs).
-fn accessor_refs(doc: &Value) -> Vec<&Value> {
-    let mut out = Vec::new();
-    for mesh in doc["meshes"].as_array().into_iter().flatten() {
-        for p in mesh["primitives"].as_array().into_iter().flatten() {
-            out.extend(p["attributes"].as_object().into_iter().flat_map(|a| a.values()));
-            out.push(&p["indices"]);
-        }
-    }
-    for anim in doc["animations"].as_array().into_iter().flatten() {
-        for s in anim["samplers"].as_array().into_iter().flatten() {
-            out.extend([&s["input"], &s["output"]]);
-        }
-    }
-    out
-}
-
-fn accessor_refs_mut(doc: &mut Value) -> Vec<&mut Value> {
-    let mut out = Vec::new();
-    let (meshes, anims) = match doc.as_object_mut() {
-        Some(o) => {
-            let mut meshes = None;
-            let mut anims = None;
-            for (k, v) in o.iter_mut() {
-                match k.as_str() {
-                    "meshes" => meshes = Some(v),
-                    "animations" => anims = Some(v),
-                    _ => {}
-                }
-            }
-            (meshes, anims)
-        }
-        None => return out,
-    };
-    for mesh in meshes.and_then(Value::as_array_mut).into_iter().flatten() {
-        for p in mesh["primitives"].as_array_mut().into_iter().flatten() {
-            let Some(p) = p.as_object_mut() else { continue };
-            for (k, v) in p.iter_mut() {
-                match k.as_str() {
-                    "attributes" => out.extend(v.as_object_mut().into_iter().flat_map(|a| a.values_mut())),
-                    "indices" => out.push(v),
-                    _ => {}
-                }
-            }
-        }
-    }
-    for anim in anims.and_then(Value::as_array_mut).into_iter().flatten() {
-        for s in anim["samplers"].as_array_mut().into_iter().flatten() {
-            let Some(s) = s.as_object_mut() else { continue };
-            out.extend(s.iter_mut().filter(|(k, _)| *k == "input" || *k == "output").map(|(_, v)| v));
-        }
-    }
-    out
-}
-
-/// Drops the entries of `doc[key]` outside `used(doc)` and lets `fix` re-index references with
-/// the old → new map.
-fn compact(doc: &mut Value, key: &str, used: impl Fn(&Value) -> BTreeSet<u64>, fix: impl Fn(&mut Value, &[usize])) {
-    let used = used(doc);
-    let Some(items) = doc[key].as_array().cloned() else { return };
-    if used.len() == items.len() {
-        return;
-    }
-    let mut map = vec![usize::MAX; items.len()];
-    let mut kept = Vec::new();
-    for (i, it) in items.into_iter().enumerate() {
-        if used.contains(&(i as u64)) {
-            map[i] = kept.len();
-            kept.push(it);
-        }
-    }
-    doc[key] = json!(kept);
-    fix(doc, &map);
 }
 
 /// Adds one skinned body to the document: texture, material, mesh, skin over the joint nodes
@@ -290,8 +83,9 @@ fn add_body(out: &mut Appender, name: &str, body: &SkinnedBody, first: usize) ->
 }
 
 /// The animated document of [`animated_gltf_document`] with every character that has a body
-/// skinned: its bone boxes removed, the body added as a skinned mesh on its joint nodes (which keep
-/// their animation channels). Characters without a body (`None`) keep the stick figure.
+/// skinned: built without its bone boxes, the body added as a skinned mesh on its joint nodes
+/// (which keep their animation channels). Characters without a body (`None`) keep the stick
+/// figure.
 pub fn skinned_gltf_document(
     cast: &SkinnedCast,
     model: &dyn Fn(&str) -> Option<PathBuf>,
@@ -299,16 +93,6 @@ pub fn skinned_gltf_document(
     let SkinnedCast { scene, cat, characters, bodies, camera, fps } = *cast;
     if bodies.len() != characters.len() {
         return Err(ScriptError::Invalid(format!("{} bodies for {} characters", bodies.len(), characters.len())));
-    }
-    let (mut doc, mut bin, notes) = animated_gltf_document(scene, cat, characters, camera, fps, model)?;
-    let mut taken = BTreeSet::new();
-    let mut found = Vec::new();
-    for (name, m) in characters {
-        let (root, first) = joint_nodes(&doc, name, m.skeleton(), &taken).ok_or_else(|| {
-            ScriptError::Invalid(format!("character '{name}': no joint nodes in the animated document"))
-        })?;
-        taken.insert(root);
-        found.push((root, first));
     }
     for ((_, m), body) in characters.iter().zip(bodies) {
         if let Some(b) = body {
@@ -321,26 +105,14 @@ pub fn skinned_gltf_document(
             }
         }
     }
-    // The stick figure's boxes of skinned characters: mesh children of their joint nodes.
-    let mut drop = BTreeSet::new();
-    for (((_, m), body), &(_, first)) in characters.iter().zip(bodies).zip(&found) {
-        if body.is_none() {
-            continue;
-        }
-        for j in first..first + m.skeleton().len() {
-            for c in doc["nodes"][j]["children"].as_array().into_iter().flatten().filter_map(Value::as_u64) {
-                if doc["nodes"][c as usize].get("mesh").is_some() {
-                    drop.insert(c as usize);
-                }
-            }
-        }
-    }
-    remove_nodes(&mut doc, &drop);
-    let shift = |i: usize| i - drop.range(..i).count();
+    // Bone boxes only for the characters without a body; the bodies go on their joint nodes.
+    let kinds: Vec<Body> = bodies.iter().map(|b| if b.is_some() { Body::Skinned } else { Body::Boxes }).collect();
+    let AnimatedDocument { mut doc, mut bin, notes, first_joint } =
+        animated_document(scene, cat, characters, &kinds, camera, fps, model)?;
     let mut out = Appender { doc: &mut doc, bin: &mut bin };
-    for (((name, _), body), &(_, first)) in characters.iter().zip(bodies).zip(&found) {
+    for (((name, _), body), &first) in characters.iter().zip(bodies).zip(&first_joint) {
         if let Some(b) = body {
-            add_body(&mut out, name, b, shift(first))?;
+            add_body(&mut out, name, b, first)?;
         }
     }
     pad_to_4(&mut bin);

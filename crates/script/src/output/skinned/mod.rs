@@ -16,12 +16,13 @@
 //!   joints (knee and ankle, elbow and wrist, spine joints), triangles clipped with their
 //!   attributes interpolated, and every piece bound to the joint of its span (`UpLeg`/`Leg`/`Foot`,
 //!   `Arm`/`ForeArm`/`Hand`, `LowerBack`/`Spine`/`Spine1`, `Head`).
-//! - **Document.** [`skinned_gltf_document`] takes [`animated_gltf_document`]'s output, removes the
-//!   stick figure's bone boxes (their nodes, mesh and material) and adds per character the skin
-//!   (joints = the character's joint nodes, which carry the same animation channels), the mesh node,
-//!   its texture (the image bytes embedded in the buffer) and material.
+//! - **Document.** [`skinned_gltf_document`] builds [`animated_gltf_document`]'s document with the
+//!   body chosen up front per character (no bone boxes, mesh or material for one that has a skinned
+//!   body, so nothing is added only to be removed) and adds per skinned character the skin (joints =
+//!   the character's joint nodes, which carry the same animation channels), the mesh node, its
+//!   texture (the image bytes embedded in the buffer) and material.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{DVec3, Mat4, Quat, Vec3};
@@ -34,7 +35,7 @@ use inbetween_render::canvas::Camera3;
 use inbetween_render::Canvas;
 use serde_json::{json, Value};
 
-use super::anim_gltf::{animated_gltf_document, Appender, CameraFn};
+use super::anim_gltf::{animated_document, AnimatedDocument, Appender, Body, CameraFn};
 use super::gltf::write_document;
 use super::preview::{draw_object, draw_room, fill_convex, scale_color};
 use crate::catalogue::Catalogue;
