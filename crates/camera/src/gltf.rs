@@ -4,48 +4,39 @@
 
 use crate::dataset::Scene;
 use crate::infer::CameraTrack;
-use inbetween_io::gltf_buffer::{data_uri, ElementType, GltfBuffer};
-use serde_json::json;
+use inbetween_io::gltf_buffer::json::{animation::Property, Index, Node};
+use inbetween_io::gltf_buffer::{data_uri, node, perspective, scene, Anim, GltfDoc, Type};
 
 /// The glTF document (JSON) of `track` over `scene`.
-pub fn camera_gltf(track: &CameraTrack, scene: &Scene) -> serde_json::Value {
+pub fn camera_gltf(track: &CameraTrack, scene_: &Scene) -> serde_json::Value {
     // Animation data only: views without a target, bounds on the time input as the spec asks.
-    let mut b = GltfBuffer::default();
+    let mut d = GltfDoc::new("inbetween camera");
     let times: Vec<f32> = track.frames.iter().map(|f| (f.frame as f64 / track.fps) as f32).collect();
-    let t_acc = b.floats(&times, ElementType::Scalar, true, None);
+    let t_acc = d.floats(&times, Type::Scalar, true, None);
     let pos: Vec<f32> = track.frames.iter().flat_map(|f| f.pose.position.to_array().map(|v| v as f32)).collect();
     let rot: Vec<f32> = track.frames.iter().flat_map(|f| f.pose.rotation.to_array().map(|v| v as f32)).collect();
-    let p_acc = b.floats(&pos, ElementType::Vec3, false, None);
-    let r_acc = b.floats(&rot, ElementType::Vec4, false, None);
-    let mut nodes = vec![json!({"name": "camera", "camera": 0})];
-    let mut samplers = vec![
-        json!({"input": t_acc, "output": p_acc, "interpolation": "LINEAR"}),
-        json!({"input": t_acc, "output": r_acc, "interpolation": "LINEAR"}),
-    ];
-    let mut channels = vec![
-        json!({"sampler": 0, "target": {"node": 0, "path": "translation"}}),
-        json!({"sampler": 1, "target": {"node": 0, "path": "rotation"}}),
-    ];
-    for (i, c) in scene.characters.iter().enumerate() {
+    let p_acc = d.floats(&pos, Type::Vec3, false, None);
+    let r_acc = d.floats(&rot, Type::Vec4, false, None);
+    let lens = track.lens;
+    let cam = d.push(perspective(None, lens.fovy as f32, Some(lens.aspect as f32), 0.05, Some(500.0)));
+    let cam_node = d.push(Node { camera: Some(cam), ..node("camera") });
+    let mut anim = Anim::default();
+    anim.channel(t_acc, p_acc, cam_node, Property::Translation);
+    anim.channel(t_acc, r_acc, cam_node, Property::Rotation);
+    for c in &scene_.characters {
         let tgt: Vec<f32> =
             track.frames.iter().flat_map(|f| c.frame(f.frame).target().to_array().map(|v| v as f32)).collect();
-        let acc = b.floats(&tgt, ElementType::Vec3, false, None);
-        nodes.push(json!({"name": format!("target {}", c.name)}));
-        samplers.push(json!({"input": t_acc, "output": acc, "interpolation": "LINEAR"}));
-        channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": i + 1, "path": "translation"}}));
+        let acc = d.floats(&tgt, Type::Vec3, false, None);
+        let n = d.push(node(format!("target {}", c.name)));
+        anim.channel(t_acc, acc, n, Property::Translation);
     }
-    let lens = track.lens;
-    json!({
-        "asset": {"version": "2.0", "generator": "inbetween camera"},
-        "scene": 0,
-        "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
-        "nodes": nodes,
-        "cameras": [{"type": "perspective", "perspective": {"yfov": lens.fovy, "aspectRatio": lens.aspect, "znear": 0.05, "zfar": 500.0}}],
-        "animations": [{"name": format!("camera ({})", track.style), "samplers": samplers, "channels": channels}],
-        "buffers": [{"byteLength": b.bin.len(), "uri": data_uri(&b.bin)}],
-        "bufferViews": b.views,
-        "accessors": b.accessors,
-    })
+    d.push(anim.finish(format!("camera ({})", track.style)));
+    let nodes = (0..d.root.nodes.len() as u32).map(Index::new).collect();
+    d.root.scenes.push(scene(None, nodes));
+    d.root.scene = Some(Index::new(0));
+    let (mut doc, bin) = d.finish();
+    doc["buffers"][0]["uri"] = serde_json::json!(data_uri(&bin));
+    doc
 }
 
 /// Writes the glTF file atomically.

@@ -8,49 +8,49 @@
 //! because a browser parses the binary buffer many times faster than BVH text.
 
 use inbetween_core::Motion;
-use serde_json::{json, Value};
+use serde_json::Value;
 
-use crate::gltf_buffer::{ElementType, GltfBuffer};
+use crate::gltf_buffer::json::{animation::Property, Index, Node};
+use crate::gltf_buffer::{node, scene, Anim, GltfDoc, Type};
 
 /// The document (buffer 0 without `uri`) and its binary buffer; pass both to [`glb_bytes`] or
 /// [`crate::gltf_buffer::data_uri`].
 pub fn motion_document(motion: &Motion, name: &str, scale: f64) -> (Value, Vec<u8>) {
     let skeleton = &motion.skeleton;
     let joints = skeleton.joints();
-    let mut nodes: Vec<Value> = joints
-        .iter()
-        .map(|j| {
-            let t = j.offset * scale;
-            json!({"name": j.name, "translation": [t.x as f32, t.y as f32, t.z as f32]})
-        })
-        .collect();
-    let mut children: Vec<Vec<usize>> = vec![Vec::new(); joints.len()];
+    let mut d = GltfDoc::new("inbetween");
+    let f32s = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32];
+    for j in joints {
+        d.push(Node { translation: Some(f32s(j.offset * scale)), ..node(j.name.as_str()) });
+    }
+    let mut children: Vec<Vec<Index<Node>>> = vec![Vec::new(); joints.len()];
     let mut roots = Vec::new();
     for (i, j) in joints.iter().enumerate() {
         match j.parent {
-            Some(p) => children[p].push(i),
-            None => roots.push(i),
+            Some(p) => children[p].push(Index::new(i as u32)),
+            None => roots.push(Index::new(i as u32)),
         }
     }
     for (i, j) in joints.iter().enumerate() {
         if let Some(e) = j.end_site {
-            let e = e * scale;
-            nodes.push(json!({"name": format!("{}_end", j.name), "translation": [e.x as f32, e.y as f32, e.z as f32]}));
-            children[i].push(nodes.len() - 1);
+            let end = d.push(Node { translation: Some(f32s(e * scale)), ..node(format!("{}_end", j.name)) });
+            children[i].push(end);
         }
     }
-    for (i, c) in children.iter().enumerate() {
+    for (i, c) in children.into_iter().enumerate() {
         if !c.is_empty() {
-            nodes[i]["children"] = json!(c);
+            d.root.nodes[i].children = Some(c);
         }
     }
+    d.root.scenes.push(scene(Some(name.to_string()), roots));
+    d.root.scene = Some(Index::new(0));
     let n = motion.num_frames();
-    let mut buf = GltfBuffer::default();
     let times: Vec<f32> = (0..n).map(|f| (f as f64 * motion.frame_time) as f32).collect();
-    let input = buf.floats(&times, ElementType::Scalar, true, None);
+    let input = d.floats(&times, Type::Scalar, true, None);
     let poses: Vec<_> = (0..n).map(|f| motion.pose(f)).collect();
-    let (mut samplers, mut channels) = (Vec::new(), Vec::new());
+    let mut anim = Anim::default();
     for (j, joint) in joints.iter().enumerate() {
+        let target = Index::new(j as u32);
         let rot: Vec<f32> = poses
             .iter()
             .flat_map(|p| {
@@ -58,36 +58,18 @@ pub fn motion_document(motion: &Motion, name: &str, scale: f64) -> (Value, Vec<u
                 [q.x as f32, q.y as f32, q.z as f32, q.w as f32]
             })
             .collect();
-        let out = buf.floats(&rot, ElementType::Vec4, false, None);
-        samplers.push(json!({"input": input, "output": out, "interpolation": "LINEAR"}));
-        channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": j, "path": "rotation"}}));
+        let out = d.floats(&rot, Type::Vec4, false, None);
+        anim.channel(input, out, target, Property::Rotation);
         if joint.channels.iter().any(|c| !c.is_rotation()) {
-            let tr: Vec<f32> = poses
-                .iter()
-                .flat_map(|p| {
-                    let t = p.translations[j] * scale;
-                    [t.x as f32, t.y as f32, t.z as f32]
-                })
-                .collect();
-            let out = buf.floats(&tr, ElementType::Vec3, false, None);
-            samplers.push(json!({"input": input, "output": out, "interpolation": "LINEAR"}));
-            channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": j, "path": "translation"}}));
+            let tr: Vec<f32> = poses.iter().flat_map(|p| f32s(p.translations[j] * scale)).collect();
+            let out = d.floats(&tr, Type::Vec3, false, None);
+            anim.channel(input, out, target, Property::Translation);
         }
     }
-    buf.align();
-    let mut doc = json!({
-        "asset": {"version": "2.0", "generator": "inbetween"},
-        "scene": 0,
-        "scenes": [{"name": name, "nodes": roots}],
-        "nodes": nodes,
-        "buffers": [{"byteLength": buf.bin.len()}],
-        "bufferViews": buf.views,
-        "accessors": buf.accessors,
-    });
     if n > 0 {
-        doc["animations"] = json!([{"name": name, "samplers": samplers, "channels": channels}]);
+        d.push(anim.finish(name));
     }
-    (doc, buf.bin)
+    d.finish()
 }
 
 /// [`motion_document`] as a binary glTF (`.glb`) file's bytes.

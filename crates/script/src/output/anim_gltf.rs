@@ -11,10 +11,14 @@ use std::path::{Path, PathBuf};
 
 use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
 use inbetween_core::clip::Clip;
-use inbetween_io::gltf_buffer::{self, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
+use inbetween_io::gltf_buffer::json::animation::{Interpolation, Property};
+use inbetween_io::gltf_buffer::json::mesh::Semantic::{Normals, Positions};
+use inbetween_io::gltf_buffer::json::scene::UnitQuaternion;
+use inbetween_io::gltf_buffer::json::{self, Accessor, Index, Node};
+use inbetween_io::gltf_buffer::{material, mesh, node, perspective, Anim, GltfDoc, Type, ARRAY_BUFFER};
 use serde_json::{json, Value};
 
-use super::gltf::{gltf_document, write_document};
+use super::gltf::{scene_document, write_document};
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::scene::Scene;
@@ -63,50 +67,14 @@ pub fn look_rotation(eye: Vec3, target: Vec3) -> Quat {
     Quat::from_mat3(&Mat3::from_cols(r, u, -f)).normalize()
 }
 
-/// Appends binary data and accessors to an existing document and its buffer (also used by
-/// [`super::skinned`]).
-pub(crate) struct Appender<'a> {
-    pub(crate) doc: &'a mut Value,
-    pub(crate) bin: &'a mut Vec<u8>,
-}
-
-impl Appender<'_> {
-    pub(crate) fn push(&mut self, key: &str, v: Value) -> usize {
-        if !self.doc.get(key).is_some_and(Value::is_array) {
-            self.doc[key] = json!([]);
-        }
-        let a = self.doc[key].as_array_mut().expect("array just ensured");
-        a.push(v);
-        a.len() - 1
-    }
-
-    /// Adds `bytes` as a bufferView (4-byte aligned, see [`gltf_buffer::append_view`]).
-    pub(crate) fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        let v = gltf_buffer::append_view(self.bin, bytes, target);
-        self.push("bufferViews", v)
-    }
-
-    /// FLOAT accessor of `kind` elements in a view of its own.
-    pub(crate) fn floats(&mut self, values: &[f32], kind: ElementType, bounds: bool, target: Option<u32>) -> usize {
-        let view = self.view(&gltf_buffer::f32_bytes(values), target);
-        self.push("accessors", gltf_buffer::float_accessor(view, values, kind, bounds))
-    }
-
-    /// UNSIGNED_SHORT index accessor in an ELEMENT_ARRAY_BUFFER view.
-    fn indices(&mut self, idx: &[u16]) -> usize {
-        let view = self.view(&gltf_buffer::u16_bytes(idx), Some(ELEMENT_ARRAY_BUFFER));
-        self.push("accessors", gltf_buffer::u16_index_accessor(view, idx.len()))
-    }
-
-    /// A box mesh centred on the origin, unit edges, flat normals; one per material.
-    fn centred_box(&mut self, name: &str, material: usize) -> usize {
-        let (pos, nor, idx) = super::gltf::box_geometry(0.0);
-        let (pos, nor): (Vec<f32>, Vec<f32>) = (pos.concat(), nor.concat());
-        let p = self.floats(&pos, ElementType::Vec3, true, Some(ARRAY_BUFFER));
-        let nn = self.floats(&nor, ElementType::Vec3, false, Some(ARRAY_BUFFER));
-        let i = self.indices(&idx);
-        self.push("meshes", json!({"name": name, "primitives": [{"attributes": {"POSITION": p, "NORMAL": nn}, "indices": i, "material": material}]}))
-    }
+/// A box mesh centred on the origin, unit edges, flat normals, in `material`.
+fn centred_box(d: &mut GltfDoc, name: &str, material: Index<json::Material>) -> Index<json::Mesh> {
+    let (pos, nor, idx) = super::gltf::box_geometry(0.0);
+    let (pos, nor): (Vec<f32>, Vec<f32>) = (pos.concat(), nor.concat());
+    let p = d.floats(&pos, Type::Vec3, true, Some(ARRAY_BUFFER));
+    let nn = d.floats(&nor, Type::Vec3, false, Some(ARRAY_BUFFER));
+    let i = d.indices(&idx);
+    d.push(mesh(name, &[(Positions, p), (Normals, nn)], Some(i), Some(material)))
 }
 
 fn srgb_to_linear(c: u8) -> f32 {
@@ -134,20 +102,20 @@ fn bone_thickness(joint: &str) -> f32 {
 }
 
 /// A node that stretches a centred unit box along `offset` (from the parent joint's origin).
-fn bone_node(name: String, mesh: usize, offset: DVec3, thickness: f32) -> Option<Value> {
+fn bone_node(name: String, mesh: Index<json::Mesh>, offset: DVec3, thickness: f32) -> Option<Node> {
     let len = offset.length();
     if len < 1e-3 {
         return None;
     }
     let q = DQuat::from_rotation_arc(DVec3::Y, offset / len).normalize();
     let t = offset / 2.0;
-    Some(json!({
-        "name": name,
-        "mesh": mesh,
-        "translation": [t.x as f32, t.y as f32, t.z as f32],
-        "rotation": [q.x as f32, q.y as f32, q.z as f32, q.w as f32],
-        "scale": [thickness, len as f32, thickness],
-    }))
+    Some(Node {
+        mesh: Some(mesh),
+        translation: Some([t.x as f32, t.y as f32, t.z as f32]),
+        rotation: Some(UnitQuaternion([q.x as f32, q.y as f32, q.z as f32, q.w as f32])),
+        scale: Some([thickness, len as f32, thickness]),
+        ..node(name)
+    })
 }
 
 /// Unit quaternions (x, y, z, w) with consecutive keys in the same hemisphere, so LINEAR
@@ -179,9 +147,8 @@ pub fn animated_gltf_document(
     fps: f64,
     model: &dyn Fn(&str) -> Option<PathBuf>,
 ) -> Result<(Value, Vec<u8>, Vec<String>), ScriptError> {
-    let bodies = vec![Body::Boxes; characters.len()];
-    let out = animated_document(scene, cat, characters, &bodies, camera, fps, model)?;
-    Ok((out.doc, out.bin, out.notes))
+    let cast: Vec<_> = characters.iter().map(|&(n, c)| (n, c, Body::Boxes)).collect();
+    Ok(animated_document(scene, cat, &cast, camera, fps, model)?.finish())
 }
 
 /// How a character's body is drawn in an animated document.
@@ -195,79 +162,86 @@ pub(crate) enum Body {
 
 /// An animated document under construction and where each character's joint nodes are.
 pub(crate) struct AnimatedDocument {
-    pub doc: Value,
-    pub bin: Vec<u8>,
+    pub d: GltfDoc,
+    /// The "story" animation, added to the document by [`AnimatedDocument::finish`].
+    pub anim: Anim,
     pub notes: Vec<String>,
     /// Per character, the node index of its root joint; its other joints follow in skeleton order.
     pub first_joint: Vec<usize>,
+    /// The field-of-view channel (its position among the channels, its sampler, the JSON
+    /// pointer it drives): `gltf-json` 1.4 has no KHR_animation_pointer target (its targets need a
+    /// node and a TRS path), so it is written into the JSON when the document is finished.
+    fov: Option<(usize, usize, String)>,
 }
 
-/// [`animated_gltf_document`] with each character's body chosen up front (`bodies[c]`), so a
-/// skinned character never gets bone boxes. The buffer is padded but `buffers` is left for the
-/// caller to set when it adds no more data.
-#[allow(clippy::too_many_arguments)]
+impl AnimatedDocument {
+    /// The document as JSON and its buffer.
+    pub fn finish(mut self) -> (Value, Vec<u8>, Vec<String>) {
+        let anim = std::mem::take(&mut self.anim);
+        self.d.push(anim.finish(ANIMATION_NAME));
+        let (mut doc, bin) = self.d.finish();
+        if let Some((at, sampler, pointer)) = self.fov {
+            let channel = json!({"sampler": sampler, "target": {"path": "pointer", "extensions": {FOV_EXTENSION: {"pointer": pointer}}}});
+            if let Some(c) = doc["animations"][0]["channels"].as_array_mut() {
+                c.insert(at.min(c.len()), channel);
+            }
+        }
+        (doc, bin, self.notes)
+    }
+}
+
+/// [`animated_gltf_document`] with each character's body chosen up front (`cast[c].2`), so a
+/// skinned character never gets bone boxes; not finished, so the caller can add to it.
 pub(crate) fn animated_document(
     scene: &Scene,
     cat: &Catalogue,
-    characters: &[(&str, &Clip)],
-    bodies: &[Body],
+    cast: &[(&str, &Clip, Body)],
     camera: &CameraFn,
     fps: f64,
     model: &dyn Fn(&str) -> Option<PathBuf>,
 ) -> Result<AnimatedDocument, ScriptError> {
     check_fps(fps)?;
-    if bodies.len() != characters.len() {
-        return Err(ScriptError::Invalid(format!("{} bodies for {} characters", bodies.len(), characters.len())));
-    }
+    let characters: Vec<(&str, &Clip)> = cast.iter().map(|&(n, c, _)| (n, c)).collect();
     let mut first_joint = Vec::with_capacity(characters.len());
-    let (mut doc, mut bin, notes) = gltf_document(scene, cat, model);
-    let mut roots: Vec<usize> = Vec::new();
-    let mut samplers: Vec<Value> = Vec::new();
-    let mut channels: Vec<Value> = Vec::new();
-    let mut a = Appender { doc: &mut doc, bin: &mut bin };
+    let (mut d, notes) = scene_document(scene, cat, model, "inbetween script (animated)");
+    let mut roots: Vec<Index<Node>> = Vec::new();
+    let mut anim = Anim::default();
     // Time accessors shared by every channel with the same key count and frame time.
-    let mut times: Vec<(usize, u64, usize)> = Vec::new();
-    let mut time_acc = |a: &mut Appender, n: usize, dt: f64| -> usize {
+    let mut times: Vec<(usize, u64, Index<Accessor>)> = Vec::new();
+    let mut time_acc = |d: &mut GltfDoc, n: usize, dt: f64| -> Index<Accessor> {
         if let Some(&(_, _, acc)) = times.iter().find(|t| t.0 == n && t.1 == dt.to_bits()) {
             return acc;
         }
         let t: Vec<f32> = (0..n).map(|f| (f as f64 * dt) as f32).collect();
-        let acc = a.floats(&t, ElementType::Scalar, true, None);
+        let acc = d.floats(&t, Type::Scalar, true, None);
         times.push((n, dt.to_bits(), acc));
         acc
     };
-    let channel =
-        |samplers: &mut Vec<Value>, channels: &mut Vec<Value>, input: usize, output: usize, node: usize, path: &str| {
-            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-            channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
-        };
 
-    for (ci, ((name, m), body)) in characters.iter().zip(bodies).enumerate() {
+    for (ci, &(name, m, body)) in cast.iter().enumerate() {
         let sk = m.skeleton();
         let n = m.num_frames();
-        let mesh = (*body == Body::Boxes).then(|| {
-            let color = CHARACTER_COLORS[ci % CHARACTER_COLORS.len()].map(srgb_to_linear);
-            let mat = a.push(
-                "materials",
-                json!({"name": format!("{name} body"), "pbrMetallicRoughness": {"baseColorFactor": [color[0], color[1], color[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.7}}),
-            );
-            a.centred_box(&format!("{name} bone"), mat)
+        let mesh = (body == Body::Boxes).then(|| {
+            let c = CHARACTER_COLORS[ci % CHARACTER_COLORS.len()].map(srgb_to_linear);
+            let mat = d.push(material(format!("{name} body"), [c[0], c[1], c[2], 1.0], 0.7));
+            centred_box(&mut d, &format!("{name} bone"), mat)
         });
         let poses = m.poses();
-        let input = time_acc(&mut a, n, m.frame_time());
+        let input = time_acc(&mut d, n, m.frame_time());
         // Joint nodes first (their indices are needed for children lists), filled in below.
-        let first = a.doc["nodes"].as_array().map_or(0, Vec::len);
+        let first = d.root.nodes.len();
         first_joint.push(first);
-        let mut kids: Vec<Vec<usize>> = vec![Vec::new(); sk.len()];
+        let mut kids: Vec<Vec<Index<Node>>> = vec![Vec::new(); sk.len()];
         for (j, joint) in sk.joints().iter().enumerate() {
             let t = poses[0].translations[j];
             let q = poses[0].rotations[j].normalize();
-            a.push(
-                "nodes",
-                json!({"name": joint.name, "translation": [t.x as f32, t.y as f32, t.z as f32], "rotation": [q.x as f32, q.y as f32, q.z as f32, q.w as f32]}),
-            );
+            d.push(Node {
+                translation: Some([t.x as f32, t.y as f32, t.z as f32]),
+                rotation: Some(UnitQuaternion([q.x as f32, q.y as f32, q.z as f32, q.w as f32])),
+                ..node(joint.name.as_str())
+            });
             if let Some(p) = joint.parent {
-                kids[p].push(first + j);
+                kids[p].push(Index::new((first + j) as u32));
             }
         }
         for (j, joint) in sk.joints().iter().enumerate() {
@@ -276,41 +250,39 @@ pub(crate) fn animated_document(
                 if let Some(b) =
                     bone_node(format!("{} bone", joint.name), mesh, joint.offset, bone_thickness(&joint.name))
                 {
-                    let k = a.push("nodes", b);
-                    kids[p].push(k);
+                    kids[p].push(d.push(b));
                 }
             }
             if let Some(e) = joint.end_site {
                 if let Some(b) = bone_node(format!("{} end bone", joint.name), mesh, e, bone_thickness(&joint.name)) {
-                    let k = a.push("nodes", b);
-                    kids[j].push(k);
+                    kids[j].push(d.push(b));
                 }
             }
         }
         for (j, k) in kids.into_iter().enumerate() {
             if !k.is_empty() {
-                a.doc["nodes"][first + j]["children"] = json!(k);
+                d.root.nodes[first + j].children = Some(k);
             }
         }
-        let root = a.push("nodes", json!({"name": name, "children": [first]}));
-        roots.push(root);
+        roots.push(d.push(Node { children: Some(vec![Index::new(first as u32)]), ..node(name) }));
         // Channels: translation where the joint has position channels, rotation where it rotates.
         for (j, joint) in sk.joints().iter().enumerate() {
+            let target = Index::new((first + j) as u32);
             if joint.has_translation() {
                 let v: Vec<f32> = poses.iter().flat_map(|p| p.translations[j].to_array().map(|x| x as f32)).collect();
-                let out = a.floats(&v, ElementType::Vec3, false, None);
-                channel(&mut samplers, &mut channels, input, out, first + j, "translation");
+                let out = d.floats(&v, Type::Vec3, false, None);
+                anim.channel(input, out, target, Property::Translation);
             }
             if joint.rotation_order().is_some() {
                 let v = continuous_quats(poses.iter().map(|p| p.rotations[j].as_quat()));
-                let out = a.floats(&v, ElementType::Vec4, false, None);
-                channel(&mut samplers, &mut channels, input, out, first + j, "rotation");
+                let out = d.floats(&v, Type::Vec4, false, None);
+                anim.channel(input, out, target, Property::Rotation);
             }
         }
     }
 
     // The camera.
-    let n = animation_frames(characters, fps);
+    let n = animation_frames(&characters, fps);
     let shots: Vec<([f32; 3], [f32; 3], f32)> = (0..n).map(camera).collect();
     let yfov = shots[0].2;
     if let Some(f) = shots.iter().position(|s| !(s.2.is_finite() && s.2 > 0.0 && s.2 < 180.0)) {
@@ -322,40 +294,34 @@ pub(crate) fn animated_document(
     if let Some(f) = shots.iter().position(|s| !(s.0.iter().chain(&s.1).all(|v| v.is_finite()))) {
         return Err(ScriptError::Invalid(format!("camera pose at frame {f} is not finite")));
     }
-    let cam = a.push("cameras", json!({"name": "story camera", "type": "perspective", "perspective": {"yfov": yfov.to_radians(), "znear": 0.05, "zfar": 200.0}}));
-    let eye0 = shots[0].0;
+    let cam = d.push(perspective(Some("story camera".into()), yfov.to_radians(), None, 0.05, Some(200.0)));
     let q0 = look_rotation(Vec3::from(shots[0].0), Vec3::from(shots[0].1));
-    let cam_node =
-        a.push("nodes", json!({"name": "camera", "camera": cam, "translation": eye0, "rotation": q0.to_array()}));
+    let cam_node = d.push(Node {
+        camera: Some(cam),
+        translation: Some(shots[0].0),
+        rotation: Some(UnitQuaternion(q0.to_array())),
+        ..node("camera")
+    });
     roots.push(cam_node);
-    let input = time_acc(&mut a, n, 1.0 / fps);
+    let input = time_acc(&mut d, n, 1.0 / fps);
     let pos: Vec<f32> = shots.iter().flat_map(|s| s.0).collect();
-    let out = a.floats(&pos, ElementType::Vec3, false, None);
-    channel(&mut samplers, &mut channels, input, out, cam_node, "translation");
+    let out = d.floats(&pos, Type::Vec3, false, None);
+    anim.channel(input, out, cam_node, Property::Translation);
     let rot = continuous_quats(shots.iter().map(|s| look_rotation(Vec3::from(s.0), Vec3::from(s.1))));
-    let out = a.floats(&rot, ElementType::Vec4, false, None);
-    channel(&mut samplers, &mut channels, input, out, cam_node, "rotation");
+    let out = d.floats(&rot, Type::Vec4, false, None);
+    anim.channel(input, out, cam_node, Property::Rotation);
+    let mut fov = None;
     if shots.iter().any(|s| s.2 != yfov) {
         // Core glTF cannot animate a camera's field of view: KHR_animation_pointer (used, not
         // required; viewers without it keep the frame-0 value) steps it at every change.
         let v: Vec<f32> = shots.iter().map(|s| s.2.to_radians()).collect();
-        let out = a.floats(&v, ElementType::Scalar, false, None);
-        samplers.push(json!({"input": input, "output": out, "interpolation": "STEP"}));
-        let pointer = format!("/cameras/{cam}/perspective/yfov");
-        channels.push(json!({"sampler": samplers.len() - 1, "target": {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": pointer}}}}));
-        if !a.doc["extensionsUsed"].as_array().is_some_and(|u| u.iter().any(|e| e == FOV_EXTENSION)) {
-            a.push("extensionsUsed", json!(FOV_EXTENSION));
-        }
+        let out = d.floats(&v, Type::Scalar, false, None);
+        let sampler = anim.sampler(input, out, Interpolation::Step);
+        fov = Some((anim.channels.len(), sampler.value(), format!("/cameras/{}/perspective/yfov", cam.value())));
+        d.use_extension(FOV_EXTENSION);
     }
-
-    a.push("animations", json!({"name": ANIMATION_NAME, "samplers": samplers, "channels": channels}));
-    gltf_buffer::pad_to_4(&mut bin);
-    if let Some(s) = doc.pointer_mut("/scenes/0/nodes").and_then(Value::as_array_mut) {
-        s.extend(roots.into_iter().map(|r| json!(r)));
-    }
-    doc["buffers"] = json!([{"byteLength": bin.len()}]);
-    doc["asset"]["generator"] = json!("inbetween script (animated)");
-    Ok(AnimatedDocument { doc, bin, notes, first_joint })
+    d.root.scenes[0].nodes.extend(roots);
+    Ok(AnimatedDocument { d, anim, notes, first_joint, fov })
 }
 
 /// Writes the animated scene (see the module comment) as `.glb` (by extension) or `.gltf` with an
@@ -399,43 +365,37 @@ pub fn story_gltf_document(
 ) -> Result<(Value, Vec<u8>), ScriptError> {
     let chars: Vec<(&str, &Clip)> = anim.characters.iter().map(|c| (c.name.as_str(), &c.clip)).collect();
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
-    let (mut doc, mut bin, _notes) = animated_gltf_document(&anim.scene, cat, &chars, camera, anim.fps, &lookup)?;
-    let n = animation_frames(&chars, anim.fps);
-    add_prop_channels(&mut doc, &mut bin, anim, n);
+    let cast: Vec<_> = chars.iter().map(|&(n, c)| (n, c, Body::Boxes)).collect();
+    let mut doc = animated_document(&anim.scene, cat, &cast, camera, anim.fps, &lookup)?;
+    add_prop_channels(&mut doc, anim, animation_frames(&chars, anim.fps));
+    let (doc, bin, _notes) = doc.finish();
     Ok((doc, bin))
 }
 
 /// Channels moving every carried prop's object node (the scene's node named by its label) over
 /// frames `0..n` at the animation's rate.
-pub(crate) fn add_prop_channels(doc: &mut Value, bin: &mut Vec<u8>, anim: &crate::animate::Animation, n: usize) {
+pub(crate) fn add_prop_channels(doc: &mut AnimatedDocument, anim: &crate::animate::Animation, n: usize) {
     let carried: Vec<usize> =
         (0..anim.scene.objects.len()).filter(|&i| crate::animate::carried_from(anim, i).is_some()).collect();
     if carried.is_empty() || n == 0 {
         return;
     }
-    let mut a = Appender { doc, bin };
+    let d = &mut doc.d;
     let t: Vec<f32> = (0..n).map(|f| (f as f64 / anim.fps) as f32).collect();
-    let input = a.floats(&t, ElementType::Scalar, true, None);
+    let input = d.floats(&t, Type::Scalar, true, None);
     for i in carried {
         let label = anim.scene.objects[i].label.as_str();
         // Object nodes come first in the document (before the characters' joints).
-        let Some(node) = a.doc["nodes"].as_array().and_then(|ns| ns.iter().position(|x| x["name"] == label)) else {
+        let Some(node) = d.root.nodes.iter().position(|x| x.name.as_deref() == Some(label)) else {
             continue;
         };
+        let node = Index::new(node as u32);
         let poses: Vec<(DVec3, DQuat)> = (0..n).map(|f| crate::animate::object_pose(anim, i, f)).collect();
         let pos: Vec<f32> = poses.iter().flat_map(|(p, _)| [p.x as f32, p.y as f32, p.z as f32]).collect();
         let rot = continuous_quats(poses.iter().map(|(_, q)| q.as_quat()));
-        for (values, kind, path) in [(pos, ElementType::Vec3, "translation"), (rot, ElementType::Vec4, "rotation")] {
-            let output = a.floats(&values, kind, false, None);
-            let samplers = a.doc["animations"][0]["samplers"].as_array_mut().map_or(0, |s| {
-                s.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-                s.len() - 1
-            });
-            if let Some(c) = a.doc["animations"][0]["channels"].as_array_mut() {
-                c.push(json!({"sampler": samplers, "target": {"node": node, "path": path}}));
-            }
+        for (values, kind, path) in [(pos, Type::Vec3, Property::Translation), (rot, Type::Vec4, Property::Rotation)] {
+            let output = d.floats(&values, kind, false, None);
+            doc.anim.channel(input, output, node, path);
         }
     }
-    gltf_buffer::pad_to_4(bin);
-    doc["buffers"] = json!([{"byteLength": bin.len()}]);
 }

@@ -4,11 +4,15 @@
 //! re-indexed) and scaled to the object's size; plus a floor quad. `.glb` writes the binary
 //! container, anything else a `.gltf` with the buffer embedded as base64.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
-use inbetween_io::gltf_buffer::{data_uri, ElementType, GltfBuffer, ARRAY_BUFFER};
+use inbetween_io::gltf_buffer::json::mesh::Semantic::{Normals, Positions};
+use inbetween_io::gltf_buffer::json::scene::UnitQuaternion;
+use inbetween_io::gltf_buffer::json::validation::{Checked::Valid, USize64};
+use inbetween_io::gltf_buffer::json::{self, Accessor, Index, Node};
+use inbetween_io::gltf_buffer::{data_uri, material, mesh, node, GltfDoc, Type, ARRAY_BUFFER};
 use serde_json::{json, Value};
 
 /// GLB container assembly lives in io (one writer for every engine).
@@ -70,224 +74,174 @@ fn srgb_to_linear(c: u8) -> f32 {
     }
 }
 
-/// The document under construction: arrays glTF indexes into, plus the one binary buffer (with
-/// its bufferViews and accessors).
-#[derive(Default)]
+/// The scene document under construction ([`GltfDoc`]: typed glTF and buffer 0).
 struct Doc {
-    buf: GltfBuffer,
-    meshes: Vec<Value>,
-    materials: Vec<Value>,
-    nodes: Vec<Value>,
-    images: Vec<Value>,
-    textures: Vec<Value>,
-    samplers: Vec<Value>,
-    extensions_used: BTreeSet<String>,
-    extensions_required: BTreeSet<String>,
+    d: GltfDoc,
 }
 
 /// A model merged into the document: its node templates (already re-indexed meshes), its scene
 /// roots and its bounding box in the roots' frame.
 struct Merged {
-    nodes: Vec<Value>,
+    nodes: Vec<Node>,
     roots: Vec<usize>,
     min: Vec3,
     max: Vec3,
 }
 
+/// `i` moved up by `by` (an index into an array another one was appended to).
+fn shift<T>(i: Index<T>, by: usize) -> Index<T> {
+    Index::new((i.value() + by) as u32)
+}
+
 impl Doc {
     /// Vertex attribute data (ARRAY_BUFFER view); POSITION needs `bounds`.
-    fn vec3s(&mut self, values: &[[f32; 3]], bounds: bool) -> usize {
-        self.buf.floats(values.as_flattened(), ElementType::Vec3, bounds, Some(ARRAY_BUFFER))
+    fn vec3s(&mut self, values: &[[f32; 3]], bounds: bool) -> Index<Accessor> {
+        self.d.floats(values.as_flattened(), Type::Vec3, bounds, Some(ARRAY_BUFFER))
     }
 
-    fn material(&mut self, name: &str, color: [u8; 3]) -> usize {
+    fn material(&mut self, name: &str, color: [u8; 3]) -> Index<json::Material> {
         let c = color.map(srgb_to_linear);
-        self.materials.push(json!({
-            "name": name,
-            "pbrMetallicRoughness": {"baseColorFactor": [c[0], c[1], c[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}
-        }));
-        self.materials.len() - 1
+        self.d.push(material(name, [c[0], c[1], c[2], 1.0], 0.9))
     }
 
     /// Accessors (position, normal, indices) of a box with flat faces: x, z ∈ [-½, ½], y ∈ [0, 1].
-    fn unit_box(&mut self) -> (usize, usize, usize) {
+    fn unit_box(&mut self) -> (Index<Accessor>, Index<Accessor>, Index<Accessor>) {
         let (pos, nor, idx) = box_geometry(0.5);
-        (self.vec3s(&pos, true), self.vec3s(&nor, false), self.buf.indices(&idx))
+        (self.vec3s(&pos, true), self.vec3s(&nor, false), self.d.indices(&idx))
     }
 
-    /// Appends a GLB's buffers, views, accessors, images, samplers, textures, materials and
-    /// meshes with shifted indices; returns its node templates and bounds.
+    /// Appends a GLB's buffer, views, accessors, images, samplers, textures, materials and meshes
+    /// with shifted indices; returns its node templates and bounds.
     fn merge(&mut self, glb: &Glb) -> Result<Merged, String> {
-        let j = &glb.json;
-        let arr = |k: &str| j.get(k).and_then(Value::as_array).cloned().unwrap_or_default();
-        let buffers = arr("buffers");
-        if buffers.len() > 1 || buffers.first().is_some_and(|b| b.get("uri").is_some()) {
+        let j: json::Root =
+            serde_json::from_value(glb.json.clone()).map_err(|e| format!("not a glTF 2.0 document: {e}"))?;
+        if j.buffers.len() > 1 || j.buffers.first().is_some_and(|b| b.uri.is_some()) {
             return Err("models with external or several buffers are not supported".into());
         }
-        for im in arr("images") {
-            if im.get("uri").and_then(Value::as_str).is_some_and(|u| !u.starts_with("data:")) {
-                return Err("models with external image files are not supported".into());
-            }
+        if j.images.iter().any(|im| im.uri.as_deref().is_some_and(|u| !u.starts_with("data:"))) {
+            return Err("models with external image files are not supported".into());
         }
-        self.buf.align();
-        let bin_off = self.buf.bin.len();
-        self.buf.bin.extend_from_slice(&glb.bin);
+        let r = &mut self.d.root;
+        self.d.bin.resize(self.d.bin.len().next_multiple_of(4), 0);
+        let bin_off = self.d.bin.len();
+        self.d.bin.extend_from_slice(&glb.bin);
         let (v0, a0, m0, t0, i0, s0, me0) = (
-            self.buf.views.len(),
-            self.buf.accessors.len(),
-            self.materials.len(),
-            self.textures.len(),
-            self.images.len(),
-            self.samplers.len(),
-            self.meshes.len(),
+            r.buffer_views.len(),
+            r.accessors.len(),
+            r.materials.len(),
+            r.textures.len(),
+            r.images.len(),
+            r.samplers.len(),
+            r.meshes.len(),
         );
-        let add = |v: &mut Value, key: &str, off: usize| {
-            if let Some(x) = v.get(key).and_then(Value::as_u64) {
-                v[key] = json!(x as usize + off);
-            }
-        };
-        for mut bv in arr("bufferViews") {
-            let off = bv.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-            bv["buffer"] = json!(0);
-            bv["byteOffset"] = json!(bin_off + off);
-            self.buf.views.push(bv);
+        for mut bv in j.buffer_views.iter().cloned() {
+            let off = bv.byte_offset.map_or(0, |o| o.0 as usize);
+            bv.buffer = Index::new(0);
+            bv.byte_offset = Some(USize64::from(bin_off + off));
+            r.buffer_views.push(bv);
         }
-        for mut a in arr("accessors") {
-            add(&mut a, "bufferView", v0);
-            if let Some(sp) = a.get_mut("sparse") {
-                for part in ["indices", "values"] {
-                    if let Some(p) = sp.get_mut(part) {
-                        add(p, "bufferView", v0);
+        for mut a in j.accessors.iter().cloned() {
+            a.buffer_view = a.buffer_view.map(|v| shift(v, v0));
+            if let Some(sp) = &mut a.sparse {
+                sp.indices.buffer_view = shift(sp.indices.buffer_view, v0);
+                sp.values.buffer_view = shift(sp.values.buffer_view, v0);
+            }
+            r.accessors.push(a);
+        }
+        for mut im in j.images.iter().cloned() {
+            im.buffer_view = im.buffer_view.map(|v| shift(v, v0));
+            r.images.push(im);
+        }
+        r.samplers.extend(j.samplers.iter().cloned());
+        for mut t in j.textures.iter().cloned() {
+            t.source = shift(t.source, i0);
+            t.sampler = t.sampler.map(|s| shift(s, s0));
+            r.textures.push(t);
+        }
+        for mut m in j.materials.iter().cloned() {
+            let pbr = &mut m.pbr_metallic_roughness;
+            for info in [&mut pbr.base_color_texture, &mut pbr.metallic_roughness_texture, &mut m.emissive_texture]
+                .into_iter()
+                .flatten()
+            {
+                info.index = shift(info.index, t0);
+            }
+            if let Some(n) = &mut m.normal_texture {
+                n.index = shift(n.index, t0);
+            }
+            if let Some(o) = &mut m.occlusion_texture {
+                o.index = shift(o.index, t0);
+            }
+            r.materials.push(m);
+        }
+        for mut mesh in j.meshes.iter().cloned() {
+            for p in &mut mesh.primitives {
+                for a in p.attributes.values_mut() {
+                    *a = shift(*a, a0);
+                }
+                for t in p.targets.iter_mut().flatten() {
+                    for a in [&mut t.positions, &mut t.normals, &mut t.tangents].into_iter().flatten() {
+                        *a = shift(*a, a0);
                     }
                 }
+                p.indices = p.indices.map(|i| shift(i, a0));
+                p.material = p.material.map(|m| shift(m, m0));
             }
-            self.buf.accessors.push(a);
+            r.meshes.push(mesh);
         }
-        for mut im in arr("images") {
-            add(&mut im, "bufferView", v0);
-            self.images.push(im);
+        for e in &j.extensions_used {
+            self.d.use_extension(e);
         }
-        self.samplers.extend(arr("samplers"));
-        for mut t in arr("textures") {
-            add(&mut t, "source", i0);
-            add(&mut t, "sampler", s0);
-            self.textures.push(t);
-        }
-        fn shift_textures(v: &mut Value, off: usize) {
-            if let Value::Object(map) = v {
-                for (k, val) in map.iter_mut() {
-                    if k.ends_with("Texture") {
-                        if let Some(i) = val.get("index").and_then(Value::as_u64) {
-                            val["index"] = json!(i as usize + off);
-                        }
-                    }
-                    shift_textures(val, off);
-                }
-            }
-        }
-        for mut m in arr("materials") {
-            shift_textures(&mut m, t0);
-            self.materials.push(m);
-        }
-        for mut mesh in arr("meshes") {
-            if let Some(prims) = mesh.get_mut("primitives").and_then(Value::as_array_mut) {
-                for p in prims {
-                    if let Some(Value::Object(at)) = p.get_mut("attributes") {
-                        for v in at.values_mut() {
-                            *v = json!(v.as_u64().unwrap_or(0) as usize + a0);
-                        }
-                    }
-                    if let Some(Value::Array(ts)) = p.get_mut("targets") {
-                        for t in ts {
-                            if let Value::Object(at) = t {
-                                for v in at.values_mut() {
-                                    *v = json!(v.as_u64().unwrap_or(0) as usize + a0);
-                                }
-                            }
-                        }
-                    }
-                    add(p, "indices", a0);
-                    add(p, "material", m0);
-                }
-            }
-            self.meshes.push(mesh);
-        }
-        for key in ["extensionsUsed", "extensionsRequired"] {
-            for e in arr(key).iter().filter_map(Value::as_str) {
-                if key == "extensionsUsed" { &mut self.extensions_used } else { &mut self.extensions_required }
-                    .insert(e.to_string());
+        for e in &j.extensions_required {
+            if !self.d.root.extensions_required.contains(e) {
+                self.d.root.extensions_required.push(e.clone());
             }
         }
         // Node templates: meshes re-indexed, skins and cameras dropped.
-        let nodes: Vec<Value> = arr("nodes")
-            .into_iter()
-            .map(|mut n| {
-                add(&mut n, "mesh", me0);
-                if let Value::Object(m) = &mut n {
-                    m.remove("skin");
-                    m.remove("camera");
-                    m.remove("weights");
-                }
-                n
-            })
+        let nodes: Vec<Node> = j
+            .nodes
+            .iter()
+            .cloned()
+            .map(|n| Node { mesh: n.mesh.map(|m| shift(m, me0)), skin: None, camera: None, weights: None, ..n })
             .collect();
-        let scene = j.get("scene").and_then(Value::as_u64).unwrap_or(0) as usize;
-        let roots: Vec<usize> =
-            match j.get("scenes").and_then(|s| s.get(scene)).and_then(|s| s.get("nodes")).and_then(Value::as_array) {
-                Some(r) => {
-                    r.iter().filter_map(Value::as_u64).map(|x| x as usize).filter(|&x| x < nodes.len()).collect()
-                }
-                None => (0..nodes.len()).collect(),
-            };
+        let scene = j.scene.map_or(0, |s| s.value());
+        let roots: Vec<usize> = match j.scenes.get(scene) {
+            Some(s) => s.nodes.iter().map(|x| x.value()).filter(|&x| x < nodes.len()).collect(),
+            None => (0..nodes.len()).collect(),
+        };
         // Bounds through the node transforms, from POSITION min/max.
         let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-        let accessors = arr("accessors");
-        let meshes = arr("meshes");
         let mut stack: Vec<(usize, Mat4, usize)> = roots.iter().map(|&r| (r, Mat4::IDENTITY, 0)).collect();
         while let Some((k, parent, depth)) = stack.pop() {
-            let Some(n) = arr("nodes").get(k).cloned() else { continue };
+            let Some(n) = j.nodes.get(k) else { continue };
             if depth > 64 {
                 continue;
             }
-            let m = parent * node_matrix(&n);
-            if let Some(mi) = n.get("mesh").and_then(Value::as_u64) {
-                for p in meshes
-                    .get(mi as usize)
-                    .and_then(|x| x.get("primitives"))
-                    .and_then(Value::as_array)
-                    .into_iter()
-                    .flatten()
-                {
-                    let Some(acc) = p
-                        .pointer("/attributes/POSITION")
-                        .and_then(Value::as_u64)
-                        .and_then(|a| accessors.get(a as usize))
-                    else {
-                        continue;
-                    };
-                    let v3 = |key: &str| -> Option<Vec3> {
-                        let a = acc.get(key)?.as_array()?;
-                        Some(Vec3::new(
-                            a.first()?.as_f64()? as f32,
-                            a.get(1)?.as_f64()? as f32,
-                            a.get(2)?.as_f64()? as f32,
-                        ))
-                    };
-                    let (Some(mn), Some(mx)) = (v3("min"), v3("max")) else { continue };
-                    for c in 0..8 {
-                        let p = Vec3::new(
-                            if c & 1 == 0 { mn.x } else { mx.x },
-                            if c & 2 == 0 { mn.y } else { mx.y },
-                            if c & 4 == 0 { mn.z } else { mx.z },
-                        );
-                        let w = m.transform_point3(p);
-                        lo = lo.min(w);
-                        hi = hi.max(w);
-                    }
+            let m = parent * node_matrix(n);
+            for p in n.mesh.and_then(|mi| j.meshes.get(mi.value())).into_iter().flat_map(|x| &x.primitives) {
+                let Some(acc) =
+                    p.attributes.get(&Valid(json::mesh::Semantic::Positions)).and_then(|a| j.accessors.get(a.value()))
+                else {
+                    continue;
+                };
+                let v3 = |v: &Option<Value>| -> Option<Vec3> {
+                    let a = v.as_ref()?.as_array()?;
+                    Some(Vec3::new(a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32, a.get(2)?.as_f64()? as f32))
+                };
+                let (Some(mn), Some(mx)) = (v3(&acc.min), v3(&acc.max)) else { continue };
+                for c in 0..8 {
+                    let p = Vec3::new(
+                        if c & 1 == 0 { mn.x } else { mx.x },
+                        if c & 2 == 0 { mn.y } else { mx.y },
+                        if c & 4 == 0 { mn.z } else { mx.z },
+                    );
+                    let w = m.transform_point3(p);
+                    lo = lo.min(w);
+                    hi = hi.max(w);
                 }
             }
-            for c in n.get("children").and_then(Value::as_array).into_iter().flatten().filter_map(Value::as_u64) {
-                stack.push((c as usize, m, depth + 1));
+            for c in n.children.iter().flatten() {
+                stack.push((c.value(), m, depth + 1));
             }
         }
         if lo.x > hi.x {
@@ -297,48 +251,27 @@ impl Doc {
     }
 
     /// Copies model node `k` (and its subtree) into the document; returns the new index.
-    fn instantiate(&mut self, m: &Merged, k: usize, depth: usize) -> usize {
+    fn instantiate(&mut self, m: &Merged, k: usize, depth: usize) -> Index<Node> {
         let mut n = m.nodes[k].clone();
         let children: Vec<usize> = if depth < 64 {
-            n.get("children")
-                .and_then(Value::as_array)
-                .cloned()
-                .unwrap_or_default()
-                .iter()
-                .filter_map(Value::as_u64)
-                .map(|c| c as usize)
-                .filter(|&c| c < m.nodes.len())
-                .collect()
+            n.children.iter().flatten().map(|c| c.value()).filter(|&c| c < m.nodes.len()).collect()
         } else {
             Vec::new()
         };
-        let new_children: Vec<usize> = children.into_iter().map(|c| self.instantiate(m, c, depth + 1)).collect();
-        if new_children.is_empty() {
-            if let Value::Object(o) = &mut n {
-                o.remove("children");
-            }
-        } else {
-            n["children"] = json!(new_children);
-        }
-        self.nodes.push(n);
-        self.nodes.len() - 1
+        let new_children: Vec<Index<Node>> = children.into_iter().map(|c| self.instantiate(m, c, depth + 1)).collect();
+        n.children = (!new_children.is_empty()).then_some(new_children);
+        self.d.push(n)
     }
 }
 
 /// A node's local matrix from `matrix` or translation/rotation/scale.
-fn node_matrix(n: &Value) -> Mat4 {
-    let nums = |k: &str| -> Option<Vec<f32>> {
-        Some(n.get(k)?.as_array()?.iter().filter_map(|v| v.as_f64().map(|x| x as f32)).collect())
-    };
-    if let Some(m) = nums("matrix").filter(|m| m.len() == 16) {
-        return Mat4::from_cols_slice(&m);
+fn node_matrix(n: &Node) -> Mat4 {
+    if let Some(m) = n.matrix {
+        return Mat4::from_cols_array(&m);
     }
-    let t = nums("translation").filter(|v| v.len() == 3).map(|v| Vec3::new(v[0], v[1], v[2])).unwrap_or(Vec3::ZERO);
-    let r = nums("rotation")
-        .filter(|v| v.len() == 4)
-        .map(|v| Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize())
-        .unwrap_or(Quat::IDENTITY);
-    let s = nums("scale").filter(|v| v.len() == 3).map(|v| Vec3::new(v[0], v[1], v[2])).unwrap_or(Vec3::ONE);
+    let t = n.translation.map_or(Vec3::ZERO, Vec3::from_array);
+    let r = n.rotation.map_or(Quat::IDENTITY, |q| Quat::from_array(q.0).normalize());
+    let s = n.scale.map_or(Vec3::ONE, Vec3::from_array);
     Mat4::from_scale_rotation_translation(s, r, t)
 }
 
@@ -350,10 +283,23 @@ pub fn gltf_document(
     cat: &Catalogue,
     model: &dyn Fn(&str) -> Option<PathBuf>,
 ) -> (Value, Vec<u8>, Vec<String>) {
-    let mut d = Doc::default();
+    let (d, notes) = scene_document(scene, cat, model, "inbetween script");
+    let (doc, bin) = d.finish();
+    (doc, bin, notes)
+}
+
+/// [`gltf_document`] before it is finished: the typed document (the room node its scene's only
+/// root) for writers that add to it (`generator` names them), and the notes.
+pub(crate) fn scene_document(
+    scene: &Scene,
+    cat: &Catalogue,
+    model: &dyn Fn(&str) -> Option<PathBuf>,
+    generator: &str,
+) -> (GltfDoc, Vec<String>) {
+    let mut d = Doc { d: GltfDoc::new(generator) };
     let mut notes = Vec::new();
     let (bp, bn, bi) = d.unit_box();
-    let mut box_mesh: BTreeMap<String, usize> = BTreeMap::new();
+    let mut box_mesh: BTreeMap<String, Index<json::Mesh>> = BTreeMap::new();
     let mut models: BTreeMap<String, Option<Merged>> = BTreeMap::new();
     let mut children = Vec::new();
 
@@ -361,11 +307,10 @@ pub fn gltf_document(
     let (w, dd) = (scene.room.width, scene.room.depth);
     let fp = d.vec3s(&[[0.0, 0.0, 0.0], [0.0, 0.0, dd], [w, 0.0, dd], [w, 0.0, 0.0]], true);
     let fnrm = d.vec3s(&[[0.0, 1.0, 0.0]; 4], false);
-    let fi = d.buf.indices(&[0, 1, 2, 0, 2, 3]);
+    let fi = d.d.indices(&[0, 1, 2, 0, 2, 3]);
     let fmat = d.material("floor", [200, 200, 195]);
-    d.meshes.push(json!({"name": "floor", "primitives": [{"attributes": {"POSITION": fp, "NORMAL": fnrm}, "indices": fi, "material": fmat}]}));
-    d.nodes.push(json!({"name": "floor", "mesh": d.meshes.len() - 1}));
-    children.push(d.nodes.len() - 1);
+    let floor = d.d.push(mesh("floor", &[(Positions, fp), (Normals, fnrm)], Some(fi), Some(fmat)));
+    children.push(d.d.push(Node { mesh: Some(floor), ..node("floor") }));
 
     for o in &scene.objects {
         if !models.contains_key(&o.category) {
@@ -379,52 +324,42 @@ pub fn gltf_document(
             models.insert(o.category.clone(), merged);
         }
         let child = if let Some(m) = models.get(&o.category).and_then(Option::as_ref) {
-            let roots: Vec<usize> = m.roots.clone().into_iter().map(|r| d.instantiate(m, r, 0)).collect();
+            let roots: Vec<Index<Node>> = m.roots.clone().into_iter().map(|r| d.instantiate(m, r, 0)).collect();
             let ext = (m.max - m.min).max(Vec3::splat(1e-6));
             let s = Vec3::from_array(o.size) / ext;
             let t = -Vec3::new((m.min.x + m.max.x) / 2.0 * s.x, m.min.y * s.y, (m.min.z + m.max.z) / 2.0 * s.z);
-            json!({"name": format!("{} model", o.label), "translation": t.to_array(), "scale": s.to_array(), "children": roots})
+            Node {
+                translation: Some(t.to_array()),
+                scale: Some(s.to_array()),
+                children: Some(roots),
+                ..node(format!("{} model", o.label))
+            }
         } else {
-            let mesh = *box_mesh.entry(o.category.clone()).or_insert_with(|| {
+            let mesh_index = *box_mesh.entry(o.category.clone()).or_insert_with(|| {
                 let mat = d.material(&o.category, super::category_color(cat, &o.category));
-                d.meshes.push(json!({"name": format!("{} box", o.category), "primitives": [{"attributes": {"POSITION": bp, "NORMAL": bn}, "indices": bi, "material": mat}]}));
-                d.meshes.len() - 1
+                d.d.push(mesh(format!("{} box", o.category), &[(Positions, bp), (Normals, bn)], Some(bi), Some(mat)))
             });
-            json!({"name": format!("{} box", o.label), "mesh": mesh, "scale": o.size.map(|v| v.max(1e-4))})
+            Node {
+                mesh: Some(mesh_index),
+                scale: Some(o.size.map(|v| v.max(1e-4))),
+                ..node(format!("{} box", o.label))
+            }
         };
-        d.nodes.push(child);
-        let c = d.nodes.len() - 1;
+        let c = d.d.push(child);
         let (s, co) = (o.yaw / 2.0).sin_cos();
-        d.nodes
-            .push(json!({"name": o.label, "translation": o.position, "rotation": [0.0, s, 0.0, co], "children": [c]}));
-        children.push(d.nodes.len() - 1);
+        children.push(d.d.push(Node {
+            translation: Some(o.position),
+            rotation: Some(UnitQuaternion([0.0, s, 0.0, co])),
+            children: Some(vec![c]),
+            ..node(o.label.as_str())
+        }));
     }
-    d.nodes.push(json!({"name": scene.room.name, "children": children}));
-    let root = d.nodes.len() - 1;
-    d.buf.align();
-    let mut doc = json!({
-        "asset": {"version": "2.0", "generator": "inbetween script"},
-        "scene": 0,
-        "scenes": [{"name": scene.room.name, "nodes": [root]}],
-        "nodes": d.nodes,
-        "meshes": d.meshes,
-        "materials": d.materials,
-        "accessors": d.buf.accessors,
-        "bufferViews": d.buf.views,
-        "buffers": [{"byteLength": d.buf.bin.len()}],
-    });
-    for (k, v) in [("images", d.images), ("textures", d.textures), ("samplers", d.samplers)] {
-        if !v.is_empty() {
-            doc[k] = json!(v);
-        }
-    }
-    if !d.extensions_used.is_empty() {
-        doc["extensionsUsed"] = json!(d.extensions_used);
-    }
-    if !d.extensions_required.is_empty() {
-        doc["extensionsRequired"] = json!(d.extensions_required);
-    }
-    (doc, d.buf.bin, notes)
+    let root = d.d.push(Node { children: Some(children), ..node(scene.room.name.as_str()) });
+    d.d.root.scenes.push(inbetween_io::gltf_buffer::scene(Some(scene.room.name.clone()), vec![root]));
+    d.d.root.scene = Some(Index::new(0));
+    d.d.root.extensions_used.sort();
+    d.d.root.extensions_required.sort();
+    (d.d, notes)
 }
 
 /// Writes `scene` as `.glb` (by extension) or `.gltf` with an embedded buffer (atomic): Kenney

@@ -30,12 +30,15 @@ use image::RgbImage;
 use inbetween_core::clip::Clip;
 use inbetween_core::fk::{forward, GlobalPose};
 use inbetween_core::{Pose, Skeleton};
-use inbetween_io::gltf_buffer::{pad_to_4, ElementType, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT};
+use inbetween_io::gltf_buffer::json::accessor::ComponentType;
+use inbetween_io::gltf_buffer::json::validation::Checked::Valid;
+use inbetween_io::gltf_buffer::json::{self, Index};
+use inbetween_io::gltf_buffer::{material, mesh, node, GltfDoc, Type, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER};
 use inbetween_render::canvas::Camera3;
 use inbetween_render::Canvas;
-use serde_json::{json, Value};
+use serde_json::Value;
 
-use super::anim_gltf::{animated_document, AnimatedDocument, Appender, Body, CameraFn};
+use super::anim_gltf::{animated_document, AnimatedDocument, Body, CameraFn};
 use super::gltf::write_document;
 use super::preview::{draw_object, draw_room, fill_convex, scale_color};
 use crate::catalogue::Catalogue;
@@ -241,7 +244,8 @@ pub fn skinned_story_document(
     let refs: Vec<Option<&SkinnedBody>> = bodies.iter().map(Some).collect();
     let lookup = |category: &str| cat.model_path(category).filter(|p| p.is_file());
     let cast = SkinnedCast { scene: &anim.scene, cat, characters: &chars, bodies: &refs, camera, fps: anim.fps };
-    let (mut doc, mut bin, _) = skinned_gltf_document(&cast, &lookup)?;
-    super::anim_gltf::add_prop_channels(&mut doc, &mut bin, anim, super::anim_gltf::animation_frames(&chars, anim.fps));
+    let mut doc = document::skinned_document(&cast, &lookup)?;
+    super::anim_gltf::add_prop_channels(&mut doc, anim, super::anim_gltf::animation_frames(&chars, anim.fps));
+    let (doc, bin, _) = doc.finish();
     Ok((doc, bin))
 }
