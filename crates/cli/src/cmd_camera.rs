@@ -12,6 +12,7 @@ use inbetween_io::{LimitExceeded, OutputSet};
 use std::path::{Path, PathBuf};
 
 use crate::errors;
+use crate::scale::ScaleArgs;
 
 #[derive(Subcommand)]
 pub enum CameraCommand {
@@ -26,16 +27,6 @@ pub enum CameraCommand {
     /// Scaling bench: `camera generate` on the demo's example (300 frames, 3 keys) at 1×, 10×,
     /// 100×, with time and peak memory per run.
     Scale(ScaleArgs),
-}
-
-#[derive(Args)]
-pub struct ScaleArgs {
-    /// Folder for the table (CSV, Markdown, text).
-    #[arg(short, long, default_value = "out/camera-scale")]
-    pub out: PathBuf,
-    /// Multiples of the example to run.
-    #[arg(long, value_delimiter = ',', default_value = "1,10,100")]
-    pub scales: Vec<usize>,
 }
 
 #[derive(Args)]
@@ -363,7 +354,7 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 
 fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
     crate::scale::run(
-        &a.out,
+        &a.out_or("camera"),
         "camera_scale",
         "camera generate (orbit style) at multiples of the demo's example",
         "camera scaling",

@@ -21,6 +21,7 @@ use inbetween_face::{corpus, procedural, weights};
 use inbetween_io::{OutputSet, Progress};
 
 use crate::errors;
+use crate::scale::ScaleArgs;
 
 #[derive(Subcommand)]
 pub enum FaceCommand {
@@ -35,16 +36,6 @@ pub enum FaceCommand {
     /// Scaling bench: `face edit` on the demo's example (10 s clip, 3 s gap) at 1×, 10×, 100×, with
     /// time and peak memory per run.
     Scale(ScaleArgs),
-}
-
-#[derive(Args)]
-pub struct ScaleArgs {
-    /// Folder for the table (CSV, Markdown, text).
-    #[arg(short, long, default_value = "out/face-scale")]
-    pub out: PathBuf,
-    /// Multiples of the example to run.
-    #[arg(long, value_delimiter = ',', default_value = "1,10,100")]
-    pub scales: Vec<usize>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -599,7 +590,7 @@ fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
 
 fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
     crate::scale::run(
-        &a.out,
+        &a.out_or("face"),
         "face_scale",
         "face edit (unguided network) at multiples of the demo's example",
         "face scaling",

@@ -4,7 +4,26 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use clap::Args;
 use inbetween_io::scale::{scale_table, ScaleRow};
+
+/// The arguments every engine's `scale` subcommand takes.
+#[derive(Args)]
+pub struct ScaleArgs {
+    /// Folder for the table (CSV, Markdown, text) [default: out/<engine>-scale].
+    #[arg(short, long)]
+    pub out: Option<PathBuf>,
+    /// Multiples of the example to run.
+    #[arg(long, value_delimiter = ',', default_value = "1,10,100")]
+    pub scales: Vec<usize>,
+}
+
+impl ScaleArgs {
+    /// `--out`, else `out/<engine>-scale`.
+    pub fn out_or(&self, engine: &str) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| PathBuf::from(format!("out/{engine}-scale")))
+    }
+}
 
 /// Runs `rows(exe, scratch)` (one measured run per scale), then prints the table `name` with
 /// `title` and writes it into `out` as the report `report_title`.

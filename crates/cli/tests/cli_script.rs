@@ -143,3 +143,16 @@ fn an_oversized_story_is_refused_at_once_naming_the_limit_and_its_flag_and_write
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("words") && err.contains("raise it with --max-words"), "{err}");
 }
+
+#[test]
+fn scale_measures_the_demo_story_and_writes_its_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scale");
+    let o = inbetween().args(["script", "scale", "--scales", "1,2", "-o"]).arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("script_scale.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    // The demo's 4 scene lines plus 3 direction sentences per copy.
+    assert!(rows[0].contains("7 sentences, 5 actions") && rows[1].contains("10 sentences, 10 actions"), "{csv}");
+}

@@ -98,6 +98,20 @@ Eve types on the laptop.
 Tom walks slowly to the sofa and sits on it.
 ";
 
+/// The demo story at `k` times its size, for scaling runs: the demo's scene lines once, then its
+/// three direction sentences (five actions) `k` times in a row (Eve sits down, types, and walks
+/// back to the desk again; Tom returns to the sofa each time).
+pub fn scaled_demo(k: usize) -> String {
+    let (scene, directions): (Vec<&str>, Vec<&str>) =
+        DEMO.lines().filter(|l| !l.starts_with('#')).partition(|l| l.ends_with('$') || l.starts_with("camera"));
+    let mut text = scene.join("\n") + "\n";
+    for _ in 0..k {
+        text.push_str(&directions.join("\n"));
+        text.push('\n');
+    }
+    text
+}
+
 /// A few lines in the paper's style for "Night of the Living Dead" (1968, public domain): the
 /// farmhouse living room. Our own wording: scene and actions only, no dialogue.
 pub const NIGHT_OF_THE_LIVING_DEAD: &str =
@@ -221,4 +235,21 @@ pub fn random_story(seed: u64) -> String {
         }
     }
     lines.join("\n") + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_scaled_demo_repeats_the_directions_not_the_scene() {
+        let one = scaled_demo(1);
+        let three = scaled_demo(3);
+        let count = |t: &str, s: &str| t.matches(s).count();
+        assert_eq!(count(&three, "organized desk"), 1);
+        assert_eq!(count(&three, "camera front"), 1);
+        assert_eq!(count(&three, "Eve types on the laptop."), 3);
+        assert_eq!(crate::script::split(&three).len() - crate::script::split(&one).len(), 6);
+        assert_eq!(crate::script::split(&one).len(), crate::script::split(DEMO).len());
+    }
 }
