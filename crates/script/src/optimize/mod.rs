@@ -150,11 +150,11 @@ fn radius(name: &str) -> f64 {
     }
 }
 
-/// The body of a pose as spheres (centre, radius): every joint and every bone's midpoint.
-fn body_spheres(rig: &Rig, g: &inbetween_core::fk::GlobalPose, out: &mut Vec<(DVec3, f64)>) {
+/// The body of a pose as spheres (centre, radius): every joint and every bone's midpoint;
+/// `radii[j]` is [`radius`] of joint `j`'s name.
+fn body_spheres(rig: &Rig, radii: &[f64], g: &inbetween_core::fk::GlobalPose, out: &mut Vec<(DVec3, f64)>) {
     out.clear();
-    for (j, joint) in rig.skeleton.joints().iter().enumerate() {
-        let r = radius(&joint.name);
+    for (j, &r) in radii.iter().enumerate() {
         out.push((g.positions[j], r));
         if let Some(p) = rig.skeleton.parent(j) {
             if (g.positions[j] - g.positions[p]).length() > 2.0 * r {
@@ -176,14 +176,17 @@ pub fn collision_cost(anim: &Animation, box_size: f32) -> (f64, usize, usize) {
     let mut spheres = Vec::new();
     for c in &anim.characters {
         let Ok(rig) = Rig::try_of(c.clip.skeleton().clone()) else { continue };
+        let radii: Vec<f64> = rig.skeleton.joints().iter().map(|j| radius(&j.name)).collect();
+        let (mut pose, mut g) = (inbetween_core::Pose::rest(&rig.skeleton), forward(&rig.skeleton, &rig.standing()));
         let mut seg = 0;
         for f in 0..c.clip.num_frames() {
             while seg + 1 < c.segments.len() && f >= c.segments[seg].end {
                 seg += 1;
             }
             let touching: &[usize] = c.segments.get(seg).map(|s| s.touching.as_slice()).unwrap_or(&[]);
-            let g = forward(&rig.skeleton, &c.clip.pose(f));
-            body_spheres(&rig, &g, &mut spheres);
+            c.clip.pose_into(f, &mut pose);
+            inbetween_core::fk::forward_into(&rig.skeleton, &pose, &mut g);
+            body_spheres(&rig, &radii, &g, &mut spheres);
             for (i, o) in objs.iter().enumerate() {
                 // Flat objects (rugs) are walked on, not into.
                 if touching.contains(&i) || o.top() < crate::layout::grid::FLAT || f >= carried[i] {
