@@ -118,6 +118,10 @@ pub struct RunArgs {
     /// figures.
     #[arg(long)]
     pub skinned: bool,
+    /// Stop after this many seconds of work; nothing is written then (the whole output set is
+    /// moved into place only when the run finishes).
+    #[arg(long)]
+    pub time_limit: Option<f64>,
 }
 
 #[derive(Args)]
@@ -207,10 +211,11 @@ fn run_job(a: &RunArgs) -> RunJob {
         optimize: !a.no_optimize,
         shared_motions: a.shared_motions,
         gif_width: a.gif_width,
+        cancel: Default::default(),
     }
 }
 
-fn print_run(source: &Path, r: &inbetween_script::job::RunReport) {
+fn print_run(source: &Path, r: &inbetween_script::job::RunReport, shown: &dyn Fn(&Path) -> PathBuf) {
     for d in &r.scene.diagnostics {
         eprintln!("warning: {}: {d}", source.display());
     }
@@ -241,35 +246,60 @@ fn print_run(source: &Path, r: &inbetween_script::job::RunReport) {
         );
     }
     for f in &r.files {
-        println!("  wrote {}", f.display());
+        println!("  wrote {}", shown(f).display());
     }
 }
 
+/// A path as the user will find it: one written under `staging` is shown under `out`, where the
+/// output set moved it.
+fn moved(staging: &Path, out: &Path, p: &Path) -> PathBuf {
+    p.strip_prefix(staging).map_or_else(|_| p.to_path_buf(), |rest| out.join(rest))
+}
+
+/// `script run`: every output (and the skinned ones with `--skinned`) is written into a staging
+/// folder and moved into `--out` only when the run finishes, so a failed, cancelled or timed-out
+/// run leaves no partial set.
 fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let (text, source) = load(&a.scene.script)?;
-    let report = inbetween_script::job::run_story(&text, &source, &run_job(&a))
+    let cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
+        .map_err(anyhow::Error::msg)
+        .context("--time-limit")?;
+    let mut set = inbetween_io::OutputSet::new();
+    let staging = set.dir(&a.scene.out).with_context(|| format!("preparing {}", a.scene.out.display()))?;
+    let mut job = run_job(&a);
+    job.scene.out_dir = staging.clone();
+    job.cancel = cancel;
+    let report = inbetween_script::job::run_story(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
-    print_run(&source, &report);
-    if a.skinned {
-        skinned(&a, &report)?;
+    let skinned_files = if a.skinned { Some(skinned(&a, &report, &staging)?) } else { None };
+    set.commit().with_context(|| format!("moving the outputs into {}", a.scene.out.display()))?;
+    let shown = |p: &Path| moved(&staging, &a.scene.out, p);
+    print_run(&source, &report, &shown);
+    if let Some(s) = skinned_files {
+        print_skinned(&s, &shown);
     }
     Ok(())
 }
 
-/// `--skinned`: the skinned Kenney outputs next to the story's (after them, so a missing asset
-/// folder leaves the stick-figure outputs written).
-fn skinned(a: &RunArgs, r: &inbetween_script::job::RunReport) -> anyhow::Result<()> {
+/// `--skinned`: the skinned Kenney outputs into `dir`, beside the story's.
+fn skinned(
+    a: &RunArgs,
+    r: &inbetween_script::job::RunReport,
+    dir: &Path,
+) -> anyhow::Result<inbetween_script::output::skinned::SkinnedStory> {
     let models = a.scene.models.as_deref();
     let cat = inbetween_script::job::catalogue(models)?;
-    let s = inbetween_script::output::skinned::write_skinned_story(&a.scene.out, &r.animation, &cat, models)
-        .context("writing the skinned characters")?;
+    inbetween_script::output::skinned::write_skinned_story(dir, &r.animation, &cat, models)
+        .context("writing the skinned characters")
+}
+
+fn print_skinned(s: &inbetween_script::output::skinned::SkinnedStory, shown: &dyn Fn(&Path) -> PathBuf) {
     for n in &s.notes {
         println!("  {n}");
     }
     for f in &s.files {
-        println!("  wrote {}", f.display());
+        println!("  wrote {}", shown(f).display());
     }
-    Ok(())
 }
 
 fn watch(a: WatchArgs) -> anyhow::Result<()> {
@@ -277,10 +307,11 @@ fn watch(a: WatchArgs) -> anyhow::Result<()> {
     println!("watching {} (Ctrl-C to stop)", path.display());
     inbetween_script::job::watch(&path, &run_job(&a.run), a.max_runs, |outcome| match outcome {
         Ok(r) => {
-            print_run(&path, &r);
+            print_run(&path, &r, &|p: &Path| p.to_path_buf());
             if a.run.skinned {
-                if let Err(e) = skinned(&a.run, &r) {
-                    eprintln!("error: {}: {e:#}", path.display());
+                match skinned(&a.run, &r, &a.run.scene.out) {
+                    Ok(s) => print_skinned(&s, &|p: &Path| p.to_path_buf()),
+                    Err(e) => eprintln!("error: {}: {e:#}", path.display()),
                 }
             }
         }

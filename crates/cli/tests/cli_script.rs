@@ -156,3 +156,27 @@ fn scale_measures_the_demo_story_and_writes_its_table() {
     // The demo's 4 scene lines plus 3 direction sentences per copy.
     assert!(rows[0].contains("7 sentences, 5 actions") && rows[1].contains("10 sentences, 10 actions"), "{csv}");
 }
+
+#[test]
+fn a_run_past_its_time_limit_says_so_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = inbetween()
+        .args(["script", "run", "builtin:demo", "--gif-width", "120", "--time-limit", "0.05", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("time limit of 0.05 s reached; raise it with --time-limit"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert!(!out.join("story.gltf").exists() && !out.join("scene.json").exists(), "partial outputs: {left:?}");
+    assert!(left.iter().all(|n| !n.to_string_lossy().starts_with(".inbetween-staging")), "staging left: {left:?}");
+    // Within the limit, the whole set lands in --out.
+    let o = inbetween().args(["script", "run", "builtin:demo", "--gif-width", "120", "-o"]).arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["story.gltf", "scene.json", "Eve.bvh", "story.gif"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    assert!(String::from_utf8_lossy(&o.stdout).contains(&format!("wrote {}", out.join("story.gltf").display())));
+}

@@ -43,6 +43,7 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         optimize: true,
         shared_motions: false,
         gif_width: 320,
+        cancel: Default::default(),
     };
     let story = crate::job::run_story(stories::DEMO, &PathBuf::from("builtin:demo"), &run)?;
     lines.push(format!(

@@ -55,6 +55,9 @@ pub enum ScriptError {
     /// The script asks for more than one of the job's stated limits (the error names the field).
     #[error("{0}")]
     Limit(#[from] inbetween_io::LimitExceeded),
+    /// The job's cancel token was cancelled or its time limit passed; nothing was written.
+    #[error("script job stopped: {0}")]
+    Cancelled(#[from] inbetween_core::cancel::Cancelled),
 }
 
 impl ScriptError {

@@ -129,6 +129,9 @@ pub struct RunJob {
     pub shared_motions: bool,
     /// Preview GIF options.
     pub gif_width: u32,
+    /// Checked in the long loops and before each output file (a cancel button, a time limit):
+    /// a cancelled run returns [`ScriptError::Cancelled`]. `Cancel::new()` never stops.
+    pub cancel: inbetween_core::cancel::Cancel,
 }
 
 /// What a story job wrote and measured.
@@ -196,10 +199,12 @@ pub fn run_story_in(
     let name = source.display().to_string();
     job.scene.limits.check_text(text, &name, session.catalogue())?;
     session.check_verbs(text, &name)?;
-    let u = session.update(text);
+    let cancel = &job.cancel;
+    let u = session.update_with(text, cancel)?;
     let cat = session.catalogue();
     job.scene.limits.check_animation(&name, u.animation.frames(), u.animation.fps)?;
     // One layout per run: the scene files show the optimised scene the story plays in.
+    cancel.check()?;
     let scene_files = write_scene(&u.animation.scene, &u.scene.composition.query, cat, &job.scene)?;
     let mut files = scene_files.clone();
     let dir = &job.scene.out_dir;
@@ -214,6 +219,7 @@ pub fn run_story_in(
     let track = camera_track(&animation);
     let cam = |f: usize| track.pose(f);
     let gltf = dir.join("story.gltf");
+    cancel.check()?;
     output::write_story_gltf(&gltf, &animation, cat, &cam)?;
     files.push(gltf);
     for c in &animation.characters {
@@ -223,6 +229,7 @@ pub fn run_story_in(
         files.push(bvh);
     }
     let gif = dir.join("story.gif");
+    cancel.check()?;
     let moving = (0..animation.scene.objects.len())
         .filter(|&i| crate::animate::carried_from(&animation, i).is_some())
         .map(|i| {
@@ -239,6 +246,7 @@ pub fn run_story_in(
     output::render_preview_gif(&gif, &animation.scene, cat, &chars, &cam, animation.fps, &opts)?;
     files.push(gif);
     let routes = dir.join("routes.png");
+    cancel.check()?;
     output::render_top_down_trails(&routes, &animation.scene, cat, &chars)?;
     files.push(routes);
     let composition = u.scene.composition;

@@ -52,6 +52,17 @@ impl Session {
         &self.database
     }
 
+    /// What [`Session::update`] changes (pins and sentences), to put back with
+    /// [`Session::restore`] when a caller abandons the update it started.
+    pub(crate) fn checkpoint(&self) -> (HashMap<ObjectKey, Pin>, Vec<String>) {
+        (self.pins.clone(), self.sentences.clone())
+    }
+
+    /// Puts back a [`Session::checkpoint`].
+    pub(crate) fn restore(&mut self, (pins, sentences): (HashMap<ObjectKey, Pin>, Vec<String>)) {
+        (self.pins, self.sentences) = (pins, sentences);
+    }
+
     /// Composes `text`, keeping every object of an unchanged sentence where it was.
     pub fn update(&mut self, text: &str) -> Update {
         let start = Instant::now();

@@ -25,18 +25,19 @@ use std::collections::HashMap;
 use std::time::Instant;
 
 use crate::animate::{
-    animate_planned, characters, object_of_node, Actions, AnimateConfig, Animation, CharacterPlan, WalkCache,
+    animate_planned, characters, object_of_node, Actions, AnimateConfig, Animation, CharacterPlan, Setup, WalkCache,
 };
 use crate::catalogue::Catalogue;
 use crate::compose::{ComposeConfig, ObjectKey};
 use crate::database::SceneDatabase;
 use crate::layout::{geom, grid};
 use crate::motion::MotionLibrary;
-use crate::optimize::{anneal, costs, movable_objects, optimize, CostCurves, Costs, OptimizeConfig};
+use crate::optimize::{anneal, costs, movable_objects, optimize_scene_in, CostCurves, Costs, OptimizeConfig};
 use crate::scene::{PlacedObject, Scene};
 use crate::session::{Session, Update};
 use crate::ssg::Ssg;
 use crate::ScriptError;
+use inbetween_core::cancel::{Cancel, Cancelled};
 
 /// An action compared across versions: verb, preposition, manner and the target's identity.
 type ActionSignature = (String, Option<String>, Vec<String>, Option<ObjectKey>);
@@ -144,53 +145,54 @@ impl StorySession {
 
     /// Composes and animates `text`, re-solving only what changed since the previous version.
     pub fn update(&mut self, text: &str) -> StoryUpdate {
+        self.update_with(text, &Cancel::new()).expect("an update without a cancel token runs to the end")
+    }
+
+    /// [`StorySession::update`] that stops early once `cancel` is cancelled (or its time limit
+    /// passes): the loops over characters, crowd repairs and optimisation states check it. A
+    /// stopped update returns the reason and leaves the session as it was before the call, so the
+    /// next update continues from the last finished version.
+    pub fn update_with(&mut self, text: &str, cancel: &Cancel) -> Result<StoryUpdate, Cancelled> {
         let start = Instant::now();
+        cancel.check()?;
+        let checkpoint = self.session.checkpoint();
         let up = self.session.update(text);
-        let mut out = match self.prev.take() {
-            None => self.full(up),
-            Some(prev) => self.incremental(up, prev),
+        let prev = self.prev.take();
+        let mut out = match &prev {
+            None => self.full(up, cancel),
+            Some(prev) => self.incremental(up, prev, cancel),
         };
+        if let Err(why) = cancel.check() {
+            self.session.restore(checkpoint);
+            self.prev = prev;
+            return Err(why);
+        }
         out.seconds = start.elapsed().as_secs_f64();
-        out
+        Ok(out)
     }
 
     /// The first version: compose, animate, optimise everything.
-    fn full(&mut self, up: Update) -> StoryUpdate {
+    fn full(&mut self, up: Update, cancel: &Cancel) -> StoryUpdate {
         let comp = &up.composition;
         let cat = self.session.catalogue();
+        let setup = Setup { cat, lib: &self.lib, cfg: &self.animate, cancel };
         let ocfg = self.optimize.clone();
         let (scene, before, after, curves, movable) = match &ocfg {
             Some(cfg) => {
-                let o = optimize(comp, cat, &self.lib, &self.animate, cfg);
+                let o = optimize_scene_in(&setup, &comp.scene, &comp.query, &comp.relations, cfg);
                 (o.scene, o.before, o.after, Some(o.curves), o.movable)
             }
             None => {
                 let c = costs(
-                    &animate_planned(
-                        &comp.scene,
-                        &comp.query,
-                        cat,
-                        &self.lib,
-                        &self.animate,
-                        &mut WalkCache::default(),
-                        &HashMap::new(),
-                    )
-                    .animation,
+                    &animate_planned(&setup, &comp.scene, &comp.query, &mut WalkCache::default(), &HashMap::new())
+                        .animation,
                     &OptimizeConfig::default(),
                 );
                 (comp.scene.clone(), c, c, None, Vec::new())
             }
         };
         // The best state again, with its plans (animation is deterministic: the same motion).
-        let planned = animate_planned(
-            &scene,
-            &comp.query,
-            cat,
-            &self.lib,
-            &self.animate,
-            &mut WalkCache::default(),
-            &HashMap::new(),
-        );
+        let planned = animate_planned(&setup, &scene, &comp.query, &mut WalkCache::default(), &HashMap::new());
         let names: Vec<String> = planned.animation.characters.iter().map(|c| c.name.clone()).collect();
         let resolved_objects = movable.iter().map(|&i| scene.objects[i].label.clone()).collect();
         let builds = names.iter().map(|n| (n.clone(), 1)).collect();
@@ -211,9 +213,10 @@ impl StorySession {
     }
 
     /// A later version: keep what the edit did not touch.
-    fn incremental(&mut self, up: Update, prev: Previous) -> StoryUpdate {
+    fn incremental(&mut self, up: Update, prev: &Previous, cancel: &Cancel) -> StoryUpdate {
         let comp = &up.composition;
         let cat = self.session.catalogue();
+        let setup = Setup { cat, lib: &self.lib, cfg: &self.animate, cancel };
         let keys: Vec<ObjectKey> = comp.keys.iter().map(|(k, _)| k.clone()).collect();
         // Objects part 1 kept also keep their optimised pose.
         let mut scene = comp.scene.clone();
@@ -241,10 +244,8 @@ impl StorySession {
             }
             frozen.insert(key, plan);
         }
-        let lib = &self.lib;
-        let acfg = &self.animate;
         let mut cache = WalkCache::default();
-        let planned = animate_planned(&scene, &comp.query, cat, lib, acfg, &mut cache, &frozen);
+        let planned = animate_planned(&setup, &scene, &comp.query, &mut cache, &frozen);
         let mut builds = planned.builds.clone();
         let kept_flags: Vec<bool> = planned.resolved.iter().map(|r| !r).collect();
         let kept: HashMap<String, CharacterPlan> = planned
@@ -271,7 +272,10 @@ impl StorySession {
                 if kept_clearance.iter().any(|(p, c)| walk_clearance(p, s) < c.min(grid::WALKER_RADIUS) - 1e-4) {
                     return None;
                 }
-                let pl = animate_planned(s, &comp.query, cat, lib, acfg, &mut cache, &kept);
+                if cancel.is_cancelled() {
+                    return None;
+                }
+                let pl = animate_planned(&setup, s, &comp.query, &mut cache, &kept);
                 // A kept character would have to change: the state is not taken.
                 if pl.resolved.iter().zip(&kept_flags).any(|(r, k)| *r && *k) {
                     return None;
@@ -293,7 +297,7 @@ impl StorySession {
             (o.scene, o.before, o.after, Some(o.curves))
         };
         let planned = if curves.is_some() {
-            let p = animate_planned(&final_scene, &comp.query, cat, lib, acfg, &mut cache, &kept);
+            let p = animate_planned(&setup, &final_scene, &comp.query, &mut cache, &kept);
             for (b, x) in builds.iter_mut().zip(&p.builds) {
                 *b += x;
             }

@@ -170,3 +170,31 @@ fn an_unchanged_text_re_solves_nothing() {
     }
     assert!(third.animation == second.animation, "saving the edit again gives another Animation");
 }
+
+/// A cancelled update stops early, says why, and leaves the session as it was: the next update
+/// gives exactly what it would have given had the cancelled one never been asked for.
+#[test]
+fn a_cancelled_update_leaves_the_session_as_it_was() {
+    use inbetween_core::cancel::{Cancel, Cancelled};
+    let mut s = session();
+    let first = s.update(DEMO);
+    // Cancelled before it starts: refused at once.
+    let stopped = Cancel::new();
+    stopped.cancel();
+    assert_eq!(s.update_with(&edited(), &stopped).unwrap_err(), Cancelled::Requested);
+    // Cancelled part way (a time limit far shorter than the edit takes).
+    let short = Cancel::with_time_limit(std::time::Duration::from_millis(5));
+    let t0 = std::time::Instant::now();
+    let e = s.update_with(&edited(), &short).unwrap_err();
+    assert!(matches!(e, Cancelled::TimeLimit { .. }), "{e}");
+    let stop_ms = t0.elapsed().as_secs_f64() * 1e3;
+    // The same edit afterwards equals the edit in a session that never saw the cancelled ones.
+    let after = s.update(&edited());
+    let mut clean = session();
+    assert!(clean.update(DEMO).animation == first.animation);
+    let expected = clean.update(&edited());
+    assert!(after.animation == expected.animation, "the cancelled update left a trace");
+    assert_eq!(after.resolved_characters, expected.resolved_characters);
+    let full_ms = after.seconds * 1e3;
+    eprintln!("stopped after {stop_ms:.0} ms; the whole edit takes {full_ms:.0} ms");
+}

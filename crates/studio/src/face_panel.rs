@@ -419,7 +419,7 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
             method,
             seed: req.seed,
             limits: EditLimits::default(),
-            cancel: inbetween_core::cancel::Cancel::new(),
+            cancel: job.token().clone(),
             guide_file: None,
         }
         .run()

@@ -2,11 +2,15 @@
 //! call on a blocking thread. The page follows it over server-sent events
 //! (`GET /api/jobs/{id}/events`): `progress` events (the stage and its share of the job), then one
 //! `result` or `failed` event, or `cancelled` as soon as `POST /api/jobs/{id}/cancel` arrives.
-//! The engines' library calls take no cancel flag, so a cancelled job's engine call runs to its
-//! end in the background and its result is dropped; stages after the cancel are skipped.
+//! Each job holds a cancel token ([`Job::token`]) that engines taking one check in their inner
+//! loops (the script story update, face edits), so those stop soon after the cancel; an engine call
+//! without one runs to its end in the background and its result is dropped. Stages after the
+//! cancel are skipped.
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use inbetween_core::cancel::Cancel;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -19,7 +23,7 @@ use crate::error::StudioError;
 pub struct Job {
     pub id: u64,
     pub kind: String,
-    cancelled: AtomicBool,
+    cancel: Cancel,
     log: Mutex<(Vec<(String, Value)>, bool)>,
     notify: Notify,
     started: Instant,
@@ -44,7 +48,12 @@ impl Job {
     }
 
     pub fn is_cancelled(&self) -> bool {
-        self.cancelled.load(Ordering::SeqCst)
+        self.cancel.is_cancelled()
+    }
+
+    /// The job's cancel token, for engine calls that check one.
+    pub fn token(&self) -> &Cancel {
+        &self.cancel
     }
 
     /// Milliseconds since the job started.
@@ -77,7 +86,7 @@ impl Job {
     }
 
     pub fn cancel(&self) {
-        self.cancelled.store(true, Ordering::SeqCst);
+        self.cancel.cancel();
         self.push("cancelled", json!({"job": self.id, "kind": self.kind, "ms": self.elapsed_ms()}), true);
     }
 
@@ -148,7 +157,7 @@ impl Jobs {
         let job = Arc::new(Job {
             id,
             kind: kind.to_string(),
-            cancelled: AtomicBool::new(false),
+            cancel: Cancel::new(),
             log: Mutex::new((Vec::new(), false)),
             notify: Notify::new(),
             started: Instant::now(),

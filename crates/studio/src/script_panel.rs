@@ -107,6 +107,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
             optimize: options.optimize,
             shared_motions: false,
             gif_width: 0,
+            cancel: Default::default(),
         };
         let (session, n) = story_session(&req.text, &run)?;
         notes = n;
@@ -115,11 +116,9 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let live = live.as_mut().expect("a session was just made");
     job.progress("composing the scene and animating the characters", 0.15);
     live.session.check_verbs(&req.text, "script").map_err(|e| StudioError::Engine(e.to_string()))?;
-    let up = live.session.update(&req.text);
+    // A cancelled update stops early and leaves the session at the last finished version.
+    let up = live.session.update_with(&req.text, job.token()).map_err(|e| StudioError::Engine(e.to_string()))?;
     live.version += 1;
-    if job.is_cancelled() {
-        return Err(StudioError::Engine("cancelled".into()));
-    }
     job.progress("writing the animated glTF and the BVH files", 0.8);
     let anim = &up.animation;
     let cat = live.session.catalogue();

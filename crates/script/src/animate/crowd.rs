@@ -169,6 +169,9 @@ pub(crate) fn separate(
             first_conflict(&trajs, &accepted)
         };
         let Some((f, a, b)) = conflict else { break };
+        if ctx.cancel.is_cancelled() {
+            break;
+        }
         if round >= max_rounds {
             notes.push(format!("characters: stopped repairing close passes after {max_rounds} changes"));
             break;

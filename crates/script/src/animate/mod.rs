@@ -52,7 +52,7 @@ pub(crate) use action::walk::WalkCache;
 pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
 pub use crowd::{min_clearance, Clearance};
 pub(crate) use crowd::{WalkChoice, WalkInfo};
-pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan};
+pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan, Setup};
 pub use props::{carried_from, object_pose, CarriedProp};
 
 use std::collections::HashMap;
@@ -243,5 +243,6 @@ pub(crate) fn animate_cached(
     cfg: &AnimateConfig,
     cache: &mut WalkCache,
 ) -> Animation {
-    animate_planned(scene, query, cat, lib, cfg, cache, &HashMap::new()).animation
+    let cancel = inbetween_core::cancel::Cancel::new();
+    animate_planned(&Setup { cat, lib, cfg, cancel: &cancel }, scene, query, cache, &HashMap::new()).animation
 }

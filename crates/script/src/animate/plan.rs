@@ -20,6 +20,7 @@ use crate::motion::rig::{Rig, FPS};
 use crate::motion::MotionLibrary;
 use crate::scene::Scene;
 use crate::ssg::Ssg;
+use inbetween_core::cancel::Cancel;
 
 /// A character's actions with their sentence, grouped by name in order of appearance.
 pub(crate) fn characters(query: &Ssg) -> Vec<(String, Actions)> {
@@ -45,6 +46,19 @@ pub(crate) struct Ctx<'a> {
     pub lib: &'a MotionLibrary,
     pub cfg: &'a AnimateConfig,
     pub rig: Rig,
+    /// Checked between characters and between crowd repairs; once cancelled they stop early (the
+    /// caller discards what was built).
+    pub cancel: &'a Cancel,
+}
+
+/// What every animation of a session is made with: the catalogue, the motion library, the
+/// settings, and the cancel token the long loops check.
+#[derive(Clone, Copy)]
+pub(crate) struct Setup<'a> {
+    pub cat: &'a Catalogue,
+    pub lib: &'a MotionLibrary,
+    pub cfg: &'a AnimateConfig,
+    pub cancel: &'a Cancel,
 }
 
 /// A character's actions with the sentence each comes from.
@@ -117,15 +131,14 @@ pub(crate) struct Planned {
 /// name) whose start and blocked spots are unchanged is taken as it is, and only rebuilt when a
 /// conflict cannot be solved otherwise.
 pub(crate) fn animate_planned(
+    setup: &Setup,
     scene: &Scene,
     query: &Ssg,
-    cat: &Catalogue,
-    lib: &MotionLibrary,
-    cfg: &AnimateConfig,
     cache: &mut WalkCache,
     frozen: &HashMap<String, CharacterPlan>,
 ) -> Planned {
-    let ctx = Ctx { scene, query, cat, lib, cfg, rig: Rig::standard() };
+    let Setup { cat, lib, cfg, cancel } = *setup;
+    let ctx = Ctx { scene, query, cat, lib, cfg, rig: Rig::standard(), cancel };
     let base_grid = Grid::from_objects(&scene.room, &scene.objects, grid::CELL, grid::WALKER_RADIUS);
     let mut plans: Vec<CharacterPlan> = Vec::new();
     let mut names = Vec::new();
@@ -135,6 +148,9 @@ pub(crate) fn animate_planned(
     // Every spot earlier characters stand or sit at: later stand points keep clear of them.
     let mut spots: Vec<[f32; 2]> = Vec::new();
     for (ci, (name, actions)) in characters(query).into_iter().enumerate() {
+        if cancel.is_cancelled() {
+            break;
+        }
         let mut g = base_grid.clone();
         for p in &occupied {
             g.block_rect(*p, [0.0, 0.0], 0.0, PASSING_DISTANCE + grid::CELL);
@@ -335,8 +351,18 @@ mod tests {
         let lib = MotionLibrary::procedural(0);
         let cfg = AnimateConfig::default();
         let mut cache = WalkCache::default();
-        let planned = animate_planned(&comp.scene, &comp.query, &cat, &lib, &cfg, &mut cache, &HashMap::new());
-        let ctx = Ctx { scene: &comp.scene, query: &comp.query, cat: &cat, lib: &lib, cfg: &cfg, rig: Rig::standard() };
+        let cancel = Cancel::new();
+        let setup = Setup { cat: &cat, lib: &lib, cfg: &cfg, cancel: &cancel };
+        let planned = animate_planned(&setup, &comp.scene, &comp.query, &mut cache, &HashMap::new());
+        let ctx = Ctx {
+            scene: &comp.scene,
+            query: &comp.query,
+            cat: &cat,
+            lib: &lib,
+            cfg: &cfg,
+            rig: Rig::standard(),
+            cancel: &cancel,
+        };
         let mut checked = 0;
         for plan in &planned.plans {
             for w in 0..plan.walks.len() {

@@ -29,7 +29,7 @@ use glam::DVec3;
 use inbetween_core::fk::forward;
 use rand::Rng;
 
-use crate::animate::{animate_cached, AnimateConfig, Animation, ContactJoint, WalkCache};
+use crate::animate::{animate_planned, AnimateConfig, Animation, ContactJoint, Setup, WalkCache};
 use crate::catalogue::{Catalogue, Support};
 use crate::compose::Composition;
 use crate::error::ScriptError;
@@ -38,6 +38,7 @@ use crate::motion::rig::Rig;
 use crate::motion::MotionLibrary;
 use crate::scene::{PlacedObject, Scene};
 use crate::ssg::{Relation, Ssg};
+use std::collections::HashMap;
 
 /// Default fraction of the initial cost that temperature 1 stands for (see
 /// [`OptimizeConfig::relative_temperature`]).
@@ -406,12 +407,27 @@ pub fn optimize_scene(
     acfg: &AnimateConfig,
     cfg: &OptimizeConfig,
 ) -> Optimized {
+    let cancel = inbetween_core::cancel::Cancel::new();
+    optimize_scene_in(&Setup { cat, lib, cfg: acfg, cancel: &cancel }, scene, query, relations, cfg)
+}
+
+/// [`optimize_scene`] with `setup`'s cancel token: once it is cancelled every further state is
+/// refused at once (the annealing runs out its remaining iterations without animating; the
+/// caller discards the result).
+pub(crate) fn optimize_scene_in(
+    setup: &Setup,
+    scene: &Scene,
+    query: &Ssg,
+    relations: &[(Relation, usize, usize)],
+    cfg: &OptimizeConfig,
+) -> Optimized {
     let mut cache = WalkCache::default();
-    let anim0 = animate_cached(scene, query, cat, lib, acfg, &mut cache);
+    let none = HashMap::new();
+    let anim0 = animate_planned(setup, scene, query, &mut cache, &none).animation;
     let before = costs(&anim0, cfg);
-    let movable = movable_objects(&anim0, relations, cat);
+    let movable = movable_objects(&anim0, relations, setup.cat);
     anneal(scene, relations, cfg, anim0, before, movable, &mut |s: &Scene| {
-        Some(animate_cached(s, query, cat, lib, acfg, &mut cache))
+        (!setup.cancel.is_cancelled()).then(|| animate_planned(setup, s, query, &mut cache, &none).animation)
     })
 }
 

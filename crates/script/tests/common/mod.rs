@@ -22,6 +22,7 @@ pub fn run_job(out: &std::path::Path, optimize: bool) -> RunJob {
         optimize,
         shared_motions: false,
         gif_width: 120,
+        cancel: Default::default(),
     }
 }
 
