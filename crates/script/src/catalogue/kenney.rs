@@ -122,16 +122,7 @@ pub fn glb_bounds(bytes: &[u8]) -> Result<([f32; 3], [f32; 3]), String> {
                 let (Some(amin), Some(amax)) = (amin, amax) else {
                     return Err(format!("POSITION accessor {acc} has no min/max"));
                 };
-                for k in 0..8 {
-                    let corner = Vec3::new(
-                        if k & 1 == 0 { amin.x } else { amax.x },
-                        if k & 2 == 0 { amin.y } else { amax.y },
-                        if k & 4 == 0 { amin.z } else { amax.z },
-                    );
-                    let p = world.transform_point3(corner);
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                }
+                grow_by_box(&mut lo, &mut hi, &world, amin, amax);
             }
         }
         for c in node.get("children").and_then(Value::as_array).into_iter().flatten() {
@@ -191,6 +182,21 @@ fn local_matrix(node: &Value) -> Result<Mat4, String> {
     let r = floats::<4>(node.get("rotation"))?.unwrap_or([0.0, 0.0, 0.0, 1.0]);
     let s = floats::<3>(node.get("scale"))?.unwrap_or([1.0; 3]);
     Ok(Mat4::from_scale_rotation_translation(Vec3::from(s), Quat::from_array(r).normalize(), Vec3::from(t)))
+}
+
+/// Grows the box `lo..hi` to hold the box `mn..mx` carried by `m` (all eight corners): a mesh's
+/// POSITION bounds through its node transforms (also [`crate::output::gltf`]'s model merge).
+pub(crate) fn grow_by_box(lo: &mut Vec3, hi: &mut Vec3, m: &glam::Mat4, mn: Vec3, mx: Vec3) {
+    for k in 0..8 {
+        let corner = Vec3::new(
+            if k & 1 == 0 { mn.x } else { mx.x },
+            if k & 2 == 0 { mn.y } else { mx.y },
+            if k & 4 == 0 { mn.z } else { mx.z },
+        );
+        let p = m.transform_point3(corner);
+        *lo = lo.min(p);
+        *hi = hi.max(p);
+    }
 }
 
 #[cfg(test)]

@@ -229,16 +229,7 @@ impl Doc {
                     Some(Vec3::new(a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32, a.get(2)?.as_f64()? as f32))
                 };
                 let (Some(mn), Some(mx)) = (v3(&acc.min), v3(&acc.max)) else { continue };
-                for c in 0..8 {
-                    let p = Vec3::new(
-                        if c & 1 == 0 { mn.x } else { mx.x },
-                        if c & 2 == 0 { mn.y } else { mx.y },
-                        if c & 4 == 0 { mn.z } else { mx.z },
-                    );
-                    let w = m.transform_point3(p);
-                    lo = lo.min(w);
-                    hi = hi.max(w);
-                }
+                crate::catalogue::kenney::grow_by_box(&mut lo, &mut hi, &m, mn, mx);
             }
             for c in n.children.iter().flatten() {
                 stack.push((c.value(), m, depth + 1));
