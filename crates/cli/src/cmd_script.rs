@@ -256,9 +256,10 @@ fn moved(staging: &Path, out: &Path, p: &Path) -> PathBuf {
     p.strip_prefix(staging).map_or_else(|_| p.to_path_buf(), |rest| out.join(rest))
 }
 
-/// `script run`: every output (and the skinned ones with `--skinned`) is written into a staging
-/// folder and moved into `--out` only when the run finishes, so a failed, cancelled or timed-out
-/// run leaves no partial set.
+/// `script run`: the story's outputs are written into a staging folder and moved into `--out`
+/// only when the run finishes, so a failed, cancelled or timed-out run leaves no partial set.
+/// `--skinned` outputs are a second set, written after (a missing asset folder leaves the story's
+/// outputs in place and writes none of the skinned ones).
 fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let (text, source) = load(&a.scene.script)?;
     let cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
@@ -271,12 +272,14 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
     job.cancel = cancel;
     let report = inbetween_script::job::run_story(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
-    let skinned_files = if a.skinned { Some(skinned(&a, &report, &staging)?) } else { None };
     set.commit().with_context(|| format!("moving the outputs into {}", a.scene.out.display()))?;
-    let shown = |p: &Path| moved(&staging, &a.scene.out, p);
-    print_run(&source, &report, &shown);
-    if let Some(s) = skinned_files {
-        print_skinned(&s, &shown);
+    print_run(&source, &report, &|p: &Path| moved(&staging, &a.scene.out, p));
+    if a.skinned {
+        let mut set = inbetween_io::OutputSet::new();
+        let staging = set.dir(&a.scene.out).with_context(|| format!("preparing {}", a.scene.out.display()))?;
+        let s = skinned(&a, &report, &staging)?;
+        set.commit().with_context(|| format!("moving the skinned outputs into {}", a.scene.out.display()))?;
+        print_skinned(&s, &|p: &Path| moved(&staging, &a.scene.out, p));
     }
     Ok(())
 }

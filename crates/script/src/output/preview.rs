@@ -23,12 +23,7 @@ const INK: [u8; 3] = [40, 40, 40];
 /// Polygons are clipped a little in front of the camera's near plane (cameras inside the room).
 const NEAR_CLIP: f64 = NEAR * 20.0;
 
-/// [`Canvas::fill_convex`] as a free function, for `skinned.rs` until it calls the canvas (and
-/// [`Canvas::fill_textured_triangle`]) itself; drawing lives in `inbetween_render`.
-pub(crate) fn fill_convex(cv: &mut Canvas, pts: &[(f32, f32)], color: [u8; 3]) {
-    cv.fill_convex(pts, color);
-}
-
+/// `c` darkened (or lightened) by the factor `k`, for shading faces.
 pub(crate) fn scale_color(c: [u8; 3], k: f32) -> [u8; 3] {
     c.map(|v| (v as f32 * k).round().clamp(0.0, 255.0) as u8)
 }

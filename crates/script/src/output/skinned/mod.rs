@@ -40,7 +40,7 @@ use serde_json::Value;
 
 use super::anim_gltf::{animated_document, AnimatedDocument, Body, CameraFn};
 use super::gltf::write_document;
-use super::preview::{draw_object, draw_room, fill_convex, scale_color};
+use super::preview::{draw_object, draw_room, scale_color};
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::motion::kenney::{read_character, KenneyCharacter, KenneyImage, KenneyPart};

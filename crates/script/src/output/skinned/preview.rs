@@ -89,7 +89,7 @@ pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) 
                 let o = &scene.objects[i];
                 draw_object(&mut cv, &cam, o, crate::output::category_color(cat, &o.category));
             }
-            Err((tri, colour)) => fill_convex(&mut cv, &tri, colour),
+            Err((tri, colour)) => cv.fill_convex(&tri, colour),
         }
     }
     cv.into_image()
