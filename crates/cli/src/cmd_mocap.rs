@@ -30,6 +30,9 @@ pub enum MocapCommand {
     /// Stream keyframes over TCP: `send` a clip in real time, `recv` and rebuild it.
     #[command(subcommand)]
     Stream(StreamCommand),
+    /// `mocap compress` (≤ 1 cm) on the demo's procedural walk at 1×, 10×, 100× its length: time
+    /// and peak memory per run.
+    Scale(crate::scale::ScaleArgs),
 }
 
 #[derive(Args)]
@@ -292,6 +295,7 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
         MocapCommand::Train(a) => train_cmd(a),
         MocapCommand::Stream(StreamCommand::Send(a)) => stream_send(a),
         MocapCommand::Stream(StreamCommand::Recv(a)) => stream_recv(a),
+        MocapCommand::Scale(a) => run_scale(a),
     }
 }
 
@@ -568,4 +572,43 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
         format!("the {} frames received were kept in {}", got.motion.num_frames(), a.output.display())
     })?;
     Ok(())
+}
+
+fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
+    crate::scale::run(
+        &a.out_or("mocap"),
+        "mocap_scale",
+        "mocap compress (≤ 1 cm) at multiples of the demo's walk",
+        "mocap scaling",
+        |exe, work| scale_rows(&a, exe, work),
+    )
+}
+
+/// One measured `mocap compress` per scale of `a.scales` on the demo's procedural walk (60
+/// frames at 1×), written as BVH into `work`.
+fn scale_rows(
+    a: &crate::scale::ScaleArgs,
+    exe: &Path,
+    work: &Path,
+) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
+    use inbetween_core::procedural::{gait, GaitParams};
+    use inbetween_io::scale::{run_measured, ScaleRow};
+    let mut rows = Vec::new();
+    for &k in &a.scales {
+        let walk = gait(&GaitParams { frames: 60 * k, ..GaitParams::walk() });
+        let input = work.join(format!("walk-{k}.bvh"));
+        inbetween_io::write_bvh(&input, &walk)?;
+        let out = work.join(format!("walk-{k}.ibk"));
+        let run = run_measured(
+            std::process::Command::new(exe)
+                .args(["mocap".as_ref(), "compress".as_ref(), input.as_os_str()])
+                .args(["--max-error", "1cm", "-o"])
+                .arg(&out),
+        )
+        .context("running mocap compress")?;
+        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
+        let what = format!("{} frames × {} joints at {:.0} fps", walk.num_frames(), walk.skeleton.len(), walk.fps());
+        rows.push(ScaleRow { scale: k, input: what, run });
+    }
+    Ok(rows)
 }

@@ -22,6 +22,9 @@ pub enum VideoCommand {
     Probe(ProbeArgs),
     /// M_D / Δo per clip, the ablations of Table 3 and seconds per stage (procedural and real clips).
     Bench(BenchArgs),
+    /// `video resequence` on the demo's procedural clip at 1×, 10×, 100× its frames (a scale over
+    /// the frame limit is refused, and the table says so): time and peak memory per run.
+    Scale(crate::scale::ScaleArgs),
 }
 
 #[derive(Args)]
@@ -174,6 +177,7 @@ pub fn run(c: VideoCommand) -> anyhow::Result<()> {
         VideoCommand::Synth(a) => run_synth(a),
         VideoCommand::Probe(a) => run_probe(a),
         VideoCommand::Bench(a) => run_bench(a),
+        VideoCommand::Scale(a) => run_scale(a),
     }
 }
 
@@ -455,4 +459,50 @@ fn tempfile_dir() -> anyhow::Result<PathBuf> {
     let dir = std::env::temp_dir().join(format!("inbetween-video-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     Ok(dir)
+}
+
+fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
+    crate::scale::run(
+        &a.out_or("video"),
+        "video_scale",
+        "video resequence at multiples of the demo's procedural clip",
+        "video scaling",
+        |exe, work| scale_rows(&a, exe, work),
+    )
+}
+
+/// One measured `video resequence` per scale of `a.scales` on the demo's clip (48 frames of
+/// 192×108 at 1×, from frame 6), the clip written by `video synth` into `work` (not timed).
+fn scale_rows(
+    a: &crate::scale::ScaleArgs,
+    exe: &Path,
+    work: &Path,
+) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
+    use inbetween_io::scale::{run_measured, ScaleRow};
+    use inbetween_video::demo::{FRAMES, START};
+    let mut rows = Vec::new();
+    for &k in &a.scales {
+        let frames = FRAMES * k;
+        let clip = work.join(format!("clip-{k}.gif"));
+        let synth = std::process::Command::new(exe)
+            .args(["video", "synth", "--kind", "mixed", "--width", "192", "--height", "108", "--frames"])
+            .arg(frames.to_string())
+            .arg("-o")
+            .arg(&clip)
+            .output()
+            .context("running video synth")?;
+        anyhow::ensure!(synth.status.success(), "video synth: {}", String::from_utf8_lossy(&synth.stderr));
+        let out = work.join(format!("new-{k}.gif"));
+        let run = run_measured(
+            std::process::Command::new(exe)
+                .args(["video".as_ref(), "resequence".as_ref(), clip.as_os_str(), "--start".as_ref()])
+                .arg(START.to_string())
+                .arg("-o")
+                .arg(&out),
+        )
+        .context("running video resequence")?;
+        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
+        rows.push(ScaleRow { scale: k, input: format!("{frames} frames of 192×108 px"), run });
+    }
+    Ok(rows)
 }

@@ -343,3 +343,16 @@ fn a_bound_without_a_unit_is_refused() {
     assert!(text(&o).contains("'1e9' has no length unit") && text(&o).contains("1e9cm"), "{}", text(&o));
     assert!(!Path::new(&out).exists());
 }
+
+#[test]
+fn scale_measures_compress_on_the_demo_walk_and_writes_its_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scale");
+    let o = inbetween(&["mocap", "scale", "--scales", "1,2", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = std::fs::read_to_string(out.join("mocap_scale.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert!(rows[0].contains("60 frames × 31 joints") && rows[1].contains("120 frames × 31 joints"), "{csv}");
+    assert!(rows.iter().all(|r| r.ends_with("ok")), "{csv}");
+}

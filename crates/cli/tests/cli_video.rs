@@ -125,3 +125,14 @@ fn bad_inputs_name_the_problem() {
     std::fs::write(&junk, b"GIF89a not really").unwrap();
     fails_with(&inbetween(&["video", "resequence", s(&junk), "-o", s(&d.join("o.gif"))]), "junk.gif");
 }
+
+#[test]
+fn scale_measures_resequence_on_the_demo_clip_and_writes_its_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scale");
+    ok(&inbetween(&["video", "scale", "--scales", "1", "-o", s(&out)]));
+    let csv = std::fs::read_to_string(out.join("video_scale.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 1, "{csv}");
+    assert!(rows[0].contains("48 frames of 192×108 px") && rows[0].ends_with("ok"), "{csv}");
+}
