@@ -212,6 +212,7 @@ fn run_job(a: &RunArgs) -> RunJob {
         shared_motions: a.shared_motions,
         gif_width: a.gif_width,
         cancel: Default::default(),
+        progress: inbetween_io::Progress::hidden(),
     }
 }
 
@@ -270,6 +271,7 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let mut job = run_job(&a);
     job.scene.out_dir = staging.clone();
     job.cancel = cancel;
+    job.progress = Progress::new(6, "script run");
     let report = inbetween_script::job::run_story(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
     set.commit().with_context(|| format!("moving the outputs into {}", a.scene.out.display()))?;

@@ -89,6 +89,13 @@ impl Progress {
         self.bar.println(line.as_ref());
     }
 
+    /// Redraws the bar every `every` (its elapsed time moves) while a long step reports nothing;
+    /// reveals a [`Progress::after`] bar once its delay has passed at a later update.
+    pub fn tick_every(&self, every: Duration) {
+        self.maybe_reveal();
+        self.bar.enable_steady_tick(every);
+    }
+
     /// Removes the bar from the terminal.
     pub fn finish(&self) {
         self.bar.finish_and_clear();

@@ -44,6 +44,7 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         shared_motions: false,
         gif_width: 320,
         cancel: Default::default(),
+        progress: inbetween_io::Progress::hidden(),
     };
     let story = crate::job::run_story(stories::DEMO, &PathBuf::from("builtin:demo"), &run)?;
     lines.push(format!(

@@ -132,6 +132,9 @@ pub struct RunJob {
     /// Checked in the long loops and before each output file (a cancel button, a time limit):
     /// a cancelled run returns [`ScriptError::Cancelled`]. `Cancel::new()` never stops.
     pub cancel: inbetween_core::cancel::Cancel,
+    /// Stages of the run as they start (solving the story, then each output); the CLI draws it,
+    /// `Progress::hidden()` counts silently.
+    pub progress: inbetween_io::Progress,
 }
 
 /// What a story job wrote and measured.
@@ -200,12 +203,21 @@ pub fn run_story_in(
     job.scene.limits.check_text(text, &name, session.catalogue())?;
     session.check_verbs(text, &name)?;
     let cancel = &job.cancel;
+    let progress = &job.progress;
+    // Stages: the solve, the scene files, story.gltf, the BVH files, the GIF, the routes.
+    progress.phase(6, "script run");
+    progress.set_message("composing, animating and optimising");
+    progress.tick_every(std::time::Duration::from_millis(250));
     let u = session.update_with(text, cancel)?;
+    progress.inc(1);
+    progress.set_message("writing the scene files");
     let cat = session.catalogue();
     job.scene.limits.check_animation(&name, u.animation.frames(), u.animation.fps)?;
     // One layout per run: the scene files show the optimised scene the story plays in.
     cancel.check()?;
     let scene_files = write_scene(&u.animation.scene, &u.scene.composition.query, cat, &job.scene)?;
+    progress.inc(1);
+    progress.set_message("writing story.gltf");
     let mut files = scene_files.clone();
     let dir = &job.scene.out_dir;
     if let Some(curves) = &u.curves {
@@ -222,12 +234,16 @@ pub fn run_story_in(
     cancel.check()?;
     output::write_story_gltf(&gltf, &animation, cat, &cam)?;
     files.push(gltf);
+    progress.inc(1);
+    progress.set_message("writing the BVH files");
     for c in &animation.characters {
         let safe: String = c.name.chars().map(|ch| if ch.is_alphanumeric() { ch } else { '_' }).collect();
         let bvh = dir.join(format!("{safe}.bvh"));
         output::write_character_bvh(&bvh, &c.clip)?;
         files.push(bvh);
     }
+    progress.inc(1);
+    progress.set_message("drawing story.gif");
     let gif = dir.join("story.gif");
     cancel.check()?;
     let moving = (0..animation.scene.objects.len())
@@ -245,10 +261,14 @@ pub fn run_story_in(
     let opts = output::AnimPreviewOptions { width: job.gif_width, moving, ..output::AnimPreviewOptions::default() };
     output::render_preview_gif(&gif, &animation.scene, cat, &chars, &cam, animation.fps, &opts)?;
     files.push(gif);
+    progress.inc(1);
+    progress.set_message("drawing routes.png");
     let routes = dir.join("routes.png");
     cancel.check()?;
     output::render_top_down_trails(&routes, &animation.scene, cat, &chars)?;
     files.push(routes);
+    progress.inc(1);
+    progress.finish();
     let composition = u.scene.composition;
     let diagnostics = notes.into_iter().chain(composition.diagnostics.iter().cloned()).collect();
     let scene = SceneReport { files: scene_files, composition, diagnostics, seconds: u.scene.seconds };

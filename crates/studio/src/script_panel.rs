@@ -108,6 +108,7 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
             shared_motions: false,
             gif_width: 0,
             cancel: Default::default(),
+            progress: inbetween_io::Progress::hidden(),
         };
         let (session, n) = story_session(&req.text, &run)?;
         notes = n;

@@ -23,6 +23,7 @@ pub fn run_job(out: &std::path::Path, optimize: bool) -> RunJob {
         shared_motions: false,
         gif_width: 120,
         cancel: Default::default(),
+        progress: inbetween_io::Progress::hidden(),
     }
 }
 
