@@ -354,46 +354,26 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 
 fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
     crate::scale::run(
-        &a.out_or("camera"),
-        "camera_scale",
+        &a,
+        "camera",
         "camera generate (orbit style) at multiples of the demo's example",
-        "camera scaling",
-        |exe, work| scale_rows(&a, exe, work),
+        |k, exe, work| {
+            // The demo's example, k times: a 300·k-frame scene with a key every 150 frames (3 at 1×).
+            let frames = 300 * k;
+            let scene = Scene::procedural(3, frames, 30.0);
+            let mut at: Vec<usize> = (0..frames).step_by(150).collect();
+            if at.last() != Some(&(frames - 1)) {
+                at.push(frames - 1);
+            }
+            let keys = inbetween_camera::infer::example_keys(&scene, &at);
+            let (scene_path, keys_path) = (work.join(format!("scene-{k}.json")), work.join(format!("keys-{k}.json")));
+            scene.save(&scene_path)?;
+            inbetween_camera::write_json(&keys_path, &keys)?;
+            let mut command = std::process::Command::new(exe);
+            command.args(["camera", "generate", "--style", "orbit", "--scene"]).arg(&scene_path);
+            command.arg("--keys").arg(&keys_path).arg("-o").arg(work.join(format!("cam-{k}.json")));
+            let input = format!("{frames} frames at 30 fps, {} keys", at.len());
+            Ok(crate::scale::Measured { input, command })
+        },
     )
-}
-
-/// One measured run per scale of `a.scales`, inputs written to `work`.
-fn scale_rows(a: &ScaleArgs, exe: &Path, work: &Path) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
-    use inbetween_io::scale::{run_measured, ScaleRow};
-    let mut rows = Vec::new();
-    for &k in &a.scales {
-        // The demo's example, k times: a 300·k-frame scene with a key every 150 frames (3 at 1×).
-        let frames = 300 * k;
-        let scene = Scene::procedural(3, frames, 30.0);
-        let mut at: Vec<usize> = (0..frames).step_by(150).collect();
-        if at.last() != Some(&(frames - 1)) {
-            at.push(frames - 1);
-        }
-        let keys = inbetween_camera::infer::example_keys(&scene, &at);
-        let (scene_path, keys_path) = (work.join(format!("scene-{k}.json")), work.join(format!("keys-{k}.json")));
-        scene.save(&scene_path)?;
-        inbetween_camera::write_json(&keys_path, &keys)?;
-        let out = work.join(format!("cam-{k}.json"));
-        let run = run_measured(std::process::Command::new(exe).args([
-            "camera".as_ref(),
-            "generate".as_ref(),
-            "--scene".as_ref(),
-            scene_path.as_os_str(),
-            "--keys".as_ref(),
-            keys_path.as_os_str(),
-            "--style".as_ref(),
-            "orbit".as_ref(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]))
-        .context("running camera generate")?;
-        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
-        rows.push(ScaleRow { scale: k, input: format!("{frames} frames at 30 fps, {} keys", at.len()), run });
-    }
-    Ok(rows)
 }

@@ -589,41 +589,18 @@ fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
-    crate::scale::run(
-        &a.out_or("face"),
-        "face_scale",
-        "face edit (unguided network) at multiples of the demo's example",
-        "face scaling",
-        |exe, work| scale_rows(&a, exe, work),
-    )
-}
-
-/// One measured run per scale of `a.scales`, inputs written to `work`.
-fn scale_rows(a: &ScaleArgs, exe: &Path, work: &Path) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
     use inbetween_face::demo::OCCLUSION_S;
-    use inbetween_io::scale::{run_measured, ScaleRow};
-    let mut rows = Vec::new();
-    for &k in &a.scales {
+    crate::scale::run(&a, "face", "face edit (unguided network) at multiples of the demo's example", |k, exe, work| {
         // The demo's example, k times: a 10·k s procedural clip, a gap of 3·k s from 3.5 s.
         let seconds = 10.0 * k as f64;
         let (start, end) = (OCCLUSION_S.0, OCCLUSION_S.0 + (OCCLUSION_S.1 - OCCLUSION_S.0) * k as f64);
         let p = procedural::generate(&procedural::ProceduralConfig { duration_s: seconds, ..Default::default() }, 1);
         let input = work.join(format!("clip-{k}.csv"));
         write_clip(&input, &p.clip, false)?;
-        let out = work.join(format!("edit-{k}.csv"));
-        let run = run_measured(std::process::Command::new(exe).args([
-            "face".as_ref(),
-            "edit".as_ref(),
-            input.as_os_str(),
-            "--mask".as_ref(),
-            format!("{start}s..{end}s").as_ref(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]))
-        .context("running face edit")?;
-        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
+        let mut command = std::process::Command::new(exe);
+        command.args(["face".as_ref(), "edit".as_ref(), input.as_os_str(), "--mask".as_ref()]);
+        command.arg(format!("{start}s..{end}s")).arg("-o").arg(work.join(format!("edit-{k}.csv")));
         let input = format!("{seconds} s clip ({} rows), {:.1} s gap", p.clip.num_frames(), end - start);
-        rows.push(ScaleRow { scale: k, input, run });
-    }
-    Ok(rows)
+        Ok(crate::scale::Measured { input, command })
+    })
 }

@@ -575,40 +575,16 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    crate::scale::run(
-        &a.out_or("mocap"),
-        "mocap_scale",
-        "mocap compress (≤ 1 cm) at multiples of the demo's walk",
-        "mocap scaling",
-        |exe, work| scale_rows(&a, exe, work),
-    )
-}
-
-/// One measured `mocap compress` per scale of `a.scales` on the demo's procedural walk (60
-/// frames at 1×), written as BVH into `work`.
-fn scale_rows(
-    a: &crate::scale::ScaleArgs,
-    exe: &Path,
-    work: &Path,
-) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
     use inbetween_core::procedural::{gait, GaitParams};
-    use inbetween_io::scale::{run_measured, ScaleRow};
-    let mut rows = Vec::new();
-    for &k in &a.scales {
+    // The demo's procedural walk (60 frames at 1×), k times as long, written as BVH.
+    crate::scale::run(&a, "mocap", "mocap compress (≤ 1 cm) at multiples of the demo's walk", |k, exe, work| {
         let walk = gait(&GaitParams { frames: 60 * k, ..GaitParams::walk() });
         let input = work.join(format!("walk-{k}.bvh"));
         inbetween_io::write_bvh(&input, &walk)?;
-        let out = work.join(format!("walk-{k}.ibk"));
-        let run = run_measured(
-            std::process::Command::new(exe)
-                .args(["mocap".as_ref(), "compress".as_ref(), input.as_os_str()])
-                .args(["--max-error", "1cm", "-o"])
-                .arg(&out),
-        )
-        .context("running mocap compress")?;
-        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
-        let what = format!("{} frames × {} joints at {:.0} fps", walk.num_frames(), walk.skeleton.len(), walk.fps());
-        rows.push(ScaleRow { scale: k, input: what, run });
-    }
-    Ok(rows)
+        let mut command = std::process::Command::new(exe);
+        command.args(["mocap".as_ref(), "compress".as_ref(), input.as_os_str()]);
+        command.args(["--max-error", "1cm", "-o"]).arg(work.join(format!("walk-{k}.ibk")));
+        let input = format!("{} frames × {} joints at {:.0} fps", walk.num_frames(), walk.skeleton.len(), walk.fps());
+        Ok(crate::scale::Measured { input, command })
+    })
 }

@@ -405,50 +405,19 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    crate::scale::run(
-        &a.out_or("script"),
-        "script_scale",
-        "script run at multiples of the demo story's directions",
-        "script scaling",
-        |exe, work| scale_rows(&a, exe, work),
-    )
-}
-
-/// One measured `script run` per scale of `a.scales` on [`stories::scaled_demo`], its limits
-/// raised to fit (a story of 100× the demo is over the default limits on purpose).
-fn scale_rows(
-    a: &crate::scale::ScaleArgs,
-    exe: &Path,
-    work: &Path,
-) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
-    use inbetween_io::scale::{run_measured, ScaleRow};
-    let mut rows = Vec::new();
-    for &k in &a.scales {
+    // The demo story with its directions k times (stories::scaled_demo), limits raised to fit (a
+    // story of 100× the demo is over the default limits on purpose).
+    crate::scale::run(&a, "script", "script run at multiples of the demo story's directions", |k, exe, work| {
         let text = stories::scaled_demo(k);
         let input = work.join(format!("story-{k}.txt"));
         std::fs::write(&input, &text).with_context(|| format!("writing {}", input.display()))?;
-        let out = work.join(format!("story-{k}"));
         let sentences = inbetween_script::script::split(&text).len();
         let big = (100 * k.max(1)).to_string();
-        let run = run_measured(
-            std::process::Command::new(exe)
-                .args(["script".as_ref(), "run".as_ref(), input.as_os_str(), "-o".as_ref(), out.as_os_str()])
-                .args([
-                    "--gif-width",
-                    "160",
-                    "--max-sentences",
-                    &big,
-                    "--max-words",
-                    &(10 * 100 * k.max(1)).to_string(),
-                ])
-                .args(["--max-actions", &big, "--max-animation-seconds", &(120 * k.max(1)).to_string()]),
-        )
-        .context("running script run")?;
-        if !run.success {
-            anyhow::bail!("script run at {k}× failed: {}", run.stderr.trim());
-        }
-        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
-        rows.push(ScaleRow { scale: k, input: format!("{sentences} sentences, {} actions", 5 * k), run });
-    }
-    Ok(rows)
+        let mut command = std::process::Command::new(exe);
+        command.args(["script".as_ref(), "run".as_ref(), input.as_os_str(), "-o".as_ref()]);
+        command.arg(work.join(format!("story-{k}")));
+        command.args(["--gif-width", "160", "--max-sentences", &big, "--max-words", &(1000 * k.max(1)).to_string()]);
+        command.args(["--max-actions", &big, "--max-animation-seconds", &(120 * k.max(1)).to_string()]);
+        Ok(crate::scale::Measured { input: format!("{sentences} sentences, {} actions", 5 * k), command })
+    })
 }

@@ -462,26 +462,10 @@ fn tempfile_dir() -> anyhow::Result<PathBuf> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    crate::scale::run(
-        &a.out_or("video"),
-        "video_scale",
-        "video resequence at multiples of the demo's procedural clip",
-        "video scaling",
-        |exe, work| scale_rows(&a, exe, work),
-    )
-}
-
-/// One measured `video resequence` per scale of `a.scales` on the demo's clip (48 frames of
-/// 192×108 at 1×, from frame 6), the clip written by `video synth` into `work` (not timed).
-fn scale_rows(
-    a: &crate::scale::ScaleArgs,
-    exe: &Path,
-    work: &Path,
-) -> anyhow::Result<Vec<inbetween_io::scale::ScaleRow>> {
-    use inbetween_io::scale::{run_measured, ScaleRow};
     use inbetween_video::demo::{FRAMES, START};
-    let mut rows = Vec::new();
-    for &k in &a.scales {
+    // The demo's clip (48 frames of 192×108 at 1×, from frame 6), k times as long, written by
+    // `video synth` (not timed); a scale over the frame limit is refused and the table says so.
+    crate::scale::run(&a, "video", "video resequence at multiples of the demo's procedural clip", |k, exe, work| {
         let frames = FRAMES * k;
         let clip = work.join(format!("clip-{k}.gif"));
         let synth = std::process::Command::new(exe)
@@ -492,17 +476,9 @@ fn scale_rows(
             .output()
             .context("running video synth")?;
         anyhow::ensure!(synth.status.success(), "video synth: {}", String::from_utf8_lossy(&synth.stderr));
-        let out = work.join(format!("new-{k}.gif"));
-        let run = run_measured(
-            std::process::Command::new(exe)
-                .args(["video".as_ref(), "resequence".as_ref(), clip.as_os_str(), "--start".as_ref()])
-                .arg(START.to_string())
-                .arg("-o")
-                .arg(&out),
-        )
-        .context("running video resequence")?;
-        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
-        rows.push(ScaleRow { scale: k, input: format!("{frames} frames of 192×108 px"), run });
-    }
-    Ok(rows)
+        let mut command = std::process::Command::new(exe);
+        command.args(["video".as_ref(), "resequence".as_ref(), clip.as_os_str(), "--start".as_ref()]);
+        command.arg(START.to_string()).arg("-o").arg(work.join(format!("new-{k}.gif")));
+        Ok(crate::scale::Measured { input: format!("{frames} frames of 192×108 px"), command })
+    })
 }

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use inbetween_io::scale::{scale_table, ScaleRow};
+use inbetween_io::scale::{run_measured, scale_table, ScaleRow};
+use std::process::Command;
 
 /// The arguments every engine's `scale` subcommand takes.
 #[derive(Args)]
@@ -25,25 +26,43 @@ impl ScaleArgs {
     }
 }
 
-/// Runs `rows(exe, scratch)` (one measured run per scale), then prints the table `name` with
-/// `title` and writes it into `out` as the report `report_title`.
+/// One scale's run, as an engine prepares it: the input in words with units, and the command
+/// (this binary) to measure.
+pub struct Measured {
+    pub input: String,
+    pub command: Command,
+}
+
+/// Runs `engine`'s scaling bench: for each of `a.scales`, `prepare(k, exe, scratch)` writes the
+/// input at `k`× into the scratch folder (removed afterwards) and gives the command, which is run
+/// and measured as its own process ([`run_measured`]); then the table `<engine>_scale` titled
+/// `title` is printed and written into `--out` as the report "<engine> scaling". A run that fails
+/// (a limit refusing the input, say) is a row whose result is its first error line.
 pub fn run(
-    out: &Path,
-    name: &str,
+    a: &ScaleArgs,
+    engine: &str,
     title: &str,
-    report_title: &str,
-    rows: impl FnOnce(&Path, &Path) -> anyhow::Result<Vec<ScaleRow>>,
+    mut prepare: impl FnMut(usize, &Path, &Path) -> anyhow::Result<Measured>,
 ) -> anyhow::Result<()> {
     let exe: PathBuf = std::env::current_exe().context("locating the inbetween binary")?;
     let scratch = std::env::temp_dir().join(format!("inbetween-scale-{}", std::process::id()));
     std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
-    let result = rows(&exe, &scratch);
+    let mut rows = Vec::new();
+    let result = a.scales.iter().try_for_each(|&k| -> anyhow::Result<()> {
+        let mut m = prepare(k, &exe, &scratch)?;
+        let run = run_measured(&mut m.command).with_context(|| format!("running {engine} at {k}×"))?;
+        println!("{k}×: {:.3} s, peak {:.1} MiB", run.seconds, run.peak_mib.unwrap_or(f64::NAN));
+        rows.push(ScaleRow { scale: k, input: m.input, run });
+        Ok(())
+    });
     let _ = std::fs::remove_dir_all(&scratch);
-    let table = scale_table(name, title, &result?);
-    let mut report = inbetween_io::report::Report::new("report", report_title);
+    result?;
+    let table = scale_table(&format!("{engine}_scale"), title, &rows);
+    let mut report = inbetween_io::report::Report::new("report", &format!("{engine} scaling"));
     print!("{}", table.to_text());
     report.table(table);
-    let files = report.write(out).with_context(|| format!("writing {}", out.display()))?;
+    let out = a.out_or(engine);
+    let files = report.write(&out).with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {} files to {}", files.len(), out.display());
     Ok(())
 }
