@@ -20,6 +20,9 @@ pub enum MocapError {
     Nn(#[from] inbetween_nn::NnError),
     #[error("stream: {0}")]
     Stream(String),
+    /// The caller's cancel token was cancelled (or its time limit passed).
+    #[error("stopped: {0}")]
+    Cancelled(#[from] inbetween_core::cancel::Cancelled),
 }
 
 pub type Result<T> = std::result::Result<T, MocapError>;

@@ -279,11 +279,12 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
         }
         "greedy" => {
             let k = need_k()?;
-            (select::greedy(rep, k, ErrorMeasure::Angle)?, format!("greedy K={k}"))
+            (select::greedy_cancellable(rep, k, ErrorMeasure::Angle, job.token())?, format!("greedy K={k}"))
         }
         "optimal" => {
             let k = need_k()?;
-            (select::optimal_spherical(rep, k, ErrorMeasure::Angle)?, format!("optimal K={k}"))
+            let (keys, _) = select::optimal_spherical_cancellable(rep, k, ErrorMeasure::Angle, job.token())?;
+            (keys, format!("optimal K={k}"))
         }
         "sidql" => {
             let k = need_k()?;

@@ -9,6 +9,17 @@ use inbetween_core::KeyframeSet;
 use std::collections::HashMap;
 
 pub fn greedy(model: &dyn SegmentModel, k: usize, objective: ErrorMeasure) -> Result<KeyframeSet> {
+    greedy_cancellable(model, k, objective, &inbetween_core::cancel::Cancel::new())
+}
+
+/// [`greedy`] that checks `cancel` before each key it adds and returns
+/// [`crate::MocapError::Cancelled`] once it is cancelled.
+pub fn greedy_cancellable(
+    model: &dyn SegmentModel,
+    k: usize,
+    objective: ErrorMeasure,
+    cancel: &inbetween_core::cancel::Cancel,
+) -> Result<KeyframeSet> {
     let n = model.num_frames();
     check_k(n, k)?;
     let mut keys = KeyframeSet::new(vec![], n)?;
@@ -18,6 +29,7 @@ pub fn greedy(model: &dyn SegmentModel, k: usize, objective: ErrorMeasure) -> Re
         objective.of(memo.entry((a, b)).or_insert_with(|| model.segment_cost(a, b, &mut scratch)))
     };
     while keys.len() < k {
+        cancel.check()?;
         let mut best: Option<(f64, usize)> = None;
         for (a, b) in keys.segments().collect::<Vec<_>>() {
             let whole = cost(a, b);

@@ -28,6 +28,7 @@ use super::check_k;
 use crate::metrics::{ErrorMeasure, SegmentModel, SegmentTable};
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
+use inbetween_core::cancel::Cancel;
 use inbetween_core::interp::hermite_basis;
 use inbetween_core::KeyframeSet;
 use std::f64::consts::TAU;
@@ -54,13 +55,24 @@ pub fn optimal_spherical_with_total(
     k: usize,
     objective: ErrorMeasure,
 ) -> Result<(KeyframeSet, f64)> {
+    optimal_spherical_cancellable(rep, k, objective, &Cancel::new())
+}
+
+/// [`optimal_spherical_with_total`] that checks `cancel` once per frame of each pass (a studio's
+/// cancel button, a time limit) and returns [`crate::MocapError::Cancelled`] once it is cancelled.
+pub fn optimal_spherical_cancellable(
+    rep: &SphericalMotion,
+    k: usize,
+    objective: ErrorMeasure,
+    cancel: &Cancel,
+) -> Result<(KeyframeSet, f64)> {
     let n = rep.num_frames;
     check_k(n, k)?;
     match objective {
-        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep)).solution(),
+        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel)?.solution(),
         ErrorMeasure::Position => {
             let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
-            PrunedCosts::build(n, k, &mut frames).solution()
+            PrunedCosts::build(n, k, &mut frames, cancel)?.solution()
         }
     }
 }
@@ -280,7 +292,7 @@ struct PrunedCosts {
 const SLACK: f64 = 1e-9;
 
 impl PrunedCosts {
-    fn build(n: usize, k: usize, frames: &mut impl FrameObjective) -> PrunedCosts {
+    fn build(n: usize, k: usize, frames: &mut impl FrameObjective, cancel: &Cancel) -> Result<PrunedCosts> {
         let inf = f64::INFINITY;
         let mut costs = vec![inf; n * n];
         let mut terms = vec![0.0; n];
@@ -289,6 +301,7 @@ impl PrunedCosts {
         let span = (n - 1).div_ceil(k - 1);
         let g0 = (span + span.div_ceil(2)).min(n - 1);
         for a in 0..n {
+            cancel.check()?;
             for b in a + 1..=(a + g0).min(n - 1) {
                 frames.frames(a, b, a + 1, b, &mut terms);
                 costs[a * n + b] = terms[..b - a - 1].iter().fold(0.0, |s, t| s + t);
@@ -302,6 +315,7 @@ impl PrunedCosts {
         // 2. A lower bound of every longer segment: its middle frames.
         let mut lower = costs.clone();
         for a in 0..n {
+            cancel.check()?;
             for b in a + g0 + 1..n {
                 let (lo, hi) = middle(a, b);
                 frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
@@ -326,6 +340,7 @@ impl PrunedCosts {
         table.dp[0] = 0.0;
         let room_total = bound * (1.0 + SLACK);
         for j in 1..n {
+            cancel.check()?;
             for i in 0..j.saturating_sub(g0) {
                 let room = if exact {
                     inf
@@ -342,7 +357,7 @@ impl PrunedCosts {
             }
             table.column(j);
         }
-        table
+        Ok(table)
     }
 
     /// `dp[c][j]` and its predecessor for every c, exactly as [`shortest_path`] computes them.
@@ -614,6 +629,32 @@ mod tests {
     }
 
     #[test]
+    fn a_cancelled_token_stops_optimal_and_greedy_with_the_reason() {
+        use inbetween_core::cancel::Cancelled;
+        let windows = varied_windows();
+        let rep = &windows[0];
+        let stopped = Cancel::new();
+        stopped.cancel();
+        for e in [
+            optimal_spherical_cancellable(rep, 5, ErrorMeasure::Angle, &stopped).unwrap_err(),
+            super::super::greedy_cancellable(rep, 5, ErrorMeasure::Angle, &stopped).unwrap_err(),
+        ] {
+            assert!(matches!(e, MocapError::Cancelled(Cancelled::Requested)), "{e}");
+            assert_eq!(e.to_string(), "stopped: cancelled");
+        }
+        // A token that never fires changes nothing.
+        let free = Cancel::new();
+        assert_eq!(
+            optimal_spherical_cancellable(rep, 5, ErrorMeasure::Angle, &free).unwrap(),
+            optimal_spherical_with_total(rep, 5, ErrorMeasure::Angle).unwrap()
+        );
+        assert_eq!(
+            super::super::greedy_cancellable(rep, 5, ErrorMeasure::Angle, &free).unwrap(),
+            super::super::greedy(rep, 5, ErrorMeasure::Angle).unwrap()
+        );
+    }
+
+    #[test]
     fn kept_costs_are_the_tables_and_dropped_ones_lie_on_no_optimal_path() {
         let mut dropped_at_15 = (0, 0);
         for rep in varied_windows().iter().step_by(2) {
@@ -621,7 +662,7 @@ mod tests {
             let table = SegmentTable::full_serial(rep);
             let cost = |a: usize, b: usize| table.get(a, b).unwrap().angle_sum;
             for k in [3, 5, 10, 15].into_iter().filter(|&k| k <= n) {
-                let kept = PrunedCosts::build(n, k, &mut AngleFrames::new(rep));
+                let kept = PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new()).unwrap();
                 let (_, best) = reference_optimal(&table, k, ErrorMeasure::Angle).unwrap();
                 // The least total of any k-key path through each segment, from the full table.
                 let inf = f64::INFINITY;
