@@ -3,9 +3,9 @@
 //! (`GET /api/jobs/{id}/events`): `progress` events (the stage and its share of the job), then one
 //! `result` or `failed` event, or `cancelled` as soon as `POST /api/jobs/{id}/cancel` arrives.
 //! Each job holds a cancel token ([`Job::token`]) that engines taking one check in their inner
-//! loops (the script story update, face edits, mocap greedy and optimal keys), so those stop soon
-//! after the cancel; an engine call without one runs to its end in the background and its result
-//! is dropped. Stages after the cancel are skipped.
+//! loops (the script story update, face edits, mocap greedy and optimal keys, the video analysis),
+//! so those stop soon after the cancel; an engine call without one runs to its end in the
+//! background and its result is dropped. Stages after the cancel are skipped.
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};

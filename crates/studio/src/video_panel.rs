@@ -180,7 +180,8 @@ fn opened(st: &AppState, job: &Job, name: String, clip: Clip) -> Result<Value> {
         return Err(StudioError::Engine(format!("{name}: {} frame(s); a clip needs at least 2", clip.len())));
     }
     job.progress("analysing: optical flow, RSFNet (trained on the clip, or from its cache), graph, cuts", 0.15);
-    let cfg = ResequenceConfig::default();
+    // The job's token: a cancel stops the flow, the metric's training and the graph between stages.
+    let cfg = ResequenceConfig { cancel: job.token().clone(), ..ResequenceConfig::default() };
     cfg.limits.check_clip(&clip).map_err(|e| StudioError::Engine(e.to_string()))?;
     let analysis = analyse(&clip, &cfg, &Progress::hidden()).map_err(|e| StudioError::Engine(e.to_string()))?;
     if job.is_cancelled() {
