@@ -23,8 +23,10 @@ pub mod sidql;
 pub mod uniform;
 
 pub use cost_to_go::{angle_segment_costs, completion_values, cost_to_go};
-pub use greedy::{greedy, greedy_cancellable};
-pub use optimal::{error_bounded, optimal, optimal_spherical, optimal_spherical_cancellable};
+pub use greedy::{greedy, greedy_cancellable, GreedyOrder};
+pub use optimal::{
+    error_bounded, optimal, optimal_spherical, optimal_spherical_cancellable, optimal_spherical_memo, OptimalMemo,
+};
 pub use random::random;
 pub use refine::refine_keys;
 pub use uniform::uniform;

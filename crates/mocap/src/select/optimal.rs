@@ -69,10 +69,62 @@ pub fn optimal_spherical_cancellable(
     let n = rep.num_frames;
     check_k(n, k)?;
     match objective {
-        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel)?.solution(),
+        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, None)?.solution(),
         ErrorMeasure::Position => {
             let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
-            PrunedCosts::build(n, k, &mut frames, cancel)?.solution()
+            PrunedCosts::build(n, k, &mut frames, cancel, None)?.solution()
+        }
+    }
+}
+
+/// What [`optimal_spherical_memo`] learnt about one clip's segments, for the next search on the same
+/// clip with another `k` (a studio's K slider): the cost of every segment costed in full, and for a
+/// segment given up on, the partial sum that exceeded its room (a lower bound of its cost). Known
+/// costs are not recomputed, and the bounds prune more. About `16·n²` bytes.
+#[derive(Clone, Debug)]
+pub struct OptimalMemo {
+    n: usize,
+    objective: ErrorMeasure,
+    /// `exact[a * n + b]`: the cost of segment `(a, b)`, NaN while unknown.
+    exact: Vec<f64>,
+    /// `lower[a * n + b]`: a lower bound of that cost (0 while nothing is known).
+    lower: Vec<f64>,
+}
+
+impl OptimalMemo {
+    /// An empty memo for a clip of `n` frames and one objective.
+    pub fn new(n: usize, objective: ErrorMeasure) -> OptimalMemo {
+        OptimalMemo { n, objective, exact: vec![f64::NAN; n * n], lower: vec![0.0; n * n] }
+    }
+
+    fn exact(&self, a: usize, b: usize) -> Option<f64> {
+        let c = self.exact[a * self.n + b];
+        (!c.is_nan()).then_some(c)
+    }
+}
+
+/// [`optimal_spherical_cancellable`] that reuses and extends `memo` (made for this clip and
+/// objective; another is refused): the same keys and total, bit for bit, whatever the memo holds.
+pub fn optimal_spherical_memo(
+    rep: &SphericalMotion,
+    k: usize,
+    objective: ErrorMeasure,
+    cancel: &Cancel,
+    memo: &mut OptimalMemo,
+) -> Result<(KeyframeSet, f64)> {
+    let n = rep.num_frames;
+    check_k(n, k)?;
+    if memo.n != n || memo.objective != objective {
+        return Err(MocapError::Invalid(format!(
+            "the optimal-keys memo was made for {} frames and {:?} error, not {n} frames and {objective:?}",
+            memo.n, memo.objective
+        )));
+    }
+    match objective {
+        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, Some(memo))?.solution(),
+        ErrorMeasure::Position => {
+            let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
+            PrunedCosts::build(n, k, &mut frames, cancel, Some(memo))?.solution()
         }
     }
 }
@@ -292,7 +344,14 @@ struct PrunedCosts {
 const SLACK: f64 = 1e-9;
 
 impl PrunedCosts {
-    fn build(n: usize, k: usize, frames: &mut impl FrameObjective, cancel: &Cancel) -> Result<PrunedCosts> {
+    fn build(
+        n: usize,
+        k: usize,
+        frames: &mut impl FrameObjective,
+        cancel: &Cancel,
+        mut memo: Option<&mut OptimalMemo>,
+    ) -> Result<PrunedCosts> {
+        let known = |memo: &Option<&mut OptimalMemo>, a: usize, b: usize| memo.as_ref().and_then(|m| m.exact(a, b));
         let inf = f64::INFINITY;
         let mut costs = vec![inf; n * n];
         let mut terms = vec![0.0; n];
@@ -303,8 +362,17 @@ impl PrunedCosts {
         for a in 0..n {
             cancel.check()?;
             for b in a + 1..=(a + g0).min(n - 1) {
-                frames.frames(a, b, a + 1, b, &mut terms);
-                costs[a * n + b] = terms[..b - a - 1].iter().fold(0.0, |s, t| s + t);
+                costs[a * n + b] = match known(&memo, a, b) {
+                    Some(c) => c,
+                    None => {
+                        frames.frames(a, b, a + 1, b, &mut terms);
+                        let c = terms[..b - a - 1].iter().fold(0.0, |s, t| s + t);
+                        if let Some(m) = memo.as_deref_mut() {
+                            m.exact[a * n + b] = c;
+                        }
+                        c
+                    }
+                };
             }
         }
         // The best path over them bounds the optimum U (floating-point addition is monotone, so the
@@ -312,14 +380,20 @@ impl PrunedCosts {
         let short = |a: usize, b: usize| costs[a * n + b];
         let bound = shortest_path(n, g0, k, short).map_or(inf, |(_, u)| u);
         let exact = !bound.is_finite() || costs.iter().any(|c| c.is_nan());
-        // 2. A lower bound of every longer segment: its middle frames.
+        // 2. A lower bound of every longer segment: its middle frames, or what the memo knows.
         let mut lower = costs.clone();
         for a in 0..n {
             cancel.check()?;
             for b in a + g0 + 1..n {
+                let known = memo.as_ref().map_or(0.0, |m| m.exact(a, b).unwrap_or(m.lower[a * n + b]));
                 let (lo, hi) = middle(a, b);
-                frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
-                lower[a * n + b] = terms[lo..hi].iter().sum::<f64>() * (1.0 - SLACK);
+                let mid = if known > 0.0 {
+                    0.0
+                } else {
+                    frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
+                    terms[lo..hi].iter().sum::<f64>()
+                };
+                lower[a * n + b] = mid.max(known) * (1.0 - SLACK);
             }
         }
         // 3. after[r * n + j]: a lower bound of the cost from a key at j to the last frame in r segments.
@@ -339,33 +413,66 @@ impl PrunedCosts {
         let mut table = PrunedCosts { n, k, costs, dp: vec![inf; k * n], from: vec![usize::MAX; k * n] };
         table.dp[0] = 0.0;
         let room_total = bound * (1.0 + SLACK);
+        // The least dp of each finished column and the least `after` of each frame over the c of
+        // the bound: a segment whose lower bound passes even the room they leave is dropped without
+        // the minimum over c (floating-point addition is monotone, so that room is never smaller).
+        let mut least_dp = vec![inf; n];
+        least_dp[0] = 0.0;
+        let least_after: Vec<f64> = (0..n).map(|j| (0..k - 1).map(|r| after[r * n + j]).fold(inf, f64::min)).collect();
+        // The predecessors with a cost into column j, in frame order.
+        let mut into = Vec::with_capacity(n);
         for j in 1..n {
             cancel.check()?;
+            into.clear();
             for i in 0..j.saturating_sub(g0) {
+                let low = lower[i * n + j];
                 let room = if exact {
                     inf
                 } else {
+                    if low > room_total - (least_dp[i] + least_after[j]) * (1.0 - SLACK) {
+                        continue;
+                    }
                     let base = (0..k - 1).map(|c| table.dp[c * n + i] + after[(k - 2 - c) * n + j]).fold(inf, f64::min);
                     room_total - base * (1.0 - SLACK)
                 };
-                if lower[i * n + j] > room {
+                if low > room {
                     continue;
                 }
-                if let Some(cost) = segment_within(frames, i, j, room / (1.0 - SLACK), &mut terms) {
+                if let Some(cost) = known(&memo, i, j) {
                     table.costs[i * n + j] = cost;
+                    into.push(i);
+                    continue;
+                }
+                match segment_within(frames, i, j, room / (1.0 - SLACK), &mut terms) {
+                    Ok(cost) => {
+                        table.costs[i * n + j] = cost;
+                        into.push(i);
+                        if let Some(m) = memo.as_deref_mut() {
+                            m.exact[i * n + j] = cost;
+                        }
+                    }
+                    Err(partial) => {
+                        if let Some(m) = memo.as_deref_mut() {
+                            m.lower[i * n + j] = m.lower[i * n + j].max(partial);
+                        }
+                    }
                 }
             }
-            table.column(j);
+            into.extend((j.saturating_sub(g0)..j).filter(|&i| table.costs[i * n + j].is_finite()));
+            table.column(j, &into);
+            least_dp[j] = (0..k - 1).map(|c| table.dp[c * n + j]).fold(inf, f64::min);
         }
         Ok(table)
     }
 
-    /// `dp[c][j]` and its predecessor for every c, exactly as [`shortest_path`] computes them.
-    fn column(&mut self, j: usize) {
+    /// `dp[c][j]` and its predecessor for every c, exactly as [`shortest_path`] computes them, over
+    /// the predecessors `into` (every `i` whose cost into `j` is finite, in frame order: an infinite
+    /// or NaN cost never wins the strict minimum).
+    fn column(&mut self, j: usize, into: &[usize]) {
         let n = self.n;
         for c in 1..self.k {
             let mut best = (f64::INFINITY, usize::MAX);
-            for i in 0..j {
+            for &i in into {
                 let prev = self.dp[(c - 1) * n + i];
                 if prev == f64::INFINITY {
                     continue;
@@ -401,16 +508,23 @@ fn middle(a: usize, b: usize) -> (usize, usize) {
     ((mid - 1).max(a + 1), (mid + 2).min(b))
 }
 
-/// The cost of segment `(a, b)` (its frame terms summed in frame order), or None as soon as the
-/// terms seen, from the middle outwards in growing blocks, sum past `room`.
-fn segment_within(frames: &mut impl FrameObjective, a: usize, b: usize, room: f64, terms: &mut [f64]) -> Option<f64> {
+/// The cost of segment `(a, b)` (its frame terms summed in frame order), or, as soon as the terms
+/// seen, from the middle outwards in growing blocks, sum past `room`, that partial sum (a lower bound
+/// of the cost).
+fn segment_within(
+    frames: &mut impl FrameObjective,
+    a: usize,
+    b: usize,
+    room: f64,
+    terms: &mut [f64],
+) -> std::result::Result<f64, f64> {
     let (mut lo, mut hi) = middle(a, b);
     frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
     let mut partial = terms[lo..hi].iter().sum::<f64>();
     let mut step = 2;
     while lo > a + 1 || hi < b {
         if partial > room {
-            return None;
+            return Err(partial);
         }
         let (l, h) = (lo.saturating_sub(step).max(a + 1), (hi + step).min(b));
         frames.frames(a, b, l, lo, &mut terms[l..lo]);
@@ -419,9 +533,9 @@ fn segment_within(frames: &mut impl FrameObjective, a: usize, b: usize, room: f6
         (lo, hi, step) = (l, h, 2 * step);
     }
     if partial > room {
-        return None;
+        return Err(partial);
     }
-    Some(terms[a + 1..b].iter().fold(0.0, |s, t| s + t))
+    Ok(terms[a + 1..b].iter().fold(0.0, |s, t| s + t))
 }
 
 /// The fewest keys such that no frame's position error exceeds `max_cm` (ties: lowest total
@@ -615,13 +729,27 @@ mod tests {
                 if objective == ErrorMeasure::Position && w % 2 == 1 {
                     continue;
                 }
+                // One memo carried up through the k, another down (new longer segments each time).
+                let (mut up, mut down) = (OptimalMemo::new(n, objective), OptimalMemo::new(n, objective));
+                let mut wants = Vec::new();
                 for &k in &ks {
                     let (want, want_total) = reference_optimal(&table, k, objective).unwrap();
                     let (got, got_total) = optimal_spherical_with_total(rep, k, objective).unwrap();
                     assert_eq!(got, want, "window {w}, k={k}, {objective:?}");
                     assert_eq!(got_total.to_bits(), want_total.to_bits(), "window {w}, k={k}, {objective:?}");
                     assert_eq!(optimal(&table, k, objective).unwrap(), want);
+                    let memo = optimal_spherical_memo(rep, k, objective, &Cancel::new(), &mut up).unwrap();
+                    assert_eq!(
+                        (memo.0, memo.1.to_bits()),
+                        (want.clone(), want_total.to_bits()),
+                        "up, window {w}, k={k}"
+                    );
+                    wants.push((k, want, want_total));
                     cases += 1;
+                }
+                for (k, want, want_total) in wants.into_iter().rev() {
+                    let memo = optimal_spherical_memo(rep, k, objective, &Cancel::new(), &mut down).unwrap();
+                    assert_eq!((memo.0, memo.1.to_bits()), (want, want_total.to_bits()), "down, window {w}, k={k}");
                 }
             }
         }
@@ -655,6 +783,16 @@ mod tests {
     }
 
     #[test]
+    fn a_memo_of_another_clip_or_objective_is_refused() {
+        let rep = &varied_windows()[0];
+        let n = rep.num_frames;
+        for mut memo in [OptimalMemo::new(n + 1, ErrorMeasure::Angle), OptimalMemo::new(n, ErrorMeasure::Position)] {
+            let e = optimal_spherical_memo(rep, 3, ErrorMeasure::Angle, &Cancel::new(), &mut memo).unwrap_err();
+            assert!(e.to_string().contains("memo was made for"), "{e}");
+        }
+    }
+
+    #[test]
     fn kept_costs_are_the_tables_and_dropped_ones_lie_on_no_optimal_path() {
         let mut dropped_at_15 = (0, 0);
         for rep in varied_windows().iter().step_by(2) {
@@ -662,7 +800,7 @@ mod tests {
             let table = SegmentTable::full_serial(rep);
             let cost = |a: usize, b: usize| table.get(a, b).unwrap().angle_sum;
             for k in [3, 5, 10, 15].into_iter().filter(|&k| k <= n) {
-                let kept = PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new()).unwrap();
+                let kept = PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new(), None).unwrap();
                 let (_, best) = reference_optimal(&table, k, ErrorMeasure::Angle).unwrap();
                 // The least total of any k-key path through each segment, from the full table.
                 let inf = f64::INFINITY;
