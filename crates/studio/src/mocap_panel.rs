@@ -20,6 +20,7 @@ use inbetween_mocap::codec::job::{CompressJob, CompressReport};
 use inbetween_mocap::codec::{self, Budget};
 use inbetween_mocap::metrics::SegmentModel;
 use inbetween_mocap::rotations::reconstruct_from_keys;
+use inbetween_mocap::select::OptimalMemo;
 use inbetween_mocap::select::{self, sidql::SidqlPolicy};
 use inbetween_mocap::{ErrorMeasure, RotationMotion, SegmentTable, SphericalMotion};
 use serde::Deserialize;
@@ -42,7 +43,29 @@ struct Take {
     rotations: RotationMotion,
     /// World joint positions per frame (file units), the reference of the per-frame error.
     positions: Vec<Vec<DVec3>>,
+    /// Greedy's insertion order on this take, made at the first greedy request and grown as larger
+    /// K are asked: a K change is then a prefix of it.
+    greedy: Mutex<Option<select::GreedyOrder<'static>>>,
+    /// The segment costs optimal searches on this take learnt (16·n² bytes), kept for the next K on
+    /// takes up to [`OPTIMAL_MEMO_FRAMES`]: the first optimal K costs seconds on 1000 frames, the
+    /// next ones tens of milliseconds.
+    optimal: Mutex<Option<OptimalMemo>>,
+    /// SIDQL's windows of this take and their keyings so far.
+    sidql: Mutex<Option<select::sidql::SidqlLong<'static>>>,
 }
+
+/// The committed SIDQL policy (weights compiled into the binary), loaded once.
+fn committed_policy() -> Result<&'static SidqlPolicy> {
+    static POLICY: std::sync::OnceLock<SidqlPolicy> = std::sync::OnceLock::new();
+    if let Some(p) = POLICY.get() {
+        return Ok(p);
+    }
+    let p = SidqlPolicy::committed()?;
+    Ok(POLICY.get_or_init(|| p))
+}
+
+/// The longest take whose optimal-keys memo the studio keeps (64 MB at 2000 frames).
+const OPTIMAL_MEMO_FRAMES: usize = 2000;
 
 impl Take {
     fn new(name: String, motion: Motion, unit: UnitChoice) -> Result<Take> {
@@ -51,7 +74,17 @@ impl Take {
         rep.cm_per_unit = cm;
         let rotations = RotationMotion::from_motion_in(&motion, cm)?;
         let positions = positions_clip(&motion);
-        Ok(Take { name, motion, unit, rep, rotations, positions })
+        Ok(Take {
+            name,
+            motion,
+            unit,
+            rep,
+            rotations,
+            positions,
+            greedy: Mutex::new(None),
+            optimal: Mutex::new(None),
+            sidql: Mutex::new(None),
+        })
     }
 }
 
@@ -279,19 +312,30 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
         }
         "greedy" => {
             let k = need_k()?;
-            (select::greedy_cancellable(rep, k, ErrorMeasure::Angle, job.token())?, format!("greedy K={k}"))
+            let mut order = take.greedy.lock().unwrap_or_else(|p| p.into_inner());
+            let keys = order.get_or_insert_with(|| select::GreedyOrder::angle(rep)).keys(k, job.token())?;
+            (keys, format!("greedy K={k}"))
         }
         "optimal" => {
             let k = need_k()?;
-            let (keys, _) = select::optimal_spherical_cancellable(rep, k, ErrorMeasure::Angle, job.token())?;
+            let (keys, _) = if n <= OPTIMAL_MEMO_FRAMES {
+                let mut memo = take.optimal.lock().unwrap_or_else(|p| p.into_inner());
+                let memo = memo.get_or_insert_with(|| OptimalMemo::new(n, ErrorMeasure::Angle));
+                select::optimal_spherical_memo(rep, k, ErrorMeasure::Angle, job.token(), memo)?
+            } else {
+                select::optimal_spherical_cancellable(rep, k, ErrorMeasure::Angle, job.token())?
+            };
             (keys, format!("optimal K={k}"))
         }
         "sidql" => {
             let k = need_k()?;
-            // The committed policy (weights compiled into the binary), loaded per job.
-            let policy = SidqlPolicy::committed()?;
-            // Windows of at most 64 frames on a longer take (the policy's range).
-            (select::sidql::sidql_long(&policy, m, cm, k)?, format!("SIDQL K={k}"))
+            // Windows of at most 64 frames on a longer take (the policy's range), each window's
+            // keyings kept with the take for the next K.
+            let mut sidql = take.sidql.lock().unwrap_or_else(|p| p.into_inner());
+            if sidql.is_none() {
+                *sidql = Some(select::sidql::SidqlLong::new(committed_policy()?, m, cm)?);
+            }
+            (sidql.as_mut().expect("made just above").keys(k)?, format!("SIDQL K={k}"))
         }
         "bound" => {
             let b = req

@@ -139,6 +139,27 @@ fn mocap_jobs_on_the_builtin_walk() {
         assert!(max > 0.0 && max.is_finite(), "{method}: {r}");
         assert!(r["message"].as_str().unwrap().contains("cm"), "{r}");
     }
+    // Greedy and optimal keep per-take state between K changes (greedy's insertion order, the
+    // optimal search's memo): K up and down gives the engine's own keys for each K.
+    let walk = inbetween_core::procedural::gait(&inbetween_core::procedural::GaitParams {
+        frames: 240,
+        ..inbetween_core::procedural::GaitParams::walk()
+    });
+    let rep = inbetween_mocap::SphericalMotion::from_motion(&walk).unwrap();
+    for k in [12, 7, 15, 9] {
+        let angle = inbetween_mocap::ErrorMeasure::Angle;
+        for (method, want) in [
+            ("greedy", inbetween_mocap::select::greedy(&rep, k, angle).unwrap()),
+            ("optimal", inbetween_mocap::select::optimal_spherical(&rep, k, angle).unwrap()),
+        ] {
+            let body = json!({"method": method, "k": k}).to_string();
+            let (event, r) =
+                run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
+            assert_eq!(event, "result", "{method}: {r}");
+            let keys: Vec<usize> = r["keys"].as_array().unwrap().iter().map(|k| k.as_u64().unwrap() as usize).collect();
+            assert_eq!(keys, want.frames(), "{method} K={k}");
+        }
+    }
     // SIDQL keys 64-frame windows: a 240-frame take is 4 windows, so K = 10 works and K = 4 is
     // refused with the engine's words (its 5 window ends are all keys).
     let body = json!({"method": "sidql", "k": 10}).to_string();

@@ -253,7 +253,9 @@ async function drawScript(r) {
   const gltf = await parseGlb(buf);
   const t2 = performance.now();
   const g = groups.script;
-  for (const c of [...g.children]) disposeTree(c);
+  // The old tree is freed after the first frame with the new one: materials of the same kind then
+  // find their shader programs still compiled (three.js frees a program with its last material).
+  const old = [...g.children];
   g.clear();
   g.add(gltf.scene);
   const st = S.script;
@@ -301,6 +303,7 @@ async function drawScript(r) {
   const t3 = performance.now();
   renderNow();
   S.drawTimes.render_ms = performance.now() - t3;
+  for (const c of old) disposeTree(c);
 }
 
 // ---------------------------------------------------------------- mocap panel
