@@ -11,7 +11,7 @@ use super::rig::{clip, heading_of, local_from_global, wrap, yaw, Rig, FPS};
 use crate::error::ScriptError;
 use glam::{DQuat, DVec3};
 use inbetween_core::clip::Clip;
-use inbetween_core::fk::forward;
+use inbetween_core::fk::{forward, GlobalPose};
 use inbetween_core::motion::interpolate_pose;
 use inbetween_core::Pose;
 
@@ -361,8 +361,8 @@ impl Default for LockParams {
     }
 }
 
-fn ankles(m: &Clip, rig: &Rig) -> Vec<[DVec3; 2]> {
-    m.globals().into_iter().map(|g| [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]]).collect()
+fn ankles(globals: &[GlobalPose], rig: &Rig) -> Vec<[DVec3; 2]> {
+    globals.iter().map(|g| [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]]).collect()
 }
 
 fn hspeed(a: DVec3, b: DVec3, dt: f64) -> f64 {
@@ -374,10 +374,13 @@ fn hspeed(a: DVec3, b: DVec3, dt: f64) -> f64 {
 /// An error names the joint missing when `m` is not on the common rig.
 pub fn detect_contacts(m: &Clip, p: &LockParams) -> Result<[Vec<bool>; 2], ScriptError> {
     let rig = &Rig::for_clip(m, "foot-contact detection")?;
-    let a = ankles(m, rig);
+    Ok(contacts_of(&ankles(&m.globals(), rig), rig, m.frame_time(), p))
+}
+
+/// [`detect_contacts`] from the ankles' global positions per frame.
+fn contacts_of(a: &[[DVec3; 2]], rig: &Rig, dt: f64, p: &LockParams) -> [Vec<bool>; 2] {
     let n = a.len();
-    let dt = m.frame_time();
-    Ok([0, 1].map(|k| {
+    [0, 1].map(|k| {
         let mut c: Vec<bool> = (0..n)
             .map(|f| {
                 let (f0, f1) = (f.saturating_sub(1), (f + 1).min(n - 1));
@@ -400,7 +403,7 @@ pub fn detect_contacts(m: &Clip, p: &LockParams) -> Result<[Vec<bool>; 2], Scrip
             }
         }
         c
-    }))
+    })
 }
 
 /// Foot locking: each detected contact pins the toe base at its mean floor position (the ankle
@@ -409,15 +412,16 @@ pub fn detect_contacts(m: &Clip, p: &LockParams) -> Result<[Vec<bool>; 2], Scrip
 /// are re-solved with two-bone IK (ankles keep their global orientation unless the heel rose).
 /// An error names the joint missing when `m` is not on the common rig.
 pub fn lock_feet(m: &Clip, p: &LockParams) -> Result<Clip, ScriptError> {
-    let contacts = detect_contacts(m, p)?;
     let rig = &Rig::for_clip(m, "foot locking")?;
     let n = m.num_frames();
-    let a = ankles(m, rig);
+    let globals = m.globals();
+    let a = ankles(&globals, rig);
+    let contacts = contacts_of(&a, rig, m.frame_time(), p);
     // Each contact pins the toe base (the point a foot rolls over from heel-off on) where the foot
     // lands; the ankle is moved with it, so a heel rolling up over the toes keeps its
     // own rise and the foot only stops sliding. `pins[f][k]`: (pin, weight) per frame and foot.
     let toes: Vec<[DVec3; 2]> =
-        m.globals().into_iter().map(|g| [g.positions[rig.legs[0][3]], g.positions[rig.legs[1][3]]]).collect();
+        globals.iter().map(|g| [g.positions[rig.legs[0][3]], g.positions[rig.legs[1][3]]]).collect();
     let flat = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
     let mut pins: Vec<[Option<(DVec3, f64)>; 2]> = vec![[None, None]; n];
     for k in 0..2 {
@@ -475,6 +479,9 @@ pub fn lock_feet(m: &Clip, p: &LockParams) -> Result<Clip, ScriptError> {
         })
         .collect();
     let mut poses = m.poses();
+    // The unlocked poses' global transforms (the raise and drop passes and each frame's own
+    // orientations before it is re-solved).
+    let unlocked: Vec<GlobalPose> = poses.iter().map(|q| forward(&rig.skeleton, q)).collect();
     let leg_len = {
         let s = &rig.skeleton;
         (s.joint(rig.legs[0][1]).offset.length() + s.joint(rig.legs[0][2]).offset.length()) * 0.999
@@ -483,7 +490,7 @@ pub fn lock_feet(m: &Clip, p: &LockParams) -> Result<Clip, ScriptError> {
     // about its pinned toe base (as a walker's back foot does), up to MAX_HEEL_RAISE.
     let mut raises: Vec<[Option<(DVec3, f64)>; 2]> = vec![[None, None]; n];
     for f in 0..n {
-        let g = forward(&rig.skeleton, &poses[f]);
+        let g = &unlocked[f];
         for k in 0..2 {
             let Some(t) = targets[f][k] else { continue };
             let hip = g.positions[rig.legs[k][0]];
@@ -517,7 +524,7 @@ pub fn lock_feet(m: &Clip, p: &LockParams) -> Result<Clip, ScriptError> {
     // Lower the root where a locked leg still cannot reach, smoothed over a few frames.
     let mut drop = vec![0.0f64; n];
     for f in 0..n {
-        let g = forward(&rig.skeleton, &poses[f]);
+        let g = &unlocked[f];
         for (k, t) in targets[f].iter().enumerate() {
             if let Some(t) = *t {
                 let hip = g.positions[rig.legs[k][0]];
@@ -539,7 +546,7 @@ pub fn lock_feet(m: &Clip, p: &LockParams) -> Result<Clip, ScriptError> {
         })
         .collect();
     for f in 0..n {
-        let g0 = forward(&rig.skeleton, &poses[f]);
+        let g0 = &unlocked[f];
         poses[f].translations[rig.hips].y -= smooth[f].max(0.0);
         for (k, limb) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
             if let Some(t) = targets[f][k] {
