@@ -236,14 +236,44 @@ function disposeTree(root) {
   root.traverse((o) => {
     if (o.geometry) o.geometry.dispose();
     for (const m of [].concat(o.material || [])) {
-      for (const v of Object.values(m)) if (v && v.isTexture) v.dispose();
+      for (const v of Object.values(m)) if (v && v.isTexture && !v.userData.shared) v.dispose();
       m.dispose();
     }
   });
 }
 
+// Embedded images already seen (by content and sampler), shared between loads: a story re-run
+// sends the same character skins again, and sharing them skips their decode and GPU upload.
+const sharedTextures = new Map();
+const SHARED_TEXTURES_MAX = 64;
+class SharedTextures {
+  constructor(parser) { this.parser = parser; this.name = 'inbetween_shared_textures'; }
+  loadTexture(index) {
+    const p = this.parser, json = p.json, def = json.textures[index], src = json.images[def.source];
+    if (src.bufferView === undefined || !crypto.subtle) return null; // the loader's own path
+    return p.getDependency('bufferView', src.bufferView).then(async (buf) => {
+      const digest = new Uint8Array(await crypto.subtle.digest('SHA-256', buf));
+      const key = Array.from(digest, (b) => b.toString(16).padStart(2, '0')).join('')
+        + JSON.stringify((json.samplers || [])[def.sampler] || {});
+      if (!sharedTextures.has(key)) {
+        if (sharedTextures.size >= SHARED_TEXTURES_MAX) {
+          const [oldest, t] = sharedTextures.entries().next().value;
+          sharedTextures.delete(oldest);
+          t.then((tex) => tex && tex.dispose());
+        }
+        sharedTextures.set(key, p.loadTextureImage(index, def.source, p.textureLoader).then((tex) => {
+          if (tex) tex.userData.shared = true;
+          return tex;
+        }));
+      }
+      return sharedTextures.get(key);
+    });
+  }
+}
+
 function parseGlb(buf) {
-  return new Promise((resolve, reject) => new GLTFLoader().parse(buf, '', resolve, (e) => reject(new Error(`glTF: ${e.message || e}`))));
+  return new Promise((resolve, reject) => new GLTFLoader().register((p) => new SharedTextures(p))
+    .parse(buf, '', resolve, (e) => reject(new Error(`glTF: ${e.message || e}`))));
 }
 
 async function drawScript(r) {
