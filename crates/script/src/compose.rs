@@ -167,6 +167,9 @@ pub fn query_graph(parsed: &ParsedScript) -> Ssg {
             let mut c = c.clone();
             for a in &mut c.actions {
                 a.target = a.target.map(|t| remap[t]);
+                if let Some((_, d)) = &mut a.destination {
+                    *d = remap[*d];
+                }
             }
             query.characters.push(c);
         }

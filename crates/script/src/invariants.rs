@@ -239,6 +239,20 @@ pub fn check(anim: &Animation, cat: &Catalogue, relations: &[(Relation, usize, u
             r.floating.push(p);
         }
     }
+    // A carried prop once put down rests like any object.
+    for c in &anim.characters {
+        for prop in &c.props {
+            let Some(d) = &prop.put_down else { continue };
+            let mut at = anim.scene.clone();
+            let o = &mut at.objects[prop.object];
+            o.position = [d.position.x as f32, d.position.y as f32, d.position.z as f32];
+            o.yaw = crate::motion::rig::heading_of(d.rotation) as f32;
+            o.support = d.support;
+            if let Some(p) = rest_problem(&at, cat, prop.object) {
+                r.floating.push(format!("{} (put down by {} at frame {})", p, c.name, d.frame));
+            }
+        }
+    }
     // Facing: the script's own "in front of" relations of seats.
     let objects = &anim.scene.objects;
     for &(rel, a, b) in relations {

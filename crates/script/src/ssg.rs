@@ -104,6 +104,10 @@ pub struct Action {
     pub target: Option<NodeId>,
     /// Adverbs ("madly", "unbelievably") and particles ("right" in "turns right").
     pub manner: Vec<String>,
+    /// Where the target goes, for verbs that move it ("puts the cup *on the counter*"): the
+    /// normalised preposition and the object, when a second object follows the target.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub destination: Option<(String, NodeId)>,
 }
 
 /// Verbal commands (§3.2): camera placement, weather, time of day.

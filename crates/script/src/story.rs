@@ -40,7 +40,8 @@ use crate::ScriptError;
 use inbetween_core::cancel::{Cancel, Cancelled};
 
 /// An action compared across versions: verb, preposition, manner and the target's identity.
-type ActionSignature = (String, Option<String>, Vec<String>, Option<ObjectKey>);
+/// Verb, preposition, manner, target, and destination (preposition, object).
+type ActionSignature = (String, Option<String>, Vec<String>, Option<ObjectKey>, Option<(String, Option<ObjectKey>)>);
 
 /// One character of the previous run.
 struct Kept {
@@ -357,6 +358,9 @@ fn action_signature(actions: &Actions, scene: &Scene, query: &Ssg, keys: &[Objec
                 a.preposition.clone(),
                 a.manner.clone(),
                 a.target.and_then(|t| object_of_node(scene, query, t)).and_then(|i| keys.get(i).cloned()),
+                a.destination
+                    .as_ref()
+                    .map(|(p, d)| (p.clone(), object_of_node(scene, query, *d).and_then(|i| keys.get(i).cloned()))),
             )
         })
         .collect()

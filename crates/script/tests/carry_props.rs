@@ -141,3 +141,109 @@ fn the_preview_draws_a_moving_object_where_it_is() {
     assert_eq!(still.len(), carried.len());
     assert!(still.iter().zip(&carried).all(|(a, b)| a != b), "the moved table is drawn elsewhere");
 }
+
+/// The object's base point at every frame.
+fn track_of(anim: &Animation, obj: usize) -> Vec<DVec3> {
+    (0..anim.frames()).map(|f| object_pose(anim, obj, f).0).collect()
+}
+
+#[test]
+fn a_prop_put_on_a_counter_rests_on_its_top_and_one_dropped_rests_on_the_floor() {
+    let text = "In the kitchen, a table is in the middle of the room$. A cup is on the table$. A counter is next to the wall$.\n\
+                Tom walks to the table and picks up the cup. Tom walks to the counter and puts the cup on the counter.\n\
+                Tom picks up the cup. Tom drops the cup.\n";
+    let anim = animated(text);
+    let cat = builtin();
+    let cup = anim.scene.objects.iter().position(|o| o.category == "cup").expect("a cup");
+    let counter = anim.scene.objects.iter().position(|o| o.category == "counter").expect("a counter");
+    let tom = &anim.characters[0];
+    let verbs: Vec<&str> = tom.segments.iter().map(|s| s.verb.as_str()).collect();
+    eprintln!("segments {verbs:?}, notes {:?}", anim.notes);
+    assert_eq!(verbs.iter().filter(|v| **v == "pick_up").count(), 2, "{verbs:?}");
+    assert_eq!(verbs.iter().filter(|v| **v == "put_down").count(), 2, "{verbs:?}");
+    assert_eq!(tom.props.len(), 2);
+    let (first, second) = (&tom.props[0], &tom.props[1]);
+    let on_counter = first.put_down.as_ref().expect("put down on the counter");
+    let dropped = second.put_down.as_ref().expect("dropped");
+    assert!(
+        first.from < on_counter.frame && on_counter.frame < second.from && second.from < dropped.frame,
+        "{} {} {} {}",
+        first.from,
+        on_counter.frame,
+        second.from,
+        dropped.frame
+    );
+    // On the counter's top, its centre inside the counter's footprint; then on the floor.
+    let c = &anim.scene.objects[counter];
+    assert_eq!(on_counter.support, Some(counter));
+    assert!((on_counter.position.y - c.top() as f64).abs() < 1e-5, "{} vs top {}", on_counter.position.y, c.top());
+    let local = inbetween_script::layout::geom::to_local(
+        inbetween_script::layout::geom::center(c),
+        c.yaw,
+        [on_counter.position.x as f32, on_counter.position.z as f32],
+    );
+    assert!(local[0].abs() <= c.size[0] / 2.0 && local[1].abs() <= c.size[2] / 2.0, "{local:?} off {:?}", c.size);
+    assert_eq!(dropped.support, None);
+    assert!(dropped.position.y.abs() < 1e-9);
+    // The scene's invariants hold with the prop where it was put down.
+    let report = inbetween_script::invariants::check(&anim, &cat, &[]);
+    assert!(report.floating.is_empty(), "{:?}", report.floating);
+    // The hand is on the grip the cup has at rest when it lets go.
+    let rig = Rig::standard();
+    let hand = forward(tom.clip.skeleton(), &tom.clip.pose(on_counter.frame)).positions[rig.arms[1][3]];
+    let grip_rest = {
+        let o = &anim.scene.objects[cup];
+        let g = contacts_of(&anim.scene, &cat, cup, ContactKind::Grip)[0];
+        let base = DVec3::new(o.position[0] as f64, o.position[1] as f64, o.position[2] as f64);
+        on_counter.position + (DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64) - base)
+    };
+    let gap = (hand - grip_rest).length();
+    assert!(gap < 0.05, "hand {gap:.3} m from the cup's grip at the release");
+    // It stays on the counter until picked up again, and never jumps: at most 0.1 m a frame.
+    let track = track_of(&anim, cup);
+    for (f, p) in track.iter().enumerate().take(second.from).skip(on_counter.frame) {
+        assert!((*p - on_counter.position).length() < 1e-9, "frame {f}");
+    }
+    assert!((*track.last().unwrap() - dropped.position).length() < 1e-9);
+    // No jump where the hand takes it or lets it go (the hand is on the grip then; over the
+    // settle frames the cup turns upright about the grip in the hand): the grip point's steps.
+    let grip_local = {
+        let o = &anim.scene.objects[cup];
+        let g = contacts_of(&anim.scene, &cat, cup, ContactKind::Grip)[0];
+        let base = DVec3::new(o.position[0] as f64, o.position[1] as f64, o.position[2] as f64);
+        object_pose(&anim, cup, 0).1.inverse() * (DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64) - base)
+    };
+    let grip_at = |f: usize| {
+        let (p, q) = object_pose(&anim, cup, f);
+        p + q * grip_local
+    };
+    let step = |f: usize| (grip_at(f) - grip_at(f - 1)).length();
+    for f in [first.from, second.from] {
+        assert!(step(f) < 0.03, "the cup jumps {:.3} m into the hand at frame {f}", step(f));
+    }
+    let hand_at = |f: usize| forward(tom.clip.skeleton(), &tom.clip.pose(f)).positions[rig.arms[1][3]];
+    for d in [on_counter, dropped] {
+        for f in d.frame - d.blend..=d.frame {
+            let hand_step = (hand_at(f) - hand_at(f - 1)).length();
+            assert!(
+                step(f) < hand_step + 0.02,
+                "the cup moves {:.3} m at frame {f} while set down, the hand {hand_step:.3} m",
+                step(f)
+            );
+        }
+    }
+}
+
+#[test]
+fn puts_down_without_a_place_uses_the_nearest_surface() {
+    let anim = animated(
+        "A table is in the middle of the room$. A phone is on the table$. A desk is near the wall$.\n\
+         Tom picks up the phone. Tom walks to the desk. Tom puts down the phone.\n",
+    );
+    let phone = anim.scene.objects.iter().position(|o| o.category == "phone").unwrap();
+    let desk = anim.scene.objects.iter().position(|o| o.category == "desk").unwrap();
+    let tom = &anim.characters[0];
+    let d = tom.props[0].put_down.as_ref().expect("put down");
+    assert_eq!(d.support, Some(desk), "the desk Tom stands at, not the table he left");
+    assert!((object_pose(&anim, phone, anim.frames() - 1).0 - d.position).length() < 1e-9);
+}

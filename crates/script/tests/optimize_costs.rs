@@ -95,6 +95,7 @@ fn keyboard_case() -> (Scene, Ssg, Vec<(Relation, usize, usize)>) {
         preposition: None,
         target: Some(target),
         manner: vec![],
+        destination: None,
     };
     let query = Ssg {
         room: None,

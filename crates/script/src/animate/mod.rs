@@ -53,7 +53,7 @@ pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
 pub use crowd::{min_clearance, Clearance};
 pub(crate) use crowd::{WalkChoice, WalkInfo};
 pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan, Setup};
-pub use props::{carried_from, object_pose, CarriedProp};
+pub use props::{carried_from, object_pose, CarriedProp, PutDown};
 
 use std::collections::HashMap;
 
@@ -230,7 +230,13 @@ pub const PASSING_DISTANCE: f32 = 0.5;
 /// needs a clip ([`crate::story::StorySession::check_verbs`] refuses a script with one that has
 /// none).
 pub fn verb_has_motion(verb: &str, manner: &[String], lib: &MotionLibrary) -> bool {
-    let a = crate::ssg::Action { verb: verb.to_string(), preposition: None, target: None, manner: manner.to_vec() };
+    let a = crate::ssg::Action {
+        verb: verb.to_string(),
+        preposition: None,
+        target: None,
+        manner: manner.to_vec(),
+        destination: None,
+    };
     action::plays(&action::Step::read(&a, None, lib, 0.0), lib)
 }
 

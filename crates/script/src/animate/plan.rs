@@ -272,6 +272,12 @@ fn build(
             b.walks = old.walks[..cp.walks].to_vec();
             b.seats = old.seats[..cp.seats].to_vec();
             b.props = old.track.props[..cp.props].to_vec();
+            // A prop put down after the checkpoint is still in the hand there.
+            for p in &mut b.props {
+                if p.put_down.as_ref().is_some_and(|d| d.frame >= cp.frames) {
+                    p.put_down = None;
+                }
+            }
             b.notes = old.notes[..cp.notes].to_vec();
             (old.marks[..k].to_vec(), old.checkpoints[..k].to_vec(), k, cp.frames)
         }
@@ -292,7 +298,9 @@ fn build(
         if a.target.is_some() && obj.is_none() {
             b.notes.push(format!("{}: the target of \"{}\" is not in the scene", input.name, a.verb));
         }
-        let step = Step::read(a, obj, ctx.lib, ctx.cfg.slow_speed);
+        let mut step = Step::read(a, obj, ctx.lib, ctx.cfg.slow_speed);
+        step.destination =
+            a.destination.as_ref().and_then(|(p, n)| object_of_node(scene, query, *n).map(|o| (p.clone(), o)));
         b.play(&step);
     }
     if b.frames.is_empty() {

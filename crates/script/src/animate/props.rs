@@ -10,8 +10,8 @@ use crate::catalogue::{Catalogue, ContactKind};
 use crate::scene::Scene;
 
 /// A small prop a character holds (beyond the paper, whose scene is static): it rests at its
-/// scene pose until frame `from`, when the hand closes on it, then follows that hand joint to the
-/// end (held after the track ends).
+/// scene pose until frame `from`, when the hand closes on it, then follows that hand joint, to the
+/// end (held after the track ends) or until it is put down ([`PutDown`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CarriedProp {
     /// Index into [`Scene::objects`].
@@ -23,6 +23,20 @@ pub struct CarriedProp {
     /// The prop's base point and rotation in the joint's frame: its grip point sits at the joint.
     pub offset: DVec3,
     pub rotation: DQuat,
+    /// Where and when the hand lets it go, if it does.
+    pub put_down: Option<PutDown>,
+}
+
+/// A carried prop set down: from `frame` on it rests at `position` (its base point, world
+/// metres) with `rotation`, on `support` (an object's top) or on the floor (None); over the
+/// `blend` frames before, it moves from the hand's pose onto that rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PutDown {
+    pub frame: usize,
+    pub position: DVec3,
+    pub rotation: DQuat,
+    pub support: Option<usize>,
+    pub blend: usize,
 }
 
 impl CarriedProp {
@@ -33,21 +47,43 @@ impl CarriedProp {
         if frame < self.from || n == 0 || self.joint >= track.clip.skeleton().len() {
             return None;
         }
-        let g = forward(track.clip.skeleton(), &track.clip.pose(frame.min(n - 1)));
-        let (p, q) = (g.positions[self.joint], g.rotations[self.joint]);
-        Some((p + q * self.offset, (q * self.rotation).normalize()))
+        // The hand joint's position and rotation.
+        let hand = |f: usize| {
+            let g = forward(track.clip.skeleton(), &track.clip.pose(f.min(n - 1)));
+            (g.positions[self.joint], g.rotations[self.joint])
+        };
+        // The grip in the prop's own frame (the hand joint holds it).
+        let grip = -(self.rotation.inverse() * self.offset);
+        match &self.put_down {
+            Some(d) if frame >= d.frame => Some((d.position, d.rotation)),
+            Some(d) if d.blend > 0 && frame + d.blend >= d.frame => {
+                // The grip stays in the hand while the prop turns upright about it; the hand's
+                // small miss of the rest grip at the release is taken up over the same frames.
+                let (p, q) = hand(frame);
+                let miss = (d.position + d.rotation * grip) - hand(d.frame).0;
+                let w = inbetween_core::interp::smoothstep(1.0 - (d.frame - frame) as f64 / (d.blend + 1) as f64);
+                let q = (q * self.rotation).normalize().slerp(d.rotation, w).normalize();
+                Some((p + miss * w - q * grip, q))
+            }
+            _ => {
+                let (p, q) = hand(frame);
+                Some((p + q * self.offset, (q * self.rotation).normalize()))
+            }
+        }
     }
 }
 
 /// Where object `obj` is at `frame`: its base point and rotation, carried by a character's hand
-/// or at rest in the scene.
+/// (the latest pick-up at or before `frame`), put down, or at rest in the scene.
 pub fn object_pose(anim: &Animation, obj: usize, frame: usize) -> (DVec3, DQuat) {
-    for c in &anim.characters {
-        for p in c.props.iter().filter(|p| p.object == obj) {
-            if let Some(pose) = p.pose_at(c, frame) {
-                return pose;
-            }
-        }
+    let latest = anim
+        .characters
+        .iter()
+        .flat_map(|c| c.props.iter().map(move |p| (c, p)))
+        .filter(|(_, p)| p.object == obj && p.from <= frame)
+        .max_by_key(|(_, p)| p.from);
+    if let Some(pose) = latest.and_then(|(c, p)| p.pose_at(c, frame)) {
+        return pose;
     }
     let o = &anim.scene.objects[obj];
     (DVec3::new(o.position[0] as f64, o.position[1] as f64, o.position[2] as f64), DQuat::from_rotation_y(o.yaw as f64))

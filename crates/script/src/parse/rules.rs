@@ -579,6 +579,7 @@ impl Parser<'_> {
                         preposition: None,
                         target: None,
                         manner: std::mem::take(&mut pending_manner),
+                        destination: None,
                     });
                     cur = Some(actions.len() - 1);
                 }
@@ -599,6 +600,7 @@ impl Parser<'_> {
                 i += 1;
                 continue;
             }
+            let spatial = relation_at(t, i).filter(|m| !m.dangling).map(|m| m.prep);
             let (prep, j) = if let Some(m) = relation_at(t, i) {
                 (Some(m.prep.to_string()), i + m.len)
             } else if matches!(x.tag, Tag::IN | Tag::TO) {
@@ -663,6 +665,12 @@ impl Parser<'_> {
                 if actions[c].target.is_none() {
                     actions[c].target = Some(id);
                     actions[c].preposition = prep;
+                } else if actions[c].destination.is_none() && actions[c].target != Some(id) {
+                    // A second object after a spatial phrase: where the target goes ("puts the
+                    // cup on the counter").
+                    if let Some(prep) = spatial {
+                        actions[c].destination = Some((prep.to_string(), id));
+                    }
                 }
                 last_target = Some(id);
             }

@@ -30,11 +30,22 @@ impl Builder<'_> {
         let ctx = self.ctx;
         let (scene, cat, rig, cfg) = (ctx.scene, ctx.cat, &ctx.rig, ctx.cfg);
         let (a, verb, obj) = (step.action, step.verb.as_str(), step.object);
+        // "Puts the cup on the counter": a held prop is set down; one not held yet (but small
+        // enough to carry) is picked up first and then set down.
+        if let Some(o) = obj.filter(|_| super::put_down::PUT_VERBS.contains(&a.verb.as_str())) {
+            let held = |b: &Self| b.props.iter().any(|p| p.object == o && p.put_down.is_none());
+            if !held(self) && carries("take", "reach", None, scene, cat, o) {
+                self.pick_up(o, step.speed);
+            }
+            if held(self) && self.put_down(o, step) {
+                return;
+            }
+        }
         // A small prop used in the hand is picked up first and then carried: the action plays
         // with it in the hand, not with the hand on its resting place.
         let carried = obj.filter(|&o| carries(&a.verb, verb, a.preposition.as_deref(), scene, cat, o));
         if let Some(o) = carried {
-            if !self.props.iter().any(|p| p.object == o) {
+            if !self.props.iter().any(|p| p.object == o && p.put_down.is_none()) {
                 self.pick_up(o, step.speed);
             }
         }

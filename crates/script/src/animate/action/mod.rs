@@ -7,12 +7,15 @@
 //! - [`turn`]: turning on the spot;
 //! - [`lie`]: lying down on a bed or sofa, or on the floor;
 //! - [`pick_up`]: walking to a small prop and taking it into the right hand;
+//! - [`put_down`]: setting a held prop down on a surface or the floor ("puts the cup on the
+//!   counter", "drops the cup");
 //! - [`act`]: any other verb, an action in place over the idle or seated lower body, hands on the
 //!   target's contacts (or a small prop picked up first and used in the hand).
 
 pub(crate) mod act;
 pub(crate) mod lie;
 pub(crate) mod pick_up;
+pub(crate) mod put_down;
 pub(crate) mod sit;
 pub(crate) mod stand_up;
 pub(crate) mod turn;
@@ -53,6 +56,8 @@ pub(crate) struct Step<'s> {
     pub object: Option<usize>,
     /// Cruise speed (m/s) when the manner asks for a slow walk.
     pub speed: Option<f64>,
+    /// Where the action puts its object: the preposition and the scene object ("on the counter").
+    pub destination: Option<(String, usize)>,
 }
 
 impl Verb {
@@ -89,7 +94,7 @@ impl<'s> Step<'s> {
             crate::motion::verbs::canonical(&action.verb).or_else(phrasal).unwrap_or(action.verb.as_str()).to_string();
         let slow = action.manner.iter().any(|m| matches!(m.as_str(), "slowly" | "carefully" | "gently" | "lazily"));
         let kind = Verb::of(&verb, &action.manner, lib);
-        Step { action, verb, kind, object, speed: slow.then_some(slow_speed) }
+        Step { action, verb, kind, object, speed: slow.then_some(slow_speed), destination: None }
     }
 }
 
