@@ -202,6 +202,8 @@ pub fn random_story(seed: u64) -> String {
     lines.push(format!("camera {}", pick(&mut rng, RANDOM_VIEWS)));
     let characters = rng.random_range(1..=2usize);
     let mut seats: Vec<&'static str> = furniture.iter().copied().filter(|f| RANDOM_SEATS.contains(f)).collect();
+    // Who holds the small prop.
+    let mut held: Option<usize> = None;
     for c in 0..characters {
         let name = RANDOM_NAMES[(seed as usize + c) % RANDOM_NAMES.len()];
         let mut seated = false;
@@ -219,7 +221,15 @@ pub fn random_story(seed: u64) -> String {
                     seated = false;
                     format!("{name} gets up.")
                 }
-                4 if !surfaces.is_empty() => format!("{name} picks up the {small}."),
+                // A second pick-up of the prop in hand puts it down instead.
+                4 if held == Some(c) => {
+                    held = None;
+                    format!("{name} puts the {small} on the {}.", surfaces[rng.random_range(0..surfaces.len())])
+                }
+                4 if !surfaces.is_empty() && held.is_none() => {
+                    held = Some(c);
+                    format!("{name} picks up the {small}.")
+                }
                 5 => format!("{name} looks at the {target}."),
                 6 if !seated => format!("{name} runs to the {target}."),
                 7 if !seated => match furniture.iter().find(|f| matches!(**f, "bed" | "sofa")) {
