@@ -27,6 +27,9 @@ pub struct Job {
     log: Mutex<(Vec<(String, Value)>, bool)>,
     notify: Notify,
     started: Instant,
+    /// Milliseconds from the start to when the work itself returned (a cancelled job's engine
+    /// call may run on after its `cancelled` event until it checks its token).
+    work_ms: Mutex<Option<f64>>,
 }
 
 impl Job {
@@ -88,6 +91,15 @@ impl Job {
     pub fn cancel(&self) {
         self.cancel.cancel();
         self.push("cancelled", json!({"job": self.id, "kind": self.kind, "ms": self.elapsed_ms()}), true);
+    }
+
+    /// The job's state: kind, whether its log is closed (`result`, `failed` or `cancelled`
+    /// sent), and whether its work still runs, with the time it took once it returned.
+    pub fn status(&self) -> Value {
+        let ended = self.log.lock().unwrap_or_else(|p| p.into_inner()).1;
+        let work_ms = *self.work_ms.lock().unwrap_or_else(|p| p.into_inner());
+        json!({"job": self.id, "kind": self.kind, "ended": ended, "working": work_ms.is_none(),
+               "work_ms": work_ms, "cancelled": self.is_cancelled(), "ms": self.elapsed_ms()})
     }
 
     /// Events from index `from` on, and whether the log is closed.
@@ -161,6 +173,7 @@ impl Jobs {
             log: Mutex::new((Vec::new(), false)),
             notify: Notify::new(),
             started: Instant::now(),
+            work_ms: Mutex::new(None),
         });
         {
             let mut jobs = self.jobs.lock().unwrap_or_else(|p| p.into_inner());
@@ -171,6 +184,7 @@ impl Jobs {
         tokio::task::spawn_blocking(move || {
             let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&job)));
             let ms = job.elapsed_ms();
+            *job.work_ms.lock().unwrap_or_else(|p| p.into_inner()) = Some(ms);
             match outcome {
                 Ok(Ok(mut v)) => {
                     if let Some(o) = v.as_object_mut() {

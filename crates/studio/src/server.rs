@@ -164,6 +164,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/files/{*name}", get(file))
         .route("/api/jobs/{id}/events", get(events))
         .route("/api/jobs/{id}/cancel", post(cancel))
+        .route("/api/jobs/{id}", get(job_status))
         .route("/api/script/stories", get(script_panel::stories))
         .route("/api/script/run", post(script_panel::run))
         .route("/api/mocap/corpus", get(mocap_panel::corpus))
@@ -289,6 +290,12 @@ async fn events(
         }
     });
     Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
+}
+
+/// `GET /api/jobs/{id}`: the job's state ([`crate::jobs::Job::status`]).
+async fn job_status(State(st): State<Arc<AppState>>, UrlPath(id): UrlPath<u64>) -> Result<Json<Value>> {
+    let job = st.jobs.get(id).ok_or_else(|| StudioError::NotFound(format!("no job {id}")))?;
+    Ok(Json(job.status()))
 }
 
 async fn cancel(State(st): State<Arc<AppState>>, UrlPath(id): UrlPath<u64>) -> Result<Json<Value>> {

@@ -269,3 +269,45 @@ fn new_panels_refuse_bad_requests_and_keep_serving() {
     }
     assert_eq!(get(a, "/api/info").status, 200);
 }
+
+#[test]
+fn a_cancelled_optimal_search_stops_its_engine_early() {
+    // The exact optimum on 1000 frames takes seconds the first time on a take; cancelled after
+    // 0.3 s, the engine itself must stop soon after (its cancel token is checked per frame of each
+    // pass), not only the job's events.
+    let s = studio(1_000_000, None);
+    let (event, _) = run_job(
+        s.addr(),
+        "/api/mocap/open",
+        &[("Content-Type", "application/json")],
+        br#"{"path":"builtin:walk-1000"}"#,
+    );
+    assert_eq!(event, "result");
+    let r = post_json(s.addr(), "/api/mocap/keys", &json!({"method": "optimal", "k": 20}));
+    assert_eq!(r.status, 200, "{}", r.text());
+    let answer = r.json();
+    assert!(answer.get("event").is_none(), "the search ended within the first answer: {answer}");
+    let id = answer["job"].as_u64().unwrap();
+    let status = |id: u64| get(s.addr(), &format!("/api/jobs/{id}")).json();
+    assert_eq!(status(id)["working"], true);
+    let cancelled = post_json(s.addr(), &format!("/api/jobs/{id}/cancel"), &json!({}));
+    assert_eq!(cancelled.status, 200, "{}", cancelled.text());
+    let t = std::time::Instant::now();
+    while status(id)["working"] == true {
+        assert!(t.elapsed().as_secs_f64() < 1.5, "the optimal search still runs 1.5 s after its cancel");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let st = status(id);
+    eprintln!("stopped {:.0} ms after the cancel: {st}", t.elapsed().as_secs_f64() * 1000.0);
+    assert_eq!((st["ended"].clone(), st["cancelled"].clone()), (json!(true), json!(true)));
+    assert_eq!(follow(s.addr(), id).0, "cancelled");
+    // The take still answers; an unknown job is a 404.
+    let (event, r) = run_job(
+        s.addr(),
+        "/api/mocap/keys",
+        &[("Content-Type", "application/json")],
+        json!({"method": "uniform", "k": 20}).to_string().as_bytes(),
+    );
+    assert_eq!(event, "result", "{r}");
+    assert_eq!(get(s.addr(), "/api/jobs/999999").status, 404);
+}
