@@ -247,3 +247,22 @@ fn puts_down_without_a_place_uses_the_nearest_surface() {
     assert_eq!(d.support, Some(desk), "the desk Tom stands at, not the table he left");
     assert!((object_pose(&anim, phone, anim.frames() - 1).0 - d.position).length() < 1e-9);
 }
+
+#[test]
+fn a_prop_put_on_something_that_holds_nothing_goes_on_the_floor_beside_it() {
+    // A chair has no surface: "puts the cup on the chair" sets it on the floor next to the chair.
+    let anim = animated(
+        "A table is in the middle of the room$. A cup is on the table$. A chair is near the wall$.\n\
+         Tom picks up the cup. Tom puts the cup on the chair.\n",
+    );
+    let cat = builtin();
+    let chair = anim.scene.objects.iter().position(|o| o.category == "chair").unwrap();
+    let d = anim.characters[0].props[0].put_down.as_ref().expect("put down");
+    assert_eq!(d.support, None);
+    assert!(d.position.y.abs() < 1e-9);
+    let c = &anim.scene.objects[chair];
+    let gap = (DVec3::new(c.position[0] as f64, 0.0, c.position[2] as f64) - d.position).length();
+    assert!(gap < 1.0, "the cup lands {gap:.2} m from the chair");
+    let report = inbetween_script::invariants::check(&anim, &cat, &[]);
+    assert!(report.floating.is_empty(), "{:?}", report.floating);
+}

@@ -7,6 +7,7 @@
 
 use glam::{DQuat, DVec3};
 
+use super::pick_up::REACH_SLACK;
 use super::Step;
 use crate::animate::builder::Builder;
 use crate::animate::spots::{dist2, heading_to, stand_point};
@@ -57,7 +58,7 @@ impl Builder<'_> {
         // Walk up to it when out of reach.
         let seat_before = self.st.seated;
         let spot = |b: &Builder| b.spot(o, support, beside);
-        let mut at = spot(self);
+        let (mut at, mut on) = spot(self);
         if dist2([at[0], at[2]], self.st.pos) > PLACE_REACH * PLACE_REACH {
             self.stand_up();
             let to = match (support, beside) {
@@ -70,8 +71,9 @@ impl Builder<'_> {
                 self.walk(to, h, "walk", step.speed);
                 self.push_segment("walk", start, support.or(beside), support.or(beside).into_iter().collect(), vec![]);
             }
-            at = spot(self);
+            (at, on) = spot(self);
         }
+        let support = on;
         // The prop at rest there, upright, with the yaw it had in the scene; its grip then.
         let obj = &scene.objects[o];
         let rotation = DQuat::from_rotation_y(obj.yaw as f64);
@@ -80,7 +82,12 @@ impl Builder<'_> {
         rested.objects[o].position = at;
         rested.objects[o].support = support;
         let Some(grip) = contacts_of(&rested, cat, o, ContactKind::Grip).into_iter().next() else { return false };
-        let (m, release) = self.reach_to(DVec3::new(grip[0] as f64, grip[1] as f64, grip[2] as f64));
+        let target = DVec3::new(grip[0] as f64, grip[1] as f64, grip[2] as f64);
+        let (mut m, mut release) = self.reach_to(target);
+        // Out of the arm's reach (a spot low on the floor): step up to it and reach again.
+        if self.wrist_gap(&m, release, target) > REACH_SLACK && self.step_closer(o, [grip[0], grip[2]], step.speed) {
+            (m, release) = self.reach_to(target);
+        }
         let start = self.frames.len();
         self.append(m.poses());
         self.props[k].put_down =
@@ -127,19 +134,21 @@ impl Builder<'_> {
             .map(|(s, _)| s)
     }
 
-    /// Where prop `o`'s base goes (world metres): on `support`'s top nearest the character, beside
-    /// `beside` on the floor, or on the floor in front of the character.
-    fn spot(&self, o: usize, support: Option<usize>, beside: Option<usize>) -> [f32; 3] {
+    /// Where prop `o`'s base goes (world metres) and what it rests on: `support`'s top nearest
+    /// the character, else (no room there) the floor beside it or beside `beside`, else the floor
+    /// in front of the character.
+    fn spot(&self, o: usize, support: Option<usize>, beside: Option<usize>) -> ([f32; 3], Option<usize>) {
         let scene = self.ctx.scene;
-        if let Some(p) = support.and_then(|s| free_spot(scene, o, s, self.st.pos)) {
-            return p;
+        if let Some((s, p)) = support.and_then(|s| free_spot(scene, o, s, self.st.pos).map(|p| (s, p))) {
+            return (p, Some(s));
         }
         let half = scene.objects[o].half_extents_xz();
         let r = half[0].max(half[1]);
-        let ahead = |d: f32| {
-            let h = self.st.heading as f32;
+        let ahead_at = |d: f32, turn: f32| {
+            let h = self.st.heading as f32 + turn;
             [self.st.pos[0] + h.sin() * d, self.st.pos[1] + h.cos() * d]
         };
+        let ahead = |d: f32| ahead_at(d, 0.0);
         let floor = match beside.or(support) {
             Some(b) => {
                 // The side of `b` facing the character, just off its footprint.
@@ -153,10 +162,26 @@ impl Builder<'_> {
             }
             None => ahead(0.45),
         };
-        let free = |p: [f32; 2]| self.grid.is_free_at(p);
-        let p = if free(floor) { floor } else { ahead(0.45) };
-        [p[0], 0.0, p[1]]
+
+        // That spot, else ahead of the character, turning further to the sides until clear.
+        let p = std::iter::once(floor)
+            .chain([0.0f32, -0.5, 0.5, -1.0, 1.0, -1.6, 1.6].map(|t| ahead_at(0.45, t)))
+            .find(|&p| floor_clear(scene, o, p, r))
+            .unwrap_or_else(|| ahead(0.45));
+        ([p[0], 0.0, p[1]], None)
     }
+}
+
+/// Whether prop `o` (radius `r`, metres) can stand on the floor at `p`: inside the room and off
+/// every other floor object's footprint.
+fn floor_clear(scene: &Scene, o: usize, p: [f32; 2], r: f32) -> bool {
+    let room = &scene.room;
+    let inside = p[0] > r && p[1] > r && p[0] < room.width - r && p[1] < room.depth - r;
+    inside
+        && scene.objects.iter().enumerate().filter(|&(i, x)| i != o && x.support.is_none()).all(|(_, x)| {
+            let l = geom::to_local(geom::center(x), x.yaw, p);
+            l[0].abs() >= x.size[0] / 2.0 + r || l[1].abs() >= x.size[2] / 2.0 + r
+        })
 }
 
 /// A spot (base point, world metres) on `s`'s top where prop `o` fits inside the footprint and
