@@ -11,7 +11,6 @@ use inbetween_script::catalogue::{builtin::builtin, Catalogue};
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput};
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::limits::ScriptLimits;
-use inbetween_script::parse::parse_script;
 use libfuzzer_sys::fuzz_target;
 
 fn world() -> &'static (Catalogue, SceneDatabase) {
@@ -26,10 +25,10 @@ fn world() -> &'static (Catalogue, SceneDatabase) {
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
     let (cat, db) = world();
-    if ScriptLimits::default().check_text(&text, "fuzz input", cat).is_err() {
+    // The limits' own parse is the one checked further (one parse per input, as the CLI).
+    let Ok(parsed) = ScriptLimits::default().check_and_parse(&text, "fuzz input", cat) else {
         return;
-    }
-    let parsed = parse_script(&text, cat);
+    };
     if data.len() <= 400 {
         let pins = HashMap::new();
         let _ = compose(

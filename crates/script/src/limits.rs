@@ -46,6 +46,17 @@ impl ScriptLimits {
     /// first (no parsing), then characters, objects and actions from the parse. `source` names the
     /// script in the error.
     pub fn check_text(&self, text: &str, source: &str, cat: &Catalogue) -> Result<(), LimitExceeded> {
+        self.check_and_parse(text, source, cat).map(|_| ())
+    }
+
+    /// [`ScriptLimits::check_text`] that gives the parse it made, for a caller that needs it
+    /// next (one parse instead of two).
+    pub fn check_and_parse(
+        &self,
+        text: &str,
+        source: &str,
+        cat: &Catalogue,
+    ) -> Result<crate::parse::ParsedScript, LimitExceeded> {
         let words = text.split_whitespace().count();
         LimitExceeded::check_count(source, words, self.max_words, "words", "max_words")?;
         let sentences = crate::script::split(text).len();
@@ -69,7 +80,7 @@ impl ScriptLimits {
         LimitExceeded::check_count(source, names.len(), self.max_characters, "characters", "max_characters")?;
         LimitExceeded::check_count(source, objects, self.max_objects, "objects", "max_objects")?;
         LimitExceeded::check_count(source, actions, self.max_actions, "character actions", "max_actions")?;
-        Ok(())
+        Ok(parsed)
     }
 
     /// Checks the animation's length (`frames` at `fps`) before its outputs are written.
