@@ -480,10 +480,9 @@ mod tests {
                 let p = SdpfParams { seed, ..SdpfParams::default() };
                 let path = &resequence(&a, start, &p, 1, &limits).unwrap().0[0];
                 assert_eq!(path.len(), 24, "the source's length: {:?}", path.frames);
-                // Known gap (issue 26, open): a far step back (e.g. 23 → 14 from the shot's last
-                // frame) can pass C_r's content test when the learned metric is not monotone on
-                // this tiny clip; only steps to the 3 previous frames are ruled out for sure.
-                let _far_left = steps_but_loops(path).iter().filter(|(c, k)| k < c).count();
+                // No step goes left but the marked loop backs and cuts.
+                let left: Vec<(usize, usize)> = steps_but_loops(path).into_iter().filter(|(c, k)| k < c).collect();
+                assert!(left.is_empty(), "start {start}, seed {seed}: steps left {left:?} in {:?}", path.frames);
                 assert_eq!(crate::sdpf::backward_steps(&path.frames, 3), 0);
                 let off = SdpfParams { use_cr: false, ..p };
                 let path = &resequence(&a, start, &off, 1, &limits).unwrap().0[0];

@@ -130,7 +130,8 @@ impl<'a> Ctx<'a> {
     /// when ([`Ctx::plays_backwards`]):
     /// - it replays the source's previous frames: k = c − j with 1 ≤ j ≤ `reverse_window`; or
     /// - k lies in c's shot and is closer in content (edge weight) to c's past, c − 1, than to
-    ///   its future, c + 1: whatever k shows, it shows what came before c.
+    ///   its future, c + 1: whatever k shows, it shows what came before c; or
+    /// - c is its shot's last frame and k an earlier frame of the shot (all of them its past).
     ///
     /// Skipped in shots judged undirected when `allow_reverse` is on.
     fn reverse(&self, from: usize, s1: &[usize]) -> (CrState, Vec<usize>) {
@@ -151,12 +152,18 @@ impl<'a> Ctx<'a> {
         let shot = self.motion.shot_of(c);
         let n = self.graph.n;
         let in_shot = |f: usize| self.motion.shot_of(f) == shot;
-        if !in_shot(k) || c == 0 || !in_shot(c - 1) {
+        if !in_shot(k) {
             return false;
         }
-        // At the shot's last frame there is no future to compare with: c itself stands for it.
-        let future = if c + 1 < n && in_shot(c + 1) { c + 1 } else { c };
-        self.edge(k, c - 1) < self.edge(k, future)
+        // At the shot's last frame every other frame of the shot is its past: a step back into
+        // it replays the motion from there, which the walk makes only as a marked loop back.
+        if c + 1 >= n || !in_shot(c + 1) {
+            return k < c;
+        }
+        if c == 0 || !in_shot(c - 1) {
+            return false;
+        }
+        self.edge(k, c - 1) < self.edge(k, c + 1)
     }
 
     /// Whether C_r (as configured) forbids the step `c → k`.
