@@ -45,8 +45,12 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .into_iter()
         .filter(|c| *c != w)
         .filter_map(|c| {
+            let n = c.chars().count();
+            if n.abs_diff(wc.len()) > limit {
+                return None;
+            }
             let cc: Vec<char> = c.chars().collect();
-            (cc.len().abs_diff(wc.len()) <= limit).then(|| (osa(&wc, &cc), c, cc.len()))
+            Some((osa(&wc, &cc), c, n))
         })
         .filter(|&(d, _, n)| d <= limit && d < n)
         .map(|(d, c, _)| (d, c))

@@ -62,20 +62,41 @@ impl<'a> Builder<'a> {
         let rotation = (wq.inverse() * q_obj).normalize();
         let grip_from_base = q_obj.inverse() * (target - base_point);
         let offset = -(rotation * grip_from_base);
+        let start = self.hand_action("pick_up", o, &m, grab, grip, None);
+        self.props.push(CarriedProp { object: o, joint: hand, from: start + grab, offset, rotation, put_down: None });
+        self.back_to_seat(seat_before, speed);
+    }
+
+    /// Appends a hand action `m` on prop `o` whose wrist is on `grip` at frame `peak`: a `verb`
+    /// segment touching `o` (and `also`, and the seat when seated) with the wrist's grip contact
+    /// around that frame. Returns the action's first frame.
+    pub(crate) fn hand_action(
+        &mut self,
+        verb: &str,
+        o: usize,
+        m: &inbetween_core::clip::Clip,
+        peak: usize,
+        grip: [f32; 3],
+        also: Option<usize>,
+    ) -> usize {
         let start = self.frames.len();
         self.append(m.poses());
-        self.props.push(CarriedProp { object: o, joint: hand, from: start + grab, offset, rotation, put_down: None });
         let contact = JointContact {
             joint: ContactJoint::RightWrist,
             kind: ContactKind::Grip,
             point: grip,
-            start: start + grab.saturating_sub(2),
-            end: start + grab + 3,
+            start: start + peak.saturating_sub(2),
+            end: start + peak + 3,
         };
         let mut touching = vec![o];
+        touching.extend(also);
         touching.extend(self.st.seated.map(|s| s.2));
-        self.push_segment("pick_up", start, Some(o), touching, vec![contact]);
-        // Back to the seat it left.
+        self.push_segment(verb, start, Some(o), touching, vec![contact]);
+        start
+    }
+
+    /// Sits down again on the seat `seat_before` names when an action made the character leave it.
+    pub(crate) fn back_to_seat(&mut self, seat_before: Option<([f32; 2], [f32; 3], usize)>, speed: Option<f64>) {
         if let (Some((_, s, so)), None) = (seat_before, self.st.seated) {
             self.sit_on(so, s, 10, speed);
         }

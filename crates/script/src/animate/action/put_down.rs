@@ -11,7 +11,7 @@ use super::pick_up::REACH_SLACK;
 use super::Step;
 use crate::animate::builder::Builder;
 use crate::animate::spots::{dist2, heading_to, stand_point};
-use crate::animate::{contacts_of, ContactJoint, JointContact, PutDown};
+use crate::animate::{contacts_of, PutDown};
 use crate::catalogue::ContactKind;
 use crate::layout::geom;
 use crate::scene::{PlacedObject, Scene};
@@ -88,25 +88,10 @@ impl Builder<'_> {
         if self.wrist_gap(&m, release, target) > REACH_SLACK && self.step_closer(o, [grip[0], grip[2]], step.speed) {
             (m, release) = self.reach_to(target);
         }
-        let start = self.frames.len();
-        self.append(m.poses());
+        let start = self.hand_action("put_down", o, &m, release, grip, support);
         self.props[k].put_down =
             Some(PutDown { frame: start + release, position, rotation, support, blend: SETTLE.min(release) });
-        let contact = JointContact {
-            joint: ContactJoint::RightWrist,
-            kind: ContactKind::Grip,
-            point: grip,
-            start: start + release.saturating_sub(2),
-            end: start + release + 3,
-        };
-        let mut touching = vec![o];
-        touching.extend(support);
-        touching.extend(self.st.seated.map(|s| s.2));
-        self.push_segment("put_down", start, Some(o), touching, vec![contact]);
-        // Back to the seat it left.
-        if let (Some((_, s, so)), None) = (seat_before, self.st.seated) {
-            self.sit_on(so, s, 10, step.speed);
-        }
+        self.back_to_seat(seat_before, step.speed);
         true
     }
 
