@@ -321,7 +321,8 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
             let (keys, _) = if n <= OPTIMAL_MEMO_FRAMES {
                 let mut memo = take.optimal.lock().unwrap_or_else(|p| p.into_inner());
                 let memo = memo.get_or_insert_with(|| OptimalMemo::new(n, ErrorMeasure::Angle));
-                select::optimal_spherical_memo(rep, k, ErrorMeasure::Angle, job.token(), memo)?
+                let mut progress = |f: f64| job.progress("choosing keys (exact optimum)", 0.1 + 0.5 * f);
+                select::optimal_spherical_memo(rep, k, ErrorMeasure::Angle, job.token(), memo, &mut progress)?
             } else {
                 select::optimal_spherical_cancellable(rep, k, ErrorMeasure::Angle, job.token())?
             };

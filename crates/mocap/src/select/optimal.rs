@@ -69,10 +69,12 @@ pub fn optimal_spherical_cancellable(
     let n = rep.num_frames;
     check_k(n, k)?;
     match objective {
-        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, None)?.solution(),
+        ErrorMeasure::Angle => {
+            PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, None, &mut |_| {})?.solution()
+        }
         ErrorMeasure::Position => {
             let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
-            PrunedCosts::build(n, k, &mut frames, cancel, None)?.solution()
+            PrunedCosts::build(n, k, &mut frames, cancel, None, &mut |_| {})?.solution()
         }
     }
 }
@@ -105,12 +107,14 @@ impl OptimalMemo {
 
 /// [`optimal_spherical_cancellable`] that reuses and extends `memo` (made for this clip and
 /// objective; another is refused): the same keys and total, bit for bit, whatever the memo holds.
+/// `progress` hears the share of the search done (0 to 1, about fifty times).
 pub fn optimal_spherical_memo(
     rep: &SphericalMotion,
     k: usize,
     objective: ErrorMeasure,
     cancel: &Cancel,
     memo: &mut OptimalMemo,
+    progress: &mut dyn FnMut(f64),
 ) -> Result<(KeyframeSet, f64)> {
     let n = rep.num_frames;
     check_k(n, k)?;
@@ -121,10 +125,12 @@ pub fn optimal_spherical_memo(
         )));
     }
     match objective {
-        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, Some(memo))?.solution(),
+        ErrorMeasure::Angle => {
+            PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, Some(memo), progress)?.solution()
+        }
         ErrorMeasure::Position => {
             let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
-            PrunedCosts::build(n, k, &mut frames, cancel, Some(memo))?.solution()
+            PrunedCosts::build(n, k, &mut frames, cancel, Some(memo), progress)?.solution()
         }
     }
 }
@@ -350,6 +356,7 @@ impl PrunedCosts {
         frames: &mut impl FrameObjective,
         cancel: &Cancel,
         mut memo: Option<&mut OptimalMemo>,
+        progress: &mut dyn FnMut(f64),
     ) -> Result<PrunedCosts> {
         let known = |memo: &Option<&mut OptimalMemo>, a: usize, b: usize| memo.as_ref().and_then(|m| m.exact(a, b));
         let inf = f64::INFINITY;
@@ -380,6 +387,7 @@ impl PrunedCosts {
         let short = |a: usize, b: usize| costs[a * n + b];
         let bound = shortest_path(n, g0, k, short).map_or(inf, |(_, u)| u);
         let exact = !bound.is_finite() || costs.iter().any(|c| c.is_nan());
+        progress(0.1);
         // 2. A lower bound of every longer segment: its middle frames, or what the memo knows.
         let mut lower = costs.clone();
         for a in 0..n {
@@ -421,8 +429,13 @@ impl PrunedCosts {
         let least_after: Vec<f64> = (0..n).map(|j| (0..k - 1).map(|r| after[r * n + j]).fold(inf, f64::min)).collect();
         // The predecessors with a cost into column j, in frame order.
         let mut into = Vec::with_capacity(n);
+        progress(0.2);
+        let every = (n / 50).max(1);
         for j in 1..n {
             cancel.check()?;
+            if j % every == 0 {
+                progress(0.2 + 0.8 * j as f64 / n as f64);
+            }
             into.clear();
             for i in 0..j.saturating_sub(g0) {
                 let low = lower[i * n + j];
@@ -738,7 +751,7 @@ mod tests {
                     assert_eq!(got, want, "window {w}, k={k}, {objective:?}");
                     assert_eq!(got_total.to_bits(), want_total.to_bits(), "window {w}, k={k}, {objective:?}");
                     assert_eq!(optimal(&table, k, objective).unwrap(), want);
-                    let memo = optimal_spherical_memo(rep, k, objective, &Cancel::new(), &mut up).unwrap();
+                    let memo = optimal_spherical_memo(rep, k, objective, &Cancel::new(), &mut up, &mut |_| {}).unwrap();
                     assert_eq!(
                         (memo.0, memo.1.to_bits()),
                         (want.clone(), want_total.to_bits()),
@@ -748,7 +761,8 @@ mod tests {
                     cases += 1;
                 }
                 for (k, want, want_total) in wants.into_iter().rev() {
-                    let memo = optimal_spherical_memo(rep, k, objective, &Cancel::new(), &mut down).unwrap();
+                    let memo =
+                        optimal_spherical_memo(rep, k, objective, &Cancel::new(), &mut down, &mut |_| {}).unwrap();
                     assert_eq!((memo.0, memo.1.to_bits()), (want, want_total.to_bits()), "down, window {w}, k={k}");
                 }
             }
@@ -783,11 +797,23 @@ mod tests {
     }
 
     #[test]
+    fn the_search_reports_its_progress_in_order() {
+        let rep = &varied_windows()[0];
+        let mut seen = Vec::new();
+        let mut memo = OptimalMemo::new(rep.num_frames, ErrorMeasure::Angle);
+        optimal_spherical_memo(rep, 5, ErrorMeasure::Angle, &Cancel::new(), &mut memo, &mut |f| seen.push(f)).unwrap();
+        assert!(seen.len() >= 10, "{seen:?}");
+        assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+        assert!(seen[0] > 0.0 && *seen.last().unwrap() > 0.9 && *seen.last().unwrap() <= 1.0, "{seen:?}");
+    }
+
+    #[test]
     fn a_memo_of_another_clip_or_objective_is_refused() {
         let rep = &varied_windows()[0];
         let n = rep.num_frames;
         for mut memo in [OptimalMemo::new(n + 1, ErrorMeasure::Angle), OptimalMemo::new(n, ErrorMeasure::Position)] {
-            let e = optimal_spherical_memo(rep, 3, ErrorMeasure::Angle, &Cancel::new(), &mut memo).unwrap_err();
+            let e = optimal_spherical_memo(rep, 3, ErrorMeasure::Angle, &Cancel::new(), &mut memo, &mut |_| {})
+                .unwrap_err();
             assert!(e.to_string().contains("memo was made for"), "{e}");
         }
     }
@@ -800,7 +826,8 @@ mod tests {
             let table = SegmentTable::full_serial(rep);
             let cost = |a: usize, b: usize| table.get(a, b).unwrap().angle_sum;
             for k in [3, 5, 10, 15].into_iter().filter(|&k| k <= n) {
-                let kept = PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new(), None).unwrap();
+                let kept =
+                    PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new(), None, &mut |_| {}).unwrap();
                 let (_, best) = reference_optimal(&table, k, ErrorMeasure::Angle).unwrap();
                 // The least total of any k-key path through each segment, from the full table.
                 let inf = f64::INFINITY;
