@@ -202,3 +202,36 @@ fn a_foreign_skeleton_gives_an_error_naming_the_missing_joint_not_a_panic() {
     let msg = blend_upper(&walk, &m, &BlendParams::default()).unwrap_err().to_string();
     assert!(msg.contains("one skeleton"), "{msg}");
 }
+
+#[test]
+fn a_turn_on_the_spot_steps_instead_of_gliding() {
+    // Walk 2 m along +z, then turn to face back: the feet step round instead of sliding about the
+    // hips. Over the turn, an ankle on the floor (within 2 cm of its rest height) covers at most
+    // 5 cm horizontally (it was about 0.3 m: the idle stance turned about the hips).
+    let lib = MotionLibrary::procedural(0);
+    let rig = Rig::standard();
+    let route = [[0.0f32, 0.0], [0.0, 2.0]];
+    let turned = WalkParams { final_heading: Some(std::f64::consts::PI), lock_feet: false, ..WalkParams::default() };
+    let straight = WalkParams { lock_feet: false, ..WalkParams::default() };
+    let m = walk_route(&route, &lib, &turned);
+    let s = walk_route(&route, &lib, &straight);
+    let g = m.globals();
+    let turn_frames = m.num_frames() - s.num_frames();
+    assert!(turn_frames > 10, "{turn_frames}");
+    // The turn happens before the held end, which is as long in both.
+    let hold = (WalkParams::default().hold_end * 30.0).round().max(1.0) as usize;
+    let (a, b) = (s.num_frames() - hold, m.num_frames() - hold);
+    // Per foot, the horizontal distance its ankle covers while on the floor over the turn.
+    let mut glide = [0.0f64; 2];
+    for f in a + 1..b {
+        for (k, leg) in rig.legs.iter().enumerate() {
+            let (p, q) = (g[f - 1].positions[leg[2]], g[f].positions[leg[2]]);
+            if p.y <= rig.ankle_height + 0.02 && q.y <= rig.ankle_height + 0.02 {
+                glide[k] += ((q.x - p.x).powi(2) + (q.z - p.z).powi(2)).sqrt();
+            }
+        }
+    }
+    eprintln!("turn of {turn_frames} frames: planted ankles glide {:.3} m and {:.3} m", glide[0], glide[1]);
+    assert!(glide.iter().all(|&d| d <= 0.05), "planted feet glide {glide:?} m over the turn");
+    assert!(heading_at(&m, m.num_frames() - 1).abs() > 3.0);
+}

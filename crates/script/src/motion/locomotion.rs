@@ -303,12 +303,51 @@ pub fn walk_route_stats(route: &[[f32; 2]], library: &MotionLibrary, params: &Wa
         }
     }
     if let Some(fh) = params.final_heading {
+        // A step-turn on the spot: the body turns at most `max_turn_rate` while each foot stays
+        // planted, then steps (lifted in an arc) to where the idle stance puts it at the final
+        // heading, one foot in the first half of the turn, the other in the second.
         let turn = params.max_turn_rate.max(0.1) * dt;
-        while wrap(fh - h).abs() > 1e-6 {
-            h = wrap(h + wrap(fh - h).clamp(-turn, turn));
-            let l = idle_at(t);
-            push(&mut frames, &mut t, l, path.at(len), h);
+        let mut headings = Vec::new();
+        let mut hh = h;
+        while wrap(fh - hh).abs() > 1e-6 {
+            hh = wrap(hh + wrap(fh - hh).clamp(-turn, turn));
+            headings.push(hh);
         }
+        let at = path.at(len);
+        let feet = |p: &Pose| {
+            let g = forward(&rig.skeleton, p);
+            [g.positions[rig.legs[0][2]], g.positions[rig.legs[1][2]]]
+        };
+        let m = headings.len();
+        let (start, end) = (place(&rig, idle_at(t), at, h), place(&rig, idle_at(t + m as f64 * dt), at, fh));
+        let (from, to) = (feet(&start), feet(&end));
+        // The feet keep their world orientation while planted and turn with the step.
+        let foot_turn = |p: &Pose| {
+            let g = forward(&rig.skeleton, p);
+            [g.rotations[rig.legs[0][2]], g.rotations[rig.legs[1][2]]]
+        };
+        let (turn_from, turn_to) = (foot_turn(&start), foot_turn(&end));
+        for (i, &hi) in headings.iter().enumerate() {
+            let u = (i + 1) as f64 / m as f64;
+            let mut p = place(&rig, idle_at(t), at, hi);
+            for (k, limb) in [Limb::LeftLeg, Limb::RightLeg].into_iter().enumerate() {
+                let v = if k == 0 { (2.0 * u).min(1.0) } else { (2.0 * u - 1.0).max(0.0) };
+                let a = DVec3::new(from[k].x, 0.0, from[k].z).lerp(DVec3::new(to[k].x, 0.0, to[k].z), smooth01(v));
+                let dist = DVec3::new(to[k].x - from[k].x, 0.0, to[k].z - from[k].z).length();
+                // A foot that moves at all is lifted clear of the floor (3 to 6 cm at the top).
+                let top = if dist > 0.01 { (0.5 * dist).clamp(0.03, 0.06) } else { 0.0 };
+                let lift = top * (std::f64::consts::PI * v).sin();
+                let y = from[k].y + (to[k].y - from[k].y) * smooth01(v) + lift;
+                solve_limb(&rig, &mut p, limb, DVec3::new(a.x, y, a.z), None);
+                let [_, knee, foot, _] = rig.legs[k];
+                let knee_global = forward(&rig.skeleton, &p).rotations[knee];
+                let want = turn_from[k].slerp(turn_to[k], smooth01(v)).normalize();
+                p.rotations[foot] = local_from_global(knee_global, want);
+            }
+            frames.push(p);
+            t += dt;
+        }
+        h = hh;
     }
     for _ in 0..(params.hold_end * FPS).round().max(1.0) as usize {
         let l = idle_at(t);
