@@ -187,15 +187,13 @@ fn free_spot(scene: &Scene, o: usize, s: usize, near: [f32; 2]) -> Option<[f32; 
     let others: Vec<&PlacedObject> =
         scene.objects.iter().enumerate().filter(|&(i, x)| i != o && x.support == Some(s)).map(|(_, x)| x).collect();
     let steps = 8;
+    let [ax, az] = prop.half_extents_xz();
     let mut best: Option<(f32, [f32; 2])> = None;
     for i in 0..=steps {
         for j in 0..=steps {
             let local = [-mx + 2.0 * mx * i as f32 / steps as f32, -mz + 2.0 * mz * j as f32 / steps as f32];
             let w = geom::to_world(geom::center(sup), sup.yaw, local);
-            let mut at = prop.clone();
-            at.position = [w[0], sup.top(), w[1]];
             let clear = others.iter().all(|x| {
-                let [ax, az] = at.half_extents_xz();
                 let [bx, bz] = x.half_extents_xz();
                 let c = geom::center(x);
                 (w[0] - c[0]).abs() >= ax + bx + CLEARANCE || (w[1] - c[1]).abs() >= az + bz + CLEARANCE
