@@ -68,40 +68,62 @@ pub fn optimal_spherical_cancellable(
 ) -> Result<(KeyframeSet, f64)> {
     let n = rep.num_frames;
     check_k(n, k)?;
-    match objective {
-        ErrorMeasure::Angle => {
-            PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, None, &mut |_| {})?.solution()
-        }
-        ErrorMeasure::Position => {
-            let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
-            PrunedCosts::build(n, k, &mut frames, cancel, None, &mut |_| {})?.solution()
-        }
-    }
+    optimal_spherical_memo(rep, k, objective, cancel, &mut OptimalMemo::new(n, objective), &mut |_| {})
 }
 
 /// What [`optimal_spherical_memo`] learnt about one clip's segments, for the next search on the same
-/// clip with another `k` (a studio's K slider): the cost of every segment costed in full, and for a
-/// segment given up on, the partial sum that exceeded its room (a lower bound of its cost). Known
-/// costs are not recomputed, and the bounds prune more. About `16·n²` bytes.
+/// clip with another `k` (a studio's K slider): the cost of every segment costed in full, and for
+/// every other segment a lower bound of its cost (its middle frames, or the partial sum that
+/// exceeded its room in an earlier search). Known costs are not recomputed, the bounds prune more,
+/// and a search whose `k` is near an earlier one takes its upper bound from known costs alone.
+/// About `16·n²` bytes; a search without a memo makes a temporary one.
 #[derive(Clone, Debug)]
 pub struct OptimalMemo {
     n: usize,
     objective: ErrorMeasure,
-    /// `exact[a * n + b]`: the cost of segment `(a, b)`, NaN while unknown.
+    /// `exact[b * n + a]`: the cost of segment `(a, b)`, NaN while unknown (column-major: the
+    /// programme reads the segments into one frame).
     exact: Vec<f64>,
-    /// `lower[a * n + b]`: a lower bound of that cost (0 while nothing is known).
+    /// `lower[b * n + a]`: a lower bound of that cost (its cost once known), NaN while nothing is
+    /// known: the sum of the frames within `reach[b * n + a]` of its middle (see [`Reach`]).
     lower: Vec<f64>,
+    reach: Vec<u32>,
+    /// Some cost or bound came out NaN: searches prune nothing.
+    nan: bool,
+    /// Every segment has a lower bound.
+    bounded: bool,
 }
 
 impl OptimalMemo {
     /// An empty memo for a clip of `n` frames and one objective.
     pub fn new(n: usize, objective: ErrorMeasure) -> OptimalMemo {
-        OptimalMemo { n, objective, exact: vec![f64::NAN; n * n], lower: vec![0.0; n * n] }
+        OptimalMemo {
+            n,
+            objective,
+            exact: vec![f64::NAN; n * n],
+            lower: vec![f64::NAN; n * n],
+            reach: vec![0; n * n],
+            nan: false,
+            bounded: false,
+        }
     }
 
     fn exact(&self, a: usize, b: usize) -> Option<f64> {
-        let c = self.exact[a * self.n + b];
+        let c = self.exact[b * self.n + a];
         (!c.is_nan()).then_some(c)
+    }
+
+    fn set_exact(&mut self, a: usize, b: usize, cost: f64) {
+        self.nan |= cost.is_nan();
+        self.exact[b * self.n + a] = cost;
+        self.lower[b * self.n + a] = cost;
+    }
+
+    /// The frames within `reach` of the middle of `(a, b)` sum to `bound`.
+    fn set_lower(&mut self, a: usize, b: usize, reach: usize, bound: f64) {
+        self.nan |= bound.is_nan();
+        self.lower[b * self.n + a] = bound;
+        self.reach[b * self.n + a] = u32::try_from(reach).unwrap_or(u32::MAX);
     }
 }
 
@@ -125,12 +147,10 @@ pub fn optimal_spherical_memo(
         )));
     }
     match objective {
-        ErrorMeasure::Angle => {
-            PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, Some(memo), progress)?.solution()
-        }
+        ErrorMeasure::Angle => PrunedCosts::build(n, k, &mut AngleFrames::new(rep), cancel, memo, progress)?.solution(),
         ErrorMeasure::Position => {
             let mut frames = ModelFrames { model: rep, objective, scratch: rep.scratch() };
-            PrunedCosts::build(n, k, &mut frames, cancel, Some(memo), progress)?.solution()
+            PrunedCosts::build(n, k, &mut frames, cancel, memo, progress)?.solution()
         }
     }
 }
@@ -335,15 +355,20 @@ fn wrapped_angle_difference(a: f64, b: f64) -> f64 {
     r.min(TAU - r)
 }
 
-/// The segment costs [`optimal_spherical`] computes (`n × n`, ∞ where a segment was dropped) and
-/// the programme of [`optimal`] run over them, column by column as they are computed.
+/// The programme of [`optimal`] over the segments [`optimal_spherical`] keeps, run column by column
+/// as they are costed.
 struct PrunedCosts {
     n: usize,
     k: usize,
-    costs: Vec<f64>,
-    /// `dp[c * n + j]`, `from[c * n + j]`: as in [`shortest_path`].
+    /// `dp[j * k + c]` (frame-major: a frame's states together), `from[c * n + j]`: as in
+    /// [`shortest_path`].
     dp: Vec<f64>,
     from: Vec<usize>,
+    /// A column's predecessors while it is computed.
+    best_from: Vec<usize>,
+    /// Every kept segment and its cost (tests).
+    #[cfg(test)]
+    kept: Vec<(usize, usize, f64)>,
 }
 
 /// Relative slack on every bound, far above the rounding of sums of at most a few hundred terms.
@@ -355,70 +380,78 @@ impl PrunedCosts {
         k: usize,
         frames: &mut impl FrameObjective,
         cancel: &Cancel,
-        mut memo: Option<&mut OptimalMemo>,
+        memo: &mut OptimalMemo,
         progress: &mut dyn FnMut(f64),
     ) -> Result<PrunedCosts> {
-        let known = |memo: &Option<&mut OptimalMemo>, a: usize, b: usize| memo.as_ref().and_then(|m| m.exact(a, b));
         let inf = f64::INFINITY;
-        let mut costs = vec![inf; n * n];
         let mut terms = vec![0.0; n];
-        // 1. Every segment up to g0 = ⌈1.5 · ⌈(n−1)/(k−1)⌉⌉ frames long, in full (k − 1 of them cover
-        // the clip).
+        // 1. An upper bound U of the optimum: the best path over segments up to
+        // g0 = ⌈1.5 · ⌈(n−1)/(k−1)⌉⌉ frames long (k − 1 of them cover the clip). Those the memo knows
+        // give it when they cover the clip (floating-point addition is monotone, so the full
+        // programme's value is at most the banded one's); otherwise every such segment is costed.
         let span = (n - 1).div_ceil(k - 1);
         let g0 = (span + span.div_ceil(2)).min(n - 1);
-        for a in 0..n {
-            cancel.check()?;
-            for b in a + 1..=(a + g0).min(n - 1) {
-                costs[a * n + b] = match known(&memo, a, b) {
-                    Some(c) => c,
-                    None => {
+        #[cfg(target_arch = "x86_64")]
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx2 = false;
+        let banded = |memo: &OptimalMemo| banded_total(n, g0, k, &memo.exact, avx2);
+        let mut bound = if memo.nan { inf } else { banded(memo) };
+        if !bound.is_finite() {
+            for b in 1..n {
+                cancel.check()?;
+                for a in b.saturating_sub(g0)..b {
+                    if memo.exact(a, b).is_none() {
                         frames.frames(a, b, a + 1, b, &mut terms);
-                        let c = terms[..b - a - 1].iter().fold(0.0, |s, t| s + t);
-                        if let Some(m) = memo.as_deref_mut() {
-                            m.exact[a * n + b] = c;
-                        }
-                        c
+                        memo.set_exact(a, b, terms[..b - a - 1].iter().fold(0.0, |s, t| s + t));
                     }
-                };
+                }
             }
+            bound = banded(memo);
         }
-        // The best path over them bounds the optimum U (floating-point addition is monotone, so the
-        // full programme's value is at most the banded one's). Not finite, or NaN costs: no pruning.
-        let short = |a: usize, b: usize| costs[a * n + b];
-        let bound = shortest_path(n, g0, k, short).map_or(inf, |(_, u)| u);
-        let exact = !bound.is_finite() || costs.iter().any(|c| c.is_nan());
+        // Not finite, or NaN costs: no pruning.
+        let exact = !bound.is_finite() || memo.nan;
         progress(0.1);
-        // 2. A lower bound of every longer segment: its middle frames, or what the memo knows.
-        let mut lower = costs.clone();
-        for a in 0..n {
+        // 2. A lower bound of every segment nothing is known of: its middle frames.
+        let unbounded = if memo.bounded { 0 } else { n };
+        for b in 1..unbounded {
             cancel.check()?;
-            for b in a + g0 + 1..n {
-                let known = memo.as_ref().map_or(0.0, |m| m.exact(a, b).unwrap_or(m.lower[a * n + b]));
-                let (lo, hi) = middle(a, b);
-                let mid = if known > 0.0 {
-                    0.0
-                } else {
-                    frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
-                    terms[lo..hi].iter().sum::<f64>()
-                };
-                lower[a * n + b] = mid.max(known) * (1.0 - SLACK);
+            for a in 0..b {
+                if memo.lower[b * n + a].is_nan() {
+                    if b == a + 1 {
+                        memo.set_exact(a, b, 0.0);
+                    } else {
+                        let (lo, hi) = middle(a, b);
+                        frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
+                        memo.set_lower(a, b, 0, terms[lo..hi].iter().sum::<f64>());
+                    }
+                }
             }
         }
-        // 3. after[r * n + j]: a lower bound of the cost from a key at j to the last frame in r segments.
+        memo.bounded = true;
+        // 3. after[r * n + j]: a lower bound of the cost from a key at j to the last frame in r
+        // segments (min over b of lower(j, b) + after[r − 1][b], taken segment column by column).
+        let scale = 1.0 - SLACK;
         let mut after = vec![inf; k * n];
         after[n - 1] = 0.0;
-        for r in 1..k {
-            for j in 0..n - 1 {
-                let next = &after[(r - 1) * n..r * n];
-                after[r * n + j] = (j + 1..n).map(|b| lower[j * n + b] + next[b]).fold(inf, f64::min);
-            }
+        if !exact {
+            lower_to_go(&memo.lower, &mut after, n, scale, avx2);
         }
         // 4. The programme column by column. Before column j, every state of an earlier column is
-        // final, so a longer segment (i, j) can only lie on a path of total
+        // final, so a segment (i, j) can only lie on a path of total
         // ≥ min_c dp[c][i] + cost(i, j) + after[k−2−c][j]; it is dropped once that exceeds U. The
         // states of the optimal path are exact (their segments are never dropped), and dropping a
-        // segment only raises other candidates, so every state of that path keeps its predecessor.
-        let mut table = PrunedCosts { n, k, costs, dp: vec![inf; k * n], from: vec![usize::MAX; k * n] };
+        // segment only raises other candidates, so every state of that path keeps its predecessor
+        // (the first i of its minimum: a segment of another path as good is not dropped either).
+        let mut table = PrunedCosts {
+            n,
+            k,
+            dp: vec![inf; k * n],
+            from: vec![usize::MAX; k * n],
+            best_from: Vec::with_capacity(k),
+            #[cfg(test)]
+            kept: Vec::new(),
+        };
         table.dp[0] = 0.0;
         let room_total = bound * (1.0 + SLACK);
         // The least dp of each finished column and the least `after` of each frame over the c of
@@ -427,7 +460,11 @@ impl PrunedCosts {
         let mut least_dp = vec![inf; n];
         least_dp[0] = 0.0;
         let least_after: Vec<f64> = (0..n).map(|j| (0..k - 1).map(|r| after[r * n + j]).fold(inf, f64::min)).collect();
-        // The predecessors with a cost into column j, in frame order.
+        // after_of[j * (k − 1) + c] = after[(k − 2 − c) * n + j]: the rest after a segment into j
+        // that ends the c + 1-th segment, beside dp's states of a frame.
+        let after_of: Vec<f64> =
+            (0..n).flat_map(|j| (0..k - 1).map(move |c| (k - 2 - c) * n + j)).map(|x| after[x]).collect();
+        // The predecessors with a cost into column j, in frame order, and their costs.
         let mut into = Vec::with_capacity(n);
         progress(0.2);
         let every = (n / 50).max(1);
@@ -437,81 +474,192 @@ impl PrunedCosts {
                 progress(0.2 + 0.8 * j as f64 / n as f64);
             }
             into.clear();
-            for i in 0..j.saturating_sub(g0) {
-                let low = lower[i * n + j];
+            for (i, &least) in least_dp[..j].iter().enumerate() {
                 let room = if exact {
                     inf
                 } else {
-                    if low > room_total - (least_dp[i] + least_after[j]) * (1.0 - SLACK) {
+                    let low = memo.lower[j * n + i] * scale;
+                    if low > room_total - (least + least_after[j]) * scale {
                         continue;
                     }
-                    let base = (0..k - 1).map(|c| table.dp[c * n + i] + after[(k - 2 - c) * n + j]).fold(inf, f64::min);
-                    room_total - base * (1.0 - SLACK)
+                    let states = &table.dp[i * k..i * k + k - 1];
+                    let rests = &after_of[j * (k - 1)..(j + 1) * (k - 1)];
+                    let base = min_of_sums(states, rests, avx2);
+                    let room = room_total - base * scale;
+                    if low > room {
+                        continue;
+                    }
+                    room
                 };
-                if low > room {
+                if let Some(cost) = memo.exact(i, j) {
+                    into.push((i, cost));
                     continue;
                 }
-                if let Some(cost) = known(&memo, i, j) {
-                    table.costs[i * n + j] = cost;
-                    into.push(i);
-                    continue;
-                }
-                match segment_within(frames, i, j, room / (1.0 - SLACK), &mut terms) {
+                let seen = (memo.reach[j * n + i] as usize, memo.lower[j * n + i]);
+                match segment_within(frames, i, j, room / scale, seen, &mut terms) {
                     Ok(cost) => {
-                        table.costs[i * n + j] = cost;
-                        into.push(i);
-                        if let Some(m) = memo.as_deref_mut() {
-                            m.exact[i * n + j] = cost;
-                        }
+                        memo.set_exact(i, j, cost);
+                        into.push((i, cost));
                     }
-                    Err(partial) => {
-                        if let Some(m) = memo.as_deref_mut() {
-                            m.lower[i * n + j] = m.lower[i * n + j].max(partial);
-                        }
-                    }
+                    Err((reach, partial)) => memo.set_lower(i, j, reach, partial),
                 }
             }
-            into.extend((j.saturating_sub(g0)..j).filter(|&i| table.costs[i * n + j].is_finite()));
             table.column(j, &into);
-            least_dp[j] = (0..k - 1).map(|c| table.dp[c * n + j]).fold(inf, f64::min);
+            least_dp[j] = table.dp[j * k..j * k + k - 1].iter().copied().fold(inf, f64::min);
         }
         Ok(table)
     }
 
     /// `dp[c][j]` and its predecessor for every c, exactly as [`shortest_path`] computes them, over
-    /// the predecessors `into` (every `i` whose cost into `j` is finite, in frame order: an infinite
+    /// the predecessors `into` (every `i` whose cost into `j` is kept, in frame order: an infinite
     /// or NaN cost never wins the strict minimum).
-    fn column(&mut self, j: usize, into: &[usize]) {
-        let n = self.n;
-        for c in 1..self.k {
-            let mut best = (f64::INFINITY, usize::MAX);
-            for &i in into {
-                let prev = self.dp[(c - 1) * n + i];
+    fn column(&mut self, j: usize, into: &[(usize, f64)]) {
+        let (n, k) = (self.n, self.k);
+        let (done, rest) = self.dp.split_at_mut(j * k);
+        let best = &mut rest[1..k];
+        let from = &mut self.best_from;
+        from.clear();
+        from.resize(k - 1, usize::MAX);
+        // Predecessors in frame order for every c at once: the same first minimum as one c at a time.
+        for &(i, cost) in into {
+            for ((b, f), &prev) in best.iter_mut().zip(from.iter_mut()).zip(&done[i * k..i * k + k - 1]) {
                 if prev == f64::INFINITY {
                     continue;
                 }
-                let v = prev + self.costs[i * n + j];
-                if v < best.0 {
-                    best = (v, i);
+                let v = prev + cost;
+                if v < *b {
+                    (*b, *f) = (v, i);
                 }
             }
-            (self.dp[c * n + j], self.from[c * n + j]) = best;
         }
+        for (c, &f) in (1..k).zip(from.iter()) {
+            self.from[c * n + j] = f;
+        }
+        #[cfg(test)]
+        self.kept.extend(into.iter().map(|&(i, c)| (i, j, c)));
     }
 
     /// The optimal keys and total, as [`shortest_path`] gives them over these costs.
     fn solution(&self) -> Result<(KeyframeSet, f64)> {
         let (n, k) = (self.n, self.k);
-        let total = self.dp[(k - 1) * n + n - 1];
+        let total = self.dp[(n - 1) * k + k - 1];
         if total == f64::INFINITY {
             return Err(MocapError::Invalid(format!("{k} keys cannot cover {n} frames")));
         }
         Ok((KeyframeSet::new(backtrack(&self.from, n, k - 1, n - 1), n)?, total))
     }
+}
 
-    #[cfg(test)]
-    fn get(&self, a: usize, b: usize) -> f64 {
-        self.costs[a * self.n + b]
+/// The total of [`shortest_path`]`(n, g0, k, cost)` with `cost(a, b) = costs[b·n + a]` (NaN: no
+/// such segment), ∞ when no path exists: the same minima, taken by value only.
+fn banded_total(n: usize, g0: usize, k: usize, costs: &[f64], avx2: bool) -> f64 {
+    let inf = f64::INFINITY;
+    let (mut prev, mut row) = (vec![inf; n], vec![inf; n]);
+    prev[0] = 0.0;
+    for _ in 1..k {
+        row[0] = inf;
+        for j in 1..n {
+            let lo = j.saturating_sub(g0);
+            row[j] = min_of_sums(&prev[lo..j], &costs[j * n + lo..j * n + j], avx2);
+        }
+        std::mem::swap(&mut prev, &mut row);
+    }
+    prev[n - 1]
+}
+
+/// The least `a[x] + b[x]` (∞ for none; a NaN sum never wins, as with `<`). Any order of a minimum
+/// gives the same number, so AVX2 (`avx2`: the CPU has it) takes four at a time.
+#[inline]
+fn min_of_sums(a: &[f64], b: &[f64], avx2: bool) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: the caller checked that the CPU supports AVX2.
+        return unsafe { min_of_sums_avx2(a, b) };
+    }
+    let _ = avx2;
+    a.iter().zip(b).fold(f64::INFINITY, |m, (x, y)| {
+        let v = x + y;
+        if v < m {
+            v
+        } else {
+            m
+        }
+    })
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn min_of_sums_avx2(a: &[f64], b: &[f64]) -> f64 {
+    use std::arch::x86_64::*;
+    let len = a.len().min(b.len());
+    let mut acc = _mm256_set1_pd(f64::INFINITY);
+    let mut x = 0;
+    while x + 4 <= len {
+        // SAFETY: x + 4 ≤ the length of both slices; unaligned loads. min_pd(v, acc) is `v < acc ? v : acc`.
+        unsafe {
+            let v = _mm256_add_pd(_mm256_loadu_pd(a.as_ptr().add(x)), _mm256_loadu_pd(b.as_ptr().add(x)));
+            acc = _mm256_min_pd(v, acc);
+        }
+        x += 4;
+    }
+    let mut lanes = [0.0; 4];
+    // SAFETY: four f64 lanes into a four-element array.
+    unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), acc) };
+    lanes.into_iter().chain((x..len).map(|x| a[x] + b[x])).fold(f64::INFINITY, |m, v| if v < m { v } else { m })
+}
+
+/// `after[r·n + j] = min over b > j of lower[b·n + j]·scale + after[(r − 1)·n + b]` for every row
+/// r ≥ 1 (row 0 given). Segment columns from the last frame back: a row's value at b is final once
+/// every later column is in, and each column is read once (the order of a minimum does not change
+/// it). `avx2`: the CPU has it.
+fn lower_to_go(lower: &[f64], after: &mut [f64], n: usize, scale: f64, avx2: bool) {
+    let rows = after.len() / n;
+    for b in (1..n).rev() {
+        let column = &lower[b * n..b * n + b];
+        for r in 1..rows {
+            let (done, rest) = after.split_at_mut(r * n);
+            let to_go = done[(r - 1) * n + b];
+            if to_go == f64::INFINITY {
+                continue;
+            }
+            let row = &mut rest[..b];
+            #[cfg(target_arch = "x86_64")]
+            if avx2 {
+                // SAFETY: the caller checked that the CPU supports AVX2.
+                unsafe { min_sums_avx2(row, column, scale, to_go) };
+                continue;
+            }
+            let _ = avx2;
+            for (o, &l) in row.iter_mut().zip(column) {
+                let v = l * scale + to_go;
+                *o = if v < *o { v } else { *o };
+            }
+        }
+    }
+}
+
+/// `row[x] = min(column[x]·scale + to_go, row[x])` (as `<` picks), four at a time: plain stores of
+/// `vminpd` (the compiler's own vectorisation chose masked stores, three times slower here).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn min_sums_avx2(row: &mut [f64], column: &[f64], scale: f64, to_go: f64) {
+    use std::arch::x86_64::*;
+    let len = row.len().min(column.len());
+    let (s, t) = (_mm256_set1_pd(scale), _mm256_set1_pd(to_go));
+    let mut x = 0;
+    while x + 4 <= len {
+        // SAFETY: x + 4 ≤ the length of both slices; unaligned loads and stores.
+        unsafe {
+            let l = _mm256_loadu_pd(column.as_ptr().add(x));
+            let o = _mm256_loadu_pd(row.as_ptr().add(x));
+            // min_pd(v, o) is `v < o ? v : o`.
+            _mm256_storeu_pd(row.as_mut_ptr().add(x), _mm256_min_pd(_mm256_add_pd(_mm256_mul_pd(l, s), t), o));
+        }
+        x += 4;
+    }
+    for (o, &l) in row[x..len].iter_mut().zip(&column[x..len]) {
+        let v = l * scale + to_go;
+        *o = if v < *o { v } else { *o };
     }
 }
 
@@ -521,33 +669,44 @@ fn middle(a: usize, b: usize) -> (usize, usize) {
     ((mid - 1).max(a + 1), (mid + 2).min(b))
 }
 
+/// The frames of segment `(a, b)` within `reach` frames of its middle ones, as a range.
+fn within(a: usize, b: usize, reach: usize) -> (usize, usize) {
+    let (lo, hi) = middle(a, b);
+    (lo.saturating_sub(reach).max(a + 1), (hi + reach).min(b))
+}
+
 /// The cost of segment `(a, b)` (its frame terms summed in frame order), or, as soon as the terms
-/// seen, from the middle outwards in growing blocks, sum past `room`, that partial sum (a lower bound
-/// of the cost).
+/// seen, from the middle outwards in growing steps, sum past `room`, how far they reach and that
+/// partial sum (a lower bound of the cost). `seen`: the reach and sum of an earlier call that gave
+/// up, to go on from.
 fn segment_within(
     frames: &mut impl FrameObjective,
     a: usize,
     b: usize,
     room: f64,
+    seen: (usize, f64),
     terms: &mut [f64],
-) -> std::result::Result<f64, f64> {
-    let (mut lo, mut hi) = middle(a, b);
-    frames.frames(a, b, lo, hi, &mut terms[lo..hi]);
-    let mut partial = terms[lo..hi].iter().sum::<f64>();
+) -> std::result::Result<f64, (usize, f64)> {
+    let (mut reach, mut partial) = seen;
+    let (first_lo, first_hi) = within(a, b, reach);
+    let (mut lo, mut hi) = (first_lo, first_hi);
     let mut step = 2;
     while lo > a + 1 || hi < b {
         if partial > room {
-            return Err(partial);
+            return Err((reach, partial));
         }
-        let (l, h) = (lo.saturating_sub(step).max(a + 1), (hi + step).min(b));
+        reach += step;
+        let (l, h) = within(a, b, reach);
         frames.frames(a, b, l, lo, &mut terms[l..lo]);
         frames.frames(a, b, hi, h, &mut terms[hi..h]);
         partial += terms[l..lo].iter().chain(&terms[hi..h]).sum::<f64>();
         (lo, hi, step) = (l, h, 2 * step);
     }
     if partial > room {
-        return Err(partial);
+        return Err((reach, partial));
     }
+    // The frames an earlier call summed, again for the sum in frame order.
+    frames.frames(a, b, first_lo, first_hi, &mut terms[first_lo..first_hi]);
     Ok(terms[a + 1..b].iter().fold(0.0, |s, t| s + t))
 }
 
@@ -826,8 +985,14 @@ mod tests {
             let table = SegmentTable::full_serial(rep);
             let cost = |a: usize, b: usize| table.get(a, b).unwrap().angle_sum;
             for k in [3, 5, 10, 15].into_iter().filter(|&k| k <= n) {
-                let kept =
-                    PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new(), None, &mut |_| {}).unwrap();
+                let mut memo = OptimalMemo::new(n, ErrorMeasure::Angle);
+                let built =
+                    PrunedCosts::build(n, k, &mut AngleFrames::new(rep), &Cancel::new(), &mut memo, &mut |_| {})
+                        .unwrap();
+                let mut kept = vec![f64::INFINITY; n * n];
+                for &(a, b, c) in &built.kept {
+                    kept[a * n + b] = c;
+                }
                 let (_, best) = reference_optimal(&table, k, ErrorMeasure::Angle).unwrap();
                 // The least total of any k-key path through each segment, from the full table.
                 let inf = f64::INFINITY;
@@ -842,7 +1007,7 @@ mod tests {
                 }
                 for a in 0..n {
                     for b in a + 1..n {
-                        let got = kept.get(a, b);
+                        let got = kept[a * n + b];
                         if got.is_finite() {
                             assert_eq!(got.to_bits(), cost(a, b).to_bits(), "({a}, {b}) k={k}");
                         } else {
@@ -907,6 +1072,133 @@ mod tests {
         for (a, b) in pairs {
             assert_eq!(wrapped_angle_difference(a, b).to_bits(), core_wrap(a, b).to_bits(), "{a} {b}");
         }
+    }
+
+    /// Random costs with ∞ and NaN among them, for the vector helpers.
+    fn odd_costs(len: usize, seed: u64) -> Vec<f64> {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..len)
+            .map(|_| match rng.random_range(0..20) {
+                0 => f64::INFINITY,
+                1 => f64::NAN,
+                2 => 0.0,
+                _ => rng.random_range(0.0..10.0),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn vector_helpers_give_the_plain_loops_numbers_bit_for_bit() {
+        #[cfg(target_arch = "x86_64")]
+        let paths = [false, std::arch::is_x86_feature_detected!("avx2")];
+        #[cfg(not(target_arch = "x86_64"))]
+        let paths = [false, false];
+        let inf = f64::INFINITY;
+        for seed in 0..20u64 {
+            let n = 3 + (seed as usize * 7) % 40;
+            let costs = odd_costs(n * n, seed);
+            let (a, b) = (odd_costs(n, seed + 100), odd_costs(n, seed + 200));
+            // The least sum: as a fold with `<`.
+            let plain = a.iter().zip(&b).fold(inf, |m, (x, y)| if x + y < m { x + y } else { m });
+            for avx2 in paths {
+                assert_eq!(min_of_sums(&a, &b, avx2).to_bits(), plain.to_bits(), "seed {seed}");
+                for len in 0..n {
+                    let p = a[..len].iter().zip(&b).fold(inf, |m, (x, y)| if x + y < m { x + y } else { m });
+                    assert_eq!(min_of_sums(&a[..len], &b[..len], avx2).to_bits(), p.to_bits());
+                }
+            }
+            // The banded programme's total: shortest_path's.
+            for (g0, k) in [(2, n), (n - 1, 2), (n / 2 + 1, 3), (5, n / 2 + 1)] {
+                let want = shortest_path(n, g0, k, |a, b| costs[b * n + a]).map_or(inf, |(_, u)| u);
+                for avx2 in paths {
+                    assert_eq!(
+                        banded_total(n, g0, k, &costs, avx2).to_bits(),
+                        want.to_bits(),
+                        "seed {seed}, g0 {g0}, k {k}"
+                    );
+                }
+            }
+            // Rows of lower bounds to go (no NaN there: a NaN cost turns pruning off).
+            let lower: Vec<f64> = costs.iter().map(|c| if c.is_nan() { 1.0 } else { *c }).collect();
+            let rows = 4;
+            let mut want = vec![inf; rows * n];
+            want[n - 1] = 0.0;
+            for r in 1..rows {
+                for j in 0..n {
+                    want[r * n + j] =
+                        (j + 1..n).map(|b| lower[b * n + j] * 0.5 + want[(r - 1) * n + b]).fold(inf, f64::min);
+                }
+            }
+            for avx2 in paths {
+                let mut got = vec![inf; rows * n];
+                got[n - 1] = 0.0;
+                lower_to_go(&lower, &mut got, n, 0.5, avx2);
+                assert_eq!(
+                    got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    want.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    "seed {seed}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_memo_resumes_given_up_segments_and_answers_near_k_from_known_costs() {
+        let rep = &varied_windows()[0];
+        let n = rep.num_frames;
+        let table = SegmentTable::full_serial(rep);
+        let mut memo = OptimalMemo::new(n, ErrorMeasure::Angle);
+        // Every K from 12 down to 3 and back: each answer the table's.
+        for k in (3..=12).rev().chain(3..=12) {
+            let (want, total) = reference_optimal(&table, k, ErrorMeasure::Angle).unwrap();
+            let got =
+                optimal_spherical_memo(rep, k, ErrorMeasure::Angle, &Cancel::new(), &mut memo, &mut |_| {}).unwrap();
+            assert_eq!((got.0, got.1.to_bits()), (want, total.to_bits()), "k={k}");
+        }
+        // What the memo holds: known costs are the table's, every bound is below the cost, and a
+        // bound's reach stays inside its segment.
+        for b in 1..n {
+            for a in 0..b {
+                let cost = table.get(a, b).unwrap().angle_sum;
+                if let Some(c) = memo.exact(a, b) {
+                    assert_eq!(c.to_bits(), cost.to_bits(), "({a}, {b})");
+                } else {
+                    let low = memo.lower[b * n + a];
+                    assert!(low <= cost * (1.0 + 1e-12), "({a}, {b}): bound {low} above cost {cost}");
+                    let (lo, hi) = within(a, b, memo.reach[b * n + a] as usize);
+                    assert!(a < lo && hi <= b);
+                }
+            }
+        }
+        assert!(memo.bounded && !memo.nan);
+    }
+
+    #[test]
+    fn a_nan_frame_turns_pruning_off_and_answers_as_the_table() {
+        // A NaN angle on a frame makes the segments that key or span it NaN (never chosen).
+        let mut rep = varied_windows()[1].clone();
+        let n = rep.num_frames;
+        rep.theta[3 * n + n / 2] = f64::NAN;
+        let table = SegmentTable::full_serial(&rep);
+        let mut memo = OptimalMemo::new(n, ErrorMeasure::Angle);
+        let mut answered = [0, 0];
+        for k in [6, 4, 8, 3, 2, 12] {
+            let got = optimal_spherical_memo(&rep, k, ErrorMeasure::Angle, &Cancel::new(), &mut memo, &mut |_| {});
+            match reference_optimal(&table, k, ErrorMeasure::Angle) {
+                Ok((want, total)) => {
+                    let got = got.unwrap();
+                    assert_eq!((got.0, got.1.to_bits()), (want, total.to_bits()), "k={k}");
+                    answered[0] += 1;
+                }
+                Err(_) => {
+                    assert!(got.unwrap_err().to_string().contains("cannot cover"), "k={k}");
+                    answered[1] += 1;
+                }
+            }
+        }
+        assert!(memo.nan);
+        assert!(answered[0] > 0, "{answered:?}");
     }
 
     #[test]
