@@ -62,9 +62,9 @@ impl Motion {
     pub fn from_poses(skeleton: Skeleton, frame_time: f64, poses: &[Pose]) -> Result<Motion, CoreError> {
         let nc = skeleton.num_channels();
         let mut data = vec![0.0; nc * poses.len()];
-        for (f, pose) in poses.iter().enumerate() {
-            write_pose(&skeleton, pose, &mut data[f * nc..(f + 1) * nc]);
-        }
+        // Frames are independent: in parallel (the same numbers).
+        use rayon::prelude::*;
+        data.par_chunks_mut(nc.max(1)).zip(poses).for_each(|(frame, pose)| write_pose(&skeleton, pose, frame));
         Motion::new(skeleton, frame_time, data)
     }
 

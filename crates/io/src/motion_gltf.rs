@@ -7,7 +7,7 @@
 //! Blender and three.js's GLTFLoader read it natively; the studio's viewer loads takes this way,
 //! because a browser parses the binary buffer many times faster than BVH text.
 
-use inbetween_core::Motion;
+use inbetween_core::{Motion, Pose, Skeleton};
 use serde_json::Value;
 
 use crate::gltf_buffer::json::{animation::Property, Index, Node};
@@ -16,7 +16,19 @@ use crate::gltf_buffer::{node, scene, Anim, GltfDoc, Type};
 /// The document (buffer 0 without `uri`) and its binary buffer; pass both to [`glb_bytes`] or
 /// [`crate::gltf_buffer::data_uri`].
 pub fn motion_document(motion: &Motion, name: &str, scale: f64) -> (Value, Vec<u8>) {
-    let skeleton = &motion.skeleton;
+    let poses: Vec<_> = (0..motion.num_frames()).map(|f| motion.pose(f)).collect();
+    poses_document(&motion.skeleton, motion.frame_time, &poses, name, scale)
+}
+
+/// [`motion_document`] of the clip with these local poses, one per frame `frame_time` seconds
+/// apart (for a pose clip not written as channels: no Euler angles on the way).
+pub fn poses_document(
+    skeleton: &Skeleton,
+    frame_time: f64,
+    poses: &[Pose],
+    name: &str,
+    scale: f64,
+) -> (Value, Vec<u8>) {
     let joints = skeleton.joints();
     let mut d = GltfDoc::new("inbetween");
     let f32s = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32];
@@ -44,10 +56,9 @@ pub fn motion_document(motion: &Motion, name: &str, scale: f64) -> (Value, Vec<u
     }
     d.root.scenes.push(scene(Some(name.to_string()), roots));
     d.root.scene = Some(Index::new(0));
-    let n = motion.num_frames();
-    let times: Vec<f32> = (0..n).map(|f| (f as f64 * motion.frame_time) as f32).collect();
+    let n = poses.len();
+    let times: Vec<f32> = (0..n).map(|f| (f as f64 * frame_time) as f32).collect();
     let input = d.floats(&times, Type::Scalar, true, None);
-    let poses: Vec<_> = (0..n).map(|f| motion.pose(f)).collect();
     let mut anim = Anim::default();
     for (j, joint) in joints.iter().enumerate() {
         let target = Index::new(j as u32);
@@ -70,6 +81,12 @@ pub fn motion_document(motion: &Motion, name: &str, scale: f64) -> (Value, Vec<u
         d.push(anim.finish(name));
     }
     d.finish()
+}
+
+/// [`poses_document`] as a binary glTF (`.glb`) file's bytes.
+pub fn poses_glb(skeleton: &Skeleton, frame_time: f64, poses: &[Pose], name: &str, scale: f64) -> Vec<u8> {
+    let (doc, bin) = poses_document(skeleton, frame_time, poses, name, scale);
+    glb_bytes(&doc, &bin)
 }
 
 /// [`motion_document`] as a binary glTF (`.glb`) file's bytes.

@@ -134,6 +134,17 @@ pub fn reconstruct_from_keys(
     frames: &[usize],
     keys: &[KeyPose],
 ) -> Result<Motion> {
+    let poses = reconstruct_poses(skeleton, frame_time, frames, keys)?;
+    Ok(Motion::from_poses(skeleton.clone(), frame_time, &poses)?)
+}
+
+/// The local poses of [`reconstruct_from_keys`], before they are written as channels.
+pub fn reconstruct_poses(
+    skeleton: &Skeleton,
+    frame_time: f64,
+    frames: &[usize],
+    keys: &[KeyPose],
+) -> Result<Vec<Pose>> {
     if frames.len() < 2 || frames.len() != keys.len() || frames[0] != 0 || frames.windows(2).any(|w| w[0] >= w[1]) {
         return Err(MocapError::Invalid(format!(
             "keyframes {frames:?} must start at 0, increase and number at least 2"
@@ -141,12 +152,13 @@ pub fn reconstruct_from_keys(
     }
     let nj = skeleton.len();
     let n = frames[frames.len() - 1] + 1;
-    let mut poses = Vec::with_capacity(n);
-    for (s, w) in frames.windows(2).enumerate() {
-        let (a, b) = (w[0], w[1]);
-        let h = (b - a) as f64 * frame_time;
-        let end = if s + 2 == frames.len() { b } else { b - 1 };
-        for f in a..=end {
+    // Frames are independent: in parallel (the same numbers), each from the segment it lies in.
+    use rayon::prelude::*;
+    let poses: Vec<Pose> = (0..n)
+        .into_par_iter()
+        .map(|f| {
+            let s = frames.partition_point(|&k| k <= f).saturating_sub(1).min(frames.len() - 2);
+            let (a, b) = (frames[s], frames[s + 1]);
             let mut pose = Pose { rotations: vec![DQuat::IDENTITY; nj], translations: vec![DVec3::ZERO; nj] };
             if f == a {
                 pose.rotations.copy_from_slice(&keys[s].rotations);
@@ -155,13 +167,14 @@ pub fn reconstruct_from_keys(
                 pose.rotations.copy_from_slice(&keys[s + 1].rotations);
                 pose.translations.copy_from_slice(&keys[s + 1].translations);
             } else {
+                let h = (b - a) as f64 * frame_time;
                 let u = (f - a) as f64 / (b - a) as f64;
                 interpolate_pose_into(&keys[s], &keys[s + 1], h, u, &mut pose.rotations, &mut pose.translations);
             }
-            poses.push(pose);
-        }
-    }
-    Ok(Motion::from_poses(skeleton.clone(), frame_time, &poses)?)
+            pose
+        })
+        .collect();
+    Ok(poses)
 }
 
 impl SegmentModel for RotationMotion {

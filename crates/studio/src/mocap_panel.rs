@@ -14,12 +14,12 @@ use axum::Json;
 use glam::DVec3;
 use inbetween_core::procedural::{gait, GaitParams};
 use inbetween_core::units::UnitChoice;
-use inbetween_core::{positions_clip, KeyframeSet, Motion};
-use inbetween_io::motion_gltf::motion_glb;
+use inbetween_core::{forward, positions_clip, KeyframeSet, Motion, Pose, Skeleton};
+use inbetween_io::motion_gltf::{motion_glb, poses_glb};
 use inbetween_mocap::codec::job::{CompressJob, CompressReport};
 use inbetween_mocap::codec::{self, Budget};
 use inbetween_mocap::metrics::SegmentModel;
-use inbetween_mocap::rotations::reconstruct_from_keys;
+use inbetween_mocap::rotations::reconstruct_poses;
 use inbetween_mocap::select::OptimalMemo;
 use inbetween_mocap::select::{self, sidql::SidqlPolicy};
 use inbetween_mocap::{ErrorMeasure, RotationMotion, SegmentTable, SphericalMotion};
@@ -363,17 +363,34 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
         return Err(StudioError::Engine("cancelled".into()));
     }
     job.progress("reconstructing", 0.6);
-    let planned = rep.error(&keys);
-    let rec = reconstruct(take, &keys)?;
-    let (per_frame, mean, max) = per_frame_error(&take.positions, &rec, cm);
+    // The planned error beside the reconstruction, its error curve beside its glTF (rayon's pool).
+    // Both from the rebuilt local poses: the clip's Euler channels are made for the BVH download.
+    let skeleton = &take.motion.skeleton;
+    let frame_time = take.motion.frame_time;
+    let (planned, built) = rayon::join(
+        || rep.error(&keys),
+        || -> Result<_> {
+            let poses = reconstruct(take, &keys)?;
+            let ((per_frame, mean, max), glb) = rayon::join(
+                || per_frame_error(&take.positions, skeleton, &poses, cm),
+                || poses_glb(skeleton, frame_time, &poses, "reconstructed", 1.0),
+            );
+            Ok((poses, per_frame, mean, max, glb))
+        },
+    );
+    let (poses, per_frame, mean, max, glb) = built?;
+    let skeleton = skeleton.clone();
     let v = st.mocap.next_version();
     // The viewer loads the glTF (a binary buffer the page reads at once); the BVH is made when
     // downloaded.
-    let glb = st.put_file("mocap/reconstructed.glb", "model/gltf-binary", motion_glb(&rec, "reconstructed", 1.0), v);
+    let glb = st.put_file("mocap/reconstructed.glb", "model/gltf-binary", glb, v);
     let url = st.put_lazy(
         "mocap/reconstructed.bvh",
         "text/plain; charset=utf-8",
-        move || inbetween_io::to_bvh_string(&rec).into_bytes(),
+        move || match Motion::from_poses(skeleton, frame_time, &poses) {
+            Ok(rec) => inbetween_io::to_bvh_string(&rec).into_bytes(),
+            Err(e) => format!("error: {e}\n").into_bytes(),
+        },
         v,
     );
     let ms = job.elapsed_ms();
@@ -394,17 +411,18 @@ fn keys_job(st: &AppState, job: &Job, take: &Take, req: &KeysRequest) -> Result<
     }))
 }
 
-/// The clip rebuilt from its key poses (the engine's rotation reconstruction).
-fn reconstruct(take: &Take, keys: &KeyframeSet) -> Result<Motion> {
+/// The local poses rebuilt from the key poses (the engine's rotation reconstruction).
+fn reconstruct(take: &Take, keys: &KeyframeSet) -> Result<Vec<Pose>> {
     let frames = keys.frames();
     let poses: Vec<_> = frames.iter().map(|&f| take.rotations.frames[f].clone()).collect();
-    Ok(reconstruct_from_keys(&take.motion.skeleton, take.motion.frame_time, frames, &poses)?)
+    Ok(reconstruct_poses(&take.motion.skeleton, take.motion.frame_time, frames, &poses)?)
 }
 
 /// Per frame, the mean distance (cm) between original and rebuilt joints; the mean over frames
 /// and the largest joint distance.
-fn per_frame_error(original: &[Vec<DVec3>], b: &Motion, cm: f64) -> (Vec<f64>, f64, f64) {
-    let pb = positions_clip(b);
+fn per_frame_error(original: &[Vec<DVec3>], skeleton: &Skeleton, poses: &[Pose], cm: f64) -> (Vec<f64>, f64, f64) {
+    use rayon::prelude::*;
+    let pb: Vec<Vec<DVec3>> = poses.par_iter().map(|p| forward(skeleton, p).positions).collect();
     let mut max = 0.0f64;
     let per: Vec<f64> = original
         .iter()

@@ -403,8 +403,9 @@ function bvhFigure(result, color, radius) {
   for (const b of result.skeleton.bones) b.add(new THREE.Mesh(ball, mat));
   const mixer = new THREE.AnimationMixer(helper);
   mixer.clipAction(result.clip).play();
-  return { holder, helper, mixer, root };
+  return { holder, helper, mixer, root, clip: result.clip, names: boneNames(result) };
 }
+const boneNames = (result) => result.skeleton.bones.map((b) => b.name).join('\n');
 
 async function drawTake(r) {
   const m = S.mocap;
@@ -468,9 +469,20 @@ $('mocap-compress').addEventListener('click', () => start('compress', async () =
 async function drawKeys(r) {
   const m = S.mocap;
   const parsed = await loadTake(r.files.reconstructed_glb);
-  if (m.rec) { groups.mocap.remove(m.rec.holder, m.rec.helper); disposeTree(m.rec.holder); disposeTree(m.rec.helper); m.rec.mixer.stopAllAction(); }
-  m.rec = bvhFigure(parsed, 0xff8c1a, 0.02);
-  groups.mocap.add(m.rec.holder, m.rec.helper);
+  let old = null;
+  if (m.rec && m.rec.names === boneNames(parsed)) {
+    // The same skeleton (a new K or method): the new clip drives the figure already drawn, so no
+    // geometry is rebuilt and no shader compiled again.
+    m.rec.mixer.stopAllAction();
+    m.rec.mixer.uncacheClip(m.rec.clip);
+    m.rec.clip = parsed.clip;
+    m.rec.mixer.clipAction(parsed.clip).play();
+  } else {
+    old = m.rec;
+    if (old) { groups.mocap.remove(old.holder, old.helper); old.mixer.stopAllAction(); }
+    m.rec = bvhFigure(parsed, 0xff8c1a, 0.02);
+    groups.mocap.add(m.rec.holder, m.rec.helper);
+  }
   m.keysResult = r;
   if (r.method === 'bound') $('mocap-k').value = r.k;
   const ex = $('mocap-export');
@@ -480,6 +492,8 @@ async function drawKeys(r) {
   seek(S.frame);
   drawTimeline();
   renderNow();
+  // Freed after the first frame with the new figure: its materials find their programs compiled.
+  if (old) { disposeTree(old.holder); disposeTree(old.helper); }
 }
 
 // ---------------------------------------------------------------- face panel
