@@ -95,6 +95,25 @@ pub fn exp_map(v: [f32; 3]) -> [f32; 4] {
     [v[0] * s, v[1] * s, v[2] * s, c]
 }
 
+/// Joints whose rotations [`exp_map_lanes`] turns into quaternions at once.
+const LANES: usize = 8;
+
+/// [`exp_map`] of `LANES` rotation vectors given by component (`v[c][lane]`), as
+/// quaternion components `q[c][lane]` (x, y, z, w): the same operations in the same order per
+/// lane.
+#[inline]
+fn exp_map_lanes(v: &[[f32; LANES]; 3]) -> [[f32; LANES]; 4] {
+    let mut q = [[0.0f32; LANES]; 4];
+    for k in 0..LANES {
+        let [x, y, z, w] = exp_map([v[0][k], v[1][k], v[2][k]]);
+        q[0][k] = x;
+        q[1][k] = y;
+        q[2][k] = z;
+        q[3][k] = w;
+    }
+    q
+}
+
 /// Zig-zag decoding.
 fn unzigzag(u: u64) -> i64 {
     ((u >> 1) as i64) ^ -((u & 1) as i64)
@@ -567,9 +586,13 @@ impl<'a> Clip<'a> {
         for (c, &s) in comps.iter().zip(&self.slot) {
             let bit = bit0 + c.off as usize;
             let at = bit >> 3;
-            let word = u64::from_le_bytes(data[at..at + 8].try_into().expect("8 bytes"));
+            debug_assert!(at + 8 <= data.len());
+            // SAFETY: `Clip::open` checked that every component of every frame lies in the data,
+            // which ends with 8 padding bytes, so `at + 8 <= data.len()` (asserted in debug builds).
+            let word = u64::from_le(unsafe { data.as_ptr().add(at).cast::<u64>().read_unaligned() });
             let u = (word >> (bit & 7)) & c.mask;
-            vals[s] = c.base + u as f32 * c.scale;
+            // u < 2^MAX_WIDTH: as a signed integer it converts to the same f32 in one instruction.
+            vals[s] = c.base + (u as i64) as f32 * c.scale;
         }
     }
 
@@ -585,9 +608,21 @@ impl<'a> Clip<'a> {
     /// rotation keep the quaternion [`Context::bind`] set from the rest values.
     fn fill(&self, f: usize, slot: &mut Frame) {
         self.decode_frame(f, &mut slot.vals);
-        for &j in &self.animated_rot {
-            let v = &slot.vals[6 * j..6 * j + 3];
-            slot.rot[j] = exp_map([v[0], v[1], v[2]]);
+        // Eight joints at a time in lanes (the compiler vectorises the lane loops): the same
+        // operations on each as `exp_map`, so the same quaternions.
+        for chunk in self.animated_rot.chunks(LANES) {
+            let mut v = [[0.0f32; LANES]; 3];
+            for (k, &j) in chunk.iter().enumerate() {
+                for (c, lane) in v.iter_mut().enumerate() {
+                    lane[k] = slot.vals[6 * j + c];
+                }
+            }
+            let q = exp_map_lanes(&v);
+            for (k, &j) in chunk.iter().enumerate() {
+                for (c, lane) in q.iter().enumerate() {
+                    slot.rot[c][j] = lane[k];
+                }
+            }
         }
         slot.frame = f;
     }
@@ -627,8 +662,9 @@ impl<'a> Clip<'a> {
             }
         }
         if u == 0.0 || f1 == f0 {
+            let r = &ctx.a.rot;
             for j in 0..nj {
-                rotations[j] = ctx.a.rot[j];
+                rotations[j] = [r[0][j], r[1][j], r[2][j], r[3][j]];
                 let t = &ctx.a.vals[6 * j + 3..6 * j + 6];
                 translations[j] = [t[0], t[1], t[2]];
             }
@@ -638,27 +674,43 @@ impl<'a> Clip<'a> {
             self.fill(f1, &mut ctx.b);
         }
         let (a, b) = (&ctx.a, &ctx.b);
-        for j in 0..nj {
-            let (p, q) = (a.rot[j], b.rot[j]);
-            let dot = p[0] * q[0] + p[1] * q[1] + p[2] * q[2] + p[3] * q[3];
-            let w1 = if dot < 0.0 { -u } else { u };
-            let w0 = 1.0 - u;
-            let r = [p[0] * w0 + q[0] * w1, p[1] * w0 + q[1] * w1, p[2] * w0 + q[2] * w1, p[3] * w0 + q[3] * w1];
-            let n = 1.0 / (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
-            rotations[j] = [r[0] * n, r[1] * n, r[2] * n, r[3] * n];
+        // Rotations by normalised linear interpolation, `LANES` joints at a time (the rotation
+        // buffers are padded to whole lanes; the same operations on each lane as one at a time).
+        let w0 = 1.0 - u;
+        for j0 in (0..nj).step_by(LANES) {
+            let lane = |r: &[Vec<f32>; 4], c: usize| -> [f32; LANES] {
+                r[c][j0..j0 + LANES].try_into().expect("rotation buffers hold whole lanes")
+            };
+            let (p, q) = ([0, 1, 2, 3].map(|c| lane(&a.rot, c)), [0, 1, 2, 3].map(|c| lane(&b.rot, c)));
+            let mut out = [[0.0f32; LANES]; 4];
+            for k in 0..LANES {
+                let dot = p[0][k] * q[0][k] + p[1][k] * q[1][k] + p[2][k] * q[2][k] + p[3][k] * q[3][k];
+                let w1 = if dot < 0.0 { -u } else { u };
+                let r = [0, 1, 2, 3].map(|c| p[c][k] * w0 + q[c][k] * w1);
+                let n = 1.0 / (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
+                for c in 0..4 {
+                    out[c][k] = r[c] * n;
+                }
+            }
+            for (k, rot) in rotations[j0..(j0 + LANES).min(nj)].iter_mut().enumerate() {
+                *rot = [out[0][k], out[1][k], out[2][k], out[3][k]];
+            }
+        }
+        for (j, t) in translations.iter_mut().enumerate() {
             let (ta, tb) = (&a.vals[6 * j + 3..6 * j + 6], &b.vals[6 * j + 3..6 * j + 6]);
-            translations[j] = [ta[0] + (tb[0] - ta[0]) * u, ta[1] + (tb[1] - ta[1]) * u, ta[2] + (tb[2] - ta[2]) * u];
+            *t = [ta[0] + (tb[0] - ta[0]) * u, ta[1] + (tb[1] - ta[1]) * u, ta[2] + (tb[2] - ta[2]) * u];
         }
         Ok(())
     }
 }
 
-/// One decoded frame: values (6 per joint) and rotation quaternions.
+/// One decoded frame: values (6 per joint) and rotation quaternions by component (x, y, z, w),
+/// each padded with identities to a whole number of `LANES`.
 #[derive(Clone, Debug)]
 struct Frame {
     frame: usize,
     vals: Vec<f32>,
-    rot: Vec<[f32; 4]>,
+    rot: [Vec<f32>; 4],
 }
 
 /// What [`Clip::sample`] keeps between calls: the two frames it decoded last. Made once per
@@ -676,8 +728,8 @@ impl Context {
     pub fn new(clip: &Clip) -> Context {
         let mut c = Context {
             clip: (0, 0),
-            a: Frame { frame: usize::MAX, vals: Vec::new(), rot: Vec::new() },
-            b: Frame { frame: usize::MAX, vals: Vec::new(), rot: Vec::new() },
+            a: Frame { frame: usize::MAX, vals: Vec::new(), rot: Default::default() },
+            b: Frame { frame: usize::MAX, vals: Vec::new(), rot: Default::default() },
         };
         c.bind(clip);
         c
@@ -692,8 +744,12 @@ impl Context {
                 f.frame = usize::MAX;
                 f.vals.clear();
                 f.vals.extend_from_slice(&clip.rest);
-                f.rot.clear();
-                f.rot.extend_from_slice(&clip.rest_rot);
+                let padded = clip.rest_rot.len().div_ceil(LANES) * LANES;
+                for (c, comp) in f.rot.iter_mut().enumerate() {
+                    comp.clear();
+                    comp.extend(clip.rest_rot.iter().map(|q| q[c]));
+                    comp.resize(padded, if c == 3 { 1.0 } else { 0.0 });
+                }
             }
         }
     }

@@ -320,6 +320,66 @@ mod tests {
         }
     }
 
+    /// The sampler works on eight joints at a time; each sample is the one-joint formula's (the
+    /// frames' values through `exp_map`, normalised lerp, lerp of translations), bit for bit,
+    /// on skeletons whose joint counts do and do not fill whole lanes.
+    #[test]
+    fn samples_are_the_one_joint_formulas_bit_for_bit() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for joints in [None, Some(9), Some(16), Some(17)] {
+            let mut m = walk();
+            if let Some(keep) = joints {
+                m = inbetween_core::Motion::from_poses(
+                    inbetween_core::Skeleton::new(m.skeleton.joints()[..keep].to_vec()).unwrap(),
+                    m.frame_time,
+                    &(0..m.num_frames())
+                        .map(|f| {
+                            let p = m.pose(f);
+                            inbetween_core::Pose {
+                                rotations: p.rotations[..keep].to_vec(),
+                                translations: p.translations[..keep].to_vec(),
+                            }
+                        })
+                        .collect::<Vec<_>>(),
+                )
+                .unwrap();
+            }
+            let c = compress(&m, &Options::with_format(0.05, Format::V4)).unwrap();
+            let clip = Clip::open(&c.bytes).unwrap();
+            let n = clip.num_joints();
+            let mut ctx = Context::new(&clip);
+            let (mut rot, mut tr) = (vec![[0f32; 4]; n], vec![[0f32; 3]; n]);
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            for _ in 0..200 {
+                let t = rng.random::<f64>() * clip.duration();
+                clip.sample(&mut ctx, t, &mut rot, &mut tr).unwrap();
+                let x = t / clip.frame_time();
+                let f0 = x as usize;
+                let f1 = (f0 + 1).min(clip.num_frames() - 1);
+                let u = (x - f0 as f64) as f32;
+                clip.frame_values(f0, &mut a);
+                clip.frame_values(f1, &mut b);
+                for j in 0..n {
+                    let p = exp_map([a[6 * j], a[6 * j + 1], a[6 * j + 2]]);
+                    let q = exp_map([b[6 * j], b[6 * j + 1], b[6 * j + 2]]);
+                    let (want_r, want_t) = if u == 0.0 || f1 == f0 {
+                        (p, [a[6 * j + 3], a[6 * j + 4], a[6 * j + 5]])
+                    } else {
+                        let dot = p[0] * q[0] + p[1] * q[1] + p[2] * q[2] + p[3] * q[3];
+                        let w1 = if dot < 0.0 { -u } else { u };
+                        let w0 = 1.0 - u;
+                        let r = [0, 1, 2, 3].map(|k| p[k] * w0 + q[k] * w1);
+                        let norm = 1.0 / (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]).sqrt();
+                        let lerp = |k: usize| a[6 * j + 3 + k] + (b[6 * j + 3 + k] - a[6 * j + 3 + k]) * u;
+                        (r.map(|v| v * norm), [lerp(0), lerp(1), lerp(2)])
+                    };
+                    assert_eq!(rot[j].map(f32::to_bits), want_r.map(f32::to_bits), "{n} joints, time {t}, joint {j}");
+                    assert_eq!(tr[j].map(f32::to_bits), want_t.map(f32::to_bits), "{n} joints, time {t}, joint {j}");
+                }
+            }
+        }
+    }
+
     /// A context reused across random times and playback gives what a fresh one gives.
     #[test]
     fn a_reused_context_gives_the_samples_of_a_fresh_one() {
