@@ -247,7 +247,7 @@ pub fn run_story_in(
     let gif = dir.join("story.gif");
     cancel.check()?;
     let moving = (0..animation.scene.objects.len())
-        .filter(|&i| crate::animate::carried_from(&animation, i).is_some())
+        .filter(|&i| crate::animate::moves(&animation, i))
         .map(|i| {
             let poses = (0..animation.frames())
                 .map(|f| {

@@ -128,6 +128,18 @@ camera close
 Barbra stands and looks madly at the window.
 ";
 
+/// Issue 27's bedroom: a chair in front of the desk is tucked at it; Tom pulls it out to sit
+/// and pushes it back in when he gets up.
+pub const BEDROOM_DESK: &str =
+    "# A bedroom desk: the chair is tucked at the desk, pulled out to sit on and pushed back.
+In the bedroom, a bed is next to a wardrobe$
+A desk is near the window$
+A chair is in front of the desk$
+camera front
+Tom walks to the desk and sits on the chair.
+Tom gets up and walks to the bed.
+";
+
 /// All built-in texts as (name, text).
 pub fn all() -> Vec<(&'static str, &'static str)> {
     vec![
@@ -140,6 +152,7 @@ pub fn all() -> Vec<(&'static str, &'static str)> {
         ("fig7-musicroom", FIG7_MUSIC_ROOM),
         ("demo", DEMO),
         ("night-of-the-living-dead", NIGHT_OF_THE_LIVING_DEAD),
+        ("bedroom-desk", BEDROOM_DESK),
     ]
 }
 

@@ -414,6 +414,9 @@ fn remap(
     for c in &mut p.track.props {
         c.object = map(c.object)?;
     }
+    for s in &mut p.track.slides {
+        s.object = map(s.object)?;
+    }
     if p.marks.len() != actions.len() {
         return None;
     }

@@ -168,3 +168,66 @@ fn a_chair_at_the_desk_faces_it() {
     assert!(facing_angle(chair, desk) <= FACING_TOLERANCE_DEG, "{chair:?}\n{desk:?}");
     assert!(inbetween_script::layout::relation_holds(Relation::InFrontOf, chair, desk));
 }
+
+#[test]
+fn a_chair_in_front_of_a_desk_is_tucked_and_pulled_out_to_sit_on() {
+    use inbetween_core::fk::forward;
+    use inbetween_script::animate::object_pose;
+    use inbetween_script::layout::geom::{facing_angle, local_box, FACING_TOLERANCE_DEG};
+    use inbetween_script::motion::Rig;
+    let text = "In the bedroom, a bed is next to a wardrobe$. A desk is near the window$. \
+                A chair is in front of the desk$.\nTom walks to the desk and sits on the chair. \
+                Tom gets up and walks to the bed. camera front.\n";
+    let mut session = session(10);
+    let u = session.update(text);
+    let anim = &u.animation;
+    let objs = &anim.scene.objects;
+    let chair = objs.iter().position(|o| o.category == "chair").expect("a chair");
+    let desk = objs.iter().position(|o| o.category == "desk").expect("a desk");
+    // Tucked: facing the desk, centred, its front in under the desk's top, its centre in front.
+    let (c, h) = local_box(&objs[chair], &objs[desk]);
+    let ad = objs[desk].size[2] / 2.0;
+    eprintln!("chair centre {c:?} (half {h:?}) in the desk's frame, desk half depth {ad}");
+    assert!(facing_angle(&objs[chair], &objs[desk]) <= FACING_TOLERANCE_DEG);
+    assert!(c[1] > ad && c[1] - h[1] < ad - 0.05, "not tucked: {c:?} {h:?}");
+    assert!(c[0].abs() < 0.1, "not centred: {c:?}");
+    // Tom pulls it out, sits, stands up and pushes it back in.
+    let tom = &anim.characters[0];
+    let verbs: Vec<&str> = tom.segments.iter().map(|s| s.verb.as_str()).collect();
+    eprintln!("segments {verbs:?}, notes {:?}", anim.notes);
+    let at = |v: &str| verbs.iter().position(|x| *x == v).unwrap_or_else(|| panic!("no {v} in {verbs:?}"));
+    let (pull, sit, stand, push) = (at("pull out"), at("sit"), at("stand_up"), at("push in"));
+    assert!(pull < sit && sit < stand && stand < push, "{verbs:?}");
+    assert_eq!(tom.slides.len(), 2);
+    let out = &tom.slides[0];
+    let pulled = out.to[0].hypot(out.to[1]);
+    assert!((pulled - 0.5).abs() < 1e-4 && out.object == chair, "{out:?}");
+    assert_eq!(tom.slides[1].to, [0.0, 0.0]);
+    // Seated on the pulled-out chair: the hips above its seat, the chair where it was pulled to.
+    let rig = Rig::standard();
+    let seg = &tom.segments[sit];
+    let mid = seg.end - 1;
+    let hips = forward(tom.clip.skeleton(), &tom.clip.pose(mid)).positions[rig.hips];
+    let (seat, _) = object_pose(anim, chair, mid);
+    let rest = &objs[chair].position;
+    assert!(((seat.x - rest[0] as f64).hypot(seat.z - rest[2] as f64) - 0.5).abs() < 1e-3);
+    let off = (hips.x - seat.x).hypot(hips.z - seat.z);
+    assert!(off < 0.15, "hips {off:.3} m from the pulled-out seat");
+    // Pushed back in by the end.
+    let (end, _) = object_pose(anim, chair, anim.frames() - 1);
+    assert!((end.x - rest[0] as f64).hypot(end.z - rest[2] as f64) < 1e-4);
+    // The hips and head never go into the desk (the knees may go under its top).
+    let d = &objs[desk];
+    let (s, co) = (d.yaw as f64).sin_cos();
+    for f in 0..tom.clip.num_frames() {
+        let g = forward(tom.clip.skeleton(), &tom.clip.pose(f));
+        for j in [rig.hips, rig.head] {
+            let p = g.positions[j];
+            let (dx, dz) = (p.x - d.position[0] as f64, p.z - d.position[2] as f64);
+            let (lx, lz) = (dx * co - dz * s, dx * s + dz * co);
+            let inside = lx.abs() < d.size[0] as f64 / 2.0 && lz.abs() < d.size[2] as f64 / 2.0;
+            assert!(!inside || p.y > d.top() as f64, "frame {f}: joint {j} inside the desk");
+        }
+    }
+    assert_clean("tucked chair", text, &check(anim, session.catalogue(), &u.scene.composition.relations));
+}

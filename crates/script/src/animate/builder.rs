@@ -26,6 +26,9 @@ pub(crate) struct State {
     pub seated: Option<([f32; 2], [f32; 3], usize)>,
     /// Lying (on the seat when seated, else on the floor where it stands).
     pub lying: bool,
+    /// Seated on a chair it pulled out from under a table: the chair, the spot beside it the
+    /// character pulled from, and the chair's offset from its place (pushed back on standing up).
+    pub pulled: Option<(usize, [f32; 2], [f32; 2])>,
 }
 
 /// Builds one character's frames: what every action of [`super::action`] reads and extends.
@@ -52,6 +55,8 @@ pub(crate) struct Builder<'a> {
     pub seats: Vec<[f32; 2]>,
     /// Props picked up so far.
     pub props: Vec<CarriedProp>,
+    /// Furniture slid so far.
+    pub slides: Vec<super::Slide>,
     /// What could not be done as asked.
     pub notes: Vec<String>,
 }
@@ -78,12 +83,13 @@ impl<'a> Builder<'a> {
             choices,
             cache,
             fallback: None,
-            st: State { pos: start, heading: std::f64::consts::PI, seated: None, lying: false },
+            st: State { pos: start, heading: std::f64::consts::PI, seated: None, lying: false, pulled: None },
             frames: Vec::new(),
             segments: Vec::new(),
             walks: Vec::new(),
             seats: Vec::new(),
             props: Vec::new(),
+            slides: Vec::new(),
             notes: Vec::new(),
         }
     }

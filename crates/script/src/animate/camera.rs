@@ -478,6 +478,7 @@ mod tests {
             clip: standing_at(&rig, x, 2.5, 0.0, 40),
             segments: Vec::new(),
             props: Vec::new(),
+            slides: Vec::new(),
         };
         Animation {
             fps: FPS,

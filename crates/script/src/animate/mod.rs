@@ -53,7 +53,7 @@ pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
 pub use crowd::{min_clearance, Clearance};
 pub(crate) use crowd::{WalkChoice, WalkInfo};
 pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan, Setup};
-pub use props::{carried_from, object_pose, CarriedProp, PutDown};
+pub use props::{carried_from, moves, object_pose, slide_offset, CarriedProp, PutDown, Slide};
 
 use std::collections::HashMap;
 
@@ -117,6 +117,8 @@ pub struct CharacterTrack {
     pub segments: Vec<Segment>,
     /// Small props the character picks up and carries (see [`CarriedProp`]).
     pub props: Vec<CarriedProp>,
+    /// Furniture it slides along the floor (see [`Slide`]), in time order.
+    pub slides: Vec<Slide>,
 }
 
 /// A camera view held over frames `[start, end)`.

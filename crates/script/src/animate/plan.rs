@@ -112,6 +112,7 @@ pub(crate) struct Checkpoint {
     walks: usize,
     seats: usize,
     props: usize,
+    slides: usize,
     notes: usize,
 }
 
@@ -278,6 +279,7 @@ fn build(
                     p.put_down = None;
                 }
             }
+            b.slides = old.track.slides[..cp.slides].to_vec();
             b.notes = old.notes[..cp.notes].to_vec();
             (old.marks[..k].to_vec(), old.checkpoints[..k].to_vec(), k, cp.frames)
         }
@@ -291,6 +293,7 @@ fn build(
             walks: b.walks.len(),
             seats: b.seats.len(),
             props: b.props.len(),
+            slides: b.slides.len(),
             notes: b.notes.len(),
         });
         marks.push((*sentence, b.frames.len()));
@@ -326,8 +329,8 @@ fn build(
         _ => b.frames.iter().map(root).collect(),
     };
     let clip = crate::motion::rig::clip(rig, &b.frames);
-    let Builder { segments, props, walks, seats, notes, .. } = b;
-    let track = CharacterTrack { name: input.name.clone(), clip, segments, props };
+    let Builder { segments, props, slides, walks, seats, notes, .. } = b;
+    let track = CharacterTrack { name: input.name.clone(), clip, segments, props, slides };
     let mut spots = vec![input.start];
     spots.extend(walks.iter().filter_map(|w| traj.get(w.end.saturating_sub(1)).copied()));
     spots.extend(seats.iter().copied());

@@ -1,6 +1,7 @@
 //! Carried props (beyond the paper, whose scene is static): which objects a verb takes into the
-//! hand ([`carries`]), how a held prop follows the hand ([`CarriedProp`]) and where any object is
-//! at a frame ([`object_pose`]). Picking one up is [`super::action::pick_up`].
+//! hand ([`carries`]), how a held prop follows the hand ([`CarriedProp`]), furniture slid along the
+//! floor ([`Slide`]: a chair pulled out from under a desk) and where any object is at a frame
+//! ([`object_pose`]). Picking one up is [`super::action::pick_up`].
 
 use glam::{DQuat, DVec3};
 use inbetween_core::fk::forward;
@@ -73,8 +74,47 @@ impl CarriedProp {
     }
 }
 
+/// A piece of furniture a character slides along the floor (a tucked chair pulled out to sit on,
+/// pushed back after): over frames `start..end` its offset from its scene place goes from `from`
+/// to `to` (x, z metres, eased), then stays there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slide {
+    /// Index into [`Scene::objects`].
+    pub object: usize,
+    pub start: usize,
+    pub end: usize,
+    pub from: [f32; 2],
+    pub to: [f32; 2],
+}
+
+impl Slide {
+    /// The offset at `frame` (≥ `start`).
+    pub fn offset_at(&self, frame: usize) -> [f32; 2] {
+        let span = self.end.saturating_sub(self.start).max(1);
+        let w = inbetween_core::interp::smoothstep(frame.saturating_sub(self.start) as f64 / span as f64) as f32;
+        [self.from[0] + (self.to[0] - self.from[0]) * w, self.from[1] + (self.to[1] - self.from[1]) * w]
+    }
+}
+
+/// The offset (x, z metres) slides have moved object `obj` by at `frame`: the latest slide
+/// begun at or before it, None when none has.
+pub fn slide_offset(anim: &Animation, obj: usize, frame: usize) -> Option<[f32; 2]> {
+    anim.characters
+        .iter()
+        .flat_map(|c| c.slides.iter())
+        .filter(|s| s.object == obj && s.start <= frame)
+        .max_by_key(|s| s.start)
+        .map(|s| s.offset_at(frame))
+}
+
+/// Whether object `obj` ever moves: carried by a hand or slid along the floor.
+pub fn moves(anim: &Animation, obj: usize) -> bool {
+    carried_from(anim, obj).is_some() || anim.characters.iter().any(|c| c.slides.iter().any(|s| s.object == obj))
+}
+
 /// Where object `obj` is at `frame`: its base point and rotation, carried by a character's hand
-/// (the latest pick-up at or before `frame`), put down, or at rest in the scene.
+/// (the latest pick-up at or before `frame`), put down, slid along the floor, or at rest in the
+/// scene.
 pub fn object_pose(anim: &Animation, obj: usize, frame: usize) -> (DVec3, DQuat) {
     let latest = anim
         .characters
@@ -86,7 +126,9 @@ pub fn object_pose(anim: &Animation, obj: usize, frame: usize) -> (DVec3, DQuat)
         return pose;
     }
     let o = &anim.scene.objects[obj];
-    (DVec3::new(o.position[0] as f64, o.position[1] as f64, o.position[2] as f64), DQuat::from_rotation_y(o.yaw as f64))
+    let [dx, dz] = slide_offset(anim, obj, frame).unwrap_or([0.0, 0.0]);
+    let p = DVec3::new((o.position[0] + dx) as f64, o.position[1] as f64, (o.position[2] + dz) as f64);
+    (p, DQuat::from_rotation_y(o.yaw as f64))
 }
 
 /// The first frame from which object `obj` is in someone's hand, if it ever is.

@@ -117,6 +117,17 @@ pub fn has_leg_room(category: &str) -> bool {
     ROWS.iter().any(|r| r.0 == category && r.2 == "table" && r.3[1] >= KNEE_HEIGHT)
 }
 
+/// Whether a seat of category `seat` placed in front of an `anchor` is pushed in under it (a chair
+/// at a desk, a stool at a workbench): upright seats with no arms, at a table with leg room.
+pub fn tucks_under(seat: &str, anchor: &str) -> bool {
+    tucking_seat(seat) && has_leg_room(anchor)
+}
+
+/// Seats that are tucked under a table with leg room they stand in front of.
+pub fn tucking_seat(seat: &str) -> bool {
+    matches!(seat, "chair" | "officechair" | "stool")
+}
+
 fn room(name: &str, synonyms: &[&str], size: [f32; 3]) -> RoomKind {
     RoomKind { name: name.to_string(), synonyms: synonyms.iter().map(|s| s.to_string()).collect(), size }
 }

@@ -37,6 +37,9 @@ pub const UNDER_CLEARANCE: f32 = 0.03;
 pub const SEAT_FRONT: f32 = 0.3;
 /// Objects lower than this (rugs) do not block a seat's front, metres.
 pub const SEAT_FRONT_LOW: f32 = 0.1;
+/// How far the front of a seat "in front of" a table with leg room goes in under its top, metres
+/// (the seat is tucked at it: [`crate::catalogue::builtin::tucks_under`]).
+pub const TUCK: f32 = 0.15;
 /// Height of the centre of wall objects (paintings, boards), metres.
 pub const WALL_CENTER_HEIGHT: f32 = 1.5;
 
@@ -137,7 +140,10 @@ pub fn strictly_holds(rel: Relation, active: &PlacedObject, anchor: &PlacedObjec
         Relation::On => (active.position[1] - anchor.top()).abs() <= EPS && geom::center_inside(active, anchor),
         Relation::Near => gap <= NEAR_GAP - EPS,
         Relation::NextTo => gap <= NEXT_TO_GAP - EPS && c[1].abs() < h[1] + ad && c[0].abs() >= h[0] + aw - EPS,
-        Relation::InFrontOf => c[1] - h[1] >= ad - EPS && gap <= FRONT_GAP - EPS && centred,
+        Relation::InFrontOf => {
+            let tuck = if tucks(active, anchor) { TUCK } else { 0.0 };
+            c[1] - h[1] >= ad - tuck - EPS && c[1] >= ad && gap <= FRONT_GAP - EPS && centred
+        }
         Relation::Behind => c[1] + h[1] <= -ad + EPS && gap <= FRONT_GAP - EPS && centred,
         Relation::Under => {
             active.top() <= anchor.top() - UNDER_CLEARANCE + 1e-4 && geom::footprint_inside(active, anchor)
@@ -148,6 +154,16 @@ pub fn strictly_holds(rel: Relation, active: &PlacedObject, anchor: &PlacedObjec
         Relation::In => geom::footprint_inside(active, anchor) && active.position[1] >= anchor.position[1] - EPS,
     };
     held && relation_holds(rel, active, anchor)
+}
+
+/// Whether `seat` in front of `anchor` is tucked at it (may reach [`TUCK`] in under its top).
+pub fn tucks(seat: &PlacedObject, anchor: &PlacedObject) -> bool {
+    crate::catalogue::builtin::tucks_under(&seat.category, &anchor.category)
+}
+
+/// Whether a layout relation lets `a` and `b` share floor space as a tucked seat and its table.
+pub fn tucked_pair(rel: Relation, active: &PlacedObject, anchor: &PlacedObject) -> bool {
+    rel == Relation::InFrontOf && tucks(active, anchor)
 }
 
 /// Relations under which two objects may share floor space (one rests on, hangs over, stands
@@ -161,7 +177,9 @@ fn stacking(rel: Relation) -> bool {
 fn exempt(objects: &[PlacedObject], relations: &[(Relation, usize, usize)], i: usize, j: usize) -> bool {
     objects[i].support == Some(j)
         || objects[j].support == Some(i)
-        || relations.iter().any(|&(r, a, b)| stacking(r) && ((a, b) == (i, j) || (a, b) == (j, i)))
+        || relations.iter().any(|&(r, a, b)| {
+            ((a, b) == (i, j) || (a, b) == (j, i)) && (stacking(r) || tucked_pair(r, &objects[a], &objects[b]))
+        })
 }
 
 /// The floor area in front of a seat that must stay free ([`SEAT_FRONT`] deep, the seat's
@@ -247,6 +265,13 @@ fn access_points(o: &PlacedObject) -> Vec<[f32; 2]> {
         for t in [hd, hd * 0.5, 0.0] {
             local.push([s * (hw + out), t]);
         }
+    }
+    if crate::catalogue::builtin::tucking_seat(&o.category) {
+        // A seat that may be tucked under a table is pulled out from behind or beside its back.
+        for s in [-1.0, 1.0] {
+            local.push([s * (hw + out), -hd]);
+        }
+        local.push([0.0, -hd - out]);
     }
     local.into_iter().map(|l| geom::to_world(geom::center(o), o.yaw, l)).collect()
 }

@@ -376,7 +376,9 @@ impl<'a, R: Rng> Solver<'a, R> {
             let linked = obj.support == Some(j)
                 || o.support == Some(i)
                 || self.p.relations.iter().any(|c| {
-                    stacking(c.relation) && ((c.active, c.anchor) == (i, j) || (c.active, c.anchor) == (j, i))
+                    let (me, them) = if c.active == i { (obj, o) } else { (o, obj) };
+                    ((c.active, c.anchor) == (i, j) || (c.active, c.anchor) == (j, i))
+                        && (stacking(c.relation) || super::tucked_pair(c.relation, me, them))
                 });
             let (me, them) = (&self.p.items[i], &self.p.items[j]);
             // A seat placed in front of something is there to use it (a stool at a piano): the
@@ -739,6 +741,12 @@ impl<'a, R: Rng> Solver<'a, R> {
                 // In front: facing the anchor; behind: facing the same way (a seat behind
                 // something turns its back to it, so its own front stays free).
                 let yaw = if rel == Relation::InFrontOf || item.seat { anchor.yaw + HALF } else { anchor.yaw };
+                if rel == Relation::InFrontOf
+                    && crate::catalogue::builtin::tucks_under(&item.category, &anchor.category)
+                {
+                    // Tucked at it: centred, its front [`super::TUCK`] in under the top.
+                    push(at([0.0, ad + d / 2.0 - super::TUCK]), base, yaw, None, -2.0);
+                }
                 for k in 0..24 {
                     let g = if k == 0 { 0.1 } else { self.rng.random_range(0.05..FRONT_GAP - 0.1) };
                     let lx = if k < 3 { 0.0 } else { self.rng.random_range(-0.5..=0.5) * aw };

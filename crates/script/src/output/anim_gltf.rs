@@ -375,8 +375,7 @@ pub fn story_gltf_document(
 /// Channels moving every carried prop's object node (the scene's node named by its label) over
 /// frames `0..n` at the animation's rate.
 pub(crate) fn add_prop_channels(doc: &mut AnimatedDocument, anim: &crate::animate::Animation, n: usize) {
-    let carried: Vec<usize> =
-        (0..anim.scene.objects.len()).filter(|&i| crate::animate::carried_from(anim, i).is_some()).collect();
+    let carried: Vec<usize> = (0..anim.scene.objects.len()).filter(|&i| crate::animate::moves(anim, i)).collect();
     if carried.is_empty() || n == 0 {
         return;
     }

@@ -19,5 +19,21 @@ impl Builder<'_> {
         self.append(poses);
         self.push_segment("stand_up", start, Some(obj), vec![obj], Vec::new());
         self.st.pos = at;
+        // A chair pulled out from under a table: a step to its side, then pushed back in.
+        if let Some((chair, side, offset)) = self.st.pulled.take() {
+            let from = self.frames.len();
+            self.step_to(side, self.st.heading, None);
+            let push = self.frames.len();
+            let poses = self.in_place(super::sit::PULL_FRAMES);
+            self.append(poses);
+            self.slides.push(crate::animate::Slide {
+                object: chair,
+                start: push,
+                end: self.frames.len(),
+                from: offset,
+                to: [0.0, 0.0],
+            });
+            self.push_segment("push in", from, Some(chair), vec![chair], Vec::new());
+        }
     }
 }

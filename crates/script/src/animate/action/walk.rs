@@ -79,9 +79,20 @@ impl Builder<'_> {
     /// Walks along a route to `to`, turning to `final_heading`, after waiting in place as this
     /// walk's [`crate::animate::WalkChoice`] says.
     pub fn walk(&mut self, to: [f32; 2], final_heading: f64, verb: &str, speed: Option<f64>) {
+        self.walk_on(to, final_heading, verb, speed, false);
+    }
+
+    /// [`Builder::walk`] in a straight line (a step beside furniture the grid does not know
+    /// has moved), unless this walk's choice gives a route.
+    pub fn step_to(&mut self, to: [f32; 2], final_heading: f64, speed: Option<f64>) {
+        self.walk_on(to, final_heading, "walk", speed, true);
+    }
+
+    fn walk_on(&mut self, to: [f32; 2], final_heading: f64, verb: &str, speed: Option<f64>, straight: bool) {
         let choice = self.choices.get(self.walks.len()).cloned().unwrap_or_default();
         let route = match choice.route {
             Some(r) => r,
+            None if straight => vec![self.st.pos, to],
             None => route(self.grid, self.st.pos, to).unwrap_or_else(|| {
                 self.notes.push(format!(
                     "{}: no route from ({:.2}, {:.2}) to ({:.2}, {:.2}); walking straight",
