@@ -6,7 +6,7 @@
 use super::Step;
 use crate::animate::builder::placed;
 use crate::animate::builder::{smooth, Builder};
-use crate::animate::spots::{dist2, SPOT_MARGIN};
+use crate::animate::spots::{dist2, heading_to, SPOT_MARGIN};
 use crate::animate::{contacts_of, ContactJoint, JointContact, PASSING_DISTANCE};
 use crate::catalogue::ContactKind;
 use crate::motion::ik::PELVIS_ABOVE_SEAT;
@@ -72,7 +72,10 @@ impl Builder<'_> {
         let pull = self.pull_spot(o, s, f, stand_of);
         let s = match pull {
             Some((side, offset, pulled)) => {
-                self.walk(side, yaw, "walk", speed);
+                // Arrive turned to where the chair will stand (the chair before it, a little
+                // towards the table), so the step in is a walk forwards.
+                let stand = stand_of(pulled);
+                self.walk(side, heading_to(side, stand, yaw), "walk", speed);
                 self.push_segment("walk", start, Some(o), vec![o], Vec::new());
                 let from = self.frames.len();
                 let poses = self.in_place(PULL_FRAMES);
