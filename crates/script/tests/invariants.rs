@@ -200,8 +200,10 @@ fn a_chair_in_front_of_a_desk_is_tucked_and_pulled_out_to_sit_on() {
     assert!(pull < sit && sit < stand && stand < push, "{verbs:?}");
     assert_eq!(tom.slides.len(), 2);
     let out = &tom.slides[0];
-    let pulled = out.to[0].hypot(out.to[1]);
-    assert!((pulled - 0.5).abs() < 1e-4 && out.object == chair, "{out:?}");
+    // Out from under the desk far enough for the stand point in front of the seat to keep 0.22 m
+    // from the desk's edge.
+    let pulled = out.to[0].hypot(out.to[1]) as f64;
+    assert!((0.4..0.7).contains(&pulled) && out.object == chair, "{out:?}");
     assert_eq!(tom.slides[1].to, [0.0, 0.0]);
     // Seated on the pulled-out chair: the hips above its seat, the chair where it was pulled to.
     let rig = Rig::standard();
@@ -210,7 +212,7 @@ fn a_chair_in_front_of_a_desk_is_tucked_and_pulled_out_to_sit_on() {
     let hips = forward(tom.clip.skeleton(), &tom.clip.pose(mid)).positions[rig.hips];
     let (seat, _) = object_pose(anim, chair, mid);
     let rest = &objs[chair].position;
-    assert!(((seat.x - rest[0] as f64).hypot(seat.z - rest[2] as f64) - 0.5).abs() < 1e-3);
+    assert!(((seat.x - rest[0] as f64).hypot(seat.z - rest[2] as f64) - pulled).abs() < 1e-3);
     let off = (hips.x - seat.x).hypot(hips.z - seat.z);
     assert!(off < 0.15, "hips {off:.3} m from the pulled-out seat");
     // Pushed back in by the end.
@@ -230,4 +232,80 @@ fn a_chair_in_front_of_a_desk_is_tucked_and_pulled_out_to_sit_on() {
         }
     }
     assert_clean("tucked chair", text, &check(anim, session.catalogue(), &u.scene.composition.relations));
+}
+
+/// Stories around a seat tucked at a table (the random stories rarely sit on one): a room, a desk
+/// or table, a chair or stool in front of it, other furniture related at random, one or two
+/// characters of whom the first sits on the tucked seat, then gets up and walks away or stays.
+fn tucked_story(seed: u64) -> String {
+    use rand::seq::IndexedRandom;
+    use rand::Rng;
+    let mut rng = inbetween_core::seed::rng(seed);
+    let room = *["office", "bedroom", "living room", "kitchen"].choose(&mut rng).unwrap();
+    let table = *["desk", "table"].choose(&mut rng).unwrap();
+    let seat = *["chair", "stool"].choose(&mut rng).unwrap();
+    let mut lines = vec![format!(
+        "In the {room}, a {table} is {} a {}$",
+        ["near", "next to"].choose(&mut rng).unwrap(),
+        ["bookcase", "wardrobe", "sofa", "bed", "cabinet"].choose(&mut rng).unwrap()
+    )];
+    lines.push(format!("A {seat} is in front of the {table}$"));
+    if rng.random_bool(0.5) {
+        lines.push(format!("An armchair is {} the {seat}$", ["near", "next to", "behind"].choose(&mut rng).unwrap()));
+    }
+    lines.push(format!("camera {}", ["front", "left", "right", "wide"].choose(&mut rng).unwrap()));
+    lines.push(format!("Tom walks to the {table} and sits on the {seat}."));
+    if rng.random_bool(0.7) {
+        lines.push(format!(
+            "Tom gets up and walks to the {}.",
+            ["door", "window", "armchair", table].choose(&mut rng).unwrap()
+        ));
+    }
+    if rng.random_bool(0.5) {
+        lines.push("Eve walks to the window.".to_string());
+    }
+    lines.join("\n") + "\n"
+}
+
+#[test]
+fn tucked_seats_keep_the_invariants_and_stay_out_of_the_table() {
+    use inbetween_core::fk::forward;
+    use inbetween_script::motion::Rig;
+    let rig = Rig::standard();
+    let mut pulled = 0;
+    for seed in 0..10 {
+        let text = tucked_story(seed);
+        let mut s = session(5);
+        let u = s.update(&text);
+        let anim = &u.animation;
+        let slides: usize = anim.characters.iter().map(|c| c.slides.len()).sum();
+        pulled += usize::from(slides > 0);
+        let r = check(anim, s.catalogue(), &u.scene.composition.relations);
+        eprintln!("tucked {seed}: {} slides, {:?}\n{text}", slides, r.counts());
+        assert_clean(&format!("tucked story {seed}"), &text, &r);
+        // No hips or head inside a table with leg room at any frame, where the seat was tucked
+        // (a seat the layout could not tuck stands just in front, and the stand point in front of
+        // it reaches in under the table's edge: not done).
+        for c in anim.characters.iter().filter(|_| slides > 0) {
+            for f in 0..c.clip.num_frames() {
+                let g = forward(c.clip.skeleton(), &c.clip.pose(f));
+                for d in anim.scene.objects.iter().filter(|o| matches!(o.category.as_str(), "desk" | "table")) {
+                    let (sn, co) = (d.yaw as f64).sin_cos();
+                    for j in [rig.hips, rig.head] {
+                        let p = g.positions[j];
+                        let (dx, dz) = (p.x - d.position[0] as f64, p.z - d.position[2] as f64);
+                        let (lx, lz) = (dx * co - dz * sn, dx * sn + dz * co);
+                        let inside = lx.abs() < d.size[0] as f64 / 2.0 && lz.abs() < d.size[2] as f64 / 2.0;
+                        assert!(
+                            !inside || p.y > d.top() as f64,
+                            "story {seed}, {} frame {f}: joint {j} inside the {}\n{text}",
+                            c.name,
+                            d.label
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(pulled >= 6, "only {pulled} of 10 stories pulled a seat out");
 }
