@@ -46,7 +46,7 @@ struct Take {
     /// Greedy's insertion order on this take, made at the first greedy request and grown as larger
     /// K are asked: a K change is then a prefix of it.
     greedy: Mutex<Option<select::GreedyOrder<'static>>>,
-    /// The segment costs optimal searches on this take learnt (16·n² bytes), kept for the next K on
+    /// The segment costs optimal searches on this take learnt (20·n² bytes), kept for the next K on
     /// takes up to [`OPTIMAL_MEMO_FRAMES`]: the first optimal K costs seconds on 1000 frames, the
     /// next ones tens of milliseconds.
     optimal: Mutex<Option<OptimalMemo>>,
@@ -64,7 +64,7 @@ fn committed_policy() -> Result<&'static SidqlPolicy> {
     Ok(POLICY.get_or_init(|| p))
 }
 
-/// The longest take whose optimal-keys memo the studio keeps (64 MB at 2000 frames).
+/// The longest take whose optimal-keys memo the studio keeps (80 MB at 2000 frames).
 const OPTIMAL_MEMO_FRAMES: usize = 2000;
 
 impl Take {

@@ -76,7 +76,7 @@ pub fn optimal_spherical_cancellable(
 /// every other segment a lower bound of its cost (its middle frames, or the partial sum that
 /// exceeded its room in an earlier search). Known costs are not recomputed, the bounds prune more,
 /// and a search whose `k` is near an earlier one takes its upper bound from known costs alone.
-/// About `16·n²` bytes; a search without a memo makes a temporary one.
+/// About `20·n²` bytes (costs, bounds and their reach); a search without a memo makes a temporary one.
 #[derive(Clone, Debug)]
 pub struct OptimalMemo {
     n: usize,
