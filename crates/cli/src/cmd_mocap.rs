@@ -16,8 +16,8 @@ use std::time::Instant;
 
 #[derive(Subcommand)]
 pub enum MocapCommand {
-    /// Compress a clip into an .ibk file: every frame within --max-error (version 3, the default), or
-    /// keyframes (-k N, or --format v2).
+    /// Compress a clip into an .ibk file: every frame within --max-error (version 4, the default; or
+    /// --format v3), or keyframes (-k N, or --format v2).
     Compress(CompressArgs),
     /// Rebuild a whole clip from an .ibk file and write it as BVH.
     Decompress(DecompressArgs),
