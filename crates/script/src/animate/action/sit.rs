@@ -20,7 +20,7 @@ pub const CLEAR: f32 = 0.22;
 /// Least pull worth the walk round.
 const MIN_PULL: f32 = 0.05;
 /// Frames a chair takes to be pulled out or pushed back.
-pub(crate) const PULL_FRAMES: usize = 18;
+const PULL_FRAMES: usize = 18;
 /// Sideways distance from a pulled-out chair's stand point to where the character pulls it from,
 /// metres (beside the chair, clear of it).
 const BESIDE: f32 = 0.6;
@@ -82,15 +82,7 @@ impl Builder<'_> {
                 self.walk(side, heading_to(side, stand, yaw), "walk", speed);
                 self.push_segment("walk", start, Some(o), vec![o], Vec::new());
                 let from = self.frames.len();
-                let poses = self.in_place(PULL_FRAMES);
-                self.append(poses);
-                self.slides.push(crate::animate::Slide {
-                    object: o,
-                    start: from,
-                    end: self.frames.len(),
-                    from: [0.0, 0.0],
-                    to: offset,
-                });
+                self.slide_seat(o, [0.0, 0.0], offset);
                 self.step_to(stand_of(pulled), yaw, speed);
                 self.push_segment("pull out", from, Some(o), vec![o], Vec::new());
                 pulled
@@ -122,6 +114,15 @@ impl Builder<'_> {
             end: self.frames.len(),
         };
         self.push_segment("sit", start, Some(o), vec![o], vec![hips]);
+    }
+
+    /// Stands still over [`PULL_FRAMES`] while seat `o` slides from offset `from` to `to` (x, z
+    /// metres from its place).
+    pub(crate) fn slide_seat(&mut self, o: usize, from: [f32; 2], to: [f32; 2]) {
+        let start = self.frames.len();
+        let poses = self.in_place(PULL_FRAMES);
+        self.append(poses);
+        self.slides.push(crate::animate::Slide { object: o, start, end: self.frames.len(), from, to });
     }
 
     /// For a chair tucked under a table with leg room (centred in front of it, facing it, its

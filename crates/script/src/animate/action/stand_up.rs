@@ -23,16 +23,7 @@ impl Builder<'_> {
         if let Some((chair, side, offset)) = self.st.pulled.take() {
             let from = self.frames.len();
             self.step_to(side, self.st.heading, None);
-            let push = self.frames.len();
-            let poses = self.in_place(super::sit::PULL_FRAMES);
-            self.append(poses);
-            self.slides.push(crate::animate::Slide {
-                object: chair,
-                start: push,
-                end: self.frames.len(),
-                from: offset,
-                to: [0.0, 0.0],
-            });
+            self.slide_seat(chair, offset, [0.0, 0.0]);
             self.push_segment("push in", from, Some(chair), vec![chair], Vec::new());
         }
     }
