@@ -336,11 +336,9 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         (MethodArg::Cubic, _) => Method::Cubic,
         (MethodArg::Retrieval, _) => {
             // Enough candidates that every variant is a different segment.
-            let candidates = RetrievalOptions::default().candidates.max(a.variants as usize);
-            Method::Retrieval(
-                library.as_ref().expect("built above"),
-                RetrievalOptions { candidates, ..Default::default() },
-            )
+            let options = RetrievalOptions::for_kind(guide.kind());
+            let candidates = options.candidates.max(a.variants as usize);
+            Method::Retrieval(library.as_ref().expect("built above"), RetrievalOptions { candidates, ..options })
         }
         (MethodArg::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
         (MethodArg::Network, None) => unreachable!("a network was loaded above"),

@@ -406,7 +406,7 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
         let net = if method_name == "network" { Some(state.face.network(kind)?) } else { None };
         let method = match method_name {
             "network" => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
-            "retrieval" => Method::Retrieval(state.face.library(), RetrievalOptions::default()),
+            "retrieval" => Method::Retrieval(state.face.library(), RetrievalOptions::for_kind(kind)),
             "linear" => Method::Linear,
             _ => Method::Cubic,
         };

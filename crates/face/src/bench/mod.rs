@@ -192,7 +192,10 @@ fn methods<'a>(kind: ConstraintKind, sets: &'a [NetworkSet], libs: &'a [Library]
     }
     if kind != ConstraintKind::Visemes {
         for l in libs {
-            m.push((format!("retrieval ({})", l.label), Method::Retrieval(&l.library, RetrievalOptions::default())));
+            m.push((
+                format!("retrieval ({})", l.label),
+                Method::Retrieval(&l.library, RetrievalOptions::for_kind(kind)),
+            ));
         }
     }
     m

@@ -9,6 +9,11 @@
 //! * the **constraint**: the keys' weights at their frames (keyframe edits) or the noisy guide inside
 //!   the span (noisy edits), weighted by [`RetrievalOptions::key_weight`] / [`RetrievalOptions::guide_weight`].
 //!
+//! With [`RetrievalOptions::by_region`] (keyframe edits) each face region ([`REGIONS`]: eyes, brows,
+//! lower face) is scored on its own channels and drawn apart, so dense keys on the eyes and the mouth
+//! can each be met by a segment that passes near them; a region keeps its own channels together (a
+//! blink stays both eyes, speech stays jaw and lips).
+//!
 //! The seed picks one of the best [`RetrievalOptions::candidates`] non-overlapping segments (rank
 //! `seed mod k`), so consecutive seeds give different plausible fills and the same seed the same one. The segment is joined by offsets that fade out over [`RetrievalOptions::blend`]
 //! frames from each border (a blink in the segment stays a whole blink; a long fade would hold an eye
@@ -20,7 +25,8 @@ use inbetween_core::interp::smoothstep;
 
 use crate::data::NUM_ARKIT;
 
-use super::constraints::Constraint;
+use super::constraints::{Constraint, ConstraintKind};
+use super::groups::Group;
 use super::mask::{Mask, Segment};
 use super::Frame;
 
@@ -80,6 +86,10 @@ pub struct RetrievalOptions {
     /// Scale of the segment's motion around its own border line, on every channel but the eyelids
     /// (default 1: the segment's motion as recorded).
     pub detail: f64,
+    /// Draw one segment per face region (eyes, brows, lower face: [`REGIONS`]) instead of one for the
+    /// whole face, each scored on its own channels' borders and keys (default false;
+    /// [`RetrievalOptions::for_kind`] sets it for keyframes, where it is measured to help).
+    pub by_region: bool,
 }
 
 impl Default for RetrievalOptions {
@@ -92,7 +102,18 @@ impl Default for RetrievalOptions {
             guide_weight: 1.0,
             guide_smoothing: 37,
             detail: 1.0,
+            by_region: false,
         }
+    }
+}
+
+impl RetrievalOptions {
+    /// The defaults for a constraint type: regions drawn apart for keyframe edits (`face bench` on
+    /// held-out captures: masked MSE 1.62× → 1.27× linear's and the two-sample AUC 0.87 → 0.82 with
+    /// the real split, as dense keys are hit by smaller bends), one draw for the whole face otherwise
+    /// (with the procedural library, regions raised the noisy AUC 0.64 → 0.78).
+    pub fn for_kind(kind: ConstraintKind) -> Self {
+        RetrievalOptions { by_region: kind == ConstraintKind::Keyframes, ..Default::default() }
     }
 }
 
@@ -109,8 +130,9 @@ pub struct Source {
 
 /// Fill every erased span of `anim` from `library` (and from `anim` outside its spans). Entries outside
 /// the mask are `anim`'s; inside, the drawn segments joined as the module docs say. Returns the frames and,
-/// per span, the source drawn (`None` when no segment of the span's length exists anywhere: that span
-/// keeps `anim`'s values, and the caller's post-processing interpolates it).
+/// per span, the sources drawn: one for the whole face, or one per region with
+/// [`RetrievalOptions::by_region`] (none when no segment of the span's length exists anywhere: those
+/// channels keep `anim`'s values, and the caller's post-processing interpolates them).
 pub fn retrieve(
     anim: &[Frame],
     mask: &Mask,
@@ -118,36 +140,63 @@ pub fn retrieve(
     library: &MotionLibrary,
     options: &RetrievalOptions,
     seed: u64,
-) -> (Vec<Frame>, Vec<Option<Source>>) {
+) -> (Vec<Frame>, Vec<Vec<Source>>) {
     let n = anim.len();
     let spans = mask.segments();
     let mut out = anim.to_vec();
     let mut sources = Vec::with_capacity(spans.len());
     for span in &spans {
-        let channels: Vec<usize> =
+        let erased: Vec<usize> =
             (0..NUM_ARKIT).filter(|c| (span.start..span.end).any(|f| mask.erased(f, *c))).collect();
         let guide = match constraint {
             Constraint::Noisy(g) => Some(calibrate_guide(anim, mask, g, *span)),
             _ => None,
         };
-        let scorer = Scorer { anim, guide: guide.as_deref(), span: *span, channels: &channels, constraint, options, n };
-        let mut cands: Vec<Source> = Vec::new();
-        for (i, clip) in library.clips.iter().enumerate() {
-            scorer.scan(clip, Some(i), &[], &mut cands);
+        let regions: Vec<Vec<usize>> = if options.by_region {
+            REGIONS
+                .iter()
+                .map(|r| erased.iter().copied().filter(|&c| r.iter().any(|g| g.contains(c))).collect::<Vec<_>>())
+                .filter(|r| !r.is_empty())
+                .collect()
+        } else {
+            vec![erased]
+        };
+        let mut drawn = Vec::with_capacity(regions.len());
+        for (ri, channels) in regions.iter().enumerate() {
+            let scorer = Scorer { anim, guide: guide.as_deref(), span: *span, channels, constraint, options, n };
+            let mut cands: Vec<Source> = Vec::new();
+            for (i, clip) in library.clips.iter().enumerate() {
+                scorer.scan(clip, Some(i), &[], &mut cands);
+            }
+            scorer.scan(anim, None, &spans, &mut cands);
+            let Some(chosen) = draw(&mut cands, span.len(), options.candidates, region_seed(seed, ri)) else {
+                continue;
+            };
+            let seg: &[Frame] = match chosen.clip {
+                Some(i) => &library.clips[i],
+                None => anim,
+            };
+            join(&mut out, anim, seg, chosen.start, *span, channels, guide.as_deref(), options);
+            drawn.push(chosen);
         }
-        scorer.scan(anim, None, &spans, &mut cands);
-        let Some(chosen) = draw(&mut cands, span.len(), options.candidates, seed) else {
-            sources.push(None);
-            continue;
-        };
-        let seg: &[Frame] = match chosen.clip {
-            Some(i) => &library.clips[i],
-            None => anim,
-        };
-        join(&mut out, anim, seg, chosen.start, *span, &channels, guide.as_deref(), options);
-        sources.push(Some(chosen));
+        sources.push(drawn);
     }
     (out, sources)
+}
+
+/// Face regions drawn apart with [`RetrievalOptions::by_region`]: eyes, brows, lower face (jaw,
+/// mouth, cheeks and nose, tongue move together in speech).
+pub const REGIONS: [&[Group]; 3] =
+    [&[Group::Eyes], &[Group::Brows], &[Group::Jaw, Group::Mouth, Group::Cheeks, Group::Tongue]];
+
+/// The first region draws with `seed` itself (so a whole-face draw is unchanged), the others with
+/// derived seeds.
+fn region_seed(seed: u64, region: usize) -> u64 {
+    if region == 0 {
+        seed
+    } else {
+        inbetween_core::seed::derive(seed, region as u64)
+    }
 }
 
 struct Scorer<'a> {
@@ -405,7 +454,7 @@ mod tests {
         let mask = gap(400, 150, 250);
         let lib = MotionLibrary::new(vec![blinking(300, 17)]);
         let (out, src) = retrieve(&anim, &mask, &Constraint::None, &lib, &RetrievalOptions::default(), 3);
-        assert!(src[0].is_some());
+        assert_eq!(src[0].len(), 1);
         for f in (0..150).chain(250..400) {
             assert_eq!(out[f], anim[f], "frame {f} outside the gap changed");
         }
@@ -423,7 +472,7 @@ mod tests {
         let mask = gap(300, 100, 160);
         let lib = MotionLibrary::new((0..6).map(|p| blinking(200, 3 * p)).collect());
         let opts = RetrievalOptions { candidates: 8, ..Default::default() };
-        let run = |s| retrieve(&anim, &mask, &Constraint::None, &lib, &opts, s).1[0];
+        let run = |s| retrieve(&anim, &mask, &Constraint::None, &lib, &opts, s).1[0].first().copied();
         assert_eq!(run(1), run(1));
         let distinct: std::collections::HashSet<_> =
             (0..12).map(|s| format!("{:?}", run(s).map(|x| (x.clip, x.start)))).collect();
@@ -440,7 +489,7 @@ mod tests {
         let mask = gap(300, 120, 140);
         let (_, src) =
             retrieve(&anim, &mask, &Constraint::None, &MotionLibrary::default(), &RetrievalOptions::default(), 0);
-        let s = src[0].expect("the clip outside the gap has 20-frame segments");
+        let s = src[0].first().copied().expect("the clip outside the gap has 20-frame segments");
         assert!(s.start + 20 + 8 <= 120 || s.start >= 140 + 8, "segment {s:?} overlaps the gap or its context");
     }
 
@@ -459,8 +508,44 @@ mod tests {
         let cons = Constraint::Keyframes(vec![(120, key)]);
         let opts = RetrievalOptions { candidates: 1, ..Default::default() };
         let (out, src) = retrieve(&anim, &mask, &cons, &lib, &opts, 0);
-        assert_eq!(src[0].unwrap().clip, Some(1));
+        assert_eq!(src[0][0].clip, Some(1));
         assert!(out[120][7] > 0.7, "the drawn segment passes near the key ({})", out[120][7]);
+    }
+
+    #[test]
+    fn regions_draw_their_own_segments_so_keys_on_eyes_and_mouth_are_both_met() {
+        let (eye, jaw) =
+            (crate::data::arkit_index("EyeSquintLeft").unwrap(), crate::data::arkit_index("JawOpen").unwrap());
+        let anim = blinking(300, 0);
+        let mask = gap(300, 100, 140);
+        // Clip 0 squints mid-stretch with the mouth shut, clip 1 opens the mouth with the eyes relaxed.
+        let stretch = |f: usize| f % 40 >= 15 && f % 40 < 25;
+        let mut squint = blinking(200, 0);
+        let mut talk = blinking(200, 0);
+        for f in 0..200 {
+            squint[f][eye] = if stretch(f) { 0.9 } else { 0.1 };
+            talk[f][jaw] = if stretch(f) { 0.9 } else { 0.1 };
+        }
+        let lib = MotionLibrary::new(vec![squint, talk]);
+        let mut key = anim[120];
+        (key[eye], key[jaw]) = (0.9, 0.9);
+        let cons = Constraint::Keyframes(vec![(120, key)]);
+        let whole = RetrievalOptions { candidates: 1, ..Default::default() };
+        let (out, src) = retrieve(&anim, &mask, &cons, &lib, &whole, 0);
+        assert_eq!(src[0].len(), 1);
+        assert!(out[120][eye].min(out[120][jaw]) < 0.5, "one segment cannot meet both keys");
+        let regions = RetrievalOptions { by_region: true, ..whole };
+        assert_eq!(
+            RetrievalOptions::for_kind(ConstraintKind::Keyframes),
+            RetrievalOptions { candidates: 4, ..regions }
+        );
+        let (out, src) = retrieve(&anim, &mask, &cons, &lib, &regions, 0);
+        assert_eq!(src[0].len(), REGIONS.len(), "eyes, brows and lower face each drawn");
+        assert_eq!((src[0][0].clip, src[0][2].clip), (Some(0), Some(1)));
+        assert!(out[120][eye] > 0.7 && out[120][jaw] > 0.7, "{} {}", out[120][eye], out[120][jaw]);
+        for f in (0..100).chain(140..300) {
+            assert_eq!(out[f], anim[f], "frame {f} outside the gap changed");
+        }
     }
 
     #[test]
@@ -469,7 +554,7 @@ mod tests {
         let mask = gap(60, 10, 50);
         let (out, src) =
             retrieve(&anim, &mask, &Constraint::None, &MotionLibrary::default(), &RetrievalOptions::default(), 0);
-        assert_eq!(src, vec![None]);
+        assert_eq!(src, vec![Vec::<Source>::new()]);
         assert_eq!(out, anim);
     }
 }
