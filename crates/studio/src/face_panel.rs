@@ -51,6 +51,8 @@ struct Session {
     versions: Vec<BlendshapeClip>,
     /// The version shown; versions after it are the redo stack.
     current: usize,
+    /// The fills of the last edit made with variants (the version they can replace, the clips).
+    variants: Option<(usize, Vec<BlendshapeClip>)>,
 }
 
 /// A guide file for the next edits.
@@ -225,7 +227,7 @@ fn opened(st: &AppState, name: String, layout: Layout, clip: BlendshapeClip) -> 
         "files": {"export": export},
     });
     *st.face.session.lock().unwrap_or_else(|p| p.into_inner()) =
-        Some(Session { name, layout, versions: vec![clip], current: 0 });
+        Some(Session { name, layout, versions: vec![clip], current: 0, variants: None });
     Ok(out)
 }
 
@@ -321,6 +323,17 @@ pub struct EditRequest {
     pub method: String,
     #[serde(default = "one")]
     pub seed: u64,
+    /// Fills made with seeds `seed`, `seed + 1`, … (1 to [`MAX_VARIANTS`]); the first becomes the new
+    /// version and [`pick`] swaps in another.
+    #[serde(default = "one_u32")]
+    pub variants: u32,
+}
+
+/// Most fills one edit request makes.
+pub const MAX_VARIANTS: u32 = 6;
+
+fn one_u32() -> u32 {
+    1
 }
 
 fn none() -> String {
@@ -346,6 +359,9 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
             (s.name.clone(), s.layout, s.versions[s.current].clone())
         };
         let channels = parse_groups(&req.groups).map_err(StudioError::BadRequest)?;
+        if !(1..=MAX_VARIANTS).contains(&req.variants) {
+            return Err(StudioError::BadRequest(format!("variants {}: expected 1 to {MAX_VARIANTS}", req.variants)));
+        }
         let guide = match req.constraint.as_str() {
             "none" => Guide::None,
             "keys" => {
@@ -406,78 +422,176 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
         let net = if method_name == "network" { Some(state.face.network(kind)?) } else { None };
         let method = match method_name {
             "network" => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
-            "retrieval" => Method::Retrieval(state.face.library(), RetrievalOptions::for_kind(kind)),
+            "retrieval" => {
+                // Enough candidates that every variant is a different segment.
+                let o = RetrievalOptions::for_kind(kind);
+                let candidates = o.candidates.max(req.variants as usize);
+                Method::Retrieval(state.face.library(), RetrievalOptions { candidates, ..o })
+            }
             "linear" => Method::Linear,
             _ => Method::Cubic,
         };
-        job.progress("filling the span", 0.2);
-        let out = EditJob {
-            clip: &clip,
-            spans: vec![(req.start_s, req.end_s)],
-            channels,
-            guide,
-            method,
-            seed: req.seed,
-            limits: EditLimits::default(),
-            cancel: job.token().clone(),
-            guide_file: None,
+        let n = req.variants as usize;
+        let mut fills = Vec::with_capacity(n);
+        for k in 0..n {
+            job.progress(&format!("filling the span (variant {} of {n})", k + 1), 0.2 + 0.7 * k as f64 / n as f64);
+            fills.push(fill(&clip, &req, channels, guide.clone(), method, req.seed + k as u64, job)?);
         }
-        .run()
-        .map_err(face_err)?;
-        // The masked error against what was there, at the model rate.
-        let (mut sq, mut count) = (0.0f64, 0usize);
-        for f in 0..out.mask.frames() {
-            for c in 0..NUM_ARKIT {
-                if out.mask.erased(f, c) {
-                    sq += f64::from(out.after[f][c] - out.before[f][c]).powi(2);
-                    count += 1;
-                }
-            }
-        }
-        let mse = sq / count.max(1) as f64;
-        // Rows the edit changed, and the changed columns' values there.
-        let (old, new) = (clip.values(), out.clip.values());
-        let stride = clip.num_channels();
-        let changed_rows: Vec<usize> = (0..clip.num_frames())
-            .filter(|f| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride])
-            .collect();
-        let (a, b) = match (changed_rows.first(), changed_rows.last()) {
-            (Some(a), Some(b)) => (*a, b + 1),
-            _ => (0, 0),
-        };
-        let mut changed = [false; NUM_ARKIT];
-        for f in a..b {
-            for (c, ch) in changed.iter_mut().enumerate() {
-                *ch |= old[f * stride + c] != new[f * stride + c];
-            }
-        }
+        let first = &fills[0];
         let v = state.face.next_version();
-        let export = export_url(&state, &name, layout, &out.clip, v);
-        let model_frames = out.mask.segments().iter().map(|s| s.len()).sum::<usize>();
-        let msg = format!(
+        let export = export_url(&state, &name, layout, &first.clip, v);
+        let model_frames = first.model_frames;
+        let same = fills.iter().skip(1).filter(|f| f.clip.values() == first.clip.values()).count();
+        let mut msg = format!(
             "{method_name} fill of {:.2} s..{:.2} s ({model_frames} frames at {MODEL_FPS} fps), masked error against \
-             what was there: MSE {mse:.5}",
-            req.start_s, req.end_s
+             what was there: MSE {:.5}",
+            req.start_s, req.end_s, first.mse
         );
+        if n > 1 {
+            msg += &format!("; {n} variants (seeds {}..{})", req.seed, req.seed + n as u64 - 1);
+            if same > 0 {
+                msg += &format!(", {same} the same as the first ({method_name} fills do not depend on the seed)");
+            }
+        }
+        let variants: Vec<Value> = fills
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                json!({
+                    "variant": k + 1,
+                    "seed": req.seed + k as u64,
+                    "masked_mse": f.mse,
+                    "rows": [f.rows.0, f.rows.1],
+                    "columns": columns(&f.clip, f.rows.0, f.rows.1, Some(&f.changed)),
+                })
+            })
+            .collect();
         let mut s = state.face.session.lock().unwrap_or_else(|p| p.into_inner());
         let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("the take was closed during the edit".into()))?;
         s.versions.truncate(s.current + 1);
-        s.versions.push(out.clip.clone());
+        s.versions.push(first.clip.clone());
         s.current += 1;
+        s.variants = (n > 1).then(|| (s.current, fills.iter().map(|f| f.clip.clone()).collect()));
+        let (a, b) = first.rows;
         Ok(json!({
             "ok": true,
             "message": msg,
             "method": method_name,
-            "masked_mse": mse,
+            "masked_mse": first.mse,
             "rows": [a, b],
-            "columns": columns(&out.clip, a, b, Some(&changed)),
+            "columns": columns(&first.clip, a, b, Some(&first.changed)),
             "mask": [req.start_s, req.end_s],
             "version": s.current,
             "versions": s.versions.len(),
+            "variants": if n > 1 { json!(variants) } else { Value::Null },
             "files": {"export": export},
         }))
     });
     Ok(Json(answer(&st.jobs, id).await))
+}
+
+/// One fill of an edit: the new clip, its masked error against what was there (model rate), the
+/// input rows it changed (`a..b`) and which channels.
+struct Fill {
+    clip: BlendshapeClip,
+    mse: f64,
+    model_frames: usize,
+    rows: (usize, usize),
+    changed: [bool; NUM_ARKIT],
+}
+
+fn fill(
+    clip: &BlendshapeClip,
+    req: &EditRequest,
+    channels: [bool; NUM_ARKIT],
+    guide: Guide,
+    method: Method,
+    seed: u64,
+    job: &crate::jobs::Job,
+) -> Result<Fill> {
+    let out = EditJob {
+        clip,
+        spans: vec![(req.start_s, req.end_s)],
+        channels,
+        guide,
+        method,
+        seed,
+        limits: EditLimits::default(),
+        cancel: job.token().clone(),
+        guide_file: None,
+    }
+    .run()
+    .map_err(face_err)?;
+    // The masked error against what was there, at the model rate.
+    let (mut sq, mut count) = (0.0f64, 0usize);
+    for f in 0..out.mask.frames() {
+        for c in 0..NUM_ARKIT {
+            if out.mask.erased(f, c) {
+                sq += f64::from(out.after[f][c] - out.before[f][c]).powi(2);
+                count += 1;
+            }
+        }
+    }
+    // Rows the edit changed, and the changed columns there.
+    let (old, new) = (clip.values(), out.clip.values());
+    let stride = clip.num_channels();
+    let changed_rows: Vec<usize> = (0..clip.num_frames())
+        .filter(|f| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride])
+        .collect();
+    let rows = match (changed_rows.first(), changed_rows.last()) {
+        (Some(a), Some(b)) => (*a, b + 1),
+        _ => (0, 0),
+    };
+    let mut changed = [false; NUM_ARKIT];
+    for f in rows.0..rows.1 {
+        for (c, ch) in changed.iter_mut().enumerate() {
+            *ch |= old[f * stride + c] != new[f * stride + c];
+        }
+    }
+    let model_frames = out.mask.segments().iter().map(|s| s.len()).sum::<usize>();
+    Ok(Fill { clip: out.clip, mse: sq / count.max(1) as f64, model_frames, rows, changed })
+}
+
+#[derive(Deserialize)]
+pub struct PickRequest {
+    /// 1-based, as the edit's answer numbers its variants.
+    pub variant: usize,
+}
+
+/// `POST /api/face/pick`: the version made by the last edit with variants becomes its variant
+/// `variant` (in place: undo goes back to before the edit); answers like [`history`].
+pub async fn pick(State(st): State<Arc<AppState>>, Json(req): Json<PickRequest>) -> Result<Json<Value>> {
+    let mut s = st.face.session.lock().unwrap_or_else(|p| p.into_inner());
+    let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("open a face take first".into()))?;
+    let (at, clips) = s
+        .variants
+        .as_ref()
+        .ok_or_else(|| StudioError::BadRequest("no variants to pick from: generate with variants 2 or more".into()))?;
+    if *at != s.current {
+        return Err(StudioError::BadRequest(format!(
+            "the variants belong to version {at}, version {} is shown: redo or generate again",
+            s.current
+        )));
+    }
+    let Some(clip) = req.variant.checked_sub(1).and_then(|k| clips.get(k)) else {
+        return Err(StudioError::BadRequest(format!("variant {}: expected 1 to {}", req.variant, clips.len())));
+    };
+    s.versions[s.current] = clip.clone();
+    let (name, layout, n) = (s.name.clone(), s.layout, clips.len());
+    let clip = &s.versions[s.current];
+    let v = st.face.next_version();
+    let export = export_url(&st, &name, layout, clip, v);
+    Ok(Json(json!({
+        "ok": true,
+        "kind": "face-pick",
+        "message": format!("variant {} of {n} as version {}", req.variant, s.current),
+        "variant": req.variant,
+        "rows": [0, clip.num_frames()],
+        "columns": columns(clip, 0, clip.num_frames(), None),
+        "version": s.current,
+        "versions": s.versions.len(),
+        "files": {"export": export},
+    })))
 }
 
 #[derive(Deserialize)]

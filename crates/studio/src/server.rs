@@ -178,6 +178,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/face/guide", post(face_panel::guide))
         .route("/api/face/edit", post(face_panel::edit))
         .route("/api/face/history", post(face_panel::history))
+        .route("/api/face/pick", post(face_panel::pick))
         .route("/api/video/corpus", get(video_panel::corpus))
         .route("/api/video/open", post(video_panel::open_path))
         .route("/api/video/upload", post(video_panel::upload))

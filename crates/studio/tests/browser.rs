@@ -387,6 +387,20 @@ fn face_panel_in_headless_chromium() {
     let st = click_and_wait(&b, "face-redo");
     assert_eq!(edited(&st), first, "redo");
 
+    // Variants: three fills with thumbnails, the first applied; a click on the second shows it.
+    set_value(&b, "face-variants-count", "3");
+    let st = click_and_wait(&b, "face-generate");
+    assert_eq!(st["lastJob"]["ok"], true, "{}", st["lastJob"]);
+    assert_eq!((st["face"]["variants"].as_u64(), st["face"]["picked"].as_u64()), (Some(3), Some(1)));
+    let one = edited(&st);
+    let covered = coverage(&b, "face-variant-2", [0x1b, 0x1d, 0x22]);
+    assert!(covered > 0.03, "the second variant's thumbnail looks blank: {covered:.3}");
+    let st = click_and_wait(&b, "face-variant-2");
+    assert_eq!(error_text(&b), "", "{}", st["lastJob"]);
+    assert_eq!(st["face"]["picked"].as_u64(), Some(2));
+    assert_ne!(edited(&st), one, "picking the second variant changed nothing");
+    set_value(&b, "face-variants-count", "1");
+
     // A drag on the timeline sets the span (seconds of the file's own time).
     b.eval(&format!("window.inbetweenStudio.dragTimeline({}, {})", (3.0 * fps).round(), (5.0 * fps).round())).unwrap();
     let mask: Vec<f64> = serde_json::from_value(state(&b)["face"]["mask"].clone()).unwrap();

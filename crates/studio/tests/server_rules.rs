@@ -226,6 +226,15 @@ fn new_panels_refuse_bad_requests_and_keep_serving() {
     assert!(failed("/api/face/edit", br#"{"start_s":1,"end_s":2,"constraint":"noisy"}"#).contains("needs its file"));
     let (event, r) = run_job(a, "/api/face/edit", &ct, br#"{"start_s":1,"end_s":2}"#);
     assert_eq!(event, "result", "{r}");
+    assert!(r["variants"].is_null(), "one fill, no variants: {}", r["variants"]);
+    for n in [0, 7] {
+        let body = format!(r#"{{"start_s":1,"end_s":2,"variants":{n}}}"#);
+        assert!(failed("/api/face/edit", body.as_bytes()).contains("expected 1 to 6"), "variants {n}");
+    }
+    let pick = |body: &[u8]| request(a, "POST", "/api/face/pick", &ct, body);
+    let e = pick(br#"{"variant":1}"#);
+    assert_eq!(e.status, 400);
+    assert!(e.text().contains("no variants to pick from"), "{}", e.text());
     // A camera scene, then keys the engine refuses.
     let (event, scene) = run_job(a, "/api/camera/open", &ct, br#"{"path":"builtin:pair"}"#);
     assert_eq!(event, "result", "{scene}");
@@ -245,6 +254,7 @@ fn new_panels_refuse_bad_requests_and_keep_serving() {
         "/api/face/open",
         "/api/face/edit",
         "/api/face/history",
+        "/api/face/pick",
         "/api/video/open",
         "/api/video/generate",
         "/api/camera/open",
@@ -268,6 +278,53 @@ fn new_panels_refuse_bad_requests_and_keep_serving() {
         assert!((400..500).contains(&r.status), "{route}: {} {}", r.status, r.text());
     }
     assert_eq!(get(a, "/api/info").status, 200);
+}
+
+/// An edit with variants: as many different fills as asked, the first applied; picking another makes
+/// it the version shown (undo still goes back to before the edit); a bad number or a version the
+/// variants do not belong to is refused.
+#[test]
+fn face_variants_are_different_fills_and_a_pick_swaps_the_version() {
+    let s = studio(1_000_000, None);
+    let a = s.addr();
+    let ct = [("Content-Type", "application/json")];
+    let (event, take) = run_job(a, "/api/face/open", &ct, br#"{"path":"builtin:procedural"}"#);
+    assert_eq!(event, "result", "{take}");
+    let (event, r) = run_job(a, "/api/face/edit", &ct, br#"{"start_s":3,"end_s":6,"seed":5,"variants":3}"#);
+    assert_eq!(event, "result", "{r}");
+    let vs = r["variants"].as_array().expect("variants in the answer");
+    assert_eq!(vs.len(), 3);
+    assert_eq!((r["version"].as_u64(), r["versions"].as_u64()), (Some(1), Some(2)), "one new version");
+    assert!(r["message"].as_str().unwrap().contains("3 variants (seeds 5..7)"), "{}", r["message"]);
+    assert_eq!(vs[0]["columns"], r["columns"], "the first variant is the one applied");
+    for (k, v) in vs.iter().enumerate() {
+        assert_eq!((v["variant"].as_u64(), v["seed"].as_u64()), (Some(k as u64 + 1), Some(5 + k as u64)));
+        assert!(v["masked_mse"].as_f64().unwrap() > 0.0);
+    }
+    assert_ne!(vs[0]["columns"], vs[1]["columns"], "retrieval variants draw different segments");
+    assert_ne!(vs[1]["columns"], vs[2]["columns"]);
+    let pick = |body: &[u8]| request(a, "POST", "/api/face/pick", &ct, body);
+    let p = pick(br#"{"variant":2}"#);
+    assert_eq!(p.status, 200, "{}", p.text());
+    let p = p.json();
+    assert_eq!((p["version"].as_u64(), p["versions"].as_u64()), (Some(1), Some(2)), "picked in place");
+    let (r0, r1) = (vs[1]["rows"][0].as_u64().unwrap() as usize, vs[1]["rows"][1].as_u64().unwrap() as usize);
+    for (name, col) in vs[1]["columns"].as_object().unwrap() {
+        assert_eq!(p["columns"][name].as_array().unwrap()[r0..r1], col.as_array().unwrap()[..], "{name}");
+    }
+    for bad in [&br#"{"variant":0}"#[..], br#"{"variant":4}"#] {
+        let e = pick(bad);
+        assert_eq!(e.status, 400);
+        assert!(e.text().contains("expected 1 to 3"), "{}", e.text());
+    }
+    let u = request(a, "POST", "/api/face/history", &ct, br#"{"step":"undo"}"#).json();
+    assert_eq!(u["version"].as_u64(), Some(0));
+    assert_ne!(u["columns"], p["columns"], "undo goes back to before the edit");
+    let e = pick(br#"{"variant":1}"#);
+    assert_eq!(e.status, 400);
+    assert!(e.text().contains("belong to version 1"), "{}", e.text());
+    let r = request(a, "POST", "/api/face/history", &ct, br#"{"step":"redo"}"#).json();
+    assert_eq!(r["columns"], p["columns"], "redo shows the picked variant");
 }
 
 #[test]

@@ -545,6 +545,7 @@ function exportLink(url) {
 function drawFaceTake(r) {
   const f = S.face;
   f.take = r; f.fps = r.fps; f.frames = r.frames; f.keys = []; f.changed = []; f.lastEdit = null; f.version = 0; f.versions = 1;
+  drawVariants(null);
   f.orig = r.columns;
   f.cur = Object.fromEntries(Object.entries(r.columns).map(([k, v]) => [k, v.slice()]));
   $('face-take').textContent = `${r.name}: ${r.frames} rows at ${r.fps.toFixed(3)} fps, ${r.duration_s.toFixed(2)} s.`;
@@ -567,6 +568,7 @@ function faceRequest() {
     start_s: a, end_s: b, constraint: $('face-constraint').value, text: $('face-text').value,
     keys: [...byTime.values()], groups: $('face-groups').value || 'all', method: $('face-method').value,
     seed: parseInt($('face-seed').value, 10) || 0,
+    variants: Math.min(6, Math.max(1, parseInt($('face-variants-count').value, 10) || 1)),
   };
 }
 
@@ -591,6 +593,59 @@ function runFaceEdit() {
     const r = await job('/api/face/edit', faceRequest());
     applyColumns(r);
     S.face.lastEdit = { method: r.method, masked_mse: r.masked_mse, mask: r.mask, ms: r.ms };
+    drawVariants(r.variants);
+    drawTimeline(); drawFaceView();
+    return r;
+  });
+}
+
+// The fills of an edit with variants, each a thumbnail of the two curves the first fill moved most
+// (grey: original, blue: this variant) over the rows it changed; a click makes it the version shown.
+function drawVariants(variants) {
+  const f = S.face, box = $('face-variants');
+  box.innerHTML = '';
+  f.variants = variants || null; f.picked = variants ? 1 : null;
+  if (!variants) return;
+  const names = f.changed.filter(([, m]) => m > 1e-4).slice(0, 2).map(([n]) => n);
+  for (const v of variants) {
+    const b = document.createElement('button');
+    b.className = 'variant' + (v.variant === 1 ? ' picked' : '');
+    b.dataset.testid = `face-variant-${v.variant}`;
+    b.dataset.variant = v.variant;
+    const cv = document.createElement('canvas'); cv.width = 120; cv.height = 40;
+    const c = cv.getContext('2d'), [a, e] = v.rows, n = Math.max(2, e - a);
+    c.fillStyle = '#1b1d22'; c.fillRect(0, 0, cv.width, cv.height);
+    names.forEach((name, k) => {
+      // One scale per curve for every variant, so thumbnails compare.
+      let lo = Infinity, hi = -Infinity;
+      for (const w of variants) {
+        const col = w.columns[name] || [];
+        for (let i = 0; i < col.length; i++) { lo = Math.min(lo, col[i], f.orig[name][w.rows[0] + i] ?? col[i]); hi = Math.max(hi, col[i], f.orig[name][w.rows[0] + i] ?? col[i]); }
+      }
+      if (!(hi - lo > 0.05)) { const m = Number.isFinite(lo) ? (lo + hi) / 2 : 0.5; lo = m - 0.025; hi = m + 0.025; }
+      const y0 = k * 20, line = (val, colr) => {
+        c.strokeStyle = colr; c.beginPath();
+        for (let i = 0; i < n; i++) { const x = 120 * i / (n - 1), y = y0 + 18 - 16 * (val(i) - lo) / (hi - lo); i ? c.lineTo(x, y) : c.moveTo(x, y); }
+        c.stroke();
+      };
+      line((i) => f.orig[name][a + i] ?? 0, '#8a8f98');
+      const col = v.columns[name];
+      if (col) line((i) => col[i] ?? 0, '#4da3ff');
+    });
+    const label = document.createElement('span');
+    label.innerHTML = `#${v.variant} · seed ${v.seed}<br>MSE ${v.masked_mse.toFixed(4)}`;
+    b.append(cv, label);
+    b.title = names.length ? `${names.join(', ')} inside the span` : 'no curve moved';
+    b.addEventListener('click', () => pickVariant(v.variant));
+    box.appendChild(b);
+  }
+}
+function pickVariant(k) {
+  return start('face-pick', async () => {
+    const r = await post('/api/face/pick', { variant: k });
+    applyColumns(r);
+    S.face.picked = k;
+    for (const b of $('face-variants').children) b.classList.toggle('picked', Number(b.dataset.variant) === k);
     drawTimeline(); drawFaceView();
     return r;
   });
@@ -1467,7 +1522,7 @@ function state() {
   let video = null;
   if (S.video.clip) video = { order: S.video.result ? S.video.result.order : null, md: S.video.result ? S.video.result.md : null, source_md: S.video.clip.source_md, cuts: S.video.clip.cuts, jumps: S.video.result ? S.video.result.jumps.map((j) => ({ position: j.position, from: j.from, to: j.to, kind: j.kind })) : [] };
   let face = null;
-  if (S.face.take) face = { mask: faceMask(), edited: S.face.cur, keys: S.face.keys, version: S.face.version ?? 0, versions: S.face.versions ?? 1, lastEdit: S.face.lastEdit };
+  if (S.face.take) face = { mask: faceMask(), edited: S.face.cur, keys: S.face.keys, version: S.face.version ?? 0, versions: S.face.versions ?? 1, lastEdit: S.face.lastEdit, variants: S.face.variants ? S.face.variants.length : 0, picked: S.face.picked ?? null };
   return JSON.parse(JSON.stringify({ panel: S.panel, fps: st.fps, frames: st.frames, frame: S.frame, objects, characters, camera, keys, face, video, lastJob: S.lastJob }));
 }
 
