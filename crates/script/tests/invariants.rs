@@ -205,8 +205,14 @@ fn a_chair_in_front_of_a_desk_is_tucked_and_pulled_out_to_sit_on() {
     let pulled = out.to[0].hypot(out.to[1]) as f64;
     assert!((0.4..0.7).contains(&pulled) && out.object == chair, "{out:?}");
     assert_eq!(tom.slides[1].to, [0.0, 0.0]);
-    // Seated on the pulled-out chair: the hips above its seat, the chair where it was pulled to.
+    // A hand holds the top of the backrest while the chair slides, out and back in.
+    for sl in &tom.slides {
+        let gap = hand_gap(anim, tom, sl);
+        eprintln!("slide {sl:?}: hand within {gap:.3} m of the backrest's top");
+        assert!(gap < 0.05, "the hand is {gap:.3} m from the backrest while the chair slides");
+    }
     let rig = Rig::standard();
+    // Seated on the pulled-out chair: the hips above its seat, the chair where it was pulled to.
     let seg = &tom.segments[sit];
     let mid = seg.end - 1;
     let hips = forward(tom.clip.skeleton(), &tom.clip.pose(mid)).positions[rig.hips];
@@ -232,6 +238,42 @@ fn a_chair_in_front_of_a_desk_is_tucked_and_pulled_out_to_sit_on() {
         }
     }
     assert_clean("tucked chair", text, &check(anim, session.catalogue(), &u.scene.composition.relations));
+}
+
+/// While `slide` moves its seat at full grip (all but its first 7 and last 4 frames), the largest
+/// distance from the nearer wrist to where it holds the seat: [`GRIP_ABOVE`] over the top of a
+/// chair's backrest, or over the rim of a stool's seat (metres).
+///
+/// [`GRIP_ABOVE`]: inbetween_script::animate::GRIP_ABOVE
+fn hand_gap(
+    anim: &inbetween_script::animate::Animation,
+    c: &inbetween_script::animate::CharacterTrack,
+    sl: &inbetween_script::animate::Slide,
+) -> f64 {
+    use glam::DVec3;
+    let rig = inbetween_script::motion::Rig::standard();
+    let ch = &anim.scene.objects[sl.object];
+    let (yaw, hw, hd) = (ch.yaw as f64, ch.size[0] as f64 / 2.0 - 0.04, ch.size[2] as f64 / 2.0 - 0.03);
+    let (fw, side) = (DVec3::new(yaw.sin(), 0.0, yaw.cos()), DVec3::new(yaw.cos(), 0.0, -yaw.sin()));
+    let stool = ch.category.contains("stool");
+    let mut worst: f64 = 0.0;
+    for f in sl.start + 7..sl.end - 4 {
+        let (base, _) = inbetween_script::animate::object_pose(anim, sl.object, f);
+        let top = base + DVec3::Y * (ch.size[1] as f64 + inbetween_script::animate::GRIP_ABOVE);
+        let g = inbetween_core::fk::forward(c.clip.skeleton(), &c.clip.pose(f));
+        let near = rig
+            .arms
+            .iter()
+            .map(|a| {
+                let w = g.positions[a[3]];
+                let x = (w - top).dot(side).clamp(-hw, hw);
+                let z = if stool { (w - top).dot(fw).clamp(-hd, hd) } else { -hd };
+                (w - (top + side * x + fw * z)).length()
+            })
+            .fold(f64::INFINITY, f64::min);
+        worst = worst.max(near);
+    }
+    worst
 }
 
 /// Stories around a seat tucked at a table (the random stories rarely sit on one): a room, a desk
@@ -283,6 +325,12 @@ fn tucked_seats_keep_the_invariants_and_stay_out_of_the_table() {
         let r = check(anim, s.catalogue(), &u.scene.composition.relations);
         eprintln!("tucked {seed}: {} slides, {:?}\n{text}", slides, r.counts());
         assert_clean(&format!("tucked story {seed}"), &text, &r);
+        for c in &anim.characters {
+            for sl in &c.slides {
+                let gap = hand_gap(anim, c, sl);
+                assert!(gap < 0.05, "story {seed}, {}: the hand is {gap:.3} m from the sliding seat\n{text}", c.name);
+            }
+        }
         // No hips or head inside a table with leg room at any frame, where the seat was tucked
         // (a seat the layout could not tuck stands just in front, and the stand point in front of
         // it reaches in under the table's edge: not done).

@@ -48,6 +48,7 @@ pub(crate) mod plan;
 mod props;
 pub(crate) mod spots;
 
+pub use action::sit::GRIP_ABOVE;
 pub(crate) use action::walk::WalkCache;
 pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
 pub use crowd::{min_clearance, Clearance};

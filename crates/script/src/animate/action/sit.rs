@@ -19,6 +19,8 @@ use crate::motion::procedural::{seat_point, SEAT_HEIGHT};
 pub const CLEAR: f32 = 0.22;
 /// Least pull worth the walk round.
 const MIN_PULL: f32 = 0.05;
+/// How far the wrist of the hand holding a sliding seat is above the grip, metres.
+pub const GRIP_ABOVE: f64 = 0.04;
 /// Frames a chair takes to be pulled out or pushed back.
 const PULL_FRAMES: usize = 18;
 /// Sideways distance from a pulled-out chair's stand point to where the character pulls it from,
@@ -120,9 +122,103 @@ impl Builder<'_> {
     /// metres from its place).
     pub(crate) fn slide_seat(&mut self, o: usize, from: [f32; 2], to: [f32; 2]) {
         let start = self.frames.len();
-        let poses = self.in_place(PULL_FRAMES);
+        let slide = crate::animate::Slide { object: o, start, end: start + PULL_FRAMES, from, to };
+        let mut poses = self.in_place(PULL_FRAMES);
+        self.hold_seat(&slide, &mut poses);
         self.append(poses);
-        self.slides.push(crate::animate::Slide { object: o, start, end: self.frames.len(), from, to });
+        debug_assert_eq!(self.frames.len(), slide.end);
+        self.slides.push(slide);
+    }
+
+    /// The hand nearer the sliding seat holds it while it moves: the top of a chair's backrest, or
+    /// the rim of a stool's seat, at the point nearest that shoulder halfway through; two-bone
+    /// IK each frame (§4.2 contacts), the wrist [`GRIP_ABOVE`] over the grip, in over the first
+    /// frames and out over the last (the seat barely moves then: the slide eases in and out).
+    fn hold_seat(&self, slide: &crate::animate::Slide, poses: &mut [inbetween_core::Pose]) {
+        use crate::motion::{solve_limb, Limb};
+        use glam::DVec3;
+        use inbetween_core::fk::forward;
+        let (rig, obj) = (&self.ctx.rig, &self.ctx.scene.objects[slide.object]);
+        let n = poses.len();
+        if n < 2 {
+            return;
+        }
+        let yaw = obj.yaw as f64;
+        // The seat's facing and its left-right axis; the grip in that frame (metres from its centre).
+        let (fw, side) = (DVec3::new(yaw.sin(), 0.0, yaw.cos()), DVec3::new(yaw.cos(), 0.0, -yaw.sin()));
+        let (hw, hd) = (obj.size[0] as f64 / 2.0 - 0.04, obj.size[2] as f64 / 2.0 - 0.03);
+        let stool = obj.category.contains("stool");
+        let centre = |frame: usize| {
+            let [dx, dz] = slide.offset_at(frame);
+            DVec3::new(
+                (obj.position[0] + dx) as f64,
+                obj.position[1] as f64 + obj.size[1] as f64,
+                (obj.position[2] + dz) as f64,
+            )
+        };
+        // Nearest the shoulder halfway through the slide, so the hand reaches it at both ends.
+        let mid = slide.start + n / 2;
+        let grip_of = |shoulder: DVec3| {
+            let d = shoulder - centre(mid);
+            let x = d.dot(side).clamp(-hw.max(0.0), hw.max(0.0));
+            let z = if stool { d.dot(fw).clamp(-hd.max(0.0), hd.max(0.0)) } else { -hd.max(0.0) };
+            (x, z)
+        };
+        let g0 = forward(&rig.skeleton, &poses[0]);
+        let (limb, (gx, gz)) = [(Limb::LeftArm, rig.arms[0][1]), (Limb::RightArm, rig.arms[1][1])]
+            .into_iter()
+            .map(|(limb, shoulder)| (limb, grip_of(g0.positions[shoulder]), g0.positions[shoulder]))
+            .min_by(|a, b| {
+                let at = |(x, z): (f64, f64), s: DVec3| (centre(mid) + side * x + fw * z - s).length();
+                at(a.1, a.2).total_cmp(&at(b.1, b.2))
+            })
+            .map(|(limb, grip, _)| (limb, grip))
+            .expect("two arms");
+        let [_, upper, elbow, wrist] = rig.arms[if limb == Limb::LeftArm { 0 } else { 1 }];
+        let arm = rig.skeleton.joint(elbow).offset.length() + rig.skeleton.joint(wrist).offset.length();
+        let weight = |k: usize| smooth((k as f64 / 7.0).min((n - 1 - k) as f64 / 4.0).min(1.0));
+        let target = |k: usize| centre(slide.start + k) + side * gx + fw * gz + DVec3::Y * GRIP_ABOVE;
+        // For a grip low down (a stool's seat) the knees bend: the hips drop up to 0.4 m for a grip
+        // 0.5 m or more below a backrest's usual height.
+        let low = ((0.95 - target(0).y) / 0.5).clamp(0.0, 1.0);
+        if low > 0.0 {
+            self.lift(poses, |k| -0.4 * low * weight(k));
+        }
+        // The back leans towards the grip (about the lower back) when the shoulder is out of reach.
+        let leaned = |p: &inbetween_core::Pose, t: DVec3, lean: f64| {
+            let mut p = p.clone();
+            let g = forward(&rig.skeleton, &p);
+            let to = t - g.positions[rig.lower_back];
+            let dir = DVec3::new(to.x, 0.0, to.z).normalize_or_zero();
+            let parent = rig.skeleton.parent(rig.lower_back).map_or(glam::DQuat::IDENTITY, |j| g.rotations[j]);
+            let want = glam::DQuat::from_axis_angle(DVec3::Y.cross(dir).normalize_or(DVec3::X), lean)
+                * g.rotations[rig.lower_back];
+            p.rotations[rig.lower_back] = crate::motion::rig::local_from_global(parent, want);
+            p
+        };
+        let lean = (0..n)
+            .filter(|&k| weight(k) >= 1.0)
+            .map(|k| {
+                (0..=10)
+                    .map(|i| i as f64 * 0.05)
+                    .find(|&l| {
+                        let s = forward(&rig.skeleton, &leaned(&poses[k], target(k), l)).positions[upper];
+                        (s - target(k)).length() <= 0.97 * arm
+                    })
+                    .unwrap_or(0.5)
+            })
+            .fold(0.0, f64::max);
+        for (k, p) in poses.iter_mut().enumerate() {
+            let w = weight(k);
+            if w <= 0.0 {
+                continue;
+            }
+            if lean > 0.0 {
+                *p = leaned(p, target(k), lean * w);
+            }
+            let now = forward(&rig.skeleton, p).positions[wrist];
+            solve_limb(rig, p, limb, now.lerp(target(k), w), None);
+        }
     }
 
     /// For a chair tucked under a table with leg room (centred in front of it, facing it, its
