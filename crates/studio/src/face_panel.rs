@@ -355,7 +355,7 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
     let id = st.jobs.spawn("face-edit", move |job| {
         let (name, layout, clip) = {
             let s = state.face.session.lock().unwrap_or_else(|p| p.into_inner());
-            let s = s.as_ref().ok_or_else(|| StudioError::BadRequest("open a face take first".into()))?;
+            let s = s.as_ref().ok_or_else(no_take)?;
             (s.name.clone(), s.layout, s.versions[s.current].clone())
         };
         let channels = parse_groups(&req.groups).map_err(StudioError::BadRequest)?;
@@ -562,7 +562,7 @@ pub struct PickRequest {
 /// `variant` (in place: undo goes back to before the edit); answers like [`history`].
 pub async fn pick(State(st): State<Arc<AppState>>, Json(req): Json<PickRequest>) -> Result<Json<Value>> {
     let mut s = st.face.session.lock().unwrap_or_else(|p| p.into_inner());
-    let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("open a face take first".into()))?;
+    let s = s.as_mut().ok_or_else(no_take)?;
     let (at, clips) = s
         .variants
         .as_ref()
@@ -577,21 +577,31 @@ pub async fn pick(State(st): State<Arc<AppState>>, Json(req): Json<PickRequest>)
         return Err(StudioError::BadRequest(format!("variant {}: expected 1 to {}", req.variant, clips.len())));
     };
     s.versions[s.current] = clip.clone();
-    let (name, layout, n) = (s.name.clone(), s.layout, clips.len());
+    let message = format!("variant {} of {} as version {}", req.variant, clips.len(), s.current);
+    let mut answer = shown(&st, s, "face-pick", message);
+    answer["variant"] = json!(req.variant);
+    Ok(Json(answer))
+}
+
+/// The error of a request that needs a take before one is open.
+fn no_take() -> StudioError {
+    StudioError::BadRequest("open a face take first".into())
+}
+
+/// The answer of a history step or a pick: every column of the version now shown.
+fn shown(st: &AppState, s: &Session, kind: &str, message: String) -> Value {
     let clip = &s.versions[s.current];
-    let v = st.face.next_version();
-    let export = export_url(&st, &name, layout, clip, v);
-    Ok(Json(json!({
+    let export = export_url(st, &s.name, s.layout, clip, st.face.next_version());
+    json!({
         "ok": true,
-        "kind": "face-pick",
-        "message": format!("variant {} of {n} as version {}", req.variant, s.current),
-        "variant": req.variant,
+        "kind": kind,
+        "message": message,
         "rows": [0, clip.num_frames()],
         "columns": columns(clip, 0, clip.num_frames(), None),
         "version": s.current,
         "versions": s.versions.len(),
         "files": {"export": export},
-    })))
+    })
 }
 
 #[derive(Deserialize)]
@@ -603,25 +613,13 @@ pub struct StepRequest {
 /// `POST /api/face/history`: undo or redo; answers with every column of the version now shown.
 pub async fn history(State(st): State<Arc<AppState>>, Json(req): Json<StepRequest>) -> Result<Json<Value>> {
     let mut s = st.face.session.lock().unwrap_or_else(|p| p.into_inner());
-    let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("open a face take first".into()))?;
+    let s = s.as_mut().ok_or_else(no_take)?;
     match req.step.as_str() {
         "undo" if s.current > 0 => s.current -= 1,
         "redo" if s.current + 1 < s.versions.len() => s.current += 1,
         "undo" | "redo" => {}
         other => return Err(StudioError::BadRequest(format!("step '{other}': expected undo or redo"))),
     }
-    let clip = &s.versions[s.current];
-    let (name, layout) = (s.name.clone(), s.layout);
-    let v = st.face.next_version();
-    let export = export_url(&st, &name, layout, clip, v);
-    Ok(Json(json!({
-        "ok": true,
-        "kind": format!("face-{}", req.step),
-        "message": format!("{}: version {} of {}", req.step, s.current, s.versions.len() - 1),
-        "rows": [0, clip.num_frames()],
-        "columns": columns(clip, 0, clip.num_frames(), None),
-        "version": s.current,
-        "versions": s.versions.len(),
-        "files": {"export": export},
-    })))
+    let message = format!("{}: version {} of {}", req.step, s.current, s.versions.len() - 1);
+    Ok(Json(shown(&st, s, &format!("face-{}", req.step), message)))
 }
