@@ -17,6 +17,18 @@ use crate::motion::locomotion::place_clip;
 use crate::motion::procedural::SEAT_HEIGHT;
 use crate::motion::MotionLibrary;
 
+/// A chair a seated character pulled out from under a table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Pulled {
+    pub chair: usize,
+    /// The spot beside it the character pulled from (x, z metres).
+    pub side: [f32; 2],
+    /// The chair's offset from its place once pulled out, and once scooted in with the character
+    /// on it (x, z metres).
+    pub out: [f32; 2],
+    pub inside: [f32; 2],
+}
+
 /// Where a character is between actions.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct State {
@@ -26,9 +38,9 @@ pub(crate) struct State {
     pub seated: Option<([f32; 2], [f32; 3], usize)>,
     /// Lying (on the seat when seated, else on the floor where it stands).
     pub lying: bool,
-    /// Seated on a chair it pulled out from under a table: the chair, the spot beside it the
-    /// character pulled from, and the chair's offset from its place (pushed back on standing up).
-    pub pulled: Option<(usize, [f32; 2], [f32; 2])>,
+    /// Seated on a chair it pulled out from under a table (scooted out and pushed back on
+    /// standing up).
+    pub pulled: Option<Pulled>,
 }
 
 /// Builds one character's frames: what every action of [`super::action`] reads and extends.

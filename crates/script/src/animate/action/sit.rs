@@ -19,6 +19,15 @@ use crate::motion::procedural::{seat_point, SEAT_HEIGHT};
 pub const CLEAR: f32 = 0.22;
 /// Least pull worth the walk round.
 const MIN_PULL: f32 = 0.05;
+/// Where a character seated on a pulled-out chair scoots it back to: its seat's centre this far
+/// from the table's front edge, metres (knees under the top).
+const SEATED_FROM_TABLE: f32 = 0.30;
+/// Frames a seated character takes to scoot a chair in or out.
+const SCOOT_FRAMES: usize = 20;
+/// Frames over which each foot (left, right) steps along during a scoot.
+const FOOT_STEPS: [(f64, f64); 2] = [(3.0, 9.0), (9.0, 15.0)];
+/// Height a foot is lifted to when it steps along during a scoot, metres.
+const STEP_LIFT: f64 = 0.06;
 /// How far the wrist of the hand holding a sliding seat is above the grip, metres.
 pub const GRIP_ABOVE: f64 = 0.04;
 /// Frames a chair takes to be pulled out or pushed back.
@@ -102,11 +111,18 @@ impl Builder<'_> {
         let dy = s[1] as f64 - SEAT_HEIGHT;
         self.lift(&mut poses, |k| dy * smooth(k as f64 / (n - 1) as f64));
         self.append(poses);
-        let seated_from = self.frames.len();
-        let poses = self.seated(self.st.pos, s, yaw, hold.max(1));
-        self.append(poses);
         self.st.seated = Some((self.st.pos, s, o));
-        self.st.pulled = pull.map(|(side, offset, _)| (o, side, offset));
+        // Seated on a pulled-out chair: scoot it back in towards the table.
+        self.st.pulled = pull.map(|(side, offset, _)| {
+            let scoot = CLEAR + (-seat_point().z) as f32 - SEATED_FROM_TABLE;
+            let inside = [offset[0] + scoot * f[0] as f32, offset[1] + scoot * f[1] as f32];
+            self.scoot(o, offset, inside);
+            crate::animate::builder::Pulled { chair: o, side, out: offset, inside }
+        });
+        let (at, s) = self.st.seated.map(|(at, s, _)| (at, s)).expect("seated above");
+        let seated_from = self.frames.len();
+        let poses = self.seated(at, s, yaw, hold.max(1));
+        self.append(poses);
         self.seats.push([s[0], s[2]]);
         let hips = JointContact {
             joint: ContactJoint::Hips,
@@ -128,6 +144,42 @@ impl Builder<'_> {
         self.append(poses);
         debug_assert_eq!(self.frames.len(), slide.end);
         self.slides.push(slide);
+    }
+
+    /// Seated on chair `o`, slides it from offset `from` to `to` (x, z metres from its place) with
+    /// the character on it over [`SCOOT_FRAMES`] (the seated loop carried along, the feet planted
+    /// and stepping along one after the other, [`FOOT_STEPS`]); the seat and stand point move with
+    /// it.
+    pub(crate) fn scoot(&mut self, o: usize, from: [f32; 2], to: [f32; 2]) {
+        let Some((at, seat, so)) = self.st.seated else { return };
+        let start = self.frames.len();
+        let slide = crate::animate::Slide { object: o, start, end: start + SCOOT_FRAMES, from, to };
+        let yaw = self.ctx.scene.objects[o].yaw as f64;
+        let mut poses = self.seated(at, seat, yaw, SCOOT_FRAMES);
+        let rig = &self.ctx.rig;
+        let d = glam::DVec3::new((to[0] - from[0]) as f64, 0.0, (to[1] - from[1]) as f64);
+        for (k, p) in poses.iter_mut().enumerate() {
+            // The feet stay planted, then step along one after the other, lifted on an arc.
+            let g = inbetween_core::fk::forward(&rig.skeleton, p);
+            let feet = [0, 1].map(|i| g.positions[rig.legs[i][2]]);
+            let [x, z] = slide.offset_at(start + k);
+            p.translations[rig.hips].x += (x - from[0]) as f64;
+            p.translations[rig.hips].z += (z - from[1]) as f64;
+            for (i, (limb, foot)) in
+                [crate::motion::Limb::LeftLeg, crate::motion::Limb::RightLeg].into_iter().zip(feet).enumerate()
+            {
+                let (a, b) = FOOT_STEPS[i];
+                let t = ((k as f64 - a) / (b - a)).clamp(0.0, 1.0);
+                let arc = glam::DVec3::Y * STEP_LIFT * (std::f64::consts::PI * t).sin();
+                crate::motion::solve_limb(rig, p, limb, foot + d * smooth(t) + arc, None);
+            }
+        }
+        self.append(poses);
+        self.slides.push(slide);
+        let d = [d.x as f32, d.z as f32];
+        let at = [at[0] + d[0], at[1] + d[1]];
+        self.st.seated = Some((at, [seat[0] + d[0], seat[1], seat[2] + d[1]], so));
+        self.st.pos = at;
     }
 
     /// The hand nearer the sliding seat holds it while it moves: the top of a chair's backrest, or
