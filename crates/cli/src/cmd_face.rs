@@ -335,10 +335,8 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         (MethodArg::Linear, _) => Method::Linear,
         (MethodArg::Cubic, _) => Method::Cubic,
         (MethodArg::Retrieval, _) => {
-            // Enough candidates that every variant is a different segment.
-            let options = RetrievalOptions::for_kind(guide.kind());
-            let candidates = options.candidates.max(a.variants as usize);
-            Method::Retrieval(library.as_ref().expect("built above"), RetrievalOptions { candidates, ..options })
+            let options = RetrievalOptions::for_variants(guide.kind(), a.variants as usize);
+            Method::Retrieval(library.as_ref().expect("built above"), options)
         }
         (MethodArg::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
         (MethodArg::Network, None) => unreachable!("a network was loaded above"),

@@ -423,10 +423,7 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
         let method = match method_name {
             "network" => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
             "retrieval" => {
-                // Enough candidates that every variant is a different segment.
-                let o = RetrievalOptions::for_kind(kind);
-                let candidates = o.candidates.max(req.variants as usize);
-                Method::Retrieval(state.face.library(), RetrievalOptions { candidates, ..o })
+                Method::Retrieval(state.face.library(), RetrievalOptions::for_variants(kind, req.variants as usize))
             }
             "linear" => Method::Linear,
             _ => Method::Cubic,
@@ -453,37 +450,47 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
                 msg += &format!(", {same} the same as the first ({method_name} fills do not depend on the seed)");
             }
         }
-        let variants: Vec<Value> = fills
-            .iter()
-            .enumerate()
-            .map(|(k, f)| {
-                json!({
-                    "variant": k + 1,
-                    "seed": req.seed + k as u64,
-                    "masked_mse": f.mse,
-                    "rows": [f.rows.0, f.rows.1],
-                    "columns": columns(&f.clip, f.rows.0, f.rows.1, Some(&f.changed)),
+        let (a, b) = first.rows;
+        let first_columns = columns(&first.clip, a, b, Some(&first.changed));
+        // Each variant's changed rows and columns (the first's as the answer's own), only with variants.
+        let variants: Option<Vec<Value>> = (n > 1).then(|| {
+            fills
+                .iter()
+                .enumerate()
+                .map(|(k, f)| {
+                    let cols = if k == 0 {
+                        first_columns.clone()
+                    } else {
+                        columns(&f.clip, f.rows.0, f.rows.1, Some(&f.changed))
+                    };
+                    json!({
+                        "variant": k + 1,
+                        "seed": req.seed + k as u64,
+                        "masked_mse": f.mse,
+                        "rows": [f.rows.0, f.rows.1],
+                        "columns": cols,
+                    })
                 })
-            })
-            .collect();
+                .collect()
+        });
+        let mse = first.mse;
         let mut s = state.face.session.lock().unwrap_or_else(|p| p.into_inner());
         let s = s.as_mut().ok_or_else(|| StudioError::BadRequest("the take was closed during the edit".into()))?;
         s.versions.truncate(s.current + 1);
-        s.versions.push(first.clip.clone());
+        s.versions.push(fills[0].clip.clone());
         s.current += 1;
-        s.variants = (n > 1).then(|| (s.current, fills.iter().map(|f| f.clip.clone()).collect()));
-        let (a, b) = first.rows;
+        s.variants = (n > 1).then(|| (s.current, fills.into_iter().map(|f| f.clip).collect()));
         Ok(json!({
             "ok": true,
             "message": msg,
             "method": method_name,
-            "masked_mse": first.mse,
+            "masked_mse": mse,
             "rows": [a, b],
-            "columns": columns(&first.clip, a, b, Some(&first.changed)),
+            "columns": first_columns,
             "mask": [req.start_s, req.end_s],
             "version": s.current,
             "versions": s.versions.len(),
-            "variants": if n > 1 { json!(variants) } else { Value::Null },
+            "variants": variants,
             "files": {"export": export},
         }))
     });

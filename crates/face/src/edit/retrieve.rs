@@ -115,6 +115,13 @@ impl RetrievalOptions {
     pub fn for_kind(kind: ConstraintKind) -> Self {
         RetrievalOptions { by_region: kind == ConstraintKind::Keyframes, ..Default::default() }
     }
+
+    /// [`RetrievalOptions::for_kind`] with enough candidates that seeds `S … S + variants − 1`
+    /// each draw a different segment (`face edit --variants`, the studio's variants).
+    pub fn for_variants(kind: ConstraintKind, variants: usize) -> Self {
+        let o = RetrievalOptions::for_kind(kind);
+        RetrievalOptions { candidates: o.candidates.max(variants), ..o }
+    }
 }
 
 /// Where a segment comes from: `clip` indexes the library, `None` the edited clip itself.

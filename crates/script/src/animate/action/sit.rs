@@ -200,7 +200,8 @@ impl Builder<'_> {
         let (fw, side) = (DVec3::new(yaw.sin(), 0.0, yaw.cos()), DVec3::new(yaw.cos(), 0.0, -yaw.sin()));
         let (hw, hd) = (obj.size[0] as f64 / 2.0 - 0.04, obj.size[2] as f64 / 2.0 - 0.03);
         let stool = obj.category.contains("stool");
-        let centre = |frame: usize| {
+        // The middle of the seat's top (a chair's: of its whole box, backrest included) at a frame.
+        let top = |frame: usize| {
             let [dx, dz] = slide.offset_at(frame);
             DVec3::new(
                 (obj.position[0] + dx) as f64,
@@ -211,7 +212,7 @@ impl Builder<'_> {
         // Nearest the shoulder halfway through the slide, so the hand reaches it at both ends.
         let mid = slide.start + n / 2;
         let grip_of = |shoulder: DVec3| {
-            let d = shoulder - centre(mid);
+            let d = shoulder - top(mid);
             let x = d.dot(side).clamp(-hw.max(0.0), hw.max(0.0));
             let z = if stool { d.dot(fw).clamp(-hd.max(0.0), hd.max(0.0)) } else { -hd.max(0.0) };
             (x, z)
@@ -221,7 +222,7 @@ impl Builder<'_> {
             .into_iter()
             .map(|(limb, shoulder)| (limb, grip_of(g0.positions[shoulder]), g0.positions[shoulder]))
             .min_by(|a, b| {
-                let at = |(x, z): (f64, f64), s: DVec3| (centre(mid) + side * x + fw * z - s).length();
+                let at = |(x, z): (f64, f64), s: DVec3| (top(mid) + side * x + fw * z - s).length();
                 at(a.1, a.2).total_cmp(&at(b.1, b.2))
             })
             .map(|(limb, grip, _)| (limb, grip))
@@ -229,7 +230,7 @@ impl Builder<'_> {
         let [_, upper, elbow, wrist] = rig.arms[if limb == Limb::LeftArm { 0 } else { 1 }];
         let arm = rig.skeleton.joint(elbow).offset.length() + rig.skeleton.joint(wrist).offset.length();
         let weight = |k: usize| smooth((k as f64 / 7.0).min((n - 1 - k) as f64 / 4.0).min(1.0));
-        let target = |k: usize| centre(slide.start + k) + side * gx + fw * gz + DVec3::Y * GRIP_ABOVE;
+        let target = |k: usize| top(slide.start + k) + side * gx + fw * gz + DVec3::Y * GRIP_ABOVE;
         // For a grip low down (a stool's seat) the knees bend: the hips drop up to 0.4 m for a grip
         // 0.5 m or more below a backrest's usual height.
         let low = ((0.95 - target(0).y) / 0.5).clamp(0.0, 1.0);
