@@ -1,8 +1,9 @@
 //! Core types and math every inbetween engine speaks: skeletons, BVH-form motion clips ([`Motion`]),
 //! runtime pose clips ([`clip::Clip`]), rotations, forward kinematics, resampling and windowing,
 //! curves with an [`Interval`] domain and their adapters ([`curve`]), keyframe sets, interpolation,
-//! error metrics, length units, seeding ([`seed`]), cooperative cancellation and time limits
-//! ([`cancel`]), angle wrapping ([`angle`]) and Toric space for two-subject camera framing ([`toric`]).
+//! error metrics, joint roles on any humanoid rig ([`roles`]), length units, seeding ([`seed`]),
+//! cooperative cancellation and time limits ([`cancel`]), angle wrapping ([`angle`]) and Toric space
+//! for two-subject camera framing ([`toric`]).
 
 pub mod angle;
 pub mod cancel;
@@ -14,6 +15,7 @@ pub mod keyframes;
 pub mod metrics;
 pub mod motion;
 pub mod procedural;
+pub mod roles;
 pub mod rotation;
 pub mod seed;
 pub mod skeleton;
