@@ -25,7 +25,8 @@ mod shape;
 
 pub mod fixtures;
 
-use crate::Skeleton;
+use crate::{Motion, Skeleton};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -395,9 +396,44 @@ impl fmt::Display for Roles {
     }
 }
 
+/// The roles of a clip's skeleton: [`find_roles`] on its rest pose, and where that pose is no
+/// standing one (Character Creator's BVH files model their legs pointing up with all channels at
+/// zero, and stand in a T-pose in frame 0), the shape read in its first frame.
+pub fn find_motion_roles(motion: &Motion, overrides: &RoleOverrides) -> Result<Roles, RolesError> {
+    match find_roles(&motion.skeleton, overrides) {
+        Err(e @ RolesError::Missing { .. }) if motion.num_frames() > 0 => {
+            let g = crate::fk::forward(&motion.skeleton, &motion.pose(0));
+            let mut r = find_roles_posed(&motion.skeleton, Some(&g.positions), overrides).map_err(|posed| {
+                match (e, posed) {
+                    (
+                        RolesError::Missing { missing, by_name, by_shape },
+                        RolesError::Missing { by_shape: in_pose, .. },
+                    ) => {
+                        RolesError::Missing { missing, by_name, by_shape: format!("{by_shape}; in frame 0, {in_pose}") }
+                    }
+                    (_, other) => other,
+                }
+            })?;
+            r.notes.push("shape read in frame 0 (the rest pose is not a standing one)".into());
+            Ok(r)
+        }
+        other => other,
+    }
+}
+
 /// The roles of `skeleton`: the roles file first, then names, then the shape for whatever is still
 /// missing; the spine, chest and neck from the hierarchy between them.
 pub fn find_roles(skeleton: &Skeleton, overrides: &RoleOverrides) -> Result<Roles, RolesError> {
+    find_roles_posed(skeleton, None, overrides)
+}
+
+/// [`find_roles`] reading the shape in the pose of these global joint positions (the rest pose
+/// when `None`).
+pub fn find_roles_posed(
+    skeleton: &Skeleton,
+    posed: Option<&[DVec3]>,
+    overrides: &RoleOverrides,
+) -> Result<Roles, RolesError> {
     let name_of = |j: usize| skeleton.joint(j).name.clone();
     let mut roles: BTreeMap<Role, Assigned> = BTreeMap::new();
     let mut taken = vec![false; skeleton.len()];
@@ -422,7 +458,7 @@ pub fn find_roles(skeleton: &Skeleton, overrides: &RoleOverrides) -> Result<Role
     let mut notes = Vec::new();
     let mut shape_error = String::from("not needed");
     if Role::ALL.iter().filter(|r| limb_roles(r)).any(|r| !roles.contains_key(r)) {
-        match shape::by_shape(skeleton) {
+        match shape::by_shape(skeleton, posed) {
             Ok(s) => {
                 for (role, j, c) in s.found {
                     put(&mut roles, role, j, How::Shape, c);

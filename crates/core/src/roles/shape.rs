@@ -14,14 +14,23 @@ use glam::DVec3;
 const LIMB: f64 = 0.25;
 /// Shorter than this fraction of the extent, a link is the same place (CMU's `LHipJoint`).
 const SAME_PLACE: f64 = 0.02;
+/// A child this close (fraction of the extent) whose branches fork is part of the same fork.
+const FORK_NEAR: f64 = 0.06;
 /// The knee and elbow sit this far along the path from the limb's root joint to its end joint
 /// (thigh ≈ shin; upper arm 0.186 and forearm 0.146 of the body height).
 const KNEE_AT: f64 = 0.5;
 const ELBOW_AT: f64 = 0.56;
-/// The foot starts where the leg's chain turns more than this from straight down (radians).
-const ANKLE_TURN: f64 = std::f64::consts::FRAC_PI_4;
-/// A clavicle is shorter than this fraction of the arm below it (CMU 0.26, Mixamo 0.2).
-const CLAVICLE_MAX: f64 = 0.35;
+/// The link from the ankle on is shorter than this fraction of the leg above the ankle (CMU 0.15,
+/// Character Creator 0.14; a twist joint halfway down the shin gives 0.33).
+const FOOT_MAX: f64 = 0.25;
+/// Fingers reach less than this fraction of the arm above the hand (CMU 0.14, Character Creator 0.3).
+const FINGERS_MAX: f64 = 0.5;
+/// A clavicle starts closer to the spine's axis than this fraction of the shoulder's distance from it.
+const CLAVICLE_MAX: f64 = 0.5;
+/// Or it is shorter than this fraction of the arm below it (CMU 0.4, Mixamo 0.2) and bends into
+/// the upper arm by more than [`CLAVICLE_BEND`] radians.
+const CLAVICLE_SHORT: f64 = 0.5;
+const CLAVICLE_BEND: f64 = 0.35;
 
 /// What the shape says: roles with a confidence in 0..=1, and notes on what was assumed.
 pub(crate) struct ShapeRoles {
@@ -40,7 +49,8 @@ struct Geometry<'a> {
 }
 
 impl<'a> Geometry<'a> {
-    fn new(s: &'a Skeleton) -> Geometry<'a> {
+    /// The rest pose's geometry, or that of a pose given as global joint positions.
+    fn new(s: &'a Skeleton, posed: Option<&[DVec3]>) -> Geometry<'a> {
         let n = s.len();
         let mut pos = vec![DVec3::ZERO; n];
         let mut kids = vec![Vec::new(); n];
@@ -50,12 +60,21 @@ impl<'a> Geometry<'a> {
                 kids[p].push(i);
             }
         }
+        let extent = match posed {
+            Some(g) => {
+                pos = g.iter().map(|&q| q - g[0]).collect();
+                let (lo, hi) =
+                    pos.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), &q| (l.min(q), h.max(q)));
+                (hi - lo).max_element()
+            }
+            None => rest_pose_extent(s),
+        };
         let mut reach = vec![0.0f64; n];
         for i in (0..n).rev() {
             let own = s.joint(i).end_site.map(|e| e.length()).unwrap_or(0.0);
             reach[i] = kids[i].iter().map(|&c| s.joint(c).offset.length() + reach[c]).fold(own, f64::max);
         }
-        Geometry { s, pos, reach, kids, extent: rest_pose_extent(s).max(1e-9) }
+        Geometry { s, pos, reach, kids, extent: extent.max(1e-9) }
     }
 
     /// How far the branch through child `c` reaches from its parent.
@@ -65,6 +84,21 @@ impl<'a> Geometry<'a> {
 
     fn long_kids(&self, j: usize, fraction: f64) -> Vec<usize> {
         self.kids[j].iter().copied().filter(|&c| self.through(c) >= fraction * self.extent).collect()
+    }
+
+    /// The long branches leaving `j`, looking through a child at the same place that forks itself
+    /// (Character Creator's legs leave `CC_Base_Pelvis`, a child of `CC_Base_Hip` at its place).
+    fn branches(&self, j: usize, fraction: f64) -> Vec<usize> {
+        let mut out = Vec::new();
+        for c in self.long_kids(j, fraction) {
+            let forks = self.long_kids(c, fraction);
+            if self.pos[c].distance(self.pos[j]) < FORK_NEAR * self.extent && forks.len() >= 2 {
+                out.extend(self.branches(c, fraction));
+            } else {
+                out.push(c);
+            }
+        }
+        out
     }
 
     /// The chain from `start` down the child that reaches furthest, to a leaf.
@@ -112,30 +146,27 @@ struct Arm {
     hand: usize,
 }
 
-/// Roles of `s` from its rest pose, or what could not be found.
-pub(crate) fn by_shape(s: &Skeleton) -> Result<ShapeRoles, String> {
-    let g = Geometry::new(s);
+/// Roles of `s` from its rest pose (or the pose of global joint positions `posed`), or what could
+/// not be found.
+pub(crate) fn by_shape(s: &Skeleton, posed: Option<&[DVec3]>) -> Result<ShapeRoles, String> {
+    let g = Geometry::new(s, posed);
     let order = bfs(&g);
     let hips = *order
         .iter()
-        .find(|&&j| g.long_kids(j, LIMB).len() >= 3)
+        .find(|&&j| g.branches(j, LIMB).len() >= 3)
         .ok_or("no joint has three long branches (two legs and a spine)")?;
-    let branches = g.long_kids(hips, LIMB);
-    // The torso is the branch holding a joint with two long branches (the arms).
-    let chest_in = |b: usize| bfs_from(&g, b).into_iter().find(|&j| g.long_kids(j, LIMB * 0.8).len() >= 2);
-    let torso: Vec<(usize, usize)> = branches.iter().filter_map(|&b| chest_in(b).map(|c| (b, c))).collect();
-    let &[(torso_branch, chest)] = torso.as_slice() else {
-        return Err(format!(
-            "the hips candidate '{}' has {} long branches, {} of them with two arms; expected two legs and one spine",
-            s.joint(hips).name,
-            branches.len(),
-            torso.len()
-        ));
-    };
-    let legs: Vec<usize> = branches.iter().copied().filter(|&b| b != torso_branch).collect();
-    if legs.len() != 2 {
-        return Err(format!("the hips '{}' have {} leg-like branches; expected two", s.joint(hips).name, legs.len()));
-    }
+    let branches = g.branches(hips, LIMB);
+    // The torso is the branch with the most joints (arms, fingers, head); its chest the first joint
+    // with two long branches (the arms).
+    let size = |b: usize| bfs_from(&g, b).len();
+    let torso_branch = *branches.iter().max_by_key(|&&b| (size(b), std::cmp::Reverse(b))).expect("three branches");
+    let chest = bfs_from(&g, torso_branch)
+        .into_iter()
+        .find(|&j| g.long_kids(j, LIMB * 0.8).len() >= 2)
+        .ok_or_else(|| format!("the spine from '{}' has no joint two arms branch from", s.joint(torso_branch).name))?;
+    let mut legs: Vec<usize> = branches.iter().copied().filter(|&b| b != torso_branch).collect();
+    legs.sort_by(|&a, &b| g.through(b).total_cmp(&g.through(a)));
+    legs.truncate(2);
     let up = (g.pos[chest] - g.pos[hips]).try_normalize().ok_or("the chest sits at the hips")?;
     let mut arm_roots = g.long_kids(chest, LIMB * 0.8);
     arm_roots.sort_by(|&a, &b| g.through(b).total_cmp(&g.through(a)));
@@ -152,7 +183,7 @@ pub(crate) fn by_shape(s: &Skeleton) -> Result<ShapeRoles, String> {
         })
         .ok_or("no neck branch above the arms")?;
     let (head, head_conf) = head_of(&g, neck_root);
-    let read_legs = [read_leg(&g, hips, legs[0], up)?, read_leg(&g, hips, legs[1], up)?];
+    let read_legs = [read_leg(&g, hips, legs[0])?, read_leg(&g, hips, legs[1])?];
     for leg in &read_legs {
         let down = (g.pos[leg.foot] - g.pos[leg.thigh]).normalize_or_zero().dot(-up);
         if down < 0.5 {
@@ -163,7 +194,8 @@ pub(crate) fn by_shape(s: &Skeleton) -> Result<ShapeRoles, String> {
             ));
         }
     }
-    let read_arms = [read_arm(&g, arm_roots[0])?, read_arm(&g, arm_roots[1])?];
+    let axis = (g.pos[hips], up);
+    let read_arms = [read_arm(&g, arm_roots[0], axis)?, read_arm(&g, arm_roots[1], axis)?];
 
     // Forward from the toes (foot to toe, across the up axis); the BVH and glTF convention (+Z)
     // when the feet have none.
@@ -217,8 +249,12 @@ pub(crate) fn by_shape(s: &Skeleton) -> Result<ShapeRoles, String> {
 /// (`HeadTop_End`).
 fn head_of(g: &Geometry, neck_root: usize) -> (usize, f64) {
     let chain = g.chain(neck_root);
-    if let Some(&h) = chain.iter().skip(1).find(|&&j| g.kids[j].len() >= 2) {
-        return (h, 0.9);
+    if let Some(mut k) = (1..chain.len()).find(|&k| g.kids[chain[k]].len() >= 2) {
+        // A helper at the head's place that holds the face (`CC_Base_FacialBone`) is not the head.
+        while k > 1 && g.pos[chain[k]].distance(g.pos[chain[k - 1]]) < SAME_PLACE * g.extent {
+            k -= 1;
+        }
+        return (chain[k], 0.9);
     }
     let last = *chain.last().expect("a chain holds its start");
     if chain.len() < 2 || g.s.joint(last).end_site.is_some_and(|e| e.length() > 1e-9) {
@@ -228,7 +264,7 @@ fn head_of(g: &Geometry, neck_root: usize) -> (usize, f64) {
     }
 }
 
-fn read_leg(g: &Geometry, hips: usize, start: usize, up: DVec3) -> Result<Leg, String> {
+fn read_leg(g: &Geometry, hips: usize, start: usize) -> Result<Leg, String> {
     let near = SAME_PLACE * g.extent;
     let chain: Vec<usize> = g.chain(start).into_iter().skip_while(|&j| g.pos[j].distance(g.pos[hips]) < near).collect();
     let name = &g.s.joint(start).name;
@@ -238,29 +274,43 @@ fn read_leg(g: &Geometry, hips: usize, start: usize, up: DVec3) -> Result<Leg, S
             chain.len()
         ));
     }
-    let down = -up;
-    let turns = |k: usize| {
-        let seg = g.pos[chain[k + 1]] - g.pos[chain[k]];
-        seg.length() > near && seg.angle_between(down) > ANKLE_TURN
-    };
-    let ankle = (2..chain.len() - 1).find(|&k| turns(k)).unwrap_or(chain.len() - 1);
+    // The foot starts where the chain's next link is short beside the leg above it: lengths, not
+    // directions, so a pointed foot in a posed frame reads the same.
+    let ankle = (2..chain.len() - 1)
+        .find(|&k| g.pos[chain[k + 1]].distance(g.pos[chain[k]]) < FOOT_MAX * g.along(&chain, 0, k))
+        .unwrap_or(chain.len() - 1);
     let knee = g.at_fraction(&chain, 0, ankle, 1, ankle, KNEE_AT);
     Ok(Leg { thigh: chain[0], shin: chain[knee], foot: chain[ankle], toe: chain.get(ankle + 1).copied() })
 }
 
-fn read_arm(g: &Geometry, start: usize) -> Result<Arm, String> {
+fn read_arm(g: &Geometry, start: usize, axis: (DVec3, DVec3)) -> Result<Arm, String> {
     let chain = g.chain(start);
     let name = &g.s.joint(start).name;
-    // The hand: the first joint with two comparable branches (fingers and thumb), else the chain's end.
-    let branches = |j: usize| {
+    // The hand: the first joint with two comparable branches (fingers and thumb) that are short
+    // beside the arm above (an elbow's twist bone beside the forearm is not a finger), else the
+    // chain's end.
+    let fingers = |k: usize| {
+        let j = chain[k];
         let longest = g.kids[j].iter().map(|&c| g.through(c)).fold(0.0, f64::max);
-        longest >= SAME_PLACE * g.extent && g.kids[j].iter().filter(|&&c| g.through(c) >= 0.3 * longest).count() >= 2
+        longest >= SAME_PLACE * g.extent
+            && longest < FINGERS_MAX * g.along(&chain, 0, k)
+            && g.kids[j].iter().filter(|&&c| g.through(c) >= 0.3 * longest).count() >= 2
     };
-    let h = (1..chain.len()).find(|&k| branches(chain[k])).unwrap_or(chain.len() - 1);
+    let h = (2..chain.len()).find(|&k| fingers(k)).unwrap_or(chain.len() - 1);
     if h < 2 {
         return Err(format!("the arm from '{name}' has {} joints before its hand; expected upper arm, elbow", h));
     }
-    let clavicle = h >= 3 && g.along(&chain, 0, 1) < CLAVICLE_MAX * g.along(&chain, 1, h);
+    // A clavicle starts near the spine's axis and ends at the shoulder, out to the side.
+    let from_axis = |j: usize| {
+        let d = g.pos[j] - axis.0;
+        (d - axis.1 * d.dot(axis.1)).length()
+    };
+    // In a posed frame the axis may lean: a link short beside the arm that bends into it (a twist
+    // joint continues its bone straight) is a clavicle too.
+    let link = |k: usize| g.pos[chain[k + 1]] - g.pos[chain[k]];
+    let bends = h >= 3 && link(0).angle_between(link(1)) > CLAVICLE_BEND;
+    let short = g.along(&chain, 0, 1) < CLAVICLE_SHORT * g.along(&chain, 1, h);
+    let clavicle = h >= 3 && (from_axis(chain[0]) < CLAVICLE_MAX * from_axis(chain[1]) || (short && bends));
     let s = usize::from(clavicle);
     let e = g.at_fraction(&chain, s, h, s + 1, h, ELBOW_AT);
     Ok(Arm { clavicle: clavicle.then_some(chain[0]), upper: chain[s], fore: chain[e], hand: chain[h] })
