@@ -165,3 +165,30 @@ impl ClavicleOf for Roles {
         self.get(Role::Clavicle(Side::Left)).expect("the standard skeleton has clavicles")
     }
 }
+
+#[test]
+fn correspondence_maps_roles_chains_and_fingers_across_schemes() {
+    use inbetween_core::roles::correspondence;
+    let t = standard();
+    let tr = roles(&t);
+    // Renamed to Daz: every role and chain joint maps back to the same index; with detail the
+    // hip links and the longest finger chain too; the thumb has no counterpart of the same name.
+    let s = renamed(&t, Scheme::Daz);
+    let sr = roles(&s);
+    let plain = correspondence((&t, &tr), (&s, &sr), false);
+    let detail = correspondence((&t, &tr), (&s, &sr), true);
+    for (j, joint) in t.joints().iter().enumerate() {
+        let n = joint.name.as_str();
+        let expect_plain = tr.role_of(j).is_some() || tr.spine.contains(&j) || tr.neck.contains(&j);
+        assert_eq!(plain[j].is_some(), expect_plain, "{n}");
+        if expect_plain {
+            assert_eq!(plain[j], Some(j), "{n}");
+        }
+        let expect_detail =
+            expect_plain || n.contains("HipJoint") || n.contains("FingerBase") || n.contains("HandIndex");
+        assert_eq!(detail[j], expect_detail.then_some(j), "{n}");
+    }
+    // Onto itself every joint maps to itself (by role, chain or name).
+    let same = correspondence((&t, &tr), (&t, &tr), true);
+    assert!(same.iter().enumerate().all(|(j, m)| *m == Some(j)), "{same:?}");
+}

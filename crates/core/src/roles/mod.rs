@@ -354,19 +354,24 @@ impl Roles {
         ]
     }
 
-    /// The end of the hand's longest finger chain (CMU: `LeftHandIndex1`), `None` when the hand
-    /// has no children.
-    pub fn fingertip(&self, skeleton: &Skeleton, side: Side) -> Option<usize> {
-        let mut cur = self.joint(Role::Hand(side));
+    /// The hand's longest finger chain below it (CMU: `LeftFingerBase`, `LeftHandIndex1`), empty
+    /// when the hand has no children.
+    pub fn finger_chain(&self, skeleton: &Skeleton, side: Side) -> Vec<usize> {
         let reach = shape_reach(skeleton);
-        let mut moved = false;
-        while let Some(next) = skeleton.children(cur).max_by(|&a, &b| {
-            (skeleton.joint(a).offset.length() + reach[a]).total_cmp(&(skeleton.joint(b).offset.length() + reach[b]))
-        }) {
-            cur = next;
-            moved = true;
+        let through = |c: usize| skeleton.joint(c).offset.length() + reach[c];
+        let mut out = Vec::new();
+        let mut cur = self.get(Role::Hand(side));
+        while let Some(next) = cur.and_then(|c| skeleton.children(c).max_by(|&a, &b| through(a).total_cmp(&through(b))))
+        {
+            out.push(next);
+            cur = Some(next);
         }
-        moved.then_some(cur)
+        out
+    }
+
+    /// The end of [`Roles::finger_chain`] (CMU: `LeftHandIndex1`).
+    pub fn fingertip(&self, skeleton: &Skeleton, side: Side) -> Option<usize> {
+        self.finger_chain(skeleton, side).last().copied()
     }
 }
 
@@ -512,6 +517,56 @@ pub fn find_roles_posed(
     chain(Role::Chest, spine.last());
     chain(Role::Neck, neck.first());
     Ok(Roles { roles, spine, neck, scheme, notes })
+}
+
+/// For each joint of the `target` skeleton, the `source` joint that plays its part: the same role,
+/// the same place in the spine and neck chains (by index, spread evenly when the lengths differ),
+/// and else the joint of the same name. With `detail`, also the links between the hips and each
+/// thigh and the hand's longest finger chain, by index (a retargeter that corrects each bone
+/// towards its mapped children may want fingers left to follow the hand).
+pub fn correspondence(target: (&Skeleton, &Roles), source: (&Skeleton, &Roles), detail: bool) -> Vec<Option<usize>> {
+    let ((ts, tr), (ss, sr)) = (target, source);
+    let mut map: Vec<Option<usize>> = vec![None; ts.len()];
+    let mut chain = |t: &[usize], s: &[usize], map: &mut Vec<Option<usize>>| {
+        for (k, &j) in t.iter().enumerate() {
+            let at = if t.len() == s.len() || t.len() < 2 {
+                k
+            } else {
+                (k as f64 * (s.len() as f64 - 1.0) / (t.len() as f64 - 1.0)).round() as usize
+            };
+            if let Some(&sj) = s.get(at) {
+                map[j] = Some(sj);
+            }
+        }
+    };
+    chain(&tr.spine, &sr.spine, &mut map);
+    chain(&tr.neck, &sr.neck, &mut map);
+    if detail {
+        for side in Side::BOTH {
+            let (th, sh) = (tr.get(Role::Hips), sr.get(Role::Hips));
+            let (tt, st) = (tr.get(Role::Thigh(side)), sr.get(Role::Thigh(side)));
+            if let (Some(th), Some(sh), Some(tt), Some(st)) = (th, sh, tt, st) {
+                let links = |s: &Skeleton, h: usize, t: usize| {
+                    let mut p = path_below(s, h, t).unwrap_or_default();
+                    p.pop();
+                    p
+                };
+                chain(&links(ts, th, tt), &links(ss, sh, st), &mut map);
+            }
+            let (tf, sf) = (tr.finger_chain(ts, side), sr.finger_chain(ss, side));
+            let n = tf.len().min(sf.len());
+            chain(&tf[..n], &sf[..n], &mut map);
+        }
+    }
+    for (j, joint) in ts.joints().iter().enumerate() {
+        if map[j].is_none() && tr.role_of(j).is_none() {
+            map[j] = ss.find(&joint.name).filter(|&sj| sr.role_of(sj).is_none());
+        }
+    }
+    for (role, a) in &tr.roles {
+        map[a.joint] = sr.get(*role);
+    }
+    map
 }
 
 /// Each limb's joints must run down the hierarchy: a name or shape read wrongly shows here.
