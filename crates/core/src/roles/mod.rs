@@ -527,7 +527,7 @@ pub fn find_roles_posed(
 pub fn correspondence(target: (&Skeleton, &Roles), source: (&Skeleton, &Roles), detail: bool) -> Vec<Option<usize>> {
     let ((ts, tr), (ss, sr)) = (target, source);
     let mut map: Vec<Option<usize>> = vec![None; ts.len()];
-    let mut chain = |t: &[usize], s: &[usize], map: &mut Vec<Option<usize>>| {
+    let chain = |t: &[usize], s: &[usize], map: &mut Vec<Option<usize>>| {
         for (k, &j) in t.iter().enumerate() {
             let at = if t.len() == s.len() || t.len() < 2 {
                 k
