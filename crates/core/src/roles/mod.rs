@@ -521,9 +521,10 @@ pub fn find_roles_posed(
 
 /// For each joint of the `target` skeleton, the `source` joint that plays its part: the same role,
 /// the same place in the spine and neck chains (by index, spread evenly when the lengths differ),
-/// and else the joint of the same name. With `detail`, also the links between the hips and each
-/// thigh and the hand's longest finger chain, by index (a retargeter that corrects each bone
-/// towards its mapped children may want fingers left to follow the hand).
+/// and else the joint of the same name (case aside: CMU's ASF `lthumb` is its BVH `LThumb`). With
+/// `detail`, also the links between the hips and each thigh and the hand's longest finger chain, by
+/// index (a retargeter that corrects each bone towards its mapped children may want fingers left to
+/// follow the hand).
 pub fn correspondence(target: (&Skeleton, &Roles), source: (&Skeleton, &Roles), detail: bool) -> Vec<Option<usize>> {
     let ((ts, tr), (ss, sr)) = (target, source);
     let mut map: Vec<Option<usize>> = vec![None; ts.len()];
@@ -560,7 +561,10 @@ pub fn correspondence(target: (&Skeleton, &Roles), source: (&Skeleton, &Roles), 
     }
     for (j, joint) in ts.joints().iter().enumerate() {
         if map[j].is_none() && tr.role_of(j).is_none() {
-            map[j] = ss.find(&joint.name).filter(|&sj| sr.role_of(sj).is_none());
+            let same = ss
+                .find(&joint.name)
+                .or_else(|| ss.joints().iter().position(|sj| sj.name.eq_ignore_ascii_case(&joint.name)));
+            map[j] = same.filter(|&sj| sr.role_of(sj).is_none());
         }
     }
     for (role, a) in &tr.roles {
