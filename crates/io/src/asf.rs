@@ -53,46 +53,8 @@ pub fn parse_asf_amc(asf_text: &str, amc_text: &str, asf_name: &str, amc_name: &
     Motion::new(skeleton, AMC_FRAME_TIME, data).map_err(|e| invalid(amc_name, 1, e.to_string()))
 }
 
-/// The cgspeed BVH name of a CMU ASF bone (`lfemur` → `LeftUpLeg`), for comparing both encodings.
-pub fn cmu_bvh_name(asf_bone: &str) -> Option<&'static str> {
-    const MAP: [(&str, &str); 31] = [
-        ("root", "Hips"),
-        ("lhipjoint", "LHipJoint"),
-        ("lfemur", "LeftUpLeg"),
-        ("ltibia", "LeftLeg"),
-        ("lfoot", "LeftFoot"),
-        ("ltoes", "LeftToeBase"),
-        ("rhipjoint", "RHipJoint"),
-        ("rfemur", "RightUpLeg"),
-        ("rtibia", "RightLeg"),
-        ("rfoot", "RightFoot"),
-        ("rtoes", "RightToeBase"),
-        ("lowerback", "LowerBack"),
-        ("upperback", "Spine"),
-        ("thorax", "Spine1"),
-        ("lowerneck", "Neck"),
-        ("upperneck", "Neck1"),
-        ("head", "Head"),
-        ("lclavicle", "LeftShoulder"),
-        ("lhumerus", "LeftArm"),
-        ("lradius", "LeftForeArm"),
-        ("lwrist", "LeftHand"),
-        ("lhand", "LeftFingerBase"),
-        ("lfingers", "LFingers"),
-        ("lthumb", "LThumb"),
-        ("rclavicle", "RightShoulder"),
-        ("rhumerus", "RightArm"),
-        ("rradius", "RightForeArm"),
-        ("rwrist", "RightHand"),
-        ("rhand", "RightFingerBase"),
-        ("rfingers", "RFingers"),
-        ("rthumb", "RThumb"),
-    ];
-    MAP.iter().find(|(a, _)| *a == asf_bone).map(|(_, b)| *b)
-}
-
 /// The skeleton file for an AMC file: CMU naming (`01_01.amc` → `01.asf`) or the same stem.
-pub(crate) fn find_asf_for(amc: &Path) -> Result<PathBuf, IoError> {
+pub fn find_asf_for(amc: &Path) -> Result<PathBuf, IoError> {
     let dir = amc.parent().unwrap_or(Path::new(""));
     let stem = amc.file_stem().and_then(|s| s.to_str()).unwrap_or("");
     let mut tried = Vec::new();

@@ -53,24 +53,34 @@ fn both_cmu_asf_amc_pairs_load() {
     });
 }
 
-/// Per-joint position differences in cm between two clips, joints matched by CMU name.
+/// For each joint of `a`, the joint of `b` that plays its part ([`correspondence`] with detail: roles,
+/// spine and neck chains, hip links, finger chains, names).
+fn joint_map(a: &inbetween_core::Motion, b: &inbetween_core::Motion) -> Vec<usize> {
+    use inbetween_core::roles::{correspondence, find_motion_roles, RoleOverrides};
+    let ra = find_motion_roles(a, &RoleOverrides::default()).unwrap();
+    let rb = find_motion_roles(b, &RoleOverrides::default()).unwrap();
+    let map = correspondence((&a.skeleton, &ra), (&b.skeleton, &rb), true);
+    map.iter()
+        .enumerate()
+        .map(|(j, m)| m.unwrap_or_else(|| panic!("no match for {}", a.skeleton.joint(j).name)))
+        .collect()
+}
+
+/// Per-joint position differences in cm between two clips, joints matched by [`joint_map`] and
+/// named as in `bvh`.
 fn joint_differences_cm(amc: &inbetween_core::Motion, bvh: &inbetween_core::Motion) -> Vec<(String, f64, f64)> {
     use inbetween_core::positions_clip;
     use inbetween_core::procedural::CM_PER_CMU_UNIT;
-    use inbetween_io::asf::cmu_bvh_name;
     let pa = positions_clip(amc);
     let pb = positions_clip(bvh);
-    amc.skeleton
-        .joints()
-        .iter()
-        .enumerate()
-        .map(|(ja, joint)| {
-            let name = cmu_bvh_name(&joint.name).expect("CMU bone");
-            let jb = bvh.skeleton.find(name).unwrap_or_else(|| panic!("{name} in BVH"));
+    let map = joint_map(amc, bvh);
+    (0..amc.skeleton.len())
+        .map(|ja| {
+            let jb = map[ja];
             let d: Vec<f64> = pa.iter().zip(&pb).map(|(a, b)| (a[ja] - b[jb]).length() * CM_PER_CMU_UNIT).collect();
             let mean = d.iter().sum::<f64>() / d.len() as f64;
             let max = d.iter().cloned().fold(0.0, f64::max);
-            (name.to_string(), mean, max)
+            (bvh.skeleton.joint(jb).name.clone(), mean, max)
         })
         .collect()
 }
@@ -89,7 +99,6 @@ fn summary(rows: &[(String, f64, f64)]) -> (f64, f64) {
 #[test]
 fn asf_amc_matches_cgspeed_bvh_of_the_same_take() {
     use inbetween_core::{Joint, Motion, Skeleton};
-    use inbetween_io::asf::cmu_bvh_name;
     with_shared_data("CMU 01_01 in both encodings", |data| {
         let cmu = data.join("mocap/cmu");
         let amc = load_motion(&cmu.join("asf_amc/01_01.amc")).unwrap();
@@ -109,14 +118,13 @@ fn asf_amc_matches_cgspeed_bvh_of_the_same_take() {
             amc.num_frames()
         );
 
+        let map = joint_map(&amc, &bvh);
         let with_cgspeed_offsets: Vec<Joint> = amc
             .skeleton
             .joints()
             .iter()
-            .map(|j| {
-                let b = bvh.skeleton.find(cmu_bvh_name(&j.name).unwrap()).unwrap();
-                Joint { offset: bvh.skeleton.joint(b).offset, ..j.clone() }
-            })
+            .zip(&map)
+            .map(|(j, &b)| Joint { offset: bvh.skeleton.joint(b).offset, ..j.clone() })
             .collect();
         let aligned =
             Motion::new(Skeleton::new(with_cgspeed_offsets).unwrap(), amc.frame_time, amc.data().to_vec()).unwrap();
