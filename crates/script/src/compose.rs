@@ -12,12 +12,12 @@ use std::time::Instant;
 use crate::catalogue::{Catalogue, Support};
 use crate::database::{Placement, SceneDatabase};
 use crate::error::Diagnostic;
-use crate::layout::{self, LayoutConstraint, LayoutItem, LayoutProblem, Violations};
+use crate::layout::{self, LayoutConstraint, LayoutItem, LayoutPlace, LayoutProblem, RoomPlace, Violations};
 use crate::matching::{self, MatchMap};
 use crate::parse::ParsedScript;
 use crate::scene::{Origin, PlacedObject, Room, Scene};
 use crate::script::SentenceKind;
-use crate::ssg::{Command, NodeId, Relation, Ssg};
+use crate::ssg::{Command, NodeId, Place, PlaceNode, Relation, Ssg};
 
 /// Which matcher picks the database sub-graphs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -127,8 +127,21 @@ pub fn sized(size: [f32; 3], attributes: &[String]) -> [f32; 3] {
             }
         }
     }
+    // Shape words (issue 39): a round or square top is as deep as it is wide (a round table is
+    // drawn as its square bounding box), a long one half as long again.
+    if attributes.iter().any(|a| matches!(a.as_str(), "round" | "square" | "circular")) {
+        let side = (out[0] + out[2]) / 2.0;
+        out[0] = side;
+        out[2] = side;
+    }
+    if attributes.iter().any(|a| matches!(a.as_str(), "long" | "rectangular")) {
+        out[0] *= SHAPE_LONG;
+    }
     out
 }
+
+/// How much longer a "long" object is than its category's default width.
+pub const SHAPE_LONG: f32 = 1.5;
 
 /// Builds the query SSG: every scene sentence's graph, then the objects that direction sentences
 /// target and no scene sentence names (a character walking "to the house" needs a house).
@@ -145,7 +158,13 @@ pub fn query_graph(parsed: &ParsedScript) -> Ssg {
         let lower = s.raw.at.text.to_lowercase();
         let mut remap: Vec<NodeId> = Vec::with_capacity(s.ssg.objects.len());
         for o in &s.ssg.objects {
-            let existing = query.objects.iter().rposition(|q| q.category == o.category);
+            // "the table" after "a dining table" is that table: the same category, else one
+            // whose name ends in it (diningtable, coffeetable; floorlamp for "the lamp").
+            let existing = query
+                .objects
+                .iter()
+                .rposition(|q| q.category == o.category)
+                .or_else(|| query.objects.iter().rposition(|q| q.category.ends_with(&o.category)));
             match existing {
                 Some(q) if direction || is_definite(&lower, &o.word) => remap.push(q),
                 _ => {
@@ -159,9 +178,17 @@ pub fn query_graph(parsed: &ParsedScript) -> Ssg {
         }
         for r in &s.ssg.relations {
             let (active, anchor) = (remap[r.active], remap[r.anchor]);
-            if active != anchor {
+            // A node related to itself is "each other" (two armchairs face each other).
+            if active != anchor || r.active == r.anchor {
                 query.relations.push(crate::ssg::RelationNode { active, anchor, ..r.clone() });
             }
+        }
+        for p in &s.ssg.places {
+            let place = match p.place {
+                Place::Between { first, second } => Place::Between { first: remap[first], second: remap[second] },
+                other => other,
+            };
+            query.places.push(PlaceNode { place, active: remap[p.active], ..p.clone() });
         }
         for c in &s.ssg.characters {
             let mut c = c.clone();
@@ -315,11 +342,52 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
     }
     let mut constraints = Vec::new();
     for r in &query.relations {
-        for &a in &instances[r.active] {
-            // Several actives share one anchor: "two lamps on the desk" puts both on the desk.
-            if let Some(&b) = instances[r.anchor].first() {
-                constraints.push(LayoutConstraint { relation: r.relation, active: a, anchor: b });
+        let mine = &instances[r.active];
+        if r.active == r.anchor {
+            // "each other": every instance to the next one.
+            for (k, &a) in mine.iter().enumerate().filter(|_| mine.len() > 1) {
+                constraints.push(LayoutConstraint {
+                    relation: r.relation,
+                    active: a,
+                    anchor: mine[(k + 1) % mine.len()],
+                });
             }
+            continue;
+        }
+        for (k, &a) in mine.iter().enumerate() {
+            // Several actives share one anchor: "two lamps on the desk" puts both on the desk;
+            // "on either side" gives them its sides in turn, "around" its edges.
+            let relation = match r.relation {
+                Relation::EitherSide if k % 2 == 0 => Relation::LeftOf,
+                Relation::EitherSide => Relation::RightOf,
+                Relation::Around => Relation::At,
+                r => r,
+            };
+            if let Some(&b) = instances[r.anchor].first() {
+                constraints.push(LayoutConstraint { relation, active: a, anchor: b });
+            }
+        }
+    }
+    let mut places = Vec::new();
+    for p in &query.places {
+        let place = match p.place {
+            Place::Middle => RoomPlace::Middle,
+            Place::Corner => RoomPlace::Corner,
+            Place::Wall => RoomPlace::Wall,
+            Place::Door => RoomPlace::Door,
+            Place::Between { first, second } => {
+                // "between the armchairs": the first two instances of one plural node.
+                let (a, b) = if first == second {
+                    (instances[first].first(), instances[first].get(1))
+                } else {
+                    (instances[first].first(), instances[second].first())
+                };
+                let (Some(&a), Some(&b)) = (a, b) else { continue };
+                RoomPlace::Between(a, b)
+            }
+        };
+        for &item in &instances[p.active] {
+            places.push(LayoutPlace { place, item });
         }
     }
 
@@ -367,7 +435,7 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
 
     let t1 = Instant::now();
     let n_script = items.iter().filter(|i| matches!(i.origin, Origin::Script { .. })).count();
-    let solved = solve_layout(&room, &items, &constraints, n_script, cfg.seed);
+    let solved = solve_layout(&room, &items, &constraints, &places, n_script, cfg.seed);
     let t_layout = t1.elapsed().as_secs_f64();
 
     let mut diagnostics = input.parsed.diagnostics.clone();
@@ -402,6 +470,7 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
         .iter()
         .filter_map(|c| Some((c.relation, solved.placed[c.active]?, solved.placed[c.anchor]?)))
         .collect();
+    diagnostics.extend(unkept(input.parsed, &items, &constraints, &places, &solved, &room));
     let mut keys = vec![(ObjectKey { category: String::new(), occurrence: 0 }, String::new()); solved.objects.len()];
     for (item, placed) in solved.placed.iter().enumerate() {
         if let Some(p) = placed {
@@ -432,6 +501,59 @@ pub fn compose(input: &ComposeInput, cfg: &ComposeConfig) -> Composition {
     }
 }
 
+/// A warning for every relation and place of the script's own objects that the layout could not
+/// keep (issue 39: every phrase is realised or named in a warning).
+fn unkept(
+    parsed: &ParsedScript,
+    items: &[LayoutItem],
+    constraints: &[LayoutConstraint],
+    places: &[LayoutPlace],
+    solved: &Solved,
+    room: &Room,
+) -> Vec<Diagnostic> {
+    let object = |i: usize| solved.placed[i].map(|p| &solved.objects[p]);
+    let sentence_of = |i: usize| match items[i].origin {
+        Origin::Script { sentence, .. } => parsed.sentences.iter().find(|s| s.raw.at.sentence == sentence + 1),
+        Origin::Database { .. } => None,
+    };
+    let mut out = Vec::new();
+    let mut warn = |i: usize, phrase: &str, message: String| {
+        if let Some(s) = sentence_of(i) {
+            out.push(Diagnostic {
+                at: s.raw.at.clone(),
+                word: Some(phrase.to_string()),
+                message,
+                suggestions: Vec::new(),
+            });
+        }
+    };
+    for c in constraints {
+        let (Some(a), Some(b)) = (object(c.active), object(c.anchor)) else { continue };
+        if !layout::relation_holds(c.relation, a, b) {
+            let phrase = c.relation.phrase();
+            warn(
+                c.active,
+                phrase,
+                format!("'{}' {phrase} '{}' not kept: no free place in the room keeps it", a.label, b.label),
+            );
+        }
+    }
+    for p in places {
+        let Some(o) = object(p.item) else { continue };
+        if !layout::place_holds(p.place, o, room, object) {
+            let phrase = match p.place {
+                RoomPlace::Middle => "in the middle of the room",
+                RoomPlace::Corner => "in the corner",
+                RoomPlace::Wall => "against the wall",
+                RoomPlace::Door => "by the door",
+                RoomPlace::Between(..) => "between",
+            };
+            warn(p.item, phrase, format!("'{}' {phrase} not kept: no free place in the room keeps it", o.label));
+        }
+    }
+    out
+}
+
 /// A layout where the script's objects come first.
 struct Solved {
     objects: Vec<PlacedObject>,
@@ -450,6 +572,7 @@ fn solve_layout(
     room: &Room,
     items: &[LayoutItem],
     constraints: &[LayoutConstraint],
+    places: &[LayoutPlace],
     n_script: usize,
     seed: u64,
 ) -> Solved {
@@ -471,7 +594,17 @@ fn solve_layout(
                 Some(LayoutConstraint { active: *index.get(&c.active)?, anchor: *index.get(&c.anchor)?, ..*c })
             })
             .collect();
-        LayoutProblem { room: room.clone(), items, relations }
+        let places = places
+            .iter()
+            .filter_map(|p| {
+                let place = match p.place {
+                    RoomPlace::Between(a, b) => RoomPlace::Between(*index.get(&a)?, *index.get(&b)?),
+                    other => other,
+                };
+                Some(LayoutPlace { place, item: *index.get(&p.item)? })
+            })
+            .collect();
+        LayoutProblem { room: room.clone(), items, relations, places }
     };
     let script: Vec<usize> = (0..n_script).collect();
     let first = layout::solve(&sub(&script, &HashMap::new()), seed);

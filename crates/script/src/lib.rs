@@ -45,6 +45,7 @@ pub mod demo;
 #[cfg(feature = "embeddings")]
 pub mod embed;
 pub mod error;
+pub mod fidelity;
 pub mod invariants;
 pub mod job;
 pub mod layout;

@@ -29,9 +29,32 @@ pub enum Relation {
     In,
     /// Behind the anchor.
     Behind,
+    /// Touching the anchor's side, back or front ("a cabinet is against the desk"). This and the
+    /// relations below are the text's words from issue 39 on; database scenes are described with
+    /// the eight above ([`Relation::ALL`]).
+    Against,
+    /// Across from the anchor: past its front, turned to face it ("a desk is opposite the bed").
+    Opposite,
+    /// Turned to face the anchor, wherever it stands ("an armchair faces the TV").
+    Facing,
+    /// Beside the anchor on its own left (as someone using it sees it: +x of its frame).
+    LeftOf,
+    /// Beside the anchor on its own right (−x of its frame).
+    RightOf,
+    /// At one of the anchor's edges, facing it, where a person uses it ("two chairs at the
+    /// table"; one seat "at" something keeps [`Relation::InFrontOf`]).
+    At,
+    /// Several things on both sides of the anchor: composition gives each instance
+    /// [`Relation::LeftOf`] or [`Relation::RightOf`] in turn ("two nightstands on either side of the
+    /// bed").
+    EitherSide,
+    /// Several things round the anchor, each [`Relation::At`] one of its edges ("four chairs
+    /// around the table").
+    Around,
 }
 
 impl Relation {
+    /// The relations database scenes are described with (derived from their placements).
     pub const ALL: [Relation; 8] = [
         Relation::On,
         Relation::Near,
@@ -54,8 +77,53 @@ impl Relation {
             Relation::Above => "above",
             Relation::In => "in",
             Relation::Behind => "behind",
+            Relation::Against => "against",
+            Relation::Opposite => "opposite",
+            Relation::Facing => "facing",
+            Relation::LeftOf => "to the left of",
+            Relation::RightOf => "to the right of",
+            Relation::At => "at",
+            Relation::EitherSide => "on either side of",
+            Relation::Around => "around",
         }
     }
+}
+
+/// Where in the room an object goes, or between which two objects (issue 39).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Place {
+    /// "in the middle / centre of the room".
+    Middle,
+    /// "in a / the corner": against two walls that meet.
+    Corner,
+    /// "against / along the wall": its back to a wall, facing into the room.
+    Wall,
+    /// "by / near the door": within a metre of the door (the middle of the z = depth wall).
+    Door,
+    /// "between X and Y": on the line joining their centres, away from both ends.
+    Between { first: NodeId, second: NodeId },
+}
+
+impl Place {
+    /// The words as written in a script.
+    pub fn phrase(self) -> &'static str {
+        match self {
+            Place::Middle => "in the middle of the room",
+            Place::Corner => "in the corner",
+            Place::Wall => "against the wall",
+            Place::Door => "by the door",
+            Place::Between { .. } => "between",
+        }
+    }
+}
+
+/// A place node: `active` stands at `place`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlaceNode {
+    pub place: Place,
+    pub active: NodeId,
+    pub sentence: usize,
 }
 
 /// An object node: one category, with the attributes the text gives it ("organized", "office").
@@ -108,6 +176,10 @@ pub struct Action {
     /// normalised preposition and the object, when a second object follows the target.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub destination: Option<(String, NodeId)>,
+    /// The character the action is done to or with ("sits next to *Ben*", "talks to *him*"), as
+    /// named (issue 39).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub person: Option<String>,
 }
 
 /// Verbal commands (§3.2): camera placement, weather, time of day.
@@ -129,6 +201,9 @@ pub struct Ssg {
     pub room: Option<String>,
     pub objects: Vec<ObjectNode>,
     pub relations: Vec<RelationNode>,
+    /// Room places and "between" (issue 39).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub places: Vec<PlaceNode>,
     pub characters: Vec<CharacterNode>,
     pub commands: Vec<Command>,
 }
@@ -156,10 +231,21 @@ impl Ssg {
             r.anchor += offset;
             r
         }));
+        self.places.extend(other.places.into_iter().map(|mut p| {
+            p.active += offset;
+            if let Place::Between { first, second } = &mut p.place {
+                *first += offset;
+                *second += offset;
+            }
+            p
+        }));
         self.characters.extend(other.characters.into_iter().map(|mut c| {
             for a in &mut c.actions {
                 if let Some(t) = &mut a.target {
                     *t += offset;
+                }
+                if let Some((_, d)) = &mut a.destination {
+                    *d += offset;
                 }
             }
             c

@@ -41,7 +41,7 @@ fn database_scenes_lay_out_cleanly_from_their_hints() {
             .iter()
             .map(|r| LayoutConstraint { relation: r.relation, active: r.active, anchor: r.anchor })
             .collect();
-        let p = LayoutProblem { room: s.room.clone(), items, relations };
+        let p = LayoutProblem { room: s.room.clone(), items, relations, places: vec![] };
         let t = std::time::Instant::now();
         let out = solve(&p, 1);
         let ms = t.elapsed().as_secs_f64() * 1e3;

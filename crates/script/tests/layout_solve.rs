@@ -68,6 +68,7 @@ fn problem(items: Vec<LayoutItem>, rels: &[(Relation, usize, usize)]) -> LayoutP
             .iter()
             .map(|&(relation, active, anchor)| LayoutConstraint { relation, active, anchor })
             .collect(),
+        places: vec![],
     }
 }
 
@@ -278,7 +279,7 @@ proptest! {
                 (Relation::ALL[(h >> 16) as usize % 8], active, anchor)
             })
             .collect();
-        let p = LayoutProblem { room: room(6.0, 5.0), items, relations: rels.iter().map(|&(relation, active, anchor)| LayoutConstraint { relation, active, anchor }).collect() };
+        let p = LayoutProblem { room: room(6.0, 5.0), items, relations: rels.iter().map(|&(relation, active, anchor)| LayoutConstraint { relation, active, anchor }).collect(), places: vec![] };
         let out = solve(&p, seed);
         prop_assert!(out.violations.overlaps.is_empty(), "{:?}", out.violations);
         prop_assert!(out.violations.outside.is_empty());
@@ -301,7 +302,7 @@ proptest! {
         let items: Vec<LayoutItem> = sizes.iter().enumerate().map(|(k, &(x, y, z, s))| item(&format!("thing {k}"), [x, y, z], supports[s as usize], k % 2 == 0)).collect();
         let n = items.len();
         let rels: Vec<LayoutConstraint> = (1..n).map(|k| LayoutConstraint { relation: Relation::ALL[k % 8], active: k, anchor: k - 1 }).collect();
-        let p = LayoutProblem { room: Room { name: "r".into(), width: w, depth: d, height: 2.5 }, items, relations: rels };
+        let p = LayoutProblem { room: Room { name: "r".into(), width: w, depth: d, height: 2.5 }, items, relations: rels, places: vec![] };
         let out = solve(&p, seed);
         prop_assert_eq!(out.objects.len() + out.dropped.len(), n);
         prop_assert!(out.violations.overlaps.is_empty());

@@ -96,11 +96,13 @@ fn keyboard_case() -> (Scene, Ssg, Vec<(Relation, usize, usize)>) {
         target: Some(target),
         manner: vec![],
         destination: None,
+        person: None,
     };
     let query = Ssg {
         room: None,
         objects: vec![node("desk"), node("keyboard")],
         relations: vec![],
+        places: vec![],
         characters: vec![CharacterNode {
             name: "Ann".into(),
             actions: vec![act("walk", 0), act("type", 1)],

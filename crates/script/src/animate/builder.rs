@@ -71,6 +71,8 @@ pub(crate) struct Builder<'a> {
     pub slides: Vec<super::Slide>,
     /// What could not be done as asked.
     pub notes: Vec<String>,
+    /// While sitting next to someone: the seat nearest this point is taken.
+    pub sit_toward: Option<[f32; 2]>,
 }
 
 /// Smoothstep on [0, 1] (clamped): the core's one.
@@ -103,6 +105,7 @@ impl<'a> Builder<'a> {
             props: Vec::new(),
             slides: Vec::new(),
             notes: Vec::new(),
+            sit_toward: None,
         }
     }
 

@@ -239,6 +239,7 @@ pub fn verb_has_motion(verb: &str, manner: &[String], lib: &MotionLibrary) -> bo
         target: None,
         manner: manner.to_vec(),
         destination: None,
+        person: None,
     };
     action::plays(&action::Step::read(&a, None, lib, 0.0), lib)
 }

@@ -79,6 +79,19 @@ pub(crate) struct CharacterInput {
     pub avoid: Vec<[f32; 2]>,
     /// Per walk: how long to wait first and which route to take ([`crowd::separate`]).
     pub choices: Vec<WalkChoice>,
+    /// Where the characters planned before end up, for actions done to or with them ("sits next
+    /// to Ben", "walks to Tom").
+    pub people: Vec<Person>,
+}
+
+/// Another character as an action towards them sees it: where it ends up (root and heading at
+/// its track's last frame) and the seat it sits on, if any.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Person {
+    pub name: String,
+    pub pos: [f32; 2],
+    pub heading: f64,
+    pub seated: bool,
 }
 
 /// Everything needed to rebuild one character with other walk choices, and what it built.
@@ -157,13 +170,23 @@ pub(crate) fn animate_planned(
             g.block_rect(*p, [0.0, 0.0], 0.0, PASSING_DISTANCE + grid::CELL);
         }
         let starts: Vec<[f32; 2]> = plans.iter().map(|p| p.input.start).collect();
+        let people: Vec<Person> = plans
+            .iter()
+            .filter_map(|p| {
+                let pos = *p.traj.last()?;
+                let last = p.track.clip.num_frames().checked_sub(1)?;
+                let heading = crate::motion::locomotion::heading_at(&p.track.clip, last);
+                Some(Person { name: p.input.name.clone(), pos, heading, seated: p.end_spots.len() > 1 })
+            })
+            .collect();
         let start = start_spot(scene, cfg, &base_grid, &g, &starts, ci);
         let plan = match frozen.get(&name.to_lowercase()) {
             Some(p)
                 if p.input.start == start
                     && p.input.blocked_by == occupied
                     && p.input.avoid == spots
-                    && p.input.actions == actions =>
+                    && p.input.actions == actions
+                    && p.input.people == people =>
             {
                 resolved.push(false);
                 builds.push(0);
@@ -182,6 +205,7 @@ pub(crate) fn animate_planned(
                     grid: g,
                     avoid: spots.clone(),
                     choices: Vec::new(),
+                    people,
                 };
                 build_character(&ctx, input, cache)
             }
@@ -304,7 +328,18 @@ fn build(
         let mut step = Step::read(a, obj, ctx.lib, ctx.cfg.slow_speed);
         step.destination =
             a.destination.as_ref().and_then(|(p, n)| object_of_node(scene, query, *n).map(|o| (p.clone(), o)));
-        b.play(&step);
+        let person = a.person.as_ref().map(|n| (n, input.people.iter().find(|p| p.name.eq_ignore_ascii_case(n))));
+        match person {
+            Some((_, Some(p))) => b.play_towards(&step, p),
+            Some((n, None)) => {
+                b.notes.push(format!(
+                    "{}: \"{}\" is done towards {n}, who is not placed before {} acts (name them in an earlier sentence)",
+                    input.name, a.verb, input.name
+                ));
+                b.play(&step);
+            }
+            None => b.play(&step),
+        }
     }
     if b.frames.is_empty() {
         let n = b.min_action_frames();

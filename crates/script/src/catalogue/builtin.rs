@@ -35,7 +35,7 @@ const ROWS: &[Row] = &[
     ("officechair", &["deskchair", "swivelchair", "chairdesk"], "seat", [0.6, 1.0, 0.6], Floor, false, [60, 70, 90], &[(Seat, [0.0, 0.48, 0.0])]),
     ("stool", &["barstool", "footstool"], "seat", [0.4, 0.65, 0.4], Floor, false, [120, 100, 80], &[(Seat, [0.0, 0.65, 0.0])]),
     ("armchair", &["easychair", "recliner", "lounger"], "seat", [0.85, 0.95, 0.85], Floor, false, [130, 90, 110], &[(Seat, [0.0, 0.42, 0.05])]),
-    ("bench", &["parkbench", "gymbench"], "seat", [1.4, 0.45, 0.4], Floor, false, [110, 90, 70], &[(Seat, [0.0, 0.45, 0.0])]),
+    ("bench", &["parkbench", "gymbench"], "seat", [1.4, 0.45, 0.4], Floor, false, [110, 90, 70], &[(Seat, [0.0, 0.45, 0.0]), (Seat, [-0.45, 0.45, 0.0]), (Seat, [0.45, 0.45, 0.0])]),
     ("sofa", &["couch", "settee", "loungesofa", "loveseat"], "seat", [2.0, 0.85, 0.9], Floor, false, [120, 80, 130], &[(Seat, [0.0, 0.45, 0.05]), (Seat, [-0.55, 0.45, 0.05]), (Seat, [0.55, 0.45, 0.05])]),
     ("bed", &["singlebed", "doublebed", "bedsingle"], "bed", [1.6, 0.55, 2.1], Floor, false, [200, 200, 220], &[(Seat, [0.0, 0.55, 0.7])]),
     // Storage.

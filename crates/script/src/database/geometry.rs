@@ -92,9 +92,82 @@ fn in_front(a: &Placement, b: &Placement, sign: f32) -> bool {
         && lateral.abs() <= b.size[0] / 2.0 + a_half + FRONT_SLACK
 }
 
+/// Largest gap for [`Relation::Against`], metres.
+pub const AGAINST_GAP: f32 = 0.05;
+/// Largest gap for [`Relation::LeftOf`], [`Relation::RightOf`] and [`Relation::EitherSide`], metres.
+pub const SIDE_GAP: f32 = 0.5;
+/// Largest gap for [`Relation::At`] and [`Relation::Around`] (at an edge), metres.
+pub const AT_GAP: f32 = 0.3;
+/// [`Relation::Opposite`] and [`Relation::Facing`]: at most this far, metres; "opposite" at least
+/// [`OPPOSITE_MIN_GAP`] away.
+pub const FACING_REACH: f32 = 4.0;
+pub const OPPOSITE_MIN_GAP: f32 = 0.3;
+/// Turned at most this far (degrees) from the direction to the anchor's centre to face it.
+pub const FACING_DEG: f32 = 45.0;
+
+/// Angle (degrees, 0–180) between the front of something at `from` turned by `yaw` (yaw 0 faces
+/// +z) and the direction to `to` (0 when the points coincide). One definition for the layout's
+/// facing, these relations and the fidelity checks.
+pub fn turned_from(from: [f32; 2], yaw: f32, to: [f32; 2]) -> f32 {
+    let d = [to[0] - from[0], to[1] - from[1]];
+    let len = d[0].hypot(d[1]);
+    if len < 1e-3 {
+        return 0.0;
+    }
+    let f = [yaw.sin(), yaw.cos()];
+    ((f[0] * d[0] + f[1] * d[1]) / len).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// Where point `c` lies along the segment from `p` to `q`: the fraction of the way its projection
+/// is (0 at `p`, 1 at `q`) and its distance off the line, metres ("between").
+pub fn along_segment(p: [f32; 2], q: [f32; 2], c: [f32; 2]) -> (f32, f32) {
+    let d = [q[0] - p[0], q[1] - p[1]];
+    let len2 = (d[0] * d[0] + d[1] * d[1]).max(1e-6);
+    let t = ((c[0] - p[0]) * d[0] + (c[1] - p[1]) * d[1]) / len2;
+    let off = ((c[0] - p[0]) * d[1] - (c[1] - p[1]) * d[0]).abs() / len2.sqrt();
+    (t, off)
+}
+
+/// Angle (degrees) between a's front and the direction from a's centre to b's.
+pub fn facing_deg(a: &Placement, b: &Placement) -> f32 {
+    turned_from([a.position[0], a.position[2]], a.yaw, [b.position[0], b.position[2]])
+}
+
+/// Which side of b a's centre lies on, in b's frame scaled by b's half extents: +1 on b's own
+/// left (+x), −1 on its right, 0 in front or behind.
+pub fn lateral_side(a: &Placement, b: &Placement) -> i8 {
+    let (forward, lateral, _) = frontal(a, b);
+    let x = lateral / (b.size[0] / 2.0).max(0.1);
+    let z = forward / (b.size[2] / 2.0).max(0.1);
+    if x.abs() < z.abs() {
+        0
+    } else if x > 0.0 {
+        1
+    } else {
+        -1
+    }
+}
+
+fn level(a: &Placement, b: &Placement) -> bool {
+    a.position[1] < top(b) - EPS && b.position[1] < top(a) - EPS
+}
+
 /// Whether `rel` holds with `a` active and `b` anchor (definitions in the module docs).
 pub fn holds(rel: Relation, a: &Placement, b: &Placement) -> bool {
     match rel {
+        Relation::Against => gap(a, b) <= AGAINST_GAP && level(a, b),
+        Relation::Opposite => {
+            let (forward, _, _) = frontal(a, b);
+            let g = gap(a, b);
+            forward >= b.size[2] / 2.0
+                && (OPPOSITE_MIN_GAP..=FACING_REACH).contains(&g)
+                && facing_deg(a, b) <= FACING_DEG
+        }
+        Relation::Facing => gap(a, b) <= FACING_REACH && facing_deg(a, b) <= FACING_DEG,
+        Relation::LeftOf => gap(a, b) <= SIDE_GAP && lateral_side(a, b) == 1,
+        Relation::RightOf => gap(a, b) <= SIDE_GAP && lateral_side(a, b) == -1,
+        Relation::EitherSide => gap(a, b) <= SIDE_GAP && lateral_side(a, b) != 0,
+        Relation::At | Relation::Around => gap(a, b) <= AT_GAP && facing_deg(a, b) <= FACING_DEG,
         Relation::On => (a.position[1] - top(b)).abs() <= EPS && centre_inside(a, b),
         Relation::In => footprint_inside(a, b) && a.position[1] >= b.position[1] - EPS && a.position[1] < top(b) - EPS,
         Relation::Under => {

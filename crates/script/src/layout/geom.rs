@@ -16,13 +16,7 @@ pub fn forward(yaw: f32) -> [f32; 2] {
 /// Angle (degrees, 0–180) between `active`'s front and the direction from it to `anchor`'s
 /// centre (0 when the centres coincide).
 pub fn facing_angle(active: &PlacedObject, anchor: &PlacedObject) -> f32 {
-    let to = [anchor.position[0] - active.position[0], anchor.position[2] - active.position[2]];
-    let len = to[0].hypot(to[1]);
-    if len < 1e-3 {
-        return 0.0;
-    }
-    let f = forward(active.yaw);
-    ((f[0] * to[0] + f[1] * to[1]) / len).clamp(-1.0, 1.0).acos().to_degrees()
+    crate::database::geometry::turned_from(center(active), active.yaw, center(anchor))
 }
 
 /// Largest [`facing_angle`] at which "in front of X" counts as facing X, degrees.

@@ -73,11 +73,91 @@ pub struct LayoutConstraint {
     pub anchor: usize,
 }
 
+/// Where an item must stand, in the room or between two items (issue 39; the SSG's
+/// [`crate::ssg::Place`] with item indices).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RoomPlace {
+    /// Its centre within [`middle_tolerance`] of the room's centre.
+    Middle,
+    /// Within [`CORNER_GAP`] of two walls that meet.
+    Corner,
+    /// Its back within [`WALL_GAP`] of a wall.
+    Wall,
+    /// Its footprint within [`DOOR_REACH`] of the door.
+    Door,
+    /// Its centre on the line joining the two items' centres, in the middle 80 %, within
+    /// [`BETWEEN_OFFSET`] of the line.
+    Between(usize, usize),
+}
+
+/// `items[item]` stands at `place`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LayoutPlace {
+    pub place: RoomPlace,
+    pub item: usize,
+}
+
+/// [`RoomPlace::Corner`]: largest gap to each of the two walls, metres.
+pub const CORNER_GAP: f32 = 0.15;
+/// [`RoomPlace::Wall`]: largest gap between the item's back and the wall, metres.
+pub const WALL_GAP: f32 = 0.1;
+/// [`RoomPlace::Door`]: largest distance from the door to the footprint, metres.
+pub const DOOR_REACH: f32 = 1.0;
+/// [`RoomPlace::Between`]: largest distance from the line between the two, metres.
+pub const BETWEEN_OFFSET: f32 = 0.6;
+
+/// [`RoomPlace::Middle`]: largest distance from the room's centre, metres (12 % of the smaller
+/// side, at least 0.5 m).
+pub fn middle_tolerance(room: &Room) -> f32 {
+    (0.12 * room.width.min(room.depth)).max(0.5)
+}
+
+/// Whether `o` stands at `place` (`item` gives the placed object of an item index).
+pub fn place_holds<'a>(
+    place: RoomPlace,
+    o: &PlacedObject,
+    room: &Room,
+    item: impl Fn(usize) -> Option<&'a PlacedObject>,
+) -> bool {
+    let c = geom::center(o);
+    match place {
+        RoomPlace::Middle => (c[0] - room.width / 2.0).hypot(c[1] - room.depth / 2.0) <= middle_tolerance(room),
+        RoomPlace::Corner => {
+            let [hx, hz] = o.half_extents_xz();
+            let gx = (c[0] - hx).min(room.width - c[0] - hx);
+            let gz = (c[1] - hz).min(room.depth - c[1] - hz);
+            gx <= CORNER_GAP && gz <= CORNER_GAP
+        }
+        RoomPlace::Wall => wall_gap(o, room) <= WALL_GAP,
+        RoomPlace::Door => {
+            let d = geom::to_local(c, o.yaw, door(room));
+            let dx = (d[0].abs() - o.size[0] / 2.0).max(0.0);
+            let dz = (d[1].abs() - o.size[2] / 2.0).max(0.0);
+            dx.hypot(dz) <= DOOR_REACH
+        }
+        RoomPlace::Between(a, b) => {
+            let (Some(a), Some(b)) = (item(a), item(b)) else { return false };
+            let (t, off) = crate::database::geometry::along_segment(geom::center(a), geom::center(b), c);
+            t > 0.1 && t < 0.9 && off <= BETWEEN_OFFSET
+        }
+    }
+}
+
+/// Distance from an object's back (the middle of its back edge) to the nearest wall, metres.
+pub fn wall_gap(o: &PlacedObject, room: &Room) -> f32 {
+    let f = geom::forward(o.yaw);
+    let d = o.size[2] / 2.0;
+    let back = [o.position[0] - f[0] * d, o.position[2] - f[1] * d];
+    [back[0], room.width - back[0], back[1], room.depth - back[1]].into_iter().fold(f32::INFINITY, f32::min)
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct LayoutProblem {
     pub room: Room,
     pub items: Vec<LayoutItem>,
     pub relations: Vec<LayoutConstraint>,
+    /// Places items must stand at (issue 39).
+    pub places: Vec<LayoutPlace>,
 }
 
 /// What went wrong in a layout (indices into the objects, or into the relation list for `unmet`).
@@ -91,11 +171,13 @@ pub struct Violations {
     pub outside: Vec<usize>,
     /// Floor objects whose front cannot be walked to from the door.
     pub unreachable: Vec<usize>,
+    /// Places not kept (indices into the problem's places; [`check`] leaves it empty).
+    pub unmet_places: Vec<usize>,
 }
 
 impl Violations {
     pub fn total(&self) -> usize {
-        self.overlaps.len() + self.unmet.len() + self.outside.len() + self.unreachable.len()
+        self.overlaps.len() + self.unmet.len() + self.outside.len() + self.unreachable.len() + self.unmet_places.len()
     }
 }
 
@@ -152,6 +234,14 @@ pub fn strictly_holds(rel: Relation, active: &PlacedObject, anchor: &PlacedObjec
             active.position[1] >= anchor.top() - EPS && geom::box_penetration(c, h, [0.0, 0.0], [aw, ad]) > 0.01
         }
         Relation::In => geom::footprint_inside(active, anchor) && active.position[1] >= anchor.position[1] - EPS,
+        Relation::Against
+        | Relation::Opposite
+        | Relation::Facing
+        | Relation::LeftOf
+        | Relation::RightOf
+        | Relation::EitherSide
+        | Relation::At
+        | Relation::Around => true,
     };
     held && relation_holds(rel, active, anchor)
 }
@@ -163,7 +253,7 @@ pub fn tucks(seat: &PlacedObject, anchor: &PlacedObject) -> bool {
 
 /// Whether a layout relation lets `a` and `b` share floor space as a tucked seat and its table.
 pub fn tucked_pair(rel: Relation, active: &PlacedObject, anchor: &PlacedObject) -> bool {
-    rel == Relation::InFrontOf && tucks(active, anchor)
+    matches!(rel, Relation::InFrontOf | Relation::At | Relation::Around) && tucks(active, anchor)
 }
 
 /// Relations under which two objects may share floor space (one rests on, hangs over, stands

@@ -82,7 +82,12 @@ fn placement_order(p: &LayoutProblem) -> Vec<usize> {
     }
     let support_depth = chain(&supports);
     // Then anchors before their actives.
-    let edges: Vec<(usize, usize)> = p.relations.iter().map(|c| (c.active, c.anchor)).collect();
+    let mut edges: Vec<(usize, usize)> = p.relations.iter().map(|c| (c.active, c.anchor)).collect();
+    for pl in &p.places {
+        if let RoomPlace::Between(a, b) = pl.place {
+            edges.extend([(pl.item, a), (pl.item, b)]);
+        }
+    }
     let depth = chain(&edges);
     let rank = |s: Support| match s {
         Support::Floor => 0,
@@ -100,6 +105,29 @@ fn placement_order(p: &LayoutProblem) -> Vec<usize> {
             .then(a.cmp(&b))
     });
     order
+}
+
+/// A side of an object, in its own frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Side {
+    Front,
+    Back,
+    /// Its own left (+x of its frame).
+    Left,
+    Right,
+}
+
+const SIDES: [Side; 4] = [Side::Front, Side::Back, Side::Left, Side::Right];
+
+/// How a pose beside an object is turned.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Face {
+    /// Its front to the object.
+    Toward,
+    /// Its back to the object.
+    Away,
+    /// As the object is turned.
+    Same,
 }
 
 /// A candidate pose for one item.
@@ -303,7 +331,13 @@ impl<'a, R: Rng> Solver<'a, R> {
                 .filter(|c| c.relation == Relation::InFrontOf && self.faces(c.active))
                 .filter(|c| geom::facing_angle(pair(c).0, pair(c).1) > geom::FACING_TOLERANCE_DEG)
                 .count();
-            let mut score = 100.0 * unmet as f32 + tidy + pose.penalty + 10.0 * turned_away as f32;
+            let away = self
+                .p
+                .places
+                .iter()
+                .filter(|pl| pl.item == i && !place_holds(pl.place, &obj, &self.p.room, |k| self.poses[k].as_ref()))
+                .count();
+            let mut score = 100.0 * (unmet + away) as f32 + tidy + pose.penalty + 10.0 * turned_away as f32;
             if grid::blocks_walking(&obj) && self.in_door_zone(&obj) {
                 // Furnishing never stands in the doorway; the script's own objects only when no
                 // other place meets their relations.
@@ -384,10 +418,10 @@ impl<'a, R: Rng> Solver<'a, R> {
             // A seat placed in front of something is there to use it (a stool at a piano): the
             // user's knees go under it, as under a table.
             let uses = |seat: usize, other: usize| {
-                self.p
-                    .relations
-                    .iter()
-                    .any(|c| c.relation == Relation::InFrontOf && (c.active, c.anchor) == (seat, other))
+                self.p.relations.iter().any(|c| {
+                    matches!(c.relation, Relation::InFrontOf | Relation::At | Relation::Around)
+                        && (c.active, c.anchor) == (seat, other)
+                })
             };
             let front = (self.faces(i) && obj.support.is_none() && blocks_seat(obj, o, them.surface || uses(i, j)))
                 || (self.faces(j) && o.support.is_none() && blocks_seat(o, obj, me.surface || uses(j, i)));
@@ -438,7 +472,6 @@ impl<'a, R: Rng> Solver<'a, R> {
                 }
             }
         }
-        let item = &self.p.items[i];
         for c in live {
             if c.active == i {
                 let anchor = self.poses[c.anchor].clone().expect("live relation");
@@ -448,12 +481,17 @@ impl<'a, R: Rng> Solver<'a, R> {
                 self.around(i, &active, &mut out);
             }
         }
+        let places: Vec<RoomPlace> = self.p.places.iter().filter(|pl| pl.item == i).map(|pl| pl.place).collect();
+        for &place in &places {
+            self.place_candidates(i, place, &mut out);
+        }
+        let item = &self.p.items[i];
         let generic_from = out.len();
         let anchors_above_wall =
             self.p.relations.iter().any(|c| {
                 c.anchor == i && c.relation == Relation::Above && self.p.items[c.active].support == Support::Wall
             });
-        let free = !self.p.relations.iter().any(|c| c.active == i);
+        let free = !self.p.relations.iter().any(|c| c.active == i) && places.is_empty();
         match item.support {
             Support::Floor => {
                 // Free furniture goes against walls; anchors of wall pictures "above" must.
@@ -489,7 +527,7 @@ impl<'a, R: Rng> Solver<'a, R> {
         }
         // Poses made for a relation beat generic ones that meet it by chance (a chair that happens
         // to stand in front of the desk but faces away).
-        if live.iter().any(|c| c.active == i) {
+        if live.iter().any(|c| c.active == i) || !places.is_empty() {
             for p in &mut out[generic_from..] {
                 p.penalty += 1.0;
             }
@@ -764,6 +802,52 @@ impl<'a, R: Rng> Solver<'a, R> {
                     }
                 }
             }
+            Relation::Against => {
+                for face in [Face::Away, Face::Same] {
+                    self.side_poses(i, anchor, &SIDES, &[0.01], &[0.0, 0.5, -0.5, 1.0, -1.0], face, 0.0, out);
+                }
+            }
+            Relation::Opposite => {
+                self.side_poses(
+                    i,
+                    anchor,
+                    &[Side::Front],
+                    &[1.0, 1.4, 0.7, 1.8, 2.4, 0.4],
+                    &[0.0, 0.3, -0.3],
+                    Face::Toward,
+                    0.0,
+                    out,
+                );
+            }
+            Relation::Facing => {
+                self.side_poses(
+                    i,
+                    anchor,
+                    &[Side::Front],
+                    &[0.8, 1.2, 0.5, 1.6, 2.2],
+                    &[0.0, 0.5, -0.5],
+                    Face::Toward,
+                    0.0,
+                    out,
+                );
+                self.side_poses(i, anchor, &SIDES[1..], &[0.6, 1.2], &[0.0], Face::Toward, 0.5, out);
+            }
+            Relation::LeftOf | Relation::RightOf | Relation::EitherSide => {
+                let sides: &[Side] = match rel {
+                    Relation::LeftOf => &[Side::Left],
+                    Relation::RightOf => &[Side::Right],
+                    _ => &[Side::Left, Side::Right],
+                };
+                for (face, penalty) in [(Face::Same, 0.0), (Face::Away, 0.3)] {
+                    self.side_poses(i, anchor, sides, &[0.05, 0.15, 0.3], &[0.0, 1.0, -1.0], face, penalty, out);
+                }
+            }
+            Relation::At | Relation::Around => {
+                let tuck = crate::catalogue::builtin::tucks_under(&item.category, &anchor.category);
+                let gaps: &[f32] = if tuck { &[-super::TUCK, 0.05] } else { &[0.05, 0.15] };
+                self.side_poses(i, anchor, &SIDES[..2], gaps, &[0.0, 0.5, -0.5, 0.9, -0.9], Face::Toward, 0.0, out);
+                self.side_poses(i, anchor, &SIDES[2..], gaps, &[0.0, 0.5, -0.5], Face::Toward, 0.2, out);
+            }
             Relation::Above => {
                 if item.support == Support::Wall {
                     // On the wall the anchor backs onto, over it.
@@ -790,6 +874,117 @@ impl<'a, R: Rng> Solver<'a, R> {
         }
     }
 
+    /// Poses at `sides` of the placed `anchor`: `gap` metres off the side (negative: in under it,
+    /// for a seat tucked at a table), shifted along it by `offsets` (fractions of the free half
+    /// length), turned by `face`.
+    #[allow(clippy::too_many_arguments)]
+    fn side_poses(
+        &mut self,
+        i: usize,
+        anchor: &PlacedObject,
+        sides: &[Side],
+        gaps: &[f32],
+        offsets: &[f32],
+        face: Face,
+        penalty: f32,
+        out: &mut Vec<Pose>,
+    ) {
+        let [w, _, d] = self.p.items[i].size;
+        let y = self.rest_height(i);
+        let (aw, ad) = (anchor.size[0] / 2.0, anchor.size[2] / 2.0);
+        for &side in sides {
+            // The side's outward normal and tangent in the anchor's frame, its yaw, and the
+            // anchor's extents along them.
+            let (n, t, turn, a_n, a_t) = match side {
+                Side::Front => ([0.0, 1.0], [1.0, 0.0], 0.0, ad, aw),
+                Side::Back => ([0.0, -1.0], [1.0, 0.0], HALF, ad, aw),
+                Side::Left => ([1.0, 0.0], [0.0, 1.0], QUARTER, aw, ad),
+                Side::Right => ([-1.0, 0.0], [0.0, 1.0], -QUARTER, aw, ad),
+            };
+            let normal_yaw = anchor.yaw + turn;
+            let yaw = match face {
+                Face::Toward => normal_yaw + HALF,
+                Face::Away => normal_yaw,
+                Face::Same => anchor.yaw,
+            };
+            let (s, c) = (yaw - normal_yaw).sin_cos();
+            let h_n = w / 2.0 * s.abs() + d / 2.0 * c.abs();
+            let h_t = w / 2.0 * c.abs() + d / 2.0 * s.abs();
+            for &g in gaps {
+                for &f in offsets {
+                    let along = f * (a_t - h_t).max(0.0);
+                    let out_by = a_n + h_n + g;
+                    let l = [n[0] * out_by + t[0] * along, n[1] * out_by + t[1] * along];
+                    let p = geom::to_world(geom::center(anchor), anchor.yaw, l);
+                    out.push(Pose {
+                        position: [p[0], y, p[1]],
+                        yaw,
+                        support: None,
+                        penalty: penalty + 0.2 * g.abs() + 0.05 * f.abs(),
+                    });
+                }
+            }
+        }
+    }
+
+    /// Poses that put item `i` at `place`.
+    fn place_candidates(&mut self, i: usize, place: RoomPlace, out: &mut Vec<Pose>) {
+        let [w, _, d] = self.p.items[i].size;
+        let y = self.rest_height(i);
+        let (rw, rd) = (self.p.room.width, self.p.room.depth);
+        let half = |yaw: f32| {
+            let (s, c) = yaw.sin_cos();
+            [w / 2.0 * c.abs() + d / 2.0 * s.abs(), w / 2.0 * s.abs() + d / 2.0 * c.abs()]
+        };
+        match place {
+            RoomPlace::Middle => {
+                for k in 0..4 {
+                    let yaw = k as f32 * QUARTER;
+                    out.push(Pose { position: [rw / 2.0, y, rd / 2.0], yaw, support: None, penalty: 0.0 });
+                    for _ in 0..3 {
+                        let j = [self.rng.random_range(-0.4..0.4), self.rng.random_range(-0.4..0.4)];
+                        let position = [rw / 2.0 + j[0], y, rd / 2.0 + j[1]];
+                        out.push(Pose { position, yaw, support: None, penalty: 0.3 * j[0].hypot(j[1]) });
+                    }
+                }
+            }
+            RoomPlace::Corner => {
+                for (cx, cz) in [(0.0, 0.0), (rw, 0.0), (0.0, rd), (rw, rd)] {
+                    let into_z = if cz == 0.0 { 0.0 } else { HALF };
+                    let into_x = if cx == 0.0 { QUARTER } else { -QUARTER };
+                    for yaw in [into_z, into_x] {
+                        let h = half(yaw);
+                        let x = if cx == 0.0 { h[0] } else { rw - h[0] };
+                        let z = if cz == 0.0 { h[1] } else { rd - h[1] };
+                        out.push(Pose { position: [x, y, z], yaw, support: None, penalty: 0.0 });
+                    }
+                }
+            }
+            RoomPlace::Wall => self.wall_candidates(i, y, 12, 0.0, out),
+            RoomPlace::Door => {
+                let door = door(&self.p.room);
+                let h = half(HALF);
+                for side in [-1.0f32, 1.0] {
+                    for g in [0.05, 0.2, 0.4] {
+                        let x = door[0] + side * (DOOR_ZONE[0] + h[0] + g);
+                        out.push(Pose { position: [x, y, rd - h[1]], yaw: HALF, support: None, penalty: g });
+                    }
+                }
+            }
+            RoomPlace::Between(a, b) => {
+                let (Some(pa), Some(pb)) = (self.poses[a].clone(), self.poses[b].clone()) else { return };
+                let (p, q) = (geom::center(&pa), geom::center(&pb));
+                let line = (q[0] - p[0]).atan2(q[1] - p[1]);
+                for t in [0.5, 0.45, 0.55, 0.4, 0.6, 0.35, 0.65, 0.3, 0.7] {
+                    let c = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+                    for yaw in [pa.yaw, pb.yaw, line, line + QUARTER] {
+                        out.push(Pose { position: [c[0], y, c[1]], yaw, support: None, penalty: (t - 0.5f32).abs() });
+                    }
+                }
+            }
+        }
+    }
+
     fn finish(self) -> LayoutOutcome {
         let n = self.p.items.len();
         let mut placed = vec![None; n];
@@ -811,7 +1006,19 @@ impl<'a, R: Rng> Solver<'a, R> {
                 Some((c.relation, placed.get(c.active).copied().flatten()?, placed.get(c.anchor).copied().flatten()?))
             })
             .collect();
-        let violations = check(&self.p.room, &objects, &rels);
+        let mut violations = check(&self.p.room, &objects, &rels);
+        violations.unmet_places = self
+            .p
+            .places
+            .iter()
+            .enumerate()
+            .filter(|(_, pl)| {
+                self.poses[pl.item]
+                    .as_ref()
+                    .is_some_and(|o| !place_holds(pl.place, o, &self.p.room, |k| self.poses[k].as_ref()))
+            })
+            .map(|(k, _)| k)
+            .collect();
         let mut dropped = self.dropped;
         dropped.sort_by_key(|d| d.0);
         LayoutOutcome { objects, placed, dropped, violations }

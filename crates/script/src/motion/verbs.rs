@@ -114,8 +114,38 @@ pub const VERBS: &[(&str, &[&str])] = &[
     ),
     ("bend", &["bend", "crouch", "squat", "kneel", "stoop", "lean", "bow", "curtsy"]),
     ("throw", &["throw", "toss", "pitch", "aim"]),
-    ("turn", &["turn", "rotate"]),
+    ("turn", &["turn", "rotate", "face"]),
 ];
+
+/// Verbs done to or with another person, who the character turns to ("talks to Ben", "waves at
+/// Mia"); "they talk" makes each of a group talk to the next.
+pub fn social(lemma: &str) -> bool {
+    matches!(
+        lemma,
+        "talk"
+            | "speak"
+            | "chat"
+            | "say"
+            | "tell"
+            | "ask"
+            | "answer"
+            | "laugh"
+            | "shout"
+            | "whisper"
+            | "argue"
+            | "look"
+            | "watch"
+            | "stare"
+            | "gaze"
+            | "glance"
+            | "listen"
+            | "wave"
+            | "greet"
+            | "nod"
+            | "smile"
+            | "face"
+    )
+}
 
 /// The canonical tag of a verb lemma (lower-cased; a plural/-ing/-ed form is tried as a fallback,
 /// though lemmatising is the caller's job).

@@ -9,13 +9,18 @@ use super::token::tokenize;
 use crate::catalogue::Catalogue;
 use crate::error::{Diagnostic, SentenceRef};
 use crate::script::{command_parts, RawSentence, SentenceKind, CAMERA_VIEWS, TIMES, WEATHERS};
-use crate::ssg::{Action, CharacterNode, Command, NodeId, ObjectNode, Relation, RelationNode, Ssg};
+use crate::ssg::{Action, CharacterNode, Command, NodeId, ObjectNode, Place, PlaceNode, Relation, RelationNode, Ssg};
 
 /// What carries over from one sentence to the next: who "he"/"she" is, what "it" is.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ParseState {
     /// The last character named ("Tom sits. He sings." → Tom).
     pub last_character: Option<String>,
+    /// Characters named so far, the most recent last ("him", "her": the latest other than the
+    /// subject).
+    pub recent: Vec<String>,
+    /// The last plural subject ("Anna and Ben walk in. They sit." → Anna, Ben).
+    pub last_group: Vec<String>,
     /// The last action target ("walks to the oilpainting ... is looking at it").
     pub last_target: Option<ObjectNode>,
 }
@@ -27,17 +32,27 @@ const RELATION_PHRASES: &[(&[&str], Relation)] = &[
     (&["at", "the", "front", "of"], Relation::InFrontOf),
     (&["at", "the", "back", "of"], Relation::Behind),
     (&["in", "the", "back", "of"], Relation::Behind),
-    (&["to", "the", "left", "of"], Relation::NextTo),
-    (&["to", "the", "right", "of"], Relation::NextTo),
+    (&["on", "the", "left", "side", "of"], Relation::LeftOf),
+    (&["on", "the", "right", "side", "of"], Relation::RightOf),
+    (&["to", "the", "left", "of"], Relation::LeftOf),
+    (&["to", "the", "right", "of"], Relation::RightOf),
+    (&["on", "either", "side", "of"], Relation::EitherSide),
+    (&["on", "both", "sides", "of"], Relation::EitherSide),
+    (&["on", "each", "side", "of"], Relation::EitherSide),
+    (&["at", "either", "side", "of"], Relation::EitherSide),
+    (&["either", "side", "of"], Relation::EitherSide),
     (&["on", "top", "of"], Relation::On),
     (&["in", "front", "of"], Relation::InFrontOf),
-    (&["on", "the", "left", "of"], Relation::NextTo),
-    (&["on", "the", "right", "of"], Relation::NextTo),
+    (&["on", "the", "left", "of"], Relation::LeftOf),
+    (&["on", "the", "right", "of"], Relation::RightOf),
+    (&["across", "from"], Relation::Opposite),
+    (&["opposite", "to"], Relation::Opposite),
+    (&["opposite", "of"], Relation::Opposite),
     (&["next", "to"], Relation::NextTo),
     (&["close", "to"], Relation::Near),
     (&["near", "to"], Relation::Near),
-    (&["left", "of"], Relation::NextTo),
-    (&["right", "of"], Relation::NextTo),
+    (&["left", "of"], Relation::LeftOf),
+    (&["right", "of"], Relation::RightOf),
     (&["in", "the", "front"], Relation::InFrontOf),
     (&["in", "front"], Relation::InFrontOf),
     (&["on"], Relation::On),
@@ -48,7 +63,10 @@ const RELATION_PHRASES: &[(&[&str], Relation)] = &[
     (&["by"], Relation::Near),
     (&["beside"], Relation::NextTo),
     (&["alongside"], Relation::NextTo),
-    (&["against"], Relation::NextTo),
+    (&["against"], Relation::Against),
+    (&["opposite"], Relation::Opposite),
+    (&["facing"], Relation::Facing),
+    (&["around"], Relation::Around),
     (&["before"], Relation::InFrontOf),
     // "A chair is at the desk": where one sits or stands to use it, facing it.
     (&["at"], Relation::InFrontOf),
@@ -58,6 +76,7 @@ const RELATION_PHRASES: &[(&[&str], Relation)] = &[
     (&["below"], Relation::Under),
     (&["above"], Relation::Above),
     (&["over"], Relation::Above),
+    (&["along"], Relation::NextTo),
     (&["in"], Relation::In),
     (&["inside"], Relation::In),
     (&["within"], Relation::In),
@@ -84,7 +103,24 @@ const RELATION_WORDS: &[&str] = &[
     "inside",
     "against",
     "at",
+    "between",
+    "opposite",
+    "across from",
+    "facing",
+    "to the left of",
+    "to the right of",
+    "on either side of",
+    "around",
+    "along",
 ];
+
+/// Words that name a wall (as the anchor of "against", "along", "by": [`Place::Wall`]).
+const WALL_WORDS: &[&str] = &["wall", "walls"];
+/// Words that name the room's door ([`Place::Door`]).
+const DOOR_WORDS: &[&str] = &["door", "doorway", "entrance", "doors"];
+/// Single words read as relations whatever their tag ("opposite" as an adjective, "facing" as a
+/// participle, "around" as an adverb).
+const UNTAGGED_RELATIONS: &[&str] = &["opposite", "facing", "around", "against", "beside"];
 
 /// A matched relation phrase.
 struct RelMatch {
@@ -101,7 +137,7 @@ fn relation_at(t: &[Tagged], i: usize) -> Option<RelMatch> {
         let n = words.len();
         if i + n <= t.len() && words.iter().zip(&t[i..i + n]).all(|(w, x)| *w == x.lower) {
             // A single "left"/"right"/"over" that is a particle or a verb's adverb is no relation.
-            if n == 1 && !matches!(t[i].tag, Tag::IN) {
+            if n == 1 && !matches!(t[i].tag, Tag::IN) && !UNTAGGED_RELATIONS.contains(&words[0]) {
                 continue;
             }
             let dangling = words.last() == Some(&"front") || words.last() == Some(&"back");
@@ -128,11 +164,19 @@ fn relation_at(t: &[Tagged], i: usize) -> Option<RelMatch> {
                     "underneath" => "underneath",
                     "within" => "within",
                     "alongside" => "alongside",
+                    "along" => "along",
                     "upon" => "on",
                     "atop" => "on",
+                    "opposite" => "opposite",
+                    "facing" => "facing",
+                    "around" => "around",
                     _ => "on",
                 },
                 (Relation::NextTo, _) => "next to",
+                (Relation::LeftOf, _) => "to the left of",
+                (Relation::RightOf, _) => "to the right of",
+                (Relation::Opposite, _) => "opposite",
+                (Relation::EitherSide, _) => "on either side of",
                 (Relation::Near, _) => "near",
                 (Relation::Behind, _) => "behind",
                 _ => rel.phrase(),
@@ -303,7 +347,24 @@ pub fn parse_with(raw: &RawSentence, cat: &Catalogue, state: &mut ParseState) ->
 }
 
 fn tagged(raw: &RawSentence, cat: &Catalogue) -> Vec<Tagged> {
-    tag(&tokenize(&raw.at.text), cat)
+    let mut t = tag(&tokenize(&raw.at.text), cat);
+    for k in 0..t.len() {
+        let after_subject = k > 0 && matches!(t[k - 1].tag, Tag::NN | Tag::NNS | Tag::NNP | Tag::PRP);
+        if after_subject && t[k].lower == "faces" {
+            // "A chair faces the window", "Ben faces Anna": the verb, not the plural noun.
+            t[k].tag = Tag::VBZ;
+            t[k].lemma = "face".into();
+            t[k].known = true;
+        } else if t[k].tag == Tag::NNP
+            && k > 0
+            && t[k].text.chars().all(|c| c.is_ascii_uppercase())
+            && cat.resolve(&t[k].lower).is_some()
+        {
+            // "the TV": an object written in capitals, not a name.
+            t[k].tag = Tag::NN;
+        }
+    }
+    t
 }
 
 struct Parser<'a> {
@@ -317,8 +378,48 @@ struct Parser<'a> {
 /// Pieces of a scene sentence in order.
 enum El {
     Group(Vec<NodeId>),
-    Rel(Relation),
+    /// A relation and its words as written (for messages).
+    Rel(Relation, &'static str),
+    /// A place in the room (no anchor object).
+    Place(Place),
+    /// "between": the next group's first two objects.
+    Between,
+    /// "at": [`Relation::InFrontOf`] for one thing, [`Relation::At`] for several.
+    At,
+    /// "each other", "one another" (after "face").
+    EachOther,
     Which,
+}
+
+/// Room places written as a phrase ("in the middle of", "in a corner"): the place, the phrase's
+/// length and whether it ends in "of" (an object may follow: "in the middle of the table").
+fn place_at(t: &[Tagged], i: usize) -> Option<(Place, usize, bool)> {
+    const PHRASES: &[(&[&str], Place)] = &[
+        (&["in", "the", "middle", "of"], Place::Middle),
+        (&["in", "the", "centre", "of"], Place::Middle),
+        (&["in", "the", "center", "of"], Place::Middle),
+        (&["at", "the", "centre", "of"], Place::Middle),
+        (&["at", "the", "center", "of"], Place::Middle),
+        (&["in", "the", "corner", "of"], Place::Corner),
+        (&["in", "a", "corner", "of"], Place::Corner),
+        (&["in", "one", "corner", "of"], Place::Corner),
+        (&["in", "the", "middle"], Place::Middle),
+        (&["in", "the", "centre"], Place::Middle),
+        (&["in", "the", "center"], Place::Middle),
+        (&["in", "the", "corner"], Place::Corner),
+        (&["in", "a", "corner"], Place::Corner),
+        (&["in", "one", "corner"], Place::Corner),
+        (&["into", "the", "corner"], Place::Corner),
+        (&["into", "a", "corner"], Place::Corner),
+    ];
+    PHRASES.iter().find_map(|(words, place)| {
+        let n = words.len();
+        (i + n <= t.len() && words.iter().zip(&t[i..i + n]).all(|(w, x)| *w == x.lower)).then_some((
+            *place,
+            n,
+            words[n - 1] == "of",
+        ))
+    })
 }
 
 impl Parser<'_> {
@@ -375,9 +476,55 @@ impl Parser<'_> {
                 i += 1;
                 continue;
             }
+            if t[i].lower == "between" {
+                els.push(El::Between);
+                i += 1;
+                continue;
+            }
+            if matches!(
+                (t[i].lower.as_str(), t.get(i + 1).map(|x| x.lower.as_str())),
+                ("each", Some("other")) | ("one", Some("another"))
+            ) {
+                els.push(El::EachOther);
+                i += 2;
+                continue;
+            }
+            if t[i].tag.is_verb() && t[i].lemma == "face" {
+                els.push(El::Rel(Relation::Facing, "facing"));
+                i += 1;
+                continue;
+            }
+            if let Some((place, len, of)) = place_at(t, i) {
+                let j = i + len;
+                i = j;
+                match np_at(t, j).filter(|np| of && !np.pronoun) {
+                    Some(np) => match resolve_np(t, &np, self.cat, self.sentence) {
+                        // "in the middle of the table": on it.
+                        Named::Object(_) => els.push(El::Rel(Relation::On, "on")),
+                        Named::Room(r) => {
+                            self.ssg.room.get_or_insert(r);
+                            els.push(El::Place(place));
+                            i = np.end;
+                        }
+                        _ => {
+                            els.push(El::Place(place));
+                            i = np.end;
+                        }
+                    },
+                    None => els.push(El::Place(place)),
+                }
+                continue;
+            }
             if let Some(m) = relation_at(t, i) {
                 let j = i + m.len;
                 if let Some(np) = np_at(t, j).filter(|np| !np.pronoun) {
+                    let head = t[np.head].lower.as_str();
+                    if WALL_WORDS.contains(&head) || DOOR_WORDS.contains(&head) {
+                        let place = if WALL_WORDS.contains(&head) { Place::Wall } else { Place::Door };
+                        els.push(El::Place(place));
+                        i = np.end;
+                        continue;
+                    }
                     if let Named::Room(r) = resolve_np(t, &np, self.cat, self.sentence) {
                         if m.relation == Relation::In {
                             self.ssg.room.get_or_insert(r);
@@ -387,7 +534,7 @@ impl Parser<'_> {
                     }
                 }
                 if !m.dangling {
-                    els.push(El::Rel(m.relation));
+                    els.push(if m.prep == "at" { El::At } else { El::Rel(m.relation, m.prep) });
                 }
                 i = j;
                 continue;
@@ -400,7 +547,7 @@ impl Parser<'_> {
                     let s = closest(&w, RELATION_WORDS.iter().copied());
                     self.diag(
                         Some(w.clone()),
-                        format!("unknown relation \"{w}\" (known: on, near, in front of, next to, under, above, in, behind)"),
+                        format!("unknown relation \"{w}\" (known: {})", RELATION_WORDS.join(", ")),
                         s,
                     );
                 }
@@ -431,7 +578,7 @@ impl Parser<'_> {
                     if k == i {
                         break;
                     }
-                    let anchor_group = matches!(els.last(), Some(El::Rel(_)));
+                    let anchor_group = matches!(els.last(), Some(El::Rel(..) | El::At | El::Between));
                     match np_at(t, k).filter(|np| !np.pronoun) {
                         // "near a table, and a chair is next to ...": a new clause, not one more anchor.
                         Some(next) if anchor_group && t.get(next.end).is_some_and(|x| x.tag.is_verb()) => break,
@@ -463,46 +610,198 @@ impl Parser<'_> {
             Some(El::Group(g)) => Some(g.clone()),
             _ => None,
         };
+        // The group a relation at `k` relates: the nearest group before it, else (the relation comes first: "On the desk there is a lamp") the group
+        // after its anchor, at `k + skip`.
+        let actives_of = |k: usize, skip: usize| -> Option<Vec<NodeId>> {
+            match (0..k).rev().find_map(|p| match &els[p] {
+                El::Group(g) => Some(g.clone()),
+                El::Which => Some(Vec::new()),
+                _ => None,
+            }) {
+                Some(prev) if !prev.is_empty() => Some(prev),
+                Some(_) => None,
+                None => group(k + skip),
+            }
+        };
+        let sentence = self.sentence;
         for (k, el) in els.iter().enumerate() {
-            let El::Rel(rel) = el else { continue };
-            let (actives, anchor) = if matches!(els.get(k + 1), Some(El::Which)) {
-                // "a boxing ring above which a boxingbag hangs" (Fig. 5).
-                match (k.checked_sub(1).and_then(group), group(k + 2)) {
-                    (Some(prev), Some(next)) => (next, *prev.last().unwrap()),
-                    _ => continue,
+            match el {
+                El::Place(place) => {
+                    let Some(actives) = actives_of(k, 1) else {
+                        self.left_out(place.phrase(), "nothing named stands there");
+                        continue;
+                    };
+                    for a in actives {
+                        self.ssg.places.push(PlaceNode { place: *place, active: a, sentence });
+                    }
                 }
-            } else {
-                let Some(next) = group(k + 1) else { continue };
-                match (0..k).rev().find_map(|p| match &els[p] {
-                    El::Group(g) => Some(g.clone()),
-                    El::Which => Some(Vec::new()),
-                    El::Rel(_) => None,
-                }) {
-                    Some(prev) if !prev.is_empty() => (prev, next[0]),
-                    Some(_) => continue,
-                    // "On the desk there is a lamp": the relation comes first.
-                    None => match group(k + 2) {
-                        Some(after) => (after, next[0]),
-                        None => continue,
-                    },
+                El::Between => {
+                    let anchors = group(k + 1).unwrap_or_default();
+                    let Some(actives) = actives_of(k, 2) else {
+                        self.left_out("between", "nothing named stands there");
+                        continue;
+                    };
+                    // "between the armchairs": the two instances of one plural node.
+                    let anchors = if anchors.len() == 1 && self.ssg.objects[anchors[0]].count > 1 {
+                        vec![anchors[0]; 2]
+                    } else {
+                        anchors
+                    };
+                    if anchors.len() < 2 {
+                        self.left_out(
+                            "between",
+                            "it needs two things the scene can show (\"between the sofa and the TV\")",
+                        );
+                        continue;
+                    }
+                    for a in actives.into_iter().filter(|a| !anchors[..2].contains(a)) {
+                        let place = Place::Between { first: anchors[0], second: anchors[1] };
+                        self.ssg.places.push(PlaceNode { place, active: a, sentence });
+                    }
                 }
-            };
-            for a in actives {
-                if a != anchor {
-                    self.ssg.relations.push(RelationNode {
-                        relation: *rel,
-                        active: a,
-                        anchor,
-                        sentence: self.sentence,
-                    });
+                El::Rel(..) | El::At => {
+                    let (rel, phrase) = match el {
+                        El::Rel(r, p) => (*r, *p),
+                        _ => (Relation::At, "at"),
+                    };
+                    let each_other = matches!(els.get(k + 1), Some(El::EachOther));
+                    let (actives, anchor) = if each_other {
+                        match actives_of(k, 2) {
+                            Some(a) => (a, None),
+                            None => continue,
+                        }
+                    } else if matches!(els.get(k + 1), Some(El::Which)) {
+                        // "a boxing ring above which a boxingbag hangs" (Fig. 5).
+                        match (k.checked_sub(1).and_then(group), group(k + 2)) {
+                            (Some(prev), Some(next)) => (next, Some(*prev.last().unwrap())),
+                            _ => continue,
+                        }
+                    } else {
+                        let Some(next) = group(k + 1) else {
+                            if actives_of(k, 2).is_some() {
+                                self.left_out(phrase, "no object the scene can show follows it");
+                            }
+                            continue;
+                        };
+                        match actives_of(k, 2) {
+                            Some(a) => (a, Some(next[0])),
+                            None => continue,
+                        }
+                    };
+                    let Some(anchor) = anchor else {
+                        // "Two armchairs face each other": each faces the next.
+                        if actives.len() >= 2 {
+                            for (n, &a) in actives.iter().enumerate() {
+                                let b = actives[(n + 1) % actives.len()];
+                                self.push_relation(rel, a, b);
+                            }
+                        } else if let Some(&a) = actives.first() {
+                            self.push_relation(rel, a, a);
+                        }
+                        continue;
+                    };
+                    let several = actives.len() > 1 || actives.iter().any(|&a| self.ssg.objects[a].count > 1);
+                    for (n, &a) in actives.iter().enumerate() {
+                        if a == anchor {
+                            continue;
+                        }
+                        let r = match rel {
+                            // One seat "at" a desk sits in front of it (tucked when it can be).
+                            Relation::At if !several => Relation::InFrontOf,
+                            // "a lamp and a plant on either side of the sofa": one each side;
+                            // one node of several instances is shared out by composition.
+                            Relation::EitherSide if actives.len() > 1 => {
+                                if n % 2 == 0 {
+                                    Relation::LeftOf
+                                } else {
+                                    Relation::RightOf
+                                }
+                            }
+                            Relation::EitherSide if self.ssg.objects[a].count == 1 => Relation::NextTo,
+                            r => r,
+                        };
+                        self.push_relation(r, a, anchor);
+                    }
                 }
+                El::Group(_) | El::Which | El::EachOther => {}
             }
         }
     }
 
+    fn push_relation(&mut self, relation: Relation, active: NodeId, anchor: NodeId) {
+        self.ssg.relations.push(RelationNode { relation, active, anchor, sentence: self.sentence });
+    }
+
+    /// A relation phrase the sentence has but the scene cannot show: said, never dropped quietly.
+    fn left_out(&mut self, phrase: &str, why: &str) {
+        self.diag(Some(phrase.to_string()), format!("\"{phrase}\" left out: {why}"), vec![]);
+    }
+
     /// Character direction (§3.2, Fig. 3): who, then verbs in order with preposition, target and
     /// manner. Returns false when the sentence has no character but objects (a scene without `$`).
+    /// A direction sentence, split into clauses where a new subject starts ("Max sits on the chair
+    /// and Lena stands behind him"): a conjunction or comma followed by a name or a pronoun and then
+    /// a verb.
     fn direction(&mut self, t: &[Tagged], state: &mut ParseState) -> bool {
+        let mut cuts = vec![0];
+        for k in 1..t.len() {
+            if !(t[k - 1].tag == Tag::CC || t[k - 1].lower == ",") {
+                continue;
+            }
+            let mut j = k;
+            while j < t.len() && t[j].tag == Tag::RB {
+                j += 1;
+            }
+            let subject = |x: &Tagged| {
+                x.tag == Tag::NNP
+                    || (x.tag == Tag::PRP && matches!(x.lower.as_str(), "he" | "she" | "they" | "we"))
+                    || x.tag == Tag::CC
+                    || x.lower == ","
+            };
+            while j < t.len() && subject(&t[j]) {
+                j += 1;
+            }
+            while j < t.len() && matches!(t[j].tag, Tag::RB | Tag::MD) {
+                j += 1;
+            }
+            let named = (k..j).any(|q| t[q].tag == Tag::NNP || t[q].tag == Tag::PRP);
+            // Only after a clause with its own verb ("Anna and Ben walk" is one subject).
+            let verb_before = t[cuts[cuts.len() - 1]..k].iter().any(|x| x.tag.is_verb());
+            if named && verb_before && j < t.len() && t[j].tag.is_verb() {
+                cuts.push(k);
+            }
+        }
+        cuts.push(t.len());
+        if cuts.len() == 2 {
+            return self.clause(t, state);
+        }
+        for w in cuts.windows(2) {
+            self.clause(&t[w[0]..w[1]], state);
+        }
+        true
+    }
+
+    /// A character named at `j` ("Tom", "Mary Ann") or a pronoun standing for one ("him", "her",
+    /// "them": the latest character other than `subjects`): the names and the index after them.
+    fn person_at(t: &[Tagged], j: usize, subjects: &[String], state: &ParseState) -> Option<(String, usize)> {
+        let x = t.get(j)?;
+        if x.tag == Tag::NNP {
+            let end = (j..t.len()).find(|&k| t[k].tag != Tag::NNP).unwrap_or(t.len());
+            return Some((t[j..end].iter().map(|x| x.text.as_str()).collect::<Vec<_>>().join(" "), end));
+        }
+        if x.tag == Tag::PRP && matches!(x.lower.as_str(), "him" | "her" | "them") {
+            let other = |n: &&String| !subjects.iter().any(|s| s.eq_ignore_ascii_case(n));
+            let pick = if x.lower == "them" {
+                state.last_group.iter().find(other).or_else(|| state.recent.iter().rev().find(other))
+            } else {
+                state.recent.iter().rev().find(other)
+            };
+            return pick.map(|p| (p.clone(), j + 1));
+        }
+        None
+    }
+
+    fn clause(&mut self, t: &[Tagged], state: &mut ParseState) -> bool {
         let n = t.len();
         let Some(v) = t.iter().position(|x| x.tag.is_verb() || x.tag == Tag::MD) else {
             if t.iter().any(|x| x.tag == Tag::EX) || self.names_objects(t) {
@@ -515,14 +814,28 @@ impl Parser<'_> {
         if subject.iter().any(|x| x.tag == Tag::EX) {
             return false;
         }
-        let name = if let Some(first) = subject.iter().position(|x| x.tag == Tag::NNP) {
-            let names: Vec<&str> =
-                subject[first..].iter().take_while(|x| x.tag == Tag::NNP).map(|x| x.text.as_str()).collect();
-            names.join(" ")
+        let plural_pronoun = subject.iter().any(|x| x.tag == Tag::PRP && matches!(x.lower.as_str(), "they" | "we"));
+        let mut names: Vec<String> = Vec::new();
+        let name = if subject.iter().any(|x| x.tag == Tag::NNP) {
+            // "Anna and Ben", "Anna, Ben and Tom": every run of names.
+            let mut run: Vec<&str> = Vec::new();
+            for x in subject.iter().chain(std::iter::once(&&t[v])) {
+                if x.tag == Tag::NNP {
+                    run.push(x.text.as_str());
+                } else if !run.is_empty() {
+                    names.push(run.join(" "));
+                    run.clear();
+                }
+            }
+            names[0].clone()
         } else if subject.is_empty() || subject.iter().all(|x| matches!(x.tag, Tag::PRP | Tag::RB | Tag::CC)) {
-            match &state.last_character {
-                Some(c) => c.clone(),
-                None => {
+            if plural_pronoun && !state.last_group.is_empty() {
+                names = state.last_group.clone();
+            }
+            match (&state.last_character, names.first()) {
+                (_, Some(first)) => first.clone(),
+                (Some(c), None) => c.clone(),
+                (None, None) => {
                     self.diag(None, "no character: say who acts (e.g. \"Eve walks to the desk\")".into(), vec![]);
                     return true;
                 }
@@ -543,7 +856,17 @@ impl Parser<'_> {
                 _ => subject.iter().map(|x| x.text.as_str()).collect::<Vec<_>>().join(" "),
             }
         };
-        state.last_character = Some(name.clone());
+        if names.is_empty() {
+            names.push(name.clone());
+        }
+        if names.len() > 1 {
+            state.last_group = names.clone();
+        }
+        for m in &names {
+            state.recent.retain(|r| !r.eq_ignore_ascii_case(m));
+            state.recent.push(m.clone());
+        }
+        state.last_character = Some(names.last().cloned().unwrap_or_else(|| name.clone()));
 
         let mut actions: Vec<Action> = Vec::new();
         // Unknown nouns met while the action had no target, by action index.
@@ -580,6 +903,7 @@ impl Parser<'_> {
                         target: None,
                         manner: std::mem::take(&mut pending_manner),
                         destination: None,
+                        person: None,
                     });
                     cur = Some(actions.len() - 1);
                 }
@@ -608,6 +932,14 @@ impl Parser<'_> {
             } else {
                 (None, i)
             };
+            if let Some((person, end)) = Self::person_at(t, j, &names, state) {
+                if let Some(c) = cur.filter(|&c| actions[c].person.is_none() && actions[c].target.is_none()) {
+                    actions[c].person = Some(person);
+                    actions[c].preposition = prep;
+                }
+                i = end;
+                continue;
+            }
             let Some(np) = np_at(t, j) else {
                 if prep.is_some() && j == i + 1 && matches!(x.lower.as_str(), "in" | "out" | "down" | "up" | "over") {
                     // "sits down", "walks in": a particle.
@@ -693,7 +1025,18 @@ impl Parser<'_> {
             }
             return true;
         }
-        self.ssg.characters.push(CharacterNode { name, actions, sentence: self.sentence });
+        // A plural subject acts together; "they talk" (no one named) talk to each other.
+        for (k, member) in names.iter().enumerate() {
+            let mut mine = actions.clone();
+            if names.len() > 1 {
+                for a in mine.iter_mut().filter(|a| a.person.is_none() && a.target.is_none()) {
+                    if crate::motion::verbs::social(&a.verb) {
+                        a.person = Some(names[(k + 1) % names.len()].clone());
+                    }
+                }
+            }
+            self.ssg.characters.push(CharacterNode { name: member.clone(), actions: mine, sentence: self.sentence });
+        }
         true
     }
 

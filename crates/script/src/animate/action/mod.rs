@@ -9,11 +9,14 @@
 //! - [`pick_up`]: walking to a small prop and taking it into the right hand;
 //! - [`put_down`]: setting a held prop down on a surface or the floor ("puts the cup on the
 //!   counter", "drops the cup");
+//! - [`person`]: any of these done to or with another character ("walks to Tom", "sits next to
+//!   Ben", "stands behind him", "talks to Anna");
 //! - [`act`]: any other verb, an action in place over the idle or seated lower body, hands on the
 //!   target's contacts (or a small prop picked up first and used in the hand).
 
 pub(crate) mod act;
 pub(crate) mod lie;
+pub(crate) mod person;
 pub(crate) mod pick_up;
 pub(crate) mod put_down;
 pub(crate) mod sit;

@@ -40,7 +40,18 @@ impl Builder<'_> {
     /// "sit (on X)": sits on X's best seat unless already seated there; otherwise (already
     /// seated, or nothing to sit on) holds the seat or stands, a "sit" segment either way.
     pub fn sit(&mut self, step: &Step) {
-        let (scene, obj) = (self.ctx.scene, step.object);
+        let scene = self.ctx.scene;
+        let standing = self.st.seated.is_none() && !self.st.lying;
+        // "sits down" (no seat named): the nearest free seat; a seat someone already sits on:
+        // another free one of the same kind ("Ben sits on the other chair").
+        let obj = match step.object {
+            Some(o) if standing && self.seats_taken(o) => {
+                let category = &scene.objects[o].category;
+                self.free_seat_near(self.st.pos, |k| &scene.objects[k].category == category).or(Some(o))
+            }
+            None if standing => self.free_seat_near(self.sit_toward.unwrap_or(self.st.pos), |_| true),
+            other => other,
+        };
         let seat = obj.and_then(|o| {
             let seats = contacts_of(scene, self.ctx.cat, o, ContactKind::Seat);
             // The nearest seat, away from where earlier characters stand or sit.
@@ -50,7 +61,8 @@ impl Builder<'_> {
                     .map(|a| (PASSING_DISTANCE + SPOT_MARGIN - dist2([p[0], p[2]], *a).sqrt()).max(0.0))
                     .sum::<f32>()
             };
-            let cost = |p: &[f32; 3]| 10.0 * crowd(p) + dist2([p[0], p[2]], self.st.pos).sqrt();
+            let near = self.sit_toward.unwrap_or(self.st.pos);
+            let cost = |p: &[f32; 3]| 10.0 * crowd(p) + dist2([p[0], p[2]], near).sqrt();
             seats.into_iter().min_by(|p, q| cost(p).total_cmp(&cost(q))).map(|s| (o, s))
         });
         match (seat, self.st.seated) {

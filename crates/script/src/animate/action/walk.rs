@@ -65,6 +65,12 @@ impl Builder<'_> {
                 let to = stand_point(scene, self.ctx.cat, grid, o, self.st.pos, self.avoid);
                 (to, heading_to(to, geom::center(&scene.objects[o]), self.st.heading))
             }
+            // "walks out": to the door, facing out.
+            None if step.action.manner.iter().any(|m| m == "out") => {
+                let door = crate::layout::door(&scene.room);
+                let to = grid.nearest_free([door[0], door[1] - 0.3]).map(|c| grid.center(c)).unwrap_or(self.st.pos);
+                (to, 0.0)
+            }
             None => {
                 let f = [self.st.heading.sin() as f32, self.st.heading.cos() as f32];
                 let p = [self.st.pos[0] + 2.0 * f[0], self.st.pos[1] + 2.0 * f[1]];
