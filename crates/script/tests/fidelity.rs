@@ -62,7 +62,7 @@ phrase_tests! {
     around: "around" => 100.0,
     at_a_table: "at (a table)" => 100.0,
     along_a_wall: "along a wall" => 100.0,
-    beside: "beside" => 75.0,
+    beside: "beside" => 100.0,
     near: "near" => 100.0,
     by_the_window_door: "by the window / door" => 100.0,
     counts: "counts" => 100.0,

@@ -66,6 +66,7 @@ fn room_places_and_between() {
     assert_eq!(place("A bookshelf stands against the wall$"), Place::Wall);
     assert_eq!(place("A long bench runs along the wall$"), Place::Wall);
     assert_eq!(place("The cabinet is by the door$"), Place::Door);
+    assert_eq!(place("A painting hangs in the middle of the wall$"), Place::Wall);
     let (s, _) = merged("A rug is between the sofa and the TV$");
     assert_eq!(s.places.len(), 1);
     let Place::Between { first, second } = s.places[0].place else { panic!("{:?}", s.places) };

@@ -89,6 +89,21 @@ fn placement_order(p: &LayoutProblem) -> Vec<usize> {
         }
     }
     let depth = chain(&edges);
+    // A floor object the script relates to something resting on another ("an armchair facing the
+    // TV" on a cabinet) waits for it: it counts one deeper in supports than its anchor (database
+    // furnishing keeps its order).
+    let mut support_depth = support_depth;
+    for c in &p.relations {
+        let script = |i: usize| matches!(p.items[i].origin, Origin::Script { .. });
+        if c.active < n
+            && c.anchor < n
+            && script(c.active)
+            && p.items[c.active].support == Support::Floor
+            && support_depth[c.anchor] > 0
+        {
+            support_depth[c.active] = support_depth[c.active].max(support_depth[c.anchor] + 1);
+        }
+    }
     let rank = |s: Support| match s {
         Support::Floor => 0,
         Support::Wall => 1,
@@ -118,6 +133,10 @@ enum Side {
 }
 
 const SIDES: [Side; 4] = [Side::Front, Side::Back, Side::Left, Side::Right];
+
+/// The gap "opposite" and "facing" aim at, metres (a desk across from a bed, an armchair facing
+/// the TV).
+const ACROSS_GAP: f32 = 1.5;
 
 /// How a pose beside an object is turned.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -803,34 +822,22 @@ impl<'a, R: Rng> Solver<'a, R> {
                 }
             }
             Relation::Against => {
+                // Its sides and back first: a desk's or a sofa's front is where it is used.
                 for face in [Face::Away, Face::Same] {
-                    self.side_poses(i, anchor, &SIDES, &[0.01], &[0.0, 0.5, -0.5, 1.0, -1.0], face, 0.0, out);
+                    let along = [0.0, 0.5, -0.5, 1.0, -1.0];
+                    self.side_poses(i, anchor, &SIDES[1..], &[0.01], &along, face, 0.0, out);
+                    self.side_poses(i, anchor, &SIDES[..1], &[0.01], &along, face, 0.6, out);
                 }
             }
-            Relation::Opposite => {
-                self.side_poses(
-                    i,
-                    anchor,
-                    &[Side::Front],
-                    &[1.0, 1.4, 0.7, 1.8, 2.4, 0.4],
-                    &[0.0, 0.3, -0.3],
-                    Face::Toward,
-                    0.0,
-                    out,
-                );
-            }
-            Relation::Facing => {
-                self.side_poses(
-                    i,
-                    anchor,
-                    &[Side::Front],
-                    &[0.8, 1.2, 0.5, 1.6, 2.2],
-                    &[0.0, 0.5, -0.5],
-                    Face::Toward,
-                    0.0,
-                    out,
-                );
-                self.side_poses(i, anchor, &SIDES[1..], &[0.6, 1.2], &[0.0], Face::Toward, 0.5, out);
+            Relation::Opposite | Relation::Facing => {
+                // Across the room rather than at arm's length: gaps near [`ACROSS_GAP`] first.
+                for g in [1.0, 1.4, 0.7, 1.8, 2.4, 0.4] {
+                    let penalty = 0.3 * (g - ACROSS_GAP).abs() - 0.2 * g + 0.5;
+                    self.side_poses(i, anchor, &[Side::Front], &[g], &[0.0, 0.3, -0.3], Face::Toward, penalty, out);
+                }
+                if rel == Relation::Facing {
+                    self.side_poses(i, anchor, &SIDES[1..], &[0.6, 1.2], &[0.0], Face::Toward, 1.0, out);
+                }
             }
             Relation::LeftOf | Relation::RightOf | Relation::EitherSide => {
                 let sides: &[Side] = match rel {

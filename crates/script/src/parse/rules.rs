@@ -498,6 +498,11 @@ impl Parser<'_> {
                 let j = i + len;
                 i = j;
                 match np_at(t, j).filter(|np| of && !np.pronoun) {
+                    // "in the middle of the wall": on (or against) the wall.
+                    Some(np) if WALL_WORDS.contains(&t[np.head].lower.as_str()) => {
+                        els.push(El::Place(Place::Wall));
+                        i = np.end;
+                    }
                     Some(np) => match resolve_np(t, &np, self.cat, self.sentence) {
                         // "in the middle of the table": on it.
                         Named::Object(_) => els.push(El::Rel(Relation::On, "on")),
