@@ -121,6 +121,15 @@ fn plural_subjects_act_together() {
 }
 
 #[test]
+fn they_without_a_plural_subject_is_the_last_two_named() {
+    let (s, _) = merged("A sofa is in the room$\nAnna sits on the sofa. Ben sits next to her. They talk.");
+    let p = people(&s);
+    assert_eq!(p[1], ("Ben".into(), vec![("sit".into(), Some("Anna".into()))]));
+    assert_eq!(p[2], ("Anna".into(), vec![("talk".into(), Some("Ben".into()))]));
+    assert_eq!(p[3], ("Ben".into(), vec![("talk".into(), Some("Anna".into()))]));
+}
+
+#[test]
 fn relations_to_characters() {
     let (s, _) = merged("Mia walks to the TV, turns around and walks to Tom. Tom follows Mia. Ben faces Anna.");
     let p = people(&s);

@@ -834,8 +834,19 @@ impl Parser<'_> {
             }
             names[0].clone()
         } else if subject.is_empty() || subject.iter().all(|x| matches!(x.tag, Tag::PRP | Tag::RB | Tag::CC)) {
-            if plural_pronoun && !state.last_group.is_empty() {
-                names = state.last_group.clone();
+            if plural_pronoun {
+                // "they": the last plural subject while its members are the latest named, else
+                // the last two characters named ("Anna sits. Ben sits next to her. They talk.").
+                let n = state.recent.len();
+                let g = state.last_group.len();
+                let group_latest = g > 0
+                    && g <= n
+                    && state.last_group.iter().all(|m| state.recent[n - g..].iter().any(|r| r.eq_ignore_ascii_case(m)));
+                if group_latest {
+                    names = state.last_group.clone();
+                } else if n >= 2 {
+                    names = state.recent[n - 2..].to_vec();
+                }
             }
             match (&state.last_character, names.first()) {
                 (_, Some(first)) => first.clone(),

@@ -109,14 +109,17 @@ impl Builder<'_> {
                 let d = (dist2(from, p.pos)).sqrt().max(1e-3);
                 let toward = [(from[0] - p.pos[0]) / d, (from[1] - p.pos[1]) / d];
                 let side = [toward[1], -toward[0]];
-                [0.0f32, 0.6, -0.6, 1.2, -1.2]
-                    .iter()
-                    .map(|&a| {
-                        let dir = [toward[0] + a * side[0], toward[1] + a * side[1]];
-                        let l = dir[0].hypot(dir[1]);
-                        [p.pos[0] + WITHIN_REACH * dir[0] / l, p.pos[1] + WITHIN_REACH * dir[1] / l]
-                    })
-                    .collect()
+                // From the side one comes from first, then round them (their seat or the
+                // furniture may fill that side), a little farther out last.
+                let mut out = Vec::new();
+                for reach in [WITHIN_REACH, 1.0] {
+                    for a in [0.0f32, 0.5, -0.5, 1.0, -1.0, 1.6, -1.6, 2.4, -2.4, std::f32::consts::PI] {
+                        let (s, c) = a.sin_cos();
+                        let dir = [toward[0] * c + side[0] * s, toward[1] * c + side[1] * s];
+                        out.push([p.pos[0] + reach * dir[0], p.pos[1] + reach * dir[1]]);
+                    }
+                }
+                out
             }
             // Behind or in front, a little farther when furniture (their seat) fills the spot.
             Spot::Behind | Spot::Front => {
@@ -129,21 +132,21 @@ impl Builder<'_> {
                 }
                 out
             }
-            Spot::Beside => vec![
-                [p.pos[0] + WITHIN_REACH * left[0], p.pos[1] + WITHIN_REACH * left[1]],
-                [p.pos[0] - WITHIN_REACH * left[0], p.pos[1] - WITHIN_REACH * left[1]],
-            ],
+            Spot::Beside => [WITHIN_REACH, 1.0]
+                .iter()
+                .flat_map(|&d| [1.0f32, -1.0].map(|s| [p.pos[0] + s * d * left[0], p.pos[1] + s * d * left[1]]))
+                .collect(),
         };
-        // The first wanted spot whose nearest free cell stays close to it.
+        // The first wanted spot whose nearest free cell stays close to it and can be walked to.
         let grid = self.grid;
-        let snapped: Vec<[f32; 2]> =
-            want.iter().filter_map(|w| grid.nearest_free(*w).map(|c| grid.center(c))).collect();
-        let Some(to) = snapped
+        let reach = grid.nearest_free(self.st.pos).map(|c| grid.reachable_from(c));
+        let reachable = |c: crate::layout::grid::Cell| reach.as_ref().is_none_or(|r| r[c.1 * grid.nx + c.0]);
+        let snapped: Vec<([f32; 2], [f32; 2])> = want
             .iter()
-            .zip(&want)
-            .find(|(s, w)| dist2(**s, **w) <= 0.3 * 0.3)
-            .map(|(s, _)| *s)
-            .or_else(|| snapped.first().copied())
+            .filter_map(|w| grid.nearest_free(*w).filter(|c| reachable(*c)).map(|c| (grid.center(c), *w)))
+            .collect();
+        let Some(to) =
+            snapped.iter().find(|(s, w)| dist2(*s, *w) <= 0.3 * 0.3).or_else(|| snapped.first()).map(|(s, _)| *s)
         else {
             self.notes.push(format!("{}: no free floor near {}", self.name, p.name));
             return;
