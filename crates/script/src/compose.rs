@@ -166,7 +166,8 @@ pub fn query_graph(parsed: &ParsedScript) -> Ssg {
                 .rposition(|q| q.category == o.category)
                 .or_else(|| query.objects.iter().rposition(|q| q.category.ends_with(&o.category)));
             match existing {
-                Some(q) if direction || is_definite(&lower, &o.word) => remap.push(q),
+                // "it" (a scene sentence's pronoun) is the object named before.
+                Some(q) if direction || o.word == "it" || is_definite(&lower, &o.word) => remap.push(q),
                 _ => {
                     remap.push(query.objects.len());
                     query.objects.push(o.clone());

@@ -66,6 +66,7 @@ phrase_tests! {
     near: "near" => 100.0,
     by_the_window_door: "by the window / door" => 100.0,
     in_front_of_behind: "in front of / behind" => 100.0,
+    held_out: "held out" => 100.0,
     whole_rooms: "whole rooms" => 95.0,
     counts: "counts" => 100.0,
     attributes: "attributes" => 100.0,

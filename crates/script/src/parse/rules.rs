@@ -21,6 +21,8 @@ pub struct ParseState {
     pub recent: Vec<String>,
     /// The last plural subject ("Anna and Ben walk in. They sit." → Anna, Ben).
     pub last_group: Vec<String>,
+    /// The last object a scene sentence named ("A table is in the middle$ Chairs are around it").
+    pub last_object: Option<ObjectNode>,
     /// The last action target ("walks to the oilpainting ... is looking at it").
     pub last_target: Option<ObjectNode>,
 }
@@ -328,11 +330,11 @@ pub fn parse_with(raw: &RawSentence, cat: &Catalogue, state: &mut ParseState) ->
     };
     match raw.kind {
         SentenceKind::Command => p.command(),
-        SentenceKind::Scene => p.scene(&tagged(raw, cat)),
+        SentenceKind::Scene => p.scene(&tagged(raw, cat), state),
         SentenceKind::Direction => {
             let t = tagged(raw, cat);
             if !p.direction(&t, state) {
-                p.scene(&t);
+                p.scene(&t, state);
                 if !p.ssg.objects.is_empty() || p.ssg.room.is_some() {
                     p.diag(
                         None,
@@ -391,35 +393,27 @@ enum El {
     Which,
 }
 
-/// Room places written as a phrase ("in the middle of", "in a corner"): the place, the phrase's
-/// length and whether it ends in "of" (an object may follow: "in the middle of the table").
+/// Room places written as a phrase ("in the middle of", "in a corner", "in the far corner of"):
+/// the place, the phrase's length and whether it ends in "of" (an object may follow: "in the
+/// middle of the table").
 fn place_at(t: &[Tagged], i: usize) -> Option<(Place, usize, bool)> {
-    const PHRASES: &[(&[&str], Place)] = &[
-        (&["in", "the", "middle", "of"], Place::Middle),
-        (&["in", "the", "centre", "of"], Place::Middle),
-        (&["in", "the", "center", "of"], Place::Middle),
-        (&["at", "the", "centre", "of"], Place::Middle),
-        (&["at", "the", "center", "of"], Place::Middle),
-        (&["in", "the", "corner", "of"], Place::Corner),
-        (&["in", "a", "corner", "of"], Place::Corner),
-        (&["in", "one", "corner", "of"], Place::Corner),
-        (&["in", "the", "middle"], Place::Middle),
-        (&["in", "the", "centre"], Place::Middle),
-        (&["in", "the", "center"], Place::Middle),
-        (&["in", "the", "corner"], Place::Corner),
-        (&["in", "a", "corner"], Place::Corner),
-        (&["in", "one", "corner"], Place::Corner),
-        (&["into", "the", "corner"], Place::Corner),
-        (&["into", "a", "corner"], Place::Corner),
-    ];
-    PHRASES.iter().find_map(|(words, place)| {
-        let n = words.len();
-        (i + n <= t.len() && words.iter().zip(&t[i..i + n]).all(|(w, x)| *w == x.lower)).then_some((
-            *place,
-            n,
-            words[n - 1] == "of",
-        ))
-    })
+    let first = t.get(i)?.lower.as_str();
+    if !matches!(first, "in" | "into" | "at") || !matches!(t.get(i + 1)?.lower.as_str(), "the" | "a" | "an" | "one") {
+        return None;
+    }
+    // Up to two words before the place word ("the far corner", "the very middle").
+    for k in i + 2..(i + 5).min(t.len()) {
+        let place = match t[k].lower.as_str() {
+            "middle" | "centre" | "center" => Place::Middle,
+            "corner" | "corners" => Place::Corner,
+            _ if matches!(t[k].tag, Tag::JJ | Tag::RB | Tag::VBN | Tag::VBD) => continue,
+            "far" | "back" | "front" | "left" | "right" | "near" | "opposite" | "very" | "exact" => continue,
+            _ => return None,
+        };
+        let of = t.get(k + 1).is_some_and(|x| x.lower == "of");
+        return Some((place, k + 1 + usize::from(of) - i, of));
+    }
+    None
 }
 
 impl Parser<'_> {
@@ -465,7 +459,7 @@ impl Parser<'_> {
     }
 
     /// Scene description (§4.1): objects, their relations, the room.
-    fn scene(&mut self, t: &[Tagged]) {
+    fn scene(&mut self, t: &[Tagged], state: &mut ParseState) {
         let n = t.len();
         let mut els: Vec<El> = Vec::new();
         let mut i = 0;
@@ -559,6 +553,23 @@ impl Parser<'_> {
                 i += 1;
                 continue;
             }
+            // "Six chairs are around it": the last object named before.
+            if t[i].tag == Tag::PRP
+                && t[i].lower == "it"
+                && matches!(els.last(), Some(El::Rel(..) | El::At | El::Between))
+            {
+                match state.last_object.clone() {
+                    Some(mut o) => {
+                        o.sentence = self.sentence;
+                        o.word = "it".into();
+                        let id = self.add_object(o);
+                        els.push(El::Group(vec![id]));
+                    }
+                    None => self.diag(Some("it".into()), "\"it\" refers to no object named before".into(), vec![]),
+                }
+                i += 1;
+                continue;
+            }
             if let Some(np) = np_at(t, i).filter(|np| !np.pronoun) {
                 // A coordinated group: NP ((,|and|or) NP)*.
                 let mut group = Vec::new();
@@ -601,6 +612,9 @@ impl Parser<'_> {
             i += 1;
         }
         self.relations_from(&els);
+        if let Some(o) = self.ssg.objects.iter().rev().find(|o| o.word != "it") {
+            state.last_object = Some(o.clone());
+        }
         if self.ssg.objects.is_empty() && self.ssg.room.is_none() && !unknown_any {
             self.diag(
                 None,

@@ -66,7 +66,9 @@ impl Builder<'_> {
                 (to, heading_to(to, geom::center(&scene.objects[o]), self.st.heading))
             }
             // "walks out": to the door, facing out.
-            None if step.action.manner.iter().any(|m| m == "out") => {
+            None if step.action.manner.iter().any(|m| m == "out")
+                || matches!(step.action.verb.as_str(), "leave" | "exit") =>
+            {
                 let door = crate::layout::door(&scene.room);
                 let to = grid.nearest_free([door[0], door[1] - 0.3]).map(|c| grid.center(c)).unwrap_or(self.st.pos);
                 (to, 0.0)
