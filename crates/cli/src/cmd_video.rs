@@ -80,6 +80,10 @@ pub struct ResequenceArgs {
     /// best matches or looping back.
     #[arg(long)]
     pub stop_early: bool,
+    /// Round 2's walk (ablation): where no candidate is left, a cut or one loop back to the closest
+    /// frame of the path, instead of matched transitions, and no step cap.
+    #[arg(long)]
+    pub no_transitions: bool,
     /// Let steps that play the motion backwards through in shots judged undirected (water, fire,
     /// flicker); shots judged directed keep them out. --explain says how each shot was judged.
     #[arg(long)]
@@ -346,6 +350,7 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         loop_close: a.loop_close,
         allow_cuts: a.allow_cuts,
         seed: a.seed,
+        transitions: !a.no_transitions,
         ..SdpfParams::default()
     };
     let params = if a.paper_choice { params.paper_choice() } else { params };
@@ -378,11 +383,12 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
             path.seed,
             path.frames.len()
         );
-        let (cuts, loops) = (path.cut_positions(), path.loop_positions());
+        let cuts = [path.cut_positions(), path.jump_cut_positions()].concat();
+        let loops = [path.loop_positions(), path.transition_positions()].concat();
         let opts = SheetOptions { title, cuts: cuts.clone(), loops: loops.clone(), ..SheetOptions::default() };
         write_contact_sheet(&staged_sheet, &clip.frames, &path.frames, &opts)?;
         println!(
-            "{}: {} frames ({:?}{}), {} backward steps, {} cuts, {} loop backs, M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
+            "{}: {} frames ({:?}{}), {} backward steps, {} cuts, {} jumps back or ahead (loop backs, matched transitions), M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
             out.display(),
             path.frames.len(),
             path.stop,

@@ -285,6 +285,9 @@ pub async fn generate(State(st): State<Arc<AppState>>, Json(req): Json<GenerateR
                         StepKind::Distilled => "jump",
                         StepKind::Cut { .. } => "cut",
                         StepKind::LoopBack { .. } => "loop",
+                        StepKind::Replay => "replay",
+                        StepKind::JumpCut { .. } => "cut",
+                        StepKind::Transition { .. } => "transition",
                     };
                     (kind, explain_step(t))
                 }

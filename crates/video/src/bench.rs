@@ -14,20 +14,32 @@ use std::time::Instant;
 use inbetween_io::report::{num, Report, Table};
 use inbetween_io::Progress;
 
-use crate::frames::{procedural_clip, read_clip, Clip, ProceduralKind, ReadOptions};
+use crate::frames::{multi_shot_clip, procedural_clip, read_clip, Clip, ProceduralKind, ReadOptions};
 use crate::metric::{embeddings_cached, graph_from_embeddings, pixel_graph, RsfConfig, TrainOptions};
 use crate::pipeline::{analyse, resequence, Analysis, ResequenceConfig, VideoLimits};
 use crate::preview::{contact_sheet, SheetOptions};
 use crate::sdpf::{
-    backward_steps, direction_flips, overlap_delta_o, ssim_planes, stability_md, transition_ssims, SdpfParams,
-    SSIM_SIDE,
+    backward_steps, direction_flips, distinct_fraction, longest_repeated_cycle, overlap_delta_o, per_100_frames,
+    short_cycle_repeats, shot_changes, ssim_planes, stability_md, transition_ssims, Cycle, SdpfParams, SSIM_SIDE,
 };
 use crate::VideoError;
 
 /// A clip of the bench.
 #[derive(Clone, Debug)]
 pub enum BenchClip {
-    Procedural { kind: ProceduralKind, frames: usize, width: u32, height: u32 },
+    Procedural {
+        kind: ProceduralKind,
+        frames: usize,
+        width: u32,
+        height: u32,
+    },
+    /// Procedural shots cut together ([`multi_shot_clip`]), `frames` each.
+    Shots {
+        kinds: Vec<ProceduralKind>,
+        frames: usize,
+        width: u32,
+        height: u32,
+    },
     File(PathBuf),
 }
 
@@ -66,6 +78,18 @@ impl VideoBenchConfig {
         let mut clips = vec![
             BenchClip::Procedural { kind: ProceduralKind::Mixed, frames: 72, width: 320, height: 180 },
             BenchClip::Procedural { kind: ProceduralKind::Drift, frames: 48, width: 320, height: 180 },
+            BenchClip::Shots {
+                kinds: vec![
+                    ProceduralKind::Pendulum,
+                    ProceduralKind::Walker,
+                    ProceduralKind::Drift,
+                    ProceduralKind::Slider,
+                    ProceduralKind::Pendulum,
+                ],
+                frames: 50,
+                width: 320,
+                height: 180,
+            },
         ];
         if let Some(dir) = video_dir {
             for f in ["bigbuckbunny.mp4", "bbb_png_seq", "carphone_pristine.mp4"] {
@@ -91,8 +115,10 @@ impl VideoBenchConfig {
 /// with its early stop), the full method with Eq. 20 as printed (no content term, τ = 1 on latent
 /// units), and the issue's baselines: the shortest-path walk of Fig. 3(a) on our graph and on plain
 /// pixel distances.
-const CONFIGS: [&str; 10] = [
+const CONFIGS: [&str; 12] = [
     "full",
+    "round 2 walk (no transitions, no step cap)",
+    "w/o step cap",
     "w/o C_r",
     "w/o C_d",
     "w/o C_t",
@@ -104,8 +130,10 @@ const CONFIGS: [&str; 10] = [
     "SSPF on pixel distance",
 ];
 /// The paper's Table 3 (M_D, Δ_o), same order, and its ground truth.
-const PAPER_TABLE3: [Option<(f64, f64)>; 10] = [
+const PAPER_TABLE3: [Option<(f64, f64)>; 12] = [
     Some((0.0648, 0.706)),
+    None,
+    None,
     None,
     Some((0.079, 0.827)),
     Some((0.118, 0.783)),
@@ -133,6 +161,15 @@ struct Run {
     loops: usize,
     md: f64,
     delta_o: f64,
+    /// Share of the source's frames shown at least once.
+    distinct: f64,
+    /// The repeated cycle covering the most frames, if any.
+    cycle: Option<Cycle>,
+    /// Most plays in a row of a block shorter than a second.
+    short_repeats: usize,
+    /// Steps between shots, and the run's frames; the source's own shot changes.
+    shot_changes: usize,
+    source_changes: usize,
 }
 
 struct ClipResult {
@@ -196,6 +233,10 @@ fn load(clip: &BenchClip) -> Result<(Clip, String, f64), VideoError> {
             let c = procedural_clip(*kind, *frames, *width, *height, 1);
             Ok((c, format!("procedural {kind:?}"), t.elapsed().as_secs_f64()))
         }
+        BenchClip::Shots { kinds, frames, width, height } => {
+            let c = multi_shot_clip(kinds, *frames, *width, *height, 1);
+            Ok((c, format!("procedural {} shots", kinds.len()), t.elapsed().as_secs_f64()))
+        }
         BenchClip::File(path) => {
             let (c, _) = read_clip(path, &ReadOptions::default())?;
             let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -228,6 +269,11 @@ fn ablated(
 
 fn params_for(which: &str, length: Option<usize>, seed: u64) -> SdpfParams {
     let base = if which.starts_with("paper walk") { SdpfParams::paper_walk() } else { SdpfParams::default() };
+    let base = match which {
+        "w/o step cap" => SdpfParams { step_cap: f32::MAX, ..base },
+        w if w.starts_with("round 2") => SdpfParams { transitions: false, ..base },
+        _ => base,
+    };
     let p = SdpfParams {
         use_ct: which != "w/o C_t",
         use_cd: which != "w/o C_d",
@@ -279,6 +325,7 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
     let starts: Vec<usize> = (0..k).map(|i| ((i * n) / k).min(n - 1)).collect();
     let target = cfg.length.unwrap_or(n);
     let planes = ssim_planes(&clip.frames, SSIM_SIDE);
+    let source_order: Vec<usize> = (0..n).collect();
     let (mut configs, mut ssim_configs, mut runs, mut sheets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut walk_s = 0.0;
     let mut walks = 0usize;
@@ -302,14 +349,20 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
                     walks += 1;
                 }
                 let p = &paths[0];
-                (p.frames.clone(), p.cut_positions(), p.loop_positions())
+                let cuts = [p.cut_positions(), p.jump_cut_positions()].concat();
+                (p.frames.clone(), cuts, [p.loop_positions(), p.transition_positions()].concat())
             };
-            if i == 0 && matches!(which, "full" | "w/o C_r") {
+            if i == 0 && (which == "full" || which == "w/o C_r" || which.starts_with("round 2")) {
                 let title = format!(
-                    "{name}, {which}, from frame {s}: {} frames (red BACK: backward step, blue CUT, purple LOOP)",
+                    "{name}, {which}, from frame {s}: {} frames (red BACK: backward step, blue CUT, purple LOOP: a jump back)",
                     order.len()
                 );
-                let file = format!("sheet-{}-{}.png", slug(&name), if which == "full" { "full" } else { "no-cr" });
+                let tag = match which {
+                    "full" => "full",
+                    "w/o C_r" => "no-cr",
+                    _ => "round2",
+                };
+                let file = format!("sheet-{}-{tag}.png", slug(&name));
                 sheets.push((file, sheet_png(&clip, &order, cuts.clone(), loops.clone(), title)?));
             }
             these.push(Run {
@@ -322,6 +375,11 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
                 loops: loops.len(),
                 md: stability_md(&clip.frames, &order),
                 delta_o: overlap_delta_o(&order, n),
+                distinct: distinct_fraction(&order, n),
+                cycle: longest_repeated_cycle(&order),
+                short_repeats: short_cycle_repeats(&order, full.info.min_loop_frames(1.0)),
+                shot_changes: shot_changes(&order, &shots),
+                source_changes: shot_changes(&source_order, &shots),
             });
             ssims.extend(transition_ssims(&planes, &order)?);
         }
@@ -374,6 +432,23 @@ pub fn run(cfg: &VideoBenchConfig, progress: &Progress) -> Result<Report, VideoE
     Ok(report)
 }
 
+/// `period×repeats` of a cycle, `-` for none.
+fn cycle_words(c: Option<Cycle>) -> String {
+    c.map_or_else(|| "-".to_string(), |c| format!("{}x{}", c.period, c.repeats))
+}
+
+/// The repeated cycle of `runs` covering the most frames.
+fn longest_cycle(runs: &[Run]) -> Option<Cycle> {
+    runs.iter().filter_map(|r| r.cycle).max_by_key(|c| (c.frames(), std::cmp::Reverse(c.period)))
+}
+
+/// Mean over `runs` of the steps between shots per 100 frames, and the source's own.
+fn cuts_per_100(runs: &[Run]) -> (f64, f64) {
+    let ours = mean(&runs.iter().map(|r| per_100_frames(r.shot_changes, r.length)).collect::<Vec<_>>());
+    let source = mean(&runs.iter().map(|r| per_100_frames(r.source_changes, r.length.max(1))).collect::<Vec<_>>());
+    (ours, source)
+}
+
 /// Backward steps over all steps of `runs`, percent.
 fn backward_pct(runs: &[Run]) -> f64 {
     let steps: usize = runs.iter().map(|r| r.steps).sum();
@@ -418,6 +493,11 @@ fn runs_table(results: &[ClipResult]) -> Table {
             "delta_o",
             "cuts",
             "loops",
+            "distinct_frames",
+            "longest_cycle",
+            "short_cycle_repeats",
+            "shot_changes_per_100",
+            "source_shot_changes_per_100",
         ],
     );
     for r in results {
@@ -436,13 +516,19 @@ fn runs_table(results: &[ClipResult]) -> Table {
                     num(run.delta_o, 3),
                     run.cuts.to_string(),
                     run.loops.to_string(),
+                    num(run.distinct, 2),
+                    cycle_words(run.cycle),
+                    run.short_repeats.to_string(),
+                    num(per_100_frames(run.shot_changes, run.length), 1),
+                    num(per_100_frames(run.source_changes, r.frames), 1),
                 ]);
             }
         }
     }
     t.note("backward step: a step to one of the 3 previous source frames (i -> i-1, i-2, i-3), which plays the source backwards; backward_pct = backward steps / steps");
     t.note("flips: steps between two LMS frames whose motion tendencies differ by more than 60 degrees (what C_d, Eq. 12, prevents)");
-    t.note("length: frames reached; target: the clip's frame count (the default length); cuts: steps that cut to another shot where no candidate was left; loops: loop backs (then the loop repeats)");
+    t.note("length: frames reached; target: the clip's frame count (the default length); cuts: steps that cut to another shot where no candidate was left, and (full method) jump cuts inside a shot where no matched way led on; loops: loop backs (round 2's walk; then the loop repeats) and matched transitions (the full method)");
+    t.note(CYCLE_NOTE);
     t
 }
 
@@ -463,6 +549,12 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
             "delta_o",
             "cuts",
             "loops",
+            "distinct_frames",
+            "distinct_min",
+            "longest_cycle",
+            "short_cycle_repeats",
+            "shot_changes_per_100",
+            "source_shot_changes_per_100",
             "ssim_source",
             "ssim_ours",
             "ssim_ratio",
@@ -486,6 +578,12 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
             num(dq, 3),
             r.runs[0].iter().map(|x| x.cuts).sum::<usize>().to_string(),
             r.runs[0].iter().map(|x| x.loops).sum::<usize>().to_string(),
+            num(mean(&r.runs[0].iter().map(|x| x.distinct).collect::<Vec<_>>()), 2),
+            num(r.runs[0].iter().map(|x| x.distinct).fold(f64::INFINITY, f64::min), 2),
+            cycle_words(longest_cycle(&r.runs[0])),
+            r.runs[0].iter().map(|x| x.short_repeats).max().unwrap_or(0).to_string(),
+            num(cuts_per_100(&r.runs[0]).0, 1),
+            num(cuts_per_100(&r.runs[0]).1, 1),
             num(mean(&r.ssim_source), 3),
             num(ss, 3),
             num(sr, 3),
@@ -498,10 +596,13 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
         cfg.length.map_or_else(|| "= the clip's frame count".to_string(), |l| l.to_string())
     ));
     t.note("directed_shots: shots whose motion is judged directed (at least half LMS frames); length_reached: mean share of the target length; backward_pct: steps to one of the 3 previous source frames, over all steps of the 4 starts (full method; _no_cr: without C_r); cuts, loops: summed over the starts");
+    t.note(CYCLE_NOTE);
     t.note("paper (12 clips, their own): ground truth M_D 0.050, ours 0.055 (ratio 1.10), Δo 0.73; Morace et al. 0.069, Δo 0.74");
     t.note(SSIM_NOTE);
     t
 }
+
+const CYCLE_NOTE: &str = "distinct_frames: share of the source's frames the order shows (mean over the starts; distinct_min: the lowest); longest_cycle: the block of frames played most often in a row, as frames x plays (the one covering the most frames, over the starts); short_cycle_repeats: most plays in a row of a block shorter than 1 s (issue 41's limit: 2); shot_changes_per_100: steps between shots per 100 frames of the order, beside the source's own shot changes per 100 frames";
 
 const SSIM_NOTE: &str = "ssim (ours; the paper reports none): mean SSIM (Wang et al. 2004, 11x11 Gaussian window, sigma 1.5, on luma at most 160 px on the longer side) of the transitions i -> i+1 of the new orders; ssim_source over the clip's own adjacent pairs; ssim_ratio = ours / source (1 = transitions as similar as real ones); ssim_p10 = 10th percentile of the new transitions (the worst jumps)";
 
@@ -520,6 +621,9 @@ fn table3(results: &[ClipResult]) -> Table {
             "ssim",
             "ssim_ratio",
             "ssim_p10",
+            "distinct_frames",
+            "short_cycle_repeats",
+            "shot_changes_per_100",
             "paper_md",
             "paper_md_ratio",
             "paper_delta_o",
@@ -540,6 +644,9 @@ fn table3(results: &[ClipResult]) -> Table {
         num(gt_ssim, 3),
         "1.000".into(),
         num(gt_p10, 3),
+        "1.00".into(),
+        "-".into(),
+        num(results.iter().map(|r| per_100_frames(r.direction.len().saturating_sub(1), r.frames)).sum::<f64>() / k, 1),
         num(PAPER_GT_MD, 4),
         "1.00".into(),
         "1".into(),
@@ -558,6 +665,10 @@ fn table3(results: &[ClipResult]) -> Table {
         let len = results.iter().map(|r| reached(&r.runs[i], r.target)).sum::<f64>() / k;
         let back = results.iter().map(|r| backward_pct(&r.runs[i])).sum::<f64>() / k;
         let flips = results.iter().map(|r| flip_pct(&r.runs[i])).sum::<f64>() / k;
+        let distinct =
+            results.iter().map(|r| mean(&r.runs[i].iter().map(|x| x.distinct).collect::<Vec<_>>())).sum::<f64>() / k;
+        let short = results.iter().flat_map(|r| r.runs[i].iter().map(|x| x.short_repeats)).max().unwrap_or(0);
+        let cuts = results.iter().map(|r| cuts_per_100(&r.runs[i]).0).sum::<f64>() / k;
         t.row([
             name.to_string(),
             num(len, 2),
@@ -569,6 +680,9 @@ fn table3(results: &[ClipResult]) -> Table {
             num(ss, 3),
             num(sr, 3),
             num(sp, 3),
+            num(distinct, 2),
+            short.to_string(),
+            num(cuts, 1),
             pm,
             pr,
             pd,
@@ -581,6 +695,8 @@ fn table3(results: &[ClipResult]) -> Table {
     t.note("w/o RSFNet: Euclidean distance of 32-pixel thumbnails; w/o L_d: the same network untrained (our backbone is not pretrained)");
     t.note("Eq. 20 as printed: the full method choosing by exp(-motion distance) in latent units, without our content term and relative temperature");
     t.note("SSPF: the baseline of Fig. 3(a), always the nearest unvisited frame (RSFNet graph); SSPF on pixel distance: the same on 32-pixel thumbnails; the paper gives no numbers for them");
+    t.note("distinct_frames, shot_changes_per_100: means over the clips; short_cycle_repeats: the most over every clip and start (see Table 2's note)");
+    t.note("round 2 walk: issue 26's walk, where S2 is empty a cut or one loop back to the closest frame of the path, repeated up to the length, and no step cap (the 'before' of issue 41); w/o step cap: the full method drawing from all of S2");
     t.note("ssim, ssim_ratio, ssim_p10: means over the clips of Table 2's columns (ours; the paper reports no SSIM); ground truth: the clips' own adjacent pairs");
     t
 }

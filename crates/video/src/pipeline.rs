@@ -259,7 +259,17 @@ pub fn analyse(clip: &Clip, cfg: &ResequenceConfig, progress: &Progress) -> Resu
     stages.push(("complete graph, scene cuts".to_string(), t.elapsed().as_secs_f64()));
     let direction = judge_directed(&motion.lms, &shot);
     let directed = direction.iter().map(|d| d.0).collect();
-    let info = MotionInfo { tendency: motion.tendency.clone(), lms: motion.lms.clone(), shot, directed };
+    // Appearance distances for matched transitions and the step cap (issue 41): Euclidean distance
+    // of 32-pixel thumbnails, proportional to their RMS difference (M_D's D, Eq. 21).
+    let appearance = pixel_graph(&clip.frames, 32).dist;
+    let info = MotionInfo {
+        tendency: motion.tendency.clone(),
+        lms: motion.lms.clone(),
+        shot,
+        directed,
+        appearance,
+        fps: clip.fps as f32,
+    };
     cancel.check()?;
     Ok(Analysis {
         motion,
@@ -459,7 +469,7 @@ mod tests {
     /// Every step of `order` but loop backs and cuts (the jumps an editor makes at a dead end, marked
     /// as such; on this tiny clip the cut detector can split the drift into shots), as (from, to).
     fn steps_but_loops(path: &SdpfPath) -> Vec<(usize, usize)> {
-        let jumps = [path.loop_positions(), path.cut_positions()].concat();
+        let jumps = [path.loop_positions(), path.cut_positions(), path.transition_positions()].concat();
         // After a loop back the loop repeats: its steps and its seam (the loop back) are already counted.
         let fresh = path.transitions.len().min(path.len() - 1);
         (1..=fresh).filter(|i| !jumps.contains(i)).map(|i| (path.frames[i - 1], path.frames[i])).collect()
@@ -490,6 +500,75 @@ mod tests {
             }
         }
         assert!(left_without_cr > 0, "without C_r some steps go left (what the test guards against)");
+    }
+
+    #[test]
+    fn a_pendulum_loops_long_through_matching_earlier_frames_never_backwards() {
+        // Four swings of a pendulum (period 22–34 frames): an order twice the source's length must go
+        // back, and does so by matched transitions into earlier swings, opening loops of at least a
+        // second (25 frames), never stepping to one of the 3 previous frames.
+        use crate::sdpf::{distinct_fraction, short_cycle_repeats, StepKind};
+        let dir = tempfile::tempdir().unwrap();
+        let clip = procedural_clip(ProceduralKind::Pendulum, 100, 96, 64, 3);
+        let a = analyse(&clip, &quick_config(dir.path()), &Progress::hidden()).unwrap();
+        for (start, seed) in [(0, 1), (37, 2), (90, 3)] {
+            let p = SdpfParams { seed, length: Some(200), ..SdpfParams::default() };
+            let path = &resequence(&a, start, &p, 1, &VideoLimits::default()).unwrap().0[0];
+            let o = &path.frames;
+            assert_eq!(o.len(), 200);
+            assert_eq!(crate::sdpf::backward_steps(o, 3), 0, "{o:?}");
+            assert!(short_cycle_repeats(o, 25) <= 2, "a loop under a second repeats: {o:?}");
+            assert!(distinct_fraction(o, 100) >= 0.6, "{o:?}");
+            let back: Vec<(usize, usize, f32, usize)> = path
+                .transitions
+                .iter()
+                .filter_map(|t| match (t.chosen, t.kind) {
+                    (Some(k), StepKind::Transition { cost, loop_frames }) if k < t.from => {
+                        Some((t.from, k, cost, loop_frames))
+                    }
+                    _ => None,
+                })
+                .collect();
+            assert!(!back.is_empty(), "start {start}: no transition back in {o:?}");
+            for &(from, to, cost, loop_frames) in &back {
+                assert!(from - to > 3 && loop_frames == from - to + 1);
+                assert!(cost <= p.match_threshold * p.match_relax, "{from} -> {to}: cost {cost}");
+            }
+            // A matched transition plays about like a source step: at most twice the source's
+            // largest step.
+            let rms = |x: usize, y: usize| crate::sdpf::frame_rms(&clip.frames[x], &clip.frames[y], x, y).unwrap();
+            let largest = (1..100).map(|i| rms(i - 1, i)).fold(0.0, f64::max);
+            for &(from, to, cost, _) in back.iter().filter(|b| b.2 <= p.match_threshold) {
+                assert!(rms(from, to) <= 2.0 * largest, "{from} -> {to} (cost {cost}): {} vs {largest}", rms(from, to));
+            }
+            assert!(
+                back.iter().any(|b| b.3 >= 25),
+                "start {start}: no loop of a second or more through a matched transition: {back:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn three_shots_cut_no_more_than_the_source_plus_dead_ends() {
+        use crate::frames::multi_shot_clip;
+        use crate::sdpf::{distinct_fraction, shot_changes};
+        let dir = tempfile::tempdir().unwrap();
+        let kinds = [ProceduralKind::Pendulum, ProceduralKind::Walker, ProceduralKind::Drift];
+        let clip = multi_shot_clip(&kinds, 30, 96, 64, 5);
+        let a = analyse(&clip, &quick_config(dir.path()), &Progress::hidden()).unwrap();
+        let shots: Vec<usize> = (0..90).map(|i| a.info.shot_of(i)).collect();
+        assert_eq!(a.info.shots(), 3, "{shots:?}");
+        for (start, seed) in [(0, 1), (40, 2), (75, 3)] {
+            let p = SdpfParams { seed, ..SdpfParams::default() };
+            let path = &resequence(&a, start, &p, 1, &VideoLimits::default()).unwrap().0[0];
+            let o = &path.frames;
+            // A cut only where the walk could reach no unshown frame of its shot: a dead end.
+            let changes = shot_changes(o, &shots);
+            assert_eq!(changes, path.cut_positions().len(), "every change of shot is a marked cut: {o:?}");
+            assert!(changes <= 2 + 1, "start {start}: {changes} cuts for 2 shot changes: {o:?}");
+            assert!(distinct_fraction(o, 90) >= 0.6, "{o:?}");
+            assert_eq!(crate::sdpf::backward_steps(o, 3), 0, "{o:?}");
+        }
     }
 
     #[test]

@@ -65,6 +65,30 @@ pub fn procedural_clip(kind: ProceduralKind, frames: usize, width: u32, height: 
     Clip { frames: images, fps: DEFAULT_FPS, source: format!("procedural:{kind:?}:{width}x{height}:seed={seed}") }
 }
 
+/// Several shots cut together, one after the other (issue 41's clips "with several shots"): shot `i`
+/// is a `kinds[i]` clip of `frames_per_shot` frames drawn with its own seed (its own background and
+/// colours), every other shot in inverted colours so that each cut is as hard as a change of scene,
+/// `width`×`height` at 25 fps.
+pub fn multi_shot_clip(kinds: &[ProceduralKind], frames_per_shot: usize, width: u32, height: u32, seed: u64) -> Clip {
+    let frames = kinds
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &k)| {
+            let mut shot = procedural_clip(k, frames_per_shot, width, height, derive(seed, 100 + i as u64)).frames;
+            if i % 2 == 1 {
+                shot.iter_mut().for_each(|f| f.pixels_mut().for_each(|p| p.0 = p.0.map(|v| 255 - v)));
+            }
+            shot
+        })
+        .collect();
+    let names: Vec<String> = kinds.iter().map(|k| format!("{k:?}")).collect();
+    Clip {
+        frames,
+        fps: DEFAULT_FPS,
+        source: format!("procedural shots:{}x{frames_per_shot}:{width}x{height}:seed={seed}", names.join("+")),
+    }
+}
+
 /// Parameters drawn from the seed, and the two backgrounds.
 struct Scene {
     kind: ProceduralKind,

@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use inbetween_core::cancel::Cancel;
 use rand::Rng;
 
+use super::texture::Transitions;
 use super::types::{Candidate, CdState, CrState, MotionDistance, MotionInfo, Omega, SdpfParams, StepKind, Transition};
 use crate::metric::Graph;
 use crate::motion::angle_between;
@@ -47,6 +48,8 @@ pub(crate) struct Ctx<'a> {
     pub cancel: Cancel,
     memo: RefCell<HashMap<(usize, usize), f32>>,
     floors: RefCell<HashMap<usize, f32>>,
+    /// Matched transitions (issue 41), with [`SdpfParams::transitions`] and without the early stop.
+    pub texture: Option<Transitions>,
 }
 
 impl<'a> Ctx<'a> {
@@ -60,7 +63,46 @@ impl<'a> Ctx<'a> {
             cancel: Cancel::new(),
             memo: RefCell::default(),
             floors: RefCell::default(),
+            texture: (p.transitions && !p.stop_early).then(|| {
+                let dist = if motion.appearance.len() == graph.n * graph.n { &motion.appearance } else { &graph.dist };
+                Transitions::new(dist, graph.n, motion, p)
+            }),
         }
+    }
+
+    /// The appearance distance of frames `a` and `b` ([`MotionInfo::appearance`], else the edge weight).
+    pub fn look(&self, a: usize, b: usize) -> f32 {
+        let n = self.graph.n;
+        if self.motion.appearance.len() == n * n {
+            self.motion.appearance[a * n + b]
+        } else {
+            self.edge(a, b)
+        }
+    }
+
+    /// The step cap ([`SdpfParams::step_cap`], with matched transitions on): removes from S2 the
+    /// frames farther in appearance from `t.from` than κ times the shot's median source step, or
+    /// κ times the current frame's own step to its successor when that is larger, and renormalises
+    /// the probabilities of Eq. 20 over the rest.
+    pub fn cap(&self, t: &mut Transition) {
+        let Some(tex) = &self.texture else { return };
+        let c = t.from;
+        let shot = self.motion.shot_of(c);
+        let own = if c + 1 < self.graph.n && self.motion.shot_of(c + 1) == shot { self.look(c, c + 1) } else { 0.0 };
+        let limit = self.p.step_cap * tex.step.get(shot).copied().unwrap_or(f32::INFINITY).max(own);
+        type Probs = Vec<(usize, f32)>;
+        let (kept, removed): (Probs, Probs) = t.probs.iter().copied().partition(|&(k, _)| self.look(c, k) <= limit);
+        if removed.is_empty() {
+            return;
+        }
+        t.removed_cap = removed.into_iter().map(|(k, _)| k).collect();
+        let total: f32 = kept.iter().map(|&(_, p)| p).sum();
+        t.probs = if total > 0.0 {
+            kept.into_iter().map(|(k, p)| (k, p / total)).collect()
+        } else {
+            let u = 1.0 / kept.len().max(1) as f32;
+            kept.into_iter().map(|(k, _)| (k, u)).collect()
+        };
     }
 
     /// Lines 7–21 of Algorithm 1 from frame `from`; `chosen` is left `None` for the caller's draw.
@@ -116,6 +158,7 @@ impl<'a> Ctx<'a> {
             removed_cd,
             omega,
             removed_ct,
+            removed_cap: Vec::new(),
             probs,
             kind: StepKind::Distilled,
         }

@@ -61,6 +61,14 @@ fn head(t: &Transition) -> String {
         StepKind::LoopBack { to, edge } => {
             format!(" LOOP back to position {to} (S2 empty, no other shot left; the closest frame of the path, e {edge:.3})")
         }
+        StepKind::JumpCut { cost } => format!(
+            " JUMP CUT inside the shot (S2 empty, no matched way to its frames not yet shown; {cost:.2} source steps)"
+        ),
+        StepKind::Replay => " REPLAY (S2 empty: the next source frame, already shown)".to_string(),
+        StepKind::Transition { cost, loop_frames } => {
+            let opens = if loop_frames > 0 { format!(", opens a loop of {loop_frames} frames") } else { String::new() };
+            format!(" TRANSITION (S2 empty: the frames before it match those around frame {} in content and direction, cost {cost:.2} source steps{opens})", t.from)
+        }
     };
     match t.chosen {
         Some(k) => format!("frame {} → {k}{how}", t.from),
@@ -77,6 +85,10 @@ fn body(s: &mut String, t: &Transition) {
     let _ = writeln!(s, "  C_r (reverse, beyond the paper): {}", cr_words(t));
     let _ = writeln!(s, "  C_d (Eq. 12): {}", cd_words(t));
     let _ = writeln!(s, "  C_t (Eq. 16-17): {}", ct_words(t));
+    if !t.removed_cap.is_empty() {
+        let _ =
+            writeln!(s, "  step cap (farther than the source's own steps allow): removed {}", frames(&t.removed_cap));
+    }
     let s2: Vec<String> = t.probs.iter().map(|(f, p)| format!("{f} p={p:.3}")).collect();
     let _ = writeln!(s, "  S2 with softmax probabilities (Eq. 20): {}", none_if_empty(&s2));
     match (t.chosen, t.kind) {
@@ -88,6 +100,15 @@ fn body(s: &mut String, t: &Transition) {
         }
         (Some(k), StepKind::LoopBack { .. }) => {
             let _ = writeln!(s, "  no candidate left and no other shot: loop back to {k}");
+        }
+        (Some(k), StepKind::JumpCut { .. }) => {
+            let _ = writeln!(s, "  no candidate and no matched way left: jump cut to {k}");
+        }
+        (Some(k), StepKind::Replay) => {
+            let _ = writeln!(s, "  no candidate left: play on to {k}");
+        }
+        (Some(k), StepKind::Transition { .. }) => {
+            let _ = writeln!(s, "  no candidate left: matched transition to {k}");
         }
         (None, _) => {
             let _ = writeln!(s, "  no candidate left: stop");

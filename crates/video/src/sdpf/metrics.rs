@@ -88,3 +88,89 @@ pub fn overlap(order: &[usize], source_len: usize) -> Overlap {
 pub fn overlap_delta_o(order: &[usize], source_len: usize) -> f64 {
     overlap(order, source_len).delta_o
 }
+
+/// The share of a source of `source_len` frames that `order` shows at least once, in [0, 1]
+/// (issue 41: a new order of the source's length should show most of it, not a few frames over
+/// and over). Indices out of range are ignored.
+pub fn distinct_fraction(order: &[usize], source_len: usize) -> f64 {
+    if source_len == 0 {
+        return 0.0;
+    }
+    let mut seen = vec![false; source_len];
+    order.iter().filter(|&&f| f < source_len).for_each(|&f| seen[f] = true);
+    seen.iter().filter(|&&s| s).count() as f64 / source_len as f64
+}
+
+/// A block of frames played several times in a row in an order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Cycle {
+    /// Frames in one play of the block.
+    pub period: usize,
+    /// Complete plays in a row (at least 2 for a repeated cycle).
+    pub repeats: usize,
+    /// Position of its first frame in the order.
+    pub at: usize,
+}
+
+impl Cycle {
+    /// Frames the repeats cover, `period × repeats`.
+    pub fn frames(&self) -> usize {
+        self.period * self.repeats
+    }
+}
+
+/// For every period `p`, the block of `p` frames played most times in a row in `order` (only those
+/// played at least twice), found by runs of `order[i] == order[i + p]`: a run of `r` such positions
+/// is a block of `p` frames played `1 + r / p` times. O(len²).
+fn cycles_by_period(order: &[usize]) -> Vec<Cycle> {
+    let len = order.len();
+    let mut out = Vec::new();
+    for p in 1..=len / 2 {
+        let mut best = Cycle::default();
+        let mut run = 0usize;
+        for i in 0..len - p {
+            if order[i] == order[i + p] {
+                run += 1;
+                let repeats = 1 + run / p;
+                if repeats > best.repeats {
+                    best = Cycle { period: p, repeats, at: i + 1 - run };
+                }
+            } else {
+                run = 0;
+            }
+        }
+        if best.repeats >= 2 {
+            out.push(best);
+        }
+    }
+    out
+}
+
+/// The repeated cycle of `order` that covers the most frames (`period × repeats`; among equals the
+/// shorter period, which is the one a viewer sees), or `None` when no block of frames is played twice
+/// in a row (issue 41's "longest repeated cycle").
+pub fn longest_repeated_cycle(order: &[usize]) -> Option<Cycle> {
+    cycles_by_period(order).into_iter().max_by(|a, b| a.frames().cmp(&b.frames()).then(b.period.cmp(&a.period)))
+}
+
+/// The most plays in a row of any block shorter than `min_period` frames (0 when none repeats): a
+/// loop shorter than a second played more than twice reads as a stutter (issue 41's limit: at most 2).
+pub fn short_cycle_repeats(order: &[usize], min_period: usize) -> usize {
+    cycles_by_period(order).iter().filter(|c| c.period < min_period).map(|c| c.repeats).max().unwrap_or(0)
+}
+
+/// Steps of `order` between frames of different shots (`shot[f]`: the shot of source frame `f`);
+/// for the source order itself, its shot changes. Frames without a shot count as shot 0.
+pub fn shot_changes(order: &[usize], shot: &[usize]) -> usize {
+    let of = |f: usize| shot.get(f).copied().unwrap_or(0);
+    order.windows(2).filter(|w| of(w[0]) != of(w[1])).count()
+}
+
+/// `count` per 100 frames of an order of `len` frames (0 for an empty order).
+pub fn per_100_frames(count: usize, len: usize) -> f64 {
+    if len == 0 {
+        0.0
+    } else {
+        100.0 * count as f64 / len as f64
+    }
+}

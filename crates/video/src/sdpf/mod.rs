@@ -11,7 +11,8 @@
 //! - [`metrics`]: M_D (Eq. 21) and Δo (Eq. 22–23);
 //! - [`ssim`](mod@ssim): SSIM of transitions (Wang et al. 2004; not in the paper), the bench's perceptual proxy;
 //! - [`explain`](mod@explain): `--explain` text;
-//! - [`sspf`](mod@sspf): the shortest-path baseline (Fig. 3(a)).
+//! - [`sspf`](mod@sspf): the shortest-path baseline (Fig. 3(a));
+//! - [`texture`]: matched transitions (Schödl et al. 2000), the way on where S2 is empty (issue 41).
 //!
 //! Readings of the paper where its text is ambiguous (each is documented where it is coded):
 //! - **η (Eq. 8)** is the mean of the N(N−1) off-diagonal edge weights (the paper: "Σ e_ij / N …
@@ -44,8 +45,11 @@
 //!   frames' own motions, and the previous frame moves just like the current one. In shots judged
 //!   undirected (water, fire, flicker; [`judge_directed`]) `allow_reverse` lets such steps through;
 //! - shots: no jump across a scene cut unless `allow_cuts`;
-//! - a target length, by default the source's frame count; where S2 is empty, a cut to the shot
-//!   that best matches or a loop back instead of the paper's early stop (`stop_early` keeps it);
+//! - a target length, by default the source's frame count; where S2 is empty, instead of the
+//!   paper's early stop (`stop_early` keeps it), the next source frame or a matched transition
+//!   ([`texture`]) towards frames not yet shown, a cut to the shot that best matches when none is
+//!   left in the shot, and once all is shown the longest loop; a step cap keeps Eq. 20's draws
+//!   about as smooth as the source's own steps;
 //! - loop closure back to the start frame;
 //! - several distinct sequences from one graph;
 //! - a record of every transition for `--explain`.
@@ -58,12 +62,16 @@ pub mod reverse;
 pub mod search;
 pub mod ssim;
 pub mod sspf;
+pub mod texture;
 pub mod types;
 
 pub use cuts::{cut_scores, detect_cuts, detect_cuts_with, detect_shots, shots_from_cuts, CutParams};
 pub use distill::{eta, softmax};
 pub use explain::{explain, explain_step};
-pub use metrics::{frame_rms, overlap, overlap_delta_o, source_md, stability_md, try_stability_md, Overlap};
+pub use metrics::{
+    distinct_fraction, frame_rms, longest_repeated_cycle, overlap, overlap_delta_o, per_100_frames,
+    short_cycle_repeats, shot_changes, source_md, stability_md, try_stability_md, Cycle, Overlap,
+};
 pub use reverse::{
     backward_positions, backward_steps, direction_flips, direction_words, is_backward_step, judge_directed,
     DIRECTED_LMS_SHARE,
@@ -71,6 +79,7 @@ pub use reverse::{
 pub use search::{sdpf, several, several_with};
 pub use ssim::{ssim, ssim_planes, transition_ssims, Plane, SSIM_SIDE};
 pub use sspf::sspf;
+pub use texture::Transitions;
 pub use types::{
     Candidate, CdState, CrState, MatrixMotion, MotionDistance, MotionInfo, NoMotion, Omega, Path, SdpfParams, SdpfPath,
     StepKind, StopReason, Transition,

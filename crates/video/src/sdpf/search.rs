@@ -4,7 +4,7 @@
 use inbetween_core::cancel::Cancel;
 use inbetween_core::seed::{derive, rng};
 
-use super::distill::{draw, Ctx};
+use super::distill::{draw, Ctx, MIN_LOOP};
 use super::types::{MotionDistance, MotionInfo, SdpfParams, SdpfPath, StepKind, StopReason};
 use crate::metric::Graph;
 use crate::VideoError;
@@ -140,6 +140,9 @@ fn best_walk(ctx: &Ctx, start: usize, seed: u64) -> Result<SdpfPath, VideoError>
 /// current frame ([`Ctx::cut`]) or, with no other shot left, loops back ([`Ctx::loop_back`]) and
 /// repeats the loop up to the target length.
 fn walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<SdpfPath, VideoError> {
+    if ctx.texture.is_some() {
+        return texture_walk(ctx, start, seed, attempt);
+    }
     let n = ctx.graph.n;
     let target = ctx.p.target_length(n);
     let mut rng = rng(seed);
@@ -185,6 +188,74 @@ fn walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<SdpfPath, 
             };
         };
         visited[next] = true;
+        frames.push(next);
+        current = next;
+    };
+    Ok(SdpfPath { frames, transitions, stop, closes_loop: false, closing: None, eta: ctx.eta, seed, attempt })
+}
+
+/// The walk with matched transitions (issue 41; [`SdpfParams::transitions`], the default). Each
+/// step draws from S2 under the step cap (Eq. 20, as [`walk`]); where nothing is left to draw:
+/// 1. the shortest way within the shot to a frame not yet shown, by next source frames and matched
+///    transitions ([`Transitions::route`](super::texture::Transitions::route)), followed step by
+///    step unless a later draw finds a new frame first;
+/// 2. else, with frames of the shot still unshown, a jump cut inside the shot to the one that best
+///    follows ([`Transitions::jump_in_shot`](super::texture::Transitions::jump_in_shot)), marked as a cut;
+/// 3. else a cut to the shot that best matches, if one still has frames not yet shown;
+/// 4. else round the longest loop ([`Transitions::loop_step`](super::texture::Transitions::loop_step)).
+fn texture_walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<SdpfPath, VideoError> {
+    let n = ctx.graph.n;
+    let Some(tex) = &ctx.texture else { return Err(VideoError::Invalid("SDPF: no transitions".into())) };
+    let target = ctx.p.target_length(n);
+    let mut rng = rng(seed);
+    let mut visited = vec![false; n];
+    visited[start] = true;
+    let (mut frames, mut transitions) = (vec![start], Vec::new());
+    let mut current = start;
+    // The rest of a route to unshown frames, next step last.
+    let mut plan: Vec<(usize, StepKind)> = Vec::new();
+    // How many frames were shown when a route last found nothing: until another is shown, none will.
+    let mut shown = 1usize;
+    let mut no_route_at: Option<usize> = None;
+    let stop = loop {
+        if frames.len() >= target {
+            break StopReason::TargetLength;
+        }
+        ctx.cancel.check()?;
+        let mut t = ctx.step(current, &visited);
+        ctx.cap(&mut t);
+        t.chosen = draw(&t.probs, &mut rng);
+        if t.chosen.is_some() {
+            plan.clear();
+        } else {
+            if plan.is_empty() && no_route_at != Some(shown) {
+                match tex.route(current, &visited, ctx.motion) {
+                    Some(mut steps) => {
+                        steps.reverse();
+                        plan = steps;
+                    }
+                    None => no_route_at = Some(shown),
+                }
+            }
+            let way = plan
+                .pop()
+                .or_else(|| {
+                    let look = |a: usize, b: usize| ctx.look(a, b);
+                    tex.jump_in_shot(current, &visited, ctx.motion, ctx.p.reverse_window, MIN_LOOP, look)
+                        .map(|(k, cost)| (k, StepKind::JumpCut { cost }))
+                })
+                .or_else(|| ctx.cut(current, &visited).map(|(k, edge)| (k, StepKind::Cut { edge })));
+            if let Some((k, kind)) = way.or_else(|| tex.loop_step(current, ctx.motion)) {
+                t.chosen = Some(k);
+                t.kind = kind;
+            }
+        }
+        let chosen = t.chosen;
+        transitions.push(t);
+        let Some(next) = chosen else {
+            break StopReason::DeadEnd;
+        };
+        shown += usize::from(!std::mem::replace(&mut visited[next], true));
         frames.push(next);
         current = next;
     };

@@ -76,8 +76,7 @@ fn cd_scene() -> (Graph, MotionInfo) {
         // (removed); 4: LMS −0.5 (29°, kept); 5: LMS 2π − 0.3 (17° once wrapped, kept).
         tendency: vec![Some(0.0), Some(0.2), Some(3.0), Some(0.0), Some(-0.5), Some(TAU - 0.3)],
         lms: vec![true, true, true, false, true, true],
-        shot: vec![],
-        directed: vec![],
+        ..MotionInfo::none()
     };
     (star_graph(6), motion)
 }
@@ -192,7 +191,7 @@ fn degenerate_graphs_stop_without_panicking() {
     assert_eq!((p.frames.clone(), p.stop), (vec![2], StopReason::EarlyStop));
     // NaN motion distances and tendencies everywhere: C_t cannot vouch for anyone, early stop.
     let nan_md = MatrixMotion { n: 6, dist: vec![f32::NAN; 36], floor: vec![f32::NAN; 6] };
-    let nan_m = MotionInfo { tendency: vec![Some(f32::NAN); 6], lms: vec![true; 6], shot: vec![], directed: vec![] };
+    let nan_m = MotionInfo { tendency: vec![Some(f32::NAN); 6], lms: vec![true; 6], ..MotionInfo::none() };
     let p = sdpf(&line_graph(6), &nan_m, &nan_md, 0, &SdpfParams::paper_walk()).unwrap();
     assert_eq!(p.stop, StopReason::EarlyStop);
     // Without C_t the softmax over NaN distances is uniform and the walk goes on.
@@ -613,6 +612,7 @@ fn a_cut_enters_the_other_shot_where_the_walk_can_go_on() {
         lms: vec![false; 10],
         shot: [0; 5].into_iter().chain([1; 5]).collect(),
         directed: vec![false, false],
+        ..MotionInfo::none()
     };
     let p = SdpfParams { use_cr: false, ..SdpfParams::default() };
     let ctx = Ctx::new(&g, &motion, &NoMotion, &p);

@@ -52,6 +52,28 @@ pub struct SdpfParams {
     /// whatever their edge weight (§5.1); with η the mean edge weight, S1 is about half of the
     /// clip, and a choice blind to content jumps across it (measured: M_D 1.8–3× the source's).
     pub content_weight: f32,
+    /// Matched transitions (issue 41, after Schödl et al. 2000, "Video Textures"): where S2 is empty
+    /// the walk goes on by the next source frame or by a jump `c → j` whose frames around `j − 1`
+    /// match those around `c` in content and motion direction ([`texture`](super::texture)), and
+    /// cuts to another shot only when no such way leads to an unvisited frame. Off: round 2's walk
+    /// (a cut, else one loop back to the closest frame of the path, repeated up to the length).
+    pub transitions: bool,
+    /// Frames on each side of the window a transition is matched over (`m`: 2m + 1 frame pairs,
+    /// binomial weights).
+    pub match_window: usize,
+    /// θ: a transition is accepted when its windowed distance is at most θ times the shot's median
+    /// source step (the distance between adjacent frames of the shot).
+    pub match_threshold: f32,
+    /// Where no transition under θ leads to an unvisited frame, transitions up to `relax × θ`
+    /// are tried before a cut.
+    pub match_relax: f32,
+    /// κ: with `transitions`, a step drawn by Eq. 20 may be at most κ times the shot's median source
+    /// step (or the current frame's own step to its successor, if larger) away in appearance, so that
+    /// the new order is about as smooth as the source (M_D, Eq. 21).
+    pub step_cap: f32,
+    /// Shortest loop, seconds, that the walk repeats once every frame it can reach is used: a shorter
+    /// one played over and over reads as a stutter.
+    pub min_loop_s: f32,
 }
 
 impl SdpfParams {
@@ -96,6 +118,12 @@ impl Default for SdpfParams {
             temperature: 0.1,
             relative_temperature: true,
             content_weight: 2.0,
+            transitions: true,
+            match_window: 2,
+            match_threshold: 1.0,
+            match_relax: 2.5,
+            step_cap: 1.1,
+            min_loop_s: 1.0,
         }
     }
 }
@@ -108,6 +136,16 @@ impl SdpfParams {
         }
         if !(self.temperature.is_finite() && self.temperature > 0.0) {
             return Err(VideoError::Invalid(format!("SDPF: temperature must be > 0, got {}", self.temperature)));
+        }
+        for (name, v) in [
+            ("match_threshold", self.match_threshold),
+            ("match_relax", self.match_relax),
+            ("step_cap", self.step_cap),
+            ("min_loop_s", self.min_loop_s),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(VideoError::Invalid(format!("SDPF: {name} must be a finite number ≥ 0, got {v}")));
+            }
         }
         if self.length == Some(0) {
             return Err(VideoError::Invalid(
@@ -133,6 +171,12 @@ pub struct MotionInfo {
     /// camera moves), so that playing it backwards shows; see
     /// [`judge_directed`](super::judge_directed). Empty, or a shot past its end: directed.
     pub directed: Vec<bool>,
+    /// Appearance distances `appearance[i · n + j]` between frames (the pipeline's: RMS of 32-pixel
+    /// thumbnails, the proxy of Eq. 21's `D`), for matched transitions and the step cap; empty: the
+    /// graph's edge weights stand in.
+    pub appearance: Vec<f32>,
+    /// Frames per second of the source (0: unknown, read as 25), for [`SdpfParams::min_loop_s`].
+    pub fps: f32,
 }
 
 impl MotionInfo {
@@ -144,7 +188,7 @@ impl MotionInfo {
     /// Tendencies and LMS flags with the shots that the cut flags of
     /// [`detect_cuts`](super::detect_cuts) delimit (`cuts[i]`: a cut between frames `i − 1` and `i`).
     pub fn with_cuts(tendency: Vec<Option<f32>>, lms: Vec<bool>, cuts: &[bool]) -> MotionInfo {
-        MotionInfo { tendency, lms, shot: super::cuts::shots_from_cuts(cuts), directed: Vec::new() }
+        MotionInfo { tendency, lms, shot: super::cuts::shots_from_cuts(cuts), ..MotionInfo::default() }
     }
 
     /// Checks that every non-empty vector has one entry per frame.
@@ -153,6 +197,12 @@ impl MotionInfo {
             if len != 0 && len != n {
                 return Err(VideoError::Invalid(format!("SDPF: motion {name} has {len} entries for {n} frames")));
             }
+        }
+        if !self.appearance.is_empty() && self.appearance.len() != n * n {
+            return Err(VideoError::Invalid(format!(
+                "SDPF: the appearance distances have {} entries, expected {n}×{n}",
+                self.appearance.len()
+            )));
         }
         Ok(())
     }
@@ -175,6 +225,12 @@ impl MotionInfo {
     /// Whether the shot of frame `i` is judged directed (true when unknown).
     pub fn directed_at(&self, i: usize) -> bool {
         self.directed.get(self.shot_of(i)).copied().unwrap_or(true)
+    }
+
+    /// The shortest loop [`SdpfParams::min_loop_s`] allows, in frames (at least 2).
+    pub fn min_loop_frames(&self, seconds: f32) -> usize {
+        let fps = if self.fps.is_finite() && self.fps > 0.0 { self.fps } else { 25.0 };
+        ((seconds * fps).round() as usize).max(2)
     }
 
     /// The number of shots (1 when no shots are given).
@@ -290,6 +346,8 @@ pub struct Transition {
     pub removed_cd: Vec<usize>,
     pub omega: Omega,
     pub removed_ct: Vec<usize>,
+    /// S2 frames that the step cap ([`SdpfParams::step_cap`]) removed: too far in appearance.
+    pub removed_cap: Vec<usize>,
     /// S2 with the probabilities of Eq. 20.
     pub probs: Vec<(usize, f32)>,
     /// How the step was taken: drawn from S2, or, S2 being empty, a cut or a loop back.
@@ -318,6 +376,18 @@ pub enum StepKind {
     /// S2 was empty and no other shot had frames left: back to the frame at position `to` of the
     /// path, closest in content among those C_r allows; from there the path's frames repeat (a loop).
     LoopBack { to: usize, edge: f32 },
+    /// S2 was empty: the next source frame, already shown (a replay on the way to unvisited frames,
+    /// or round and round a loop once every reachable frame is shown).
+    Replay,
+    /// S2 was empty: a matched transition (Schödl et al. 2000): the frames around `j − 1` match those
+    /// around the current frame in content and motion direction, so `j` follows as the next source
+    /// frame would. `cost`: the windowed distance over the shot's median source step (θ's unit);
+    /// `loop_frames`: when it goes back, the frames from `j` to the current one (the loop it opens).
+    Transition { cost: f32, loop_frames: usize },
+    /// S2 was empty and no next frame or transition under `relax × θ` leads to the frames of the shot
+    /// not yet shown: a jump cut inside the shot to the one that best follows (`cost` as for
+    /// [`StepKind::Transition`], or the appearance distance in source steps where no window matches).
+    JumpCut { cost: f32 },
 }
 
 impl Transition {
@@ -353,8 +423,9 @@ pub type Path = SdpfPath;
 /// A path found by SDPF: the new frame order and how each step was taken.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SdpfPath {
-    /// Source frame indices in the new order, starting with the start frame. No repeats, except
-    /// after a loop back ([`StepKind::LoopBack`]), from which the loop's frames repeat.
+    /// Source frame indices in the new order, starting with the start frame. Frames repeat only
+    /// after a matched transition or replay ([`StepKind::Transition`], [`StepKind::Replay`]), or
+    /// after a loop back ([`StepKind::LoopBack`], round 2's walk), from which the loop's frames repeat.
     pub frames: Vec<usize>,
     /// One entry per step up to and including a loop back (then the loop repeats without new
     /// steps), plus the failed step of an early stop.
@@ -391,6 +462,16 @@ impl SdpfPath {
     /// Positions `i` (in `frames`) entered by a cut (frames[i − 1] → frames[i]).
     pub fn cut_positions(&self) -> Vec<usize> {
         self.kind_positions(|k| matches!(k, StepKind::Cut { .. }))
+    }
+
+    /// Positions `i` entered by a jump cut inside a shot.
+    pub fn jump_cut_positions(&self) -> Vec<usize> {
+        self.kind_positions(|k| matches!(k, StepKind::JumpCut { .. }))
+    }
+
+    /// Positions `i` entered by a matched transition.
+    pub fn transition_positions(&self) -> Vec<usize> {
+        self.kind_positions(|k| matches!(k, StepKind::Transition { .. }))
     }
 
     /// Positions `i` entered by a loop back.
