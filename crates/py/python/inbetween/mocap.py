@@ -1,0 +1,121 @@
+"""Keyframes of a motion clip: choose them (`select_keys`), rebuild the clip from them
+(`reconstruct`), and hand them to a curve editor (`bezier_handles`)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any, Dict, Optional, Sequence
+
+import numpy as np
+
+from . import _native
+from ._native import Clip, InbetweenError
+from ._progress import Callback, progress_callback
+
+__all__ = ["Keys", "Reconstruction", "select_keys", "reconstruct", "bezier_handles", "METHODS"]
+
+METHODS = ("optimal", "error_bounded", "greedy", "sidql", "uniform")
+
+
+@dataclass(frozen=True)
+class Reconstruction:
+    """A clip rebuilt from keys and its joint position error against the source."""
+
+    clip: Clip
+    #: Mean joint position error of each frame, cm, float64 `[T]`.
+    error_per_frame_cm: np.ndarray
+    mean_error_cm: float
+    max_error_cm: float
+    report: Dict[str, Any] = field(repr=False)
+    text: str = field(repr=False)
+
+
+@dataclass(frozen=True)
+class Keys:
+    """Key frames chosen by `select_keys`, the key poses with their tangents, and the errors."""
+
+    #: Frame index of each key, int64 `[K]` (first and last frame included).
+    frames: np.ndarray
+    #: Local rotations at the keys, unit quaternions (x, y, z, w), float32 `[K, J, 4]`.
+    rotations: np.ndarray
+    #: Body-frame angular velocities at the keys (the rotation tangents), rad/s, float32 `[K, J, 3]`.
+    angular_velocities: np.ndarray
+    #: Local translations at the keys (rest offsets plus channels), cm, float32 `[K, J, 3]`.
+    translations_cm: np.ndarray
+    #: Translation velocities at the keys (the translation tangents), cm/s, float32 `[K, J, 3]`.
+    velocities_cm_s: np.ndarray
+    method: str
+    #: The rebuilt clip and its measured error.
+    reconstruction: Reconstruction
+    #: The job's report (planned spherical-model error, timings) as a dict, and in words.
+    report: Dict[str, Any] = field(repr=False)
+    text: str = field(repr=False)
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+
+def _reconstruction(clip: Clip, report: Dict[str, Any], text: str) -> Reconstruction:
+    err = report["error"]
+    return Reconstruction(
+        clip=clip,
+        error_per_frame_cm=np.asarray(err["per_frame_cm"], dtype=np.float64),
+        mean_error_cm=float(err["mean_cm"]),
+        max_error_cm=float(err["max_cm"]),
+        report=report,
+        text=text,
+    )
+
+
+def select_keys(
+    clip: Clip,
+    max_error_cm: Optional[float] = None,
+    *,
+    k: Optional[int] = None,
+    method: Optional[str] = None,
+    max_gap_s: Optional[float] = None,
+    progress: Optional[Callback] = None,
+) -> Keys:
+    """Keyframes of `clip` by the mocap engine's `SelectJob`.
+
+    Give `max_error_cm` (the fewest keys keeping every joint of every frame within it;
+    method "error_bounded") or `k` keys (method "optimal" unless `method` names "greedy", "sidql"
+    or "uniform"). The clip is rebuilt from the keys (quaternion Hermite rotations, cubic Hermite
+    translations) and the error measured on it."""
+    if method is None:
+        method = "error_bounded" if max_error_cm is not None else "optimal"
+    if method not in METHODS and method not in ("bound", "error-bounded"):
+        raise InbetweenError(f"method {method!r}: expected one of {', '.join(METHODS)}")
+    if method in ("error_bounded", "bound", "error-bounded"):
+        if max_error_cm is None or k is not None:
+            raise InbetweenError(f"method {method!r} takes max_error_cm (a bound in cm), not k")
+    elif k is None or max_error_cm is not None:
+        raise InbetweenError(f"method {method!r} takes k (the number of keys, ends included), not max_error_cm")
+    with progress_callback(progress, "choosing keys") as cb:
+        frames, poses, report_json, text, rebuilt = _native.mocap_select(clip, method, k, max_error_cm, max_gap_s, cb)
+    report = json.loads(report_json)
+    rec = report["reconstruction"]
+    return Keys(
+        frames=np.asarray(frames, dtype=np.int64),
+        rotations=poses["rotations"],
+        angular_velocities=poses["angular_velocities"],
+        translations_cm=poses["translations_cm"],
+        velocities_cm_s=poses["velocities_cm_s"],
+        method=report["method"],
+        reconstruction=_reconstruction(rebuilt, rec, str(rebuilt)),
+        report=report,
+        text=text,
+    )
+
+
+def reconstruct(clip: Clip, keys: "Keys | Sequence[int] | np.ndarray", *, progress: Optional[Callback] = None) -> Reconstruction:
+    """`clip` rebuilt from its poses at `keys` (a `Keys`, or frame indices; the first and last
+    frames are added when missing) by the mocap engine's `ReconstructJob`."""
+    frames = keys.frames if isinstance(keys, Keys) else keys
+    arr = np.asarray(frames)
+    if arr.ndim != 1 or arr.dtype.kind not in "iu":
+        raise InbetweenError(f"keys: expected frame indices, int [K]; got dtype {arr.dtype} shape {list(arr.shape)}")
+    with progress_callback(progress, "reconstructing") as cb:
+        rebuilt, report_json, text = _native.mocap_reconstruct(clip, [int(f) for f in arr], cb)
+    return _reconstruction(rebuilt, json.loads(report_json), text)

@@ -1,0 +1,85 @@
+//! The Rust side of `python -m inbetween.bench`: the same work each Python function does (the same
+//! functions of this crate, minus the Python argument and result conversion, the worker thread
+//! and the GIL), timed in Rust, so the bench can put the two side by side on the same input.
+
+use crate::clip::Clip;
+use crate::errors::{invalid, JobError};
+use crate::{ibk, mocap};
+use inbetween_core::cancel::Cancel;
+use inbetween_io::Progress;
+use inbetween_mocap::{ReconstructJob, SelectJob, Selector};
+use pyo3::prelude::*;
+use std::time::Instant;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(_bench_rust, m)?)?;
+    m.add_function(wrap_pyfunction!(_bench_sample_rust, m)?)?;
+    Ok(())
+}
+
+/// Milliseconds of each of `repeats` runs of `what` ("read", "select", "reconstruct",
+/// "compress") on `clip`, called from Rust.
+#[pyfunction]
+#[pyo3(signature = (what, clip, repeats, method=None, k=None, bound_cm=None, keys=None, max_error_cm=None))]
+#[allow(clippy::too_many_arguments)]
+fn _bench_rust(
+    py: Python<'_>,
+    what: &str,
+    clip: PyRef<'_, Clip>,
+    repeats: usize,
+    method: Option<&str>,
+    k: Option<usize>,
+    bound_cm: Option<f64>,
+    keys: Option<Vec<usize>>,
+    max_error_cm: Option<f64>,
+) -> PyResult<Vec<f64>> {
+    let clip: &Clip = &clip;
+    let (cancel, progress) = (Cancel::new(), Progress::hidden());
+    let run: Box<dyn Fn() -> Result<(), JobError> + Send + Sync + '_> = match what {
+        "read" => {
+            Box::new(|| inbetween_io::load_motion(std::path::Path::new(&clip.source)).map(|_| ()).map_err(Into::into))
+        }
+        "select" => {
+            let method = Selector::parse(method.unwrap_or("optimal")).map_err(|e| invalid(e.to_string()))?;
+            let job = SelectJob { method, k, bound_cm, ..SelectJob::default() };
+            Box::new(move || mocap::select(clip, &job, &cancel, &progress).map(|_| ()))
+        }
+        "reconstruct" => {
+            let job = ReconstructJob { keys: keys.unwrap_or_default() };
+            Box::new(move || mocap::reconstruct(clip, &job, &cancel, &progress).map(|_| ()))
+        }
+        "compress" => {
+            let job = ibk::compress_job(clip, max_error_cm, None, None, None, 0.5)?;
+            Box::new(move || ibk::compress(clip, &job).map(|_| ()))
+        }
+        other => return Err(invalid(format!("unknown bench job {other:?}"))),
+    };
+    py.detach(|| {
+        (0..repeats)
+            .map(|_| {
+                let t = Instant::now();
+                run().map(|_| t.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect::<Result<Vec<f64>, JobError>>()
+    })
+    .map_err(JobError::into_py)
+}
+
+/// Nanoseconds per pose of `inbetween_ibk::Clip::sample` at each of `times`, in Rust, into
+/// buffers made once (what `Reader.sample` does per call, without Python).
+#[pyfunction]
+fn _bench_sample_rust(py: Python<'_>, data: Vec<u8>, times: Vec<f64>) -> PyResult<f64> {
+    py.detach(|| {
+        let clip = inbetween_ibk::Clip::open(&data).map_err(|e| e.to_string())?;
+        let mut ctx = inbetween_ibk::Context::new(&clip);
+        let n = clip.num_joints();
+        let (mut r, mut tr) = (vec![[0f32; 4]; n], vec![[0f32; 3]; n]);
+        let t = Instant::now();
+        for &time in &times {
+            clip.sample(&mut ctx, time, &mut r, &mut tr).map_err(|e| e.to_string())?;
+            std::hint::black_box((&r, &tr));
+        }
+        Ok::<f64, String>(t.elapsed().as_secs_f64() * 1e9 / times.len().max(1) as f64)
+    })
+    .map_err(invalid)
+}

@@ -1,0 +1,107 @@
+//! camera `generate`: the camera engine's `GenerateJob` over two characters (mocap clips) or a
+//! scene JSON, through keyframes, in a behaviour's style (direct, relative, side, orbit) from the
+//! committed weights, as the CLI's `camera generate` runs it. The track comes back as arrays.
+
+use crate::clip::Clip;
+use crate::errors::{ctx, invalid, JobError};
+use crate::runner::run_job;
+use inbetween_camera::dataset::{Behaviour, Scene};
+use inbetween_camera::infer::{GenerateJob, GenerateOptions, Keys};
+use inbetween_camera::weights;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::{Path, PathBuf};
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(camera_generate, m)?)?;
+    Ok(())
+}
+
+/// Runs a `GenerateJob`. `keys_json` is the keyframes file's JSON. Writes the track JSON, glTF and
+/// preview GIF where paths are given. Returns a dict of arrays and the report.
+#[pyfunction]
+#[pyo3(signature = (keys_json, characters=None, scene=None, style="relative", exact_keys=true, causal=false, json=None, gltf=None, gif=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn camera_generate<'py>(
+    py: Python<'py>,
+    keys_json: &str,
+    characters: Option<(PyRef<'py, Clip>, PyRef<'py, Clip>)>,
+    scene: Option<PathBuf>,
+    style: &str,
+    exact_keys: bool,
+    causal: bool,
+    json: Option<PathBuf>,
+    gltf: Option<PathBuf>,
+    gif: Option<PathBuf>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let keys: Keys = serde_json::from_str(keys_json).map_err(|e| invalid(format!("keys: {e}")))?;
+    let behaviour = Behaviour::parse(style)
+        .ok_or_else(|| invalid(format!("unknown style `{style}` (direct, relative, side, orbit)")))?;
+    let takes = match (&characters, &scene) {
+        (Some((a, b)), None) => Some([(a.source.clone(), a.motion.clone()), (b.source.clone(), b.motion.clone())]),
+        (None, Some(_)) => None,
+        _ => return Err(invalid("give either characters=(clip_a, clip_b) or scene=PATH (a scene JSON)")),
+    };
+    let (track, scene) = run_job(py, progress.as_ref(), |cancel, bar| {
+        bar.phase(2, "generating the camera");
+        let w = weights::committed().map_err(ctx("loading the committed camera weights"))?;
+        let scene = match (&takes, &scene) {
+            (Some(t), _) => {
+                let refs: Vec<(&str, &inbetween_core::Motion)> = t.iter().map(|(n, m)| (n.as_str(), m)).collect();
+                inbetween_camera::dataset::scene_from_motions(&refs).map_err(JobError::Failed)?.0
+            }
+            (None, Some(p)) => Scene::load(p).map_err(ctx(""))?,
+            (None, None) => unreachable!("checked above"),
+        };
+        let style = w.style(behaviour).ok_or_else(|| {
+            JobError::Failed(format!("the weights card has no style code for `{}`", behaviour.name()))
+        })?;
+        bar.inc(1);
+        let options = GenerateOptions { exact_keys, causal, cancel: Some(cancel), ..GenerateOptions::default() };
+        let origin = Path::new("keys");
+        let job = GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin };
+        let track = job.run().map_err(ctx(""))?;
+        bar.inc(1);
+        if let Some(p) = &json {
+            inbetween_camera::write_json(p, &track).map_err(ctx(""))?;
+        }
+        if let Some(p) = &gltf {
+            inbetween_camera::gltf::write_gltf(p, &track, &scene).map_err(ctx(""))?;
+        }
+        if let Some(p) = &gif {
+            inbetween_camera::preview::write_preview(p, &track, &scene, 3).map_err(ctx(""))?;
+        }
+        Ok((track, scene))
+    })?;
+    let n = track.frames.len();
+    let flat = |f: &dyn Fn(&inbetween_camera::infer::CameraFrame) -> Vec<f64>| -> Vec<f64> {
+        track.frames.iter().flat_map(f).collect()
+    };
+    let d = PyDict::new(py);
+    d.set_item("frames", track.frames.iter().map(|f| f.frame).collect::<Vec<_>>())?;
+    d.set_item("positions_m", PyArray1::from_vec(py, flat(&|f| f.pose.position.to_array().to_vec())).reshape([n, 3])?)?;
+    d.set_item("rotations", PyArray1::from_vec(py, flat(&|f| f.pose.rotation.to_array().to_vec())).reshape([n, 4])?)?;
+    d.set_item("toric", PyArray1::from_vec(py, flat(&|f| f.toric.to_array().to_vec())).reshape([n, 6])?)?;
+    d.set_item("targets", track.frames.iter().map(|f| f.targets).collect::<Vec<_>>())?;
+    d.set_item("fov_y_rad", PyArray1::from_vec(py, vec![track.lens.fovy; n]))?;
+    d.set_item("aspect", track.lens.aspect)?;
+    d.set_item("fps", track.fps)?;
+    d.set_item("style", track.style.clone())?;
+    d.set_item("characters", scene.characters.iter().map(|c| c.name.clone()).collect::<Vec<_>>())?;
+    let residuals: Vec<(usize, f64)> = track.key_residuals.iter().map(|r| (r.frame, r.residual)).collect();
+    d.set_item("key_residuals", residuals)?;
+    d.set_item("worst_key_miss", track.worst_key_miss())?;
+    d.set_item("max_corrected_residual", track.max_corrected_residual)?;
+    d.set_item(
+        "text",
+        format!(
+            "{}: {n} frames (network keyframe miss max {:.4}, after correction {:.1e})",
+            track.style,
+            track.worst_key_miss(),
+            track.max_corrected_residual
+        ),
+    )?;
+    Ok(d)
+}
