@@ -9,14 +9,14 @@ use inbetween_core::cancel::Cancel;
 use inbetween_face::bench::{self, FaceBenchConfig};
 use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
-use inbetween_face::edit::mask::{parse_span_spec, SpanSpec};
 use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
+use inbetween_face::infer::plan::{captures_dir, span_seconds, viseme_runs, MethodChoice, SPEECH_GROUPS};
 use inbetween_face::infer::{
     read_keys, EditJob, EditLimits, Guide, Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
 };
 use inbetween_face::preview::{span_flags, write_edit_gif, write_edit_png, CurvePreview};
 use inbetween_face::train::{save_face_weights, train_face_cancellable, FaceTrainConfig};
-use inbetween_face::visemes::{phoneme_viseme, read_viseme_source, text_to_phonemes, PhonemeSpan};
+use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, PhonemeSpan};
 use inbetween_face::{corpus, procedural, weights};
 use inbetween_io::{OutputSet, Progress};
 
@@ -80,9 +80,11 @@ pub struct EditArgs {
     /// TextGrid tier holding the phonemes (default: "phones").
     #[arg(long)]
     pub tier: Option<String>,
-    /// Blendshape groups to regenerate: eyes, brows, jaw, mouth, cheeks, tongue, lower, upper, all.
-    #[arg(long, default_value = "all")]
-    pub groups: String,
+    /// Blendshape groups to regenerate: eyes, brows, jaw, mouth, cheeks, tongue, lower, upper, all;
+    /// the guidance acts on all of them. Default: every group, visemes (--text, --visemes) guiding
+    /// jaw, mouth, cheeks and tongue and the other groups filled unguided.
+    #[arg(long)]
+    pub groups: Option<String>,
     #[arg(long, value_enum, default_value = "auto")]
     pub method: MethodArg,
     /// Weights for the network (default: the committed ones for the guidance given).
@@ -118,6 +120,18 @@ pub struct EditArgs {
     /// Stop with an error, writing nothing, after this many seconds.
     #[arg(long)]
     pub time_limit: Option<f64>,
+}
+
+impl MethodArg {
+    fn choice(self) -> MethodChoice {
+        match self {
+            MethodArg::Auto => MethodChoice::Auto,
+            MethodArg::Network => MethodChoice::Network,
+            MethodArg::Linear => MethodChoice::Linear,
+            MethodArg::Cubic => MethodChoice::Cubic,
+            MethodArg::Retrieval => MethodChoice::Retrieval,
+        }
+    }
 }
 
 /// The edit job's limit fields and the flags that set them.
@@ -218,54 +232,6 @@ pub fn run(c: FaceCommand) -> anyhow::Result<()> {
     }
 }
 
-fn captures_dir(given: Option<&Path>) -> anyhow::Result<PathBuf> {
-    if let Some(p) = given {
-        return Ok(p.to_path_buf());
-    }
-    let root = std::env::var_os("INBETWEEN_DATA").map(PathBuf::from).unwrap_or_else(|| PathBuf::from("../shared/data"));
-    let dir = root.join("face/neurosync");
-    if !dir.is_dir() {
-        bail!("no face captures at {} (set INBETWEEN_DATA or pass --captures)", dir.display());
-    }
-    Ok(dir)
-}
-
-/// Seconds from the clip's first frame of a `--mask`-style span (frames index the clip's own frames).
-fn span_seconds(text: &str, clip: &BlendshapeClip) -> anyhow::Result<(f64, f64)> {
-    let t0 = clip.times()[0];
-    let duration = clip.duration();
-    let (a, b) = match parse_span_spec(text).map_err(anyhow::Error::msg)? {
-        SpanSpec::Seconds(a, b) => (a, b),
-        SpanSpec::Frames(a, b) => {
-            let n = clip.num_frames();
-            if a >= n {
-                bail!("mask '{text}' starts past the clip's last frame ({} frames)", n);
-            }
-            let end = clip.times().get(b).map_or(duration + 1.0 / clip.fps(), |t| t - t0);
-            (clip.times()[a] - t0, end)
-        }
-    };
-    if a >= duration {
-        bail!("mask '{text}' lies outside the clip ({duration:.2} s long)");
-    }
-    // A span in frames may end one frame past the last frame's time (it covers the last frame).
-    if b > duration + 1.0 / clip.fps() + 1e-9 {
-        bail!("mask '{text}' runs past the clip's end ({duration:.2} s long); end it at {duration:.2}s at the latest");
-    }
-    Ok((a, b))
-}
-
-fn viseme_runs(spans: &[PhonemeSpan]) -> anyhow::Result<Vec<(f64, f64, inbetween_face::visemes::Viseme)>> {
-    spans
-        .iter()
-        .map(|s| {
-            let v = phoneme_viseme(&s.phoneme)
-                .with_context(|| format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))?;
-            Ok((s.start_s, s.end_s, v))
-        })
-        .collect()
-}
-
 fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow::Result<Guide> {
     Ok(if let Some(k) = &a.keys {
         Guide::Keys(read_keys(k)?)
@@ -305,42 +271,49 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
     let limits = EditLimits { max_rows: a.max_rows, max_mask_s: a.max_mask_seconds };
     let clip = read_clip_limited(&a.input, limits.max_rows)?;
-    let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<anyhow::Result<Vec<_>>>()?;
-    let channels = parse_groups(&a.groups).map_err(anyhow::Error::msg)?;
+    let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<Result<Vec<_>, _>>()?;
+    let channels = a.groups.as_deref().map(parse_groups).transpose().map_err(anyhow::Error::msg)?;
     let guide = guide_of(&a, &clip, &spans)?;
-    let chosen = match a.method {
-        MethodArg::Auto if a.weights.is_some() => MethodArg::Network,
-        MethodArg::Auto => match guide.kind() {
-            ConstraintKind::None | ConstraintKind::Noisy => MethodArg::Retrieval,
-            ConstraintKind::Keyframes | ConstraintKind::Visemes => MethodArg::Network,
-        },
-        m => m,
-    };
+    let speech = SPEECH_GROUPS.map(|g| g.name()).join(", ");
+    if guide.kind() == ConstraintKind::Visemes {
+        match &a.groups {
+            Some(g) => {
+                eprintln!("note: --groups {g}: the visemes guide these groups (default: {speech}; the rest unguided)")
+            }
+            None => {
+                eprintln!("note: the visemes guide {speech}; eyes and brows are filled unguided (--groups overrides)")
+            }
+        }
+    }
+    let chosen = a.method.choice().resolve(guide.kind(), a.weights.is_some());
     let net = match chosen {
-        MethodArg::Network => Some(match &a.weights {
+        MethodChoice::Network => Some(match &a.weights {
             Some(w) => weights::load(w).with_context(|| format!("loading face weights {}", w.display()))?,
             None => weights::committed(guide.kind())
                 .with_context(|| format!("loading the committed {} network", guide.kind().name()))?,
         }),
         _ => None,
     };
-    if !a.library.is_empty() && !matches!(chosen, MethodArg::Retrieval) {
+    if !a.library.is_empty() && !matches!(chosen, MethodChoice::Retrieval) {
         bail!("--library is read only by --method retrieval (with --keys or --visemes, auto picks the network)");
     }
+    // Retrieval draws from the library; so do the groups the guidance leaves unguided.
+    let unguided_rest = channels.is_none() && guide.kind() == ConstraintKind::Visemes;
     let library = match chosen {
-        MethodArg::Retrieval => Some(retrieval_library(&a.library, limits.max_rows)?),
+        MethodChoice::Retrieval => Some(retrieval_library(&a.library, limits.max_rows)?),
+        _ if unguided_rest => Some(retrieval_library(&[], limits.max_rows)?),
         _ => None,
     };
     let method = match (&chosen, &net) {
-        (MethodArg::Linear, _) => Method::Linear,
-        (MethodArg::Cubic, _) => Method::Cubic,
-        (MethodArg::Retrieval, _) => {
+        (MethodChoice::Linear, _) => Method::Linear,
+        (MethodChoice::Cubic, _) => Method::Cubic,
+        (MethodChoice::Retrieval, _) => {
             let options = RetrievalOptions::for_variants(guide.kind(), a.variants as usize);
             Method::Retrieval(library.as_ref().expect("built above"), options)
         }
-        (MethodArg::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
-        (MethodArg::Network, None) => unreachable!("a network was loaded above"),
-        (MethodArg::Auto, _) => unreachable!("auto was resolved above"),
+        (MethodChoice::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
+        (MethodChoice::Network, None) => unreachable!("a network was loaded above"),
+        (MethodChoice::Auto, _) => unreachable!("auto was resolved above"),
     };
     let guide_file = [&a.keys, &a.guide, &a.visemes].into_iter().flatten().next().map(|p| p.display().to_string());
     let mut job = EditJob {
@@ -353,6 +326,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         limits,
         cancel: cancel.clone(),
         guide_file,
+        library: library.as_ref(),
     };
     let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
         && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))

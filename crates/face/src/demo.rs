@@ -48,13 +48,14 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<FaceDemo, FaceE
         let job = EditJob {
             clip: &clip,
             spans: vec![OCCLUSION_S],
-            channels: [true; NUM_ARKIT],
+            channels: Some([true; NUM_ARKIT]),
             guide: Guide::None,
             method,
             seed,
             limits: crate::infer::EditLimits::default(),
             cancel: inbetween_core::cancel::Cancel::new(),
             guide_file: None,
+            library: None,
         };
         let out = job.run()?;
         truth = out.before.clone();

@@ -127,13 +127,14 @@ fn unguided_retrieval_on_a_held_out_capture_blinks_whole_and_moves() {
             EditJob {
                 clip: &clip,
                 spans: vec![(4.0, 6.5)],
-                channels: [true; inbetween_face::data::NUM_ARKIT],
+                channels: None,
                 guide: Guide::None,
                 method,
                 seed,
                 limits: EditLimits::default(),
                 cancel: inbetween_core::cancel::Cancel::new(),
                 guide_file: None,
+                library: None,
             }
             .run()
             .unwrap()

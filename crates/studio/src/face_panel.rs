@@ -20,12 +20,11 @@ use inbetween_face::data::{
 use inbetween_face::edit::distances::{distance_bases, distance_matrix, DISTANCE_NAMES};
 use inbetween_face::edit::groups::{parse_groups, Group};
 use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
+use inbetween_face::infer::plan::{viseme_runs, MethodChoice};
 use inbetween_face::infer::{
     EditJob, EditLimits, Guide, Inpainter, KeyPose, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
 };
-use inbetween_face::visemes::{
-    parse_phoneme_csv, parse_textgrid, phoneme_viseme, text_to_phonemes, PhonemeSpan, Viseme,
-};
+use inbetween_face::visemes::{parse_phoneme_csv, parse_textgrid, text_to_phonemes, Viseme};
 use inbetween_face::weights::{self, Network};
 use serde::Deserialize;
 use serde_json::{json, Value};
@@ -268,7 +267,7 @@ pub async fn guide(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body:
                 parse_phoneme_csv(&text, &name)
             }
             .map_err(face_err)?;
-            let runs = viseme_runs(&spans)?;
+            let runs = viseme_runs(&spans).map_err(face_err)?;
             let n = runs.len();
             (GuideFile::Visemes(runs), format!("{n} phonemes"))
         } else {
@@ -280,17 +279,6 @@ pub async fn guide(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body:
         Ok(json!({"ok": true, "message": format!("guide {name}: {what}"), "guide": name, "phonemes": phonemes}))
     });
     Ok(Json(answer(&st.jobs, id).await))
-}
-
-fn viseme_runs(spans: &[PhonemeSpan]) -> Result<Vec<(f64, f64, Viseme)>> {
-    spans
-        .iter()
-        .map(|s| {
-            phoneme_viseme(&s.phoneme).map(|v| (s.start_s, s.end_s, v)).ok_or_else(|| {
-                StudioError::Engine(format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))
-            })
-        })
-        .collect()
 }
 
 /// One key of the page: a time and the shapes it sets.
@@ -314,8 +302,9 @@ pub struct EditRequest {
     /// Keys (constraint `keys`).
     #[serde(default)]
     pub keys: Vec<KeyRequest>,
-    /// Groups to regenerate (`all`, `mouth,jaw`, …).
-    #[serde(default = "all")]
+    /// Groups to regenerate (`all`, `mouth,jaw`, …); `default` (or absent): every group, visemes
+    /// guiding the speech groups and the rest filled unguided (the face engine's default).
+    #[serde(default = "default_groups")]
     pub groups: String,
     /// `auto` (the face bench's best: retrieval unguided or noisy, the network otherwise), `network`,
     /// `retrieval`, `linear` or `cubic`.
@@ -339,8 +328,8 @@ fn one_u32() -> u32 {
 fn none() -> String {
     "none".into()
 }
-fn all() -> String {
-    "all".into()
+fn default_groups() -> String {
+    "default".into()
 }
 fn auto() -> String {
     "auto".into()
@@ -358,7 +347,10 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
             let s = s.as_ref().ok_or_else(no_take)?;
             (s.name.clone(), s.layout, s.versions[s.current].clone())
         };
-        let channels = parse_groups(&req.groups).map_err(StudioError::BadRequest)?;
+        let channels = match req.groups.trim() {
+            "" | "default" => None,
+            g => Some(parse_groups(g).map_err(StudioError::BadRequest)?),
+        };
         if !(1..=MAX_VARIANTS).contains(&req.variants) {
             return Err(StudioError::BadRequest(format!("variants {}: expected 1 to {MAX_VARIANTS}", req.variants)));
         }
@@ -380,7 +372,7 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
             }
             "text" => {
                 let ph = text_to_phonemes(&req.text, req.start_s, req.end_s).map_err(face_err)?;
-                Guide::Visemes(viseme_runs(&ph.spans)?)
+                Guide::Visemes(viseme_runs(&ph.spans).map_err(face_err)?)
             }
             "noisy" | "visemes" => {
                 let g = state.face.guide.lock().unwrap_or_else(|p| p.into_inner()).clone();
@@ -407,32 +399,25 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
             }
         };
         let kind = guide.kind();
-        let method_name = match req.method.as_str() {
-            "auto" => match kind {
-                ConstraintKind::None | ConstraintKind::Noisy => "retrieval",
-                _ => "network",
-            },
-            m @ ("network" | "retrieval" | "linear" | "cubic") => m,
-            other => {
-                return Err(StudioError::BadRequest(format!(
-                    "method '{other}': expected auto, network, retrieval, linear or cubic"
-                )))
-            }
-        };
-        let net = if method_name == "network" { Some(state.face.network(kind)?) } else { None };
-        let method = match method_name {
-            "network" => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
-            "retrieval" => {
+        let chosen = MethodChoice::parse(&req.method)
+            .map_err(|e| StudioError::BadRequest(e.to_string().replace("invalid clip: ", "")))?
+            .resolve(kind, false);
+        let method_name = chosen.name();
+        let net = if chosen == MethodChoice::Network { Some(state.face.network(kind)?) } else { None };
+        let method = match chosen {
+            MethodChoice::Network => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
+            MethodChoice::Retrieval => {
                 Method::Retrieval(state.face.library(), RetrievalOptions::for_variants(kind, req.variants as usize))
             }
-            "linear" => Method::Linear,
+            MethodChoice::Linear => Method::Linear,
             _ => Method::Cubic,
         };
         let n = req.variants as usize;
         let mut fills = Vec::with_capacity(n);
         for k in 0..n {
             job.progress(&format!("filling the span (variant {} of {n})", k + 1), 0.2 + 0.7 * k as f64 / n as f64);
-            fills.push(fill(&clip, &req, channels, guide.clone(), method, req.seed + k as u64, job)?);
+            let seed = req.seed + k as u64;
+            fills.push(fill(&clip, &req, channels, guide.clone(), method, seed, state.face.library(), job)?);
         }
         let first = &fills[0];
         let v = state.face.next_version();
@@ -507,13 +492,15 @@ struct Fill {
     changed: [bool; NUM_ARKIT],
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fill(
     clip: &BlendshapeClip,
     req: &EditRequest,
-    channels: [bool; NUM_ARKIT],
+    channels: Option<[bool; NUM_ARKIT]>,
     guide: Guide,
     method: Method,
     seed: u64,
+    library: &MotionLibrary,
     job: &crate::jobs::Job,
 ) -> Result<Fill> {
     let out = EditJob {
@@ -526,6 +513,7 @@ fn fill(
         limits: EditLimits::default(),
         cancel: job.token().clone(),
         guide_file: None,
+        library: Some(library),
     }
     .run()
     .map_err(face_err)?;

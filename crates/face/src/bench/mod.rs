@@ -13,6 +13,7 @@
 //! Every edit goes through [`EditJob`], the same path as `face edit`.
 
 pub mod bezier;
+pub mod loco;
 pub mod plausibility;
 
 use std::path::{Path, PathBuf};
@@ -237,13 +238,14 @@ fn edit(
     let job = EditJob {
         clip: truth,
         spans,
-        channels: [true; NUM_ARKIT],
+        channels: Some([true; NUM_ARKIT]),
         guide: guide.clone(),
         method,
         seed,
         limits: crate::infer::EditLimits::default(),
         cancel: inbetween_core::cancel::Cancel::new(),
         guide_file: None,
+        library: None,
     };
     let out = job.run()?;
     Ok((out.after, out.mask))
@@ -400,6 +402,8 @@ pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> R
     let (auc_t, stats_t) = plausibility_tables(&tests, sets, &libs, cfg, progress)?;
     report.table(auc_t);
     report.table(stats_t);
+    let captures = if cfg.one_test_file { 2 } else { TEST_FILES.len() + TRAIN_FILES.len() };
+    report.table(loco::loco_table(&cfg.captures, captures, sets, cfg.edits_per_gap, cfg.seed, progress)?);
     report.table(table4(&tests, &proc_clips, sets, &libs, cfg.seed)?);
     report.table(table3(&tests, &proc_clips, sets, cfg.seed)?);
     charts(&mut report, &cells);
@@ -759,9 +763,27 @@ mod tests {
             let sets = vec![crate::weights::committed_set().expect("committed weights")];
             let report = run(&cfg, &sets, &Progress::hidden()).expect("bench runs");
             let names: Vec<&str> = report.tables().map(|t| t.name.as_str()).collect();
-            for n in ["heldout_by_gap", "heldout", "plausibility_by_gap", "plausibility", "visemes", "table4", "table3"]
-            {
+            for n in [
+                "heldout_by_gap",
+                "heldout",
+                "plausibility_by_gap",
+                "plausibility",
+                "plausibility_loco",
+                "visemes",
+                "table4",
+                "table3",
+            ] {
                 assert!(names.contains(&n), "{names:?}");
+            }
+            // Leave-one-capture-out: a real row and the default fill of every constraint, with AUCs.
+            let loco = report.tables().find(|t| t.name == "plausibility_loco").unwrap().to_csv();
+            println!("{loco}");
+            for kind in ["unguided", "visemes", "noisy", "keyframes"] {
+                let rows: Vec<&str> = loco.lines().filter(|l| l.starts_with(&format!("{kind},"))).collect();
+                assert!(rows.iter().any(|l| l.contains("real capture")), "{kind}: {loco}");
+                let auto = rows.iter().find(|l| l.contains(",auto")).unwrap_or_else(|| panic!("{kind}: {loco}"));
+                let auc: f64 = auto.split(',').nth(2).unwrap().parse().unwrap();
+                assert!((0.0..=1.0).contains(&auc), "{auto}");
             }
             let csv = report.tables().find(|t| t.name == "heldout").unwrap().to_csv();
             assert!(

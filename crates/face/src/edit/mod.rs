@@ -8,6 +8,7 @@ pub mod groups;
 pub mod hermite;
 pub mod mask;
 pub mod retrieve;
+pub mod seam;
 
 use crate::data::NUM_ARKIT;
 

@@ -14,6 +14,15 @@
 //! can each be met by a segment that passes near them; a region keeps its own channels together (a
 //! blink stays both eyes, speech stays jaw and lips).
 //!
+//! Segments of the library cost [`RetrievalOptions::library_cost`] times their score (issue 40): the
+//! person's own motion, the clip outside the span, is preferred to anyone else's or to procedural
+//! motion, which only wins where it matches clearly better (on captures the library never saw, the
+//! procedural library's speech made unguided mouths move 2.7× their speed outside the span).
+//!
+//! A noisy guide is **cleaned, not replaced** ([`RetrievalOptions::clean_guide`], issue 40): the
+//! calibrated guide itself is the fill, each shape smoothed by the filter that best reproduces the
+//! kept frames around the span from the guide there ([`clean_guide`]); no segment is drawn.
+//!
 //! The seed picks one of the best [`RetrievalOptions::candidates`] non-overlapping segments (rank
 //! `seed mod k`), so consecutive seeds give different plausible fills and the same seed the same one. The segment is joined by offsets that fade out over [`RetrievalOptions::blend`]
 //! frames from each border (a blink in the segment stays a whole blink; a long fade would hold an eye
@@ -90,6 +99,13 @@ pub struct RetrievalOptions {
     /// whole face, each scored on its own channels' borders and keys (default false;
     /// [`RetrievalOptions::for_kind`] sets it for keyframes, where it is measured to help).
     pub by_region: bool,
+    /// Factor on the cost of the library's segments against the edited clip's own (default 2: the
+    /// person's own motion is preferred).
+    pub library_cost: f64,
+    /// With a noisy guide, fill with the guide itself, calibrated and cleaned ([`clean_guide`]),
+    /// instead of drawing a segment (default true; false is the segment matched to the guide with
+    /// the guide's slow residual added, as before issue 40).
+    pub clean_guide: bool,
 }
 
 impl Default for RetrievalOptions {
@@ -103,6 +119,8 @@ impl Default for RetrievalOptions {
             guide_smoothing: 37,
             detail: 1.0,
             by_region: false,
+            library_cost: 2.0,
+            clean_guide: true,
         }
     }
 }
@@ -139,7 +157,8 @@ pub struct Source {
 /// the mask are `anim`'s; inside, the drawn segments joined as the module docs say. Returns the frames and,
 /// per span, the sources drawn: one for the whole face, or one per region with
 /// [`RetrievalOptions::by_region`] (none when no segment of the span's length exists anywhere: those
-/// channels keep `anim`'s values, and the caller's post-processing interpolates them).
+/// channels keep `anim`'s values, and the caller's post-processing interpolates them; none when a
+/// noisy guide was cleaned).
 pub fn retrieve(
     anim: &[Frame],
     mask: &Mask,
@@ -155,6 +174,16 @@ pub fn retrieve(
     for span in &spans {
         let erased: Vec<usize> =
             (0..NUM_ARKIT).filter(|c| (span.start..span.end).any(|f| mask.erased(f, *c))).collect();
+        if let (Constraint::Noisy(g), true) = (constraint, options.clean_guide) {
+            let cleaned = clean_guide(anim, mask, g, *span);
+            for (t, row) in cleaned.iter().enumerate() {
+                for &c in &erased {
+                    out[span.start + t][c] = row[c];
+                }
+            }
+            sources.push(Vec::new());
+            continue;
+        }
         let guide = match constraint {
             Constraint::Noisy(g) => Some(calibrate_guide(anim, mask, g, *span)),
             _ => None,
@@ -173,7 +202,11 @@ pub fn retrieve(
             let scorer = Scorer { anim, guide: guide.as_deref(), span: *span, channels, constraint, options, n };
             let mut cands: Vec<Source> = Vec::new();
             for (i, clip) in library.clips.iter().enumerate() {
+                let from = cands.len();
                 scorer.scan(clip, Some(i), &[], &mut cands);
+                for c in &mut cands[from..] {
+                    c.cost *= options.library_cost;
+                }
             }
             scorer.scan(anim, None, &spans, &mut cands);
             let Some(chosen) = draw(&mut cands, span.len(), options.candidates, region_seed(seed, ri)) else {
@@ -324,7 +357,8 @@ fn join(
             // Level from the borders, motion from the segment (scaled by `detail`).
             (0..len)
                 .map(|t| {
-                    let w = (t + 1) as f64 / (len + 1) as f64;
+                    // An eased level (no straight ramp where the segment itself is still).
+                    let w = smoothstep((t + 1) as f64 / (len + 1) as f64);
                     let lerp = |p: Option<f64>, q: Option<f64>| match (p, q) {
                         (Some(p), Some(q)) => p + (q - p) * w,
                         (Some(p), None) | (None, Some(p)) => p,
@@ -371,6 +405,28 @@ const MAX_LAG: isize = 8;
 pub fn calibrate_guide(anim: &[Frame], mask: &Mask, guide: &[Frame], span: Segment) -> Vec<Frame> {
     let n = anim.len().min(guide.len());
     let (a, b) = (span.start, span.end.min(n));
+    let (lag, fit) = calibration(anim, mask, guide, span);
+    calibrated(guide, lag, &fit, a..b)
+}
+
+/// Per shape `(gain, bias)`.
+type Fit = [(f64, f64); NUM_ARKIT];
+
+/// The guide's frames `range`, moved by `lag` frames and mapped by `fit`.
+fn calibrated(guide: &[Frame], lag: isize, fit: &Fit, range: std::ops::Range<usize>) -> Vec<Frame> {
+    let n = guide.len();
+    range
+        .map(|f| {
+            let g = &guide[(f as isize + lag).clamp(0, n as isize - 1) as usize];
+            std::array::from_fn(|c| (fit[c].0 * f64::from(g[c]) + fit[c].1).clamp(0.0, 1.0) as f32)
+        })
+        .collect()
+}
+
+/// The lag and per-shape gain and bias of [`calibrate_guide`].
+fn calibration(anim: &[Frame], mask: &Mask, guide: &[Frame], span: Segment) -> (isize, Fit) {
+    let n = anim.len().min(guide.len());
+    let (a, b) = (span.start, span.end.min(n));
     let kept: Vec<usize> = (a.saturating_sub(CALIBRATION_FRAMES)..a)
         .chain(b..(b + CALIBRATION_FRAMES).min(n))
         .filter(|f| !mask.frame_erased(*f))
@@ -405,10 +461,62 @@ pub fn calibrate_guide(anim: &[Frame], mask: &Mask, guide: &[Frame], span: Segme
             *fc = (gain, my - gain * mg);
         }
     }
-    (a..b)
-        .map(|f| {
-            let g = &guide[at(f, lag)];
-            std::array::from_fn(|c| (fit[c].0 * f64::from(g[c]) + fit[c].1).clamp(0.0, 1.0) as f32)
+    (lag, fit)
+}
+
+/// Smoothing widths [`clean_guide`] chooses from (frames of a centred moving average; 1 = none).
+const CLEAN_WIDTHS: [usize; 6] = [1, 3, 5, 7, 9, 13];
+
+/// The noisy guide over `span`, calibrated as [`calibrate_guide`] does (or as it is, when that
+/// reproduces the kept frames better) and cleaned: per shape, a
+/// centred median (none, 3 or 5 frames: a dropout's held values and spikes) then a moving average
+/// ([`CLEAN_WIDTHS`]), the pair that best reproduces the kept frames within
+/// [`CALIBRATION_FRAMES`] of the span from the calibrated guide there. The kept frames show how noisy
+/// the tracker is, so a clean take is left as it is and a noisy one smoothed as much as it needs.
+pub fn clean_guide(anim: &[Frame], mask: &Mask, guide: &[Frame], span: Segment) -> Vec<Frame> {
+    let n = anim.len().min(guide.len());
+    let (a, b) = (span.start, span.end.min(n));
+    let (w0, w1) = (a.saturating_sub(CALIBRATION_FRAMES), (b + CALIBRATION_FRAMES).min(n));
+    let (lag, fit) = calibration(anim, mask, guide, span);
+    let g = calibrated(guide, lag, &fit, w0..w1);
+    // The take as it is competes too: a clean take needs no calibration.
+    let raw = calibrated(guide, 0, &[(1.0, 0.0); NUM_ARKIT], w0..w1);
+    let mut out: Vec<Frame> = g[a - w0..b - w0].to_vec();
+    for c in 0..NUM_ARKIT {
+        let kept: Vec<usize> = (w0..w1).filter(|f| !mask.erased(*f, c)).collect();
+        if kept.is_empty() {
+            continue;
+        }
+        let mut best = (f64::INFINITY, Vec::new());
+        for source in [&g, &raw] {
+            let x: Vec<f64> = source.iter().map(|f| f64::from(f[c])).collect();
+            for median in [1, 3, 5] {
+                let m = moving_median(&x, median);
+                for width in CLEAN_WIDTHS {
+                    let y = moving_average(&m, width);
+                    let e: f64 = kept.iter().map(|&f| (y[f - w0] - f64::from(anim[f][c])).powi(2)).sum();
+                    if e < best.0 {
+                        best = (e, y);
+                    }
+                }
+            }
+        }
+        for (t, row) in out.iter_mut().enumerate() {
+            row[c] = best.1[a - w0 + t].clamp(0.0, 1.0) as f32;
+        }
+    }
+    out
+}
+
+/// Centred moving median over `width` samples (shrinking at the ends).
+fn moving_median(x: &[f64], width: usize) -> Vec<f64> {
+    let h = width / 2;
+    (0..x.len())
+        .map(|i| {
+            let (lo, hi) = (i.saturating_sub(h), (i + h + 1).min(x.len()));
+            let mut w = x[lo..hi].to_vec();
+            w.sort_by(f64::total_cmp);
+            w[w.len() / 2]
         })
         .collect()
 }

@@ -4,12 +4,17 @@
 //!
 //! Steps (§3.1, §4): resample to the model rate (25 fps) → mask (spans × selected groups) → constraint
 //! → network input → generator → recomposition `X ⊙ (1 − M) + G ⊙ M` → post-processing (exact keys, C1
-//! borders, [0, 1]) → back to the capture's frame times, touching only frames inside the spans.
+//! borders, [0, 1]) → the shapes the guidance does not act on filled unguided (issue 40) → no eye held
+//! closed longer than the capture does ([`limit_eye_holds`]; not with a noisy take, which shows the
+//! performance's own holds, nor where a key holds it) → back to the capture's frame times, touching
+//! only frames inside the spans, each border joined at the capture's own rate ([`join_borders`]) and
+//! the holds checked again there ([`limit_hold`]).
 
 use std::collections::BTreeMap;
 
 use crate::data::{BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT, NUM_HEAD_EYE};
 use crate::edit::hermite::{hermite, Knot};
+use crate::edit::seam::{is_eye_channel, join_borders, limit_eye_holds, limit_hold, JOIN_FADE_S};
 use crate::edit::{
     correct, interpolate, retrieve, Constraint, ConstraintKind, Frame, Interp, Mask, MotionLibrary, RetrievalOptions,
     Segment,
@@ -18,6 +23,7 @@ use crate::model::input;
 use crate::visemes::Viseme;
 
 use super::keys::KeyPose;
+use super::plan::guided_channels;
 use inbetween_core::cancel::Cancel;
 use inbetween_io::LimitExceeded;
 
@@ -104,8 +110,12 @@ pub struct EditJob<'a> {
     pub clip: &'a BlendshapeClip,
     /// Spans to regenerate, seconds from the first frame (`start < end`).
     pub spans: Vec<(f64, f64)>,
-    /// ARKit shapes to regenerate (others stay exactly as they are).
-    pub channels: [bool; NUM_ARKIT],
+    /// ARKit shapes to regenerate (others stay exactly as they are), the guidance acting on all of
+    /// them; `None` (the default of `face edit` and the studio): every shape, the guidance acting on
+    /// the shapes it means something for ([`super::plan::guided_channels`]: the speech groups for
+    /// visemes) and the others filled as an unguided edit is, by retrieval from `library` and the
+    /// clip itself.
+    pub channels: Option<[bool; NUM_ARKIT]>,
     /// Guidance.
     pub guide: Guide,
     /// How to fill.
@@ -118,6 +128,9 @@ pub struct EditJob<'a> {
     pub cancel: Cancel,
     /// The file the guidance was read from (keys, noisy take, visemes), named in messages.
     pub guide_file: Option<String>,
+    /// Motion the shapes the guidance does not act on are drawn from (with the clip itself outside
+    /// the spans, which is preferred); `None`: the clip alone.
+    pub library: Option<&'a MotionLibrary>,
 }
 
 /// What an edit produced.
@@ -140,6 +153,18 @@ fn invalid(m: impl Into<String>) -> FaceError {
 }
 
 impl EditJob<'_> {
+    /// The shapes the guidance and method act on, and the shapes filled unguided by retrieval
+    /// (empty unless [`EditJob::channels`] is `None` and the guidance acts on part of the face).
+    pub fn channel_split(&self) -> ([bool; NUM_ARKIT], [bool; NUM_ARKIT]) {
+        match self.channels {
+            Some(ch) => (ch, [false; NUM_ARKIT]),
+            None => {
+                let guided = guided_channels(self.guide.kind());
+                (guided, guided.map(|g| !g))
+            }
+        }
+    }
+
     /// Check everything that can be checked before running.
     pub fn validate(&self) -> Result<(), FaceError> {
         let duration = self.clip.duration();
@@ -173,7 +198,7 @@ impl EditJob<'_> {
             self.limits.max_mask_s,
             "max_mask_s",
         )?;
-        if !self.channels.iter().any(|c| *c) {
+        if !self.channel_split().0.iter().any(|c| *c) {
             return Err(invalid("no blendshape selected to edit"));
         }
         if let Method::Network(net) = self.method {
@@ -263,17 +288,18 @@ impl EditJob<'_> {
         let before: Vec<Frame> = model.arkit_frames();
         let n = before.len();
         let segments = self.segments(n);
-        let mask = Mask::from_segments(n, &segments, &self.channels);
+        let (guided, rest) = self.channel_split();
+        let mask = Mask::from_segments(n, &segments, &guided);
         let keys = self.model_keys(&before);
         let constraint = self.constraint(&model, &keys)?;
         self.cancel.check()?;
         // One generator call over a window bounded by `limits.max_mask_s`; the cancel token is
         // checked again right after it.
-        let after = match self.method {
+        let mut after = match self.method {
             Method::Network(net) => {
                 // The residual at the borders is taken against the network's own output there (not the
                 // recomposition, which equals the input outside the mask), so the join is C1.
-                let generated = generate_in_window(net, &before, &segments, &self.channels, &constraint, self.seed);
+                let generated = generate_in_window(net, &before, &segments, &guided, &constraint, self.seed);
                 correct(&generated, &before, &mask, &keys)
             }
             Method::Linear => interpolate(&before, &mask, &keys, Interp::Linear),
@@ -286,7 +312,29 @@ impl EditJob<'_> {
             }
         };
         self.cancel.check()?;
-        let clip = self.back_to_capture_rate(&after, &mask)?;
+        if rest.iter().any(|c| *c) {
+            // The shapes the guidance says nothing about: an unguided fill, as `face edit` makes one.
+            let rest_mask = Mask::from_segments(n, &segments, &rest);
+            let own_only = MotionLibrary::default();
+            let library = self.library.unwrap_or(&own_only);
+            let base = interpolate(&before, &rest_mask, &[], Interp::Linear);
+            let options = RetrievalOptions::for_kind(ConstraintKind::None);
+            let (drawn, _) = retrieve(&base, &rest_mask, &Constraint::None, library, &options, self.seed);
+            let filled = correct(&drawn, &before, &rest_mask, &[]);
+            for (f, row) in after.iter_mut().enumerate() {
+                for c in (0..NUM_ARKIT).filter(|c| rest_mask.erased(f, *c)) {
+                    row[c] = filled[f][c];
+                }
+            }
+        }
+        let mask = Mask::from_segments(n, &segments, &std::array::from_fn(|c| guided[c] || rest[c]));
+        // A noisy take shows the performance's own holds: it is followed, not cut.
+        let cut_holds = !matches!(self.guide, Guide::Noisy(_));
+        if cut_holds {
+            limit_eye_holds(&mut after, &before, &mask, &keys, MODEL_FPS);
+        }
+        self.cancel.check()?;
+        let clip = self.back_to_capture_rate(&after, &mask, &keys, cut_holds)?;
         Ok(EditOutcome { clip, before, after, mask, keys })
     }
 
@@ -343,9 +391,16 @@ impl EditJob<'_> {
     }
 
     /// The input clip with every frame inside an edited span replaced by the model-rate edit
-    /// (linear between model frames), head/eye rotations inside the spans filled by cubic Hermite
-    /// interpolation (the networks do not model them).
-    fn back_to_capture_rate(&self, after: &[Frame], mask: &Mask) -> Result<BlendshapeClip, FaceError> {
+    /// (linear between model frames) and joined to the rows around it ([`join_borders`]), head/eye
+    /// rotations inside the spans filled by cubic Hermite interpolation (the networks do not model
+    /// them).
+    fn back_to_capture_rate(
+        &self,
+        after: &[Frame],
+        mask: &Mask,
+        keys: &[(usize, Frame)],
+        cut_holds: bool,
+    ) -> Result<BlendshapeClip, FaceError> {
         let clip = self.clip;
         let t0 = clip.times()[0];
         let stride = clip.num_channels();
@@ -353,6 +408,8 @@ impl EditJob<'_> {
         let last = after.len() - 1;
         let inside: Vec<bool> =
             clip.times().iter().map(|t| self.spans.iter().any(|(a, b)| t - t0 >= *a && t - t0 <= *b)).collect();
+        let rows = clip.num_frames();
+        let mut edited = vec![[false; NUM_ARKIT]; rows];
         for (i, t) in clip.times().iter().enumerate() {
             let x = ((t - t0) * MODEL_FPS).clamp(0.0, last as f64);
             let (f0, f1) = (x.floor() as usize, (x.ceil() as usize).min(last));
@@ -364,10 +421,34 @@ impl EditJob<'_> {
             for c in 0..NUM_ARKIT {
                 if mask.erased(f0, c) || mask.erased(f1, c) {
                     values[i * stride + c] = after[f0][c] + (after[f1][c] - after[f0][c]) * w;
+                    edited[i][c] = true;
                 }
             }
         }
-        if clip.has_head_eye() && self.channels.iter().all(|c| *c) {
+        let fade = (JOIN_FADE_S * clip.fps()).round() as usize;
+        let orig = clip.values();
+        for c in 0..NUM_ARKIT {
+            let flags: Vec<bool> = edited.iter().map(|e| e[c]).collect();
+            if !flags.iter().any(|e| *e) {
+                continue;
+            }
+            let mut column: Vec<f32> = (0..rows).map(|i| values[i * stride + c]).collect();
+            let before: Vec<f32> = (0..rows).map(|i| orig[i * stride + c]).collect();
+            join_borders(&mut column, &before, &flags, fade);
+            if cut_holds && is_eye_channel(c) {
+                // Rows of keys above 0.5 on this shape pin their holds.
+                let pinned: Vec<bool> = clip
+                    .times()
+                    .iter()
+                    .map(|t| keys.iter().any(|(f, k)| k[c] > 0.5 && ((t - t0) * MODEL_FPS - *f as f64).abs() < 0.5))
+                    .collect();
+                limit_hold(&mut column, &before, &flags, &pinned, clip.fps());
+            }
+            for (i, v) in column.into_iter().enumerate() {
+                values[i * stride + c] = v;
+            }
+        }
+        if clip.has_head_eye() && mask.channels().iter().all(|c| *c) {
             fill_head_eye(&mut values, stride, clip.times(), &inside);
         }
         BlendshapeClip::new(clip.fps(), clip.times().to_vec(), clip.has_head_eye(), clip.extra_names().to_vec(), values)
@@ -500,13 +581,14 @@ mod tests {
         EditJob {
             clip,
             spans: vec![(2.0, 3.5)],
-            channels: [true; NUM_ARKIT],
+            channels: Some([true; NUM_ARKIT]),
             guide,
             method,
             seed: 1,
             limits: EditLimits::default(),
             cancel: Cancel::new(),
             guide_file: None,
+            library: None,
         }
     }
 
@@ -549,7 +631,7 @@ mod tests {
     fn group_edits_leave_other_groups_alone() {
         let clip = capture(6.0);
         let mut job = job(&clip, Guide::None, Method::Cubic);
-        job.channels = crate::edit::groups::parse_groups("mouth,jaw").unwrap();
+        job.channels = Some(crate::edit::groups::parse_groups("mouth,jaw").unwrap());
         let out = job.run().unwrap();
         let blink = arkit_index("EyeBlinkLeft").unwrap();
         for i in 0..clip.num_frames() {
@@ -565,7 +647,9 @@ mod tests {
         let net = Constant(ConstraintKind::None, 0.95);
         let out = job(&clip, Guide::None, Method::Network(&net)).run().unwrap();
         let seg = out.mask.segments()[0];
-        for c in 0..NUM_ARKIT {
+        // Eye channels held at 0.95 over the whole span are opened in its middle (limit_eye_holds),
+        // which at 25 fps moves as fast as a blink; their join is checked at 60 fps on the captures.
+        for c in (0..NUM_ARKIT).filter(|c| !crate::edit::seam::is_eye_channel(*c)) {
             let v = |f: usize| out.after[f][c];
             let own = (v(seg.start - 1) - v(seg.start - 2)).abs().max((v(seg.end + 1) - v(seg.end)).abs());
             assert!((v(seg.start) - v(seg.start - 1)).abs() < 2.0 * own + 0.02, "channel {c} start");

@@ -2,6 +2,7 @@
 
 pub mod job;
 pub mod keys;
+pub mod plan;
 
 pub use job::{EditJob, EditLimits, EditOutcome, Guide, Inpainter, Method};
 pub use keys::{read_keys, KeyPose};

@@ -1,0 +1,189 @@
+//! The policy of an edit that the front ends used to carry each on their own (issues 40 and 43): the
+//! `auto` method rule, viseme runs from phoneme timings, spans given in seconds or frames, the
+//! groups each guidance acts on, and where the shared captures are. `face edit`, the studio's face
+//! panel and the tests build their [`super::EditJob`] with these, so the rules live in one place.
+
+use std::path::{Path, PathBuf};
+
+use crate::data::{BlendshapeClip, FaceError, NUM_ARKIT};
+use crate::edit::groups::Group;
+use crate::edit::mask::{parse_span_spec, SpanSpec};
+use crate::edit::ConstraintKind;
+use crate::visemes::{phoneme_viseme, PhonemeSpan, Viseme};
+
+/// How an edit is asked to fill, before [`MethodChoice::resolve`] applies the `auto` rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodChoice {
+    /// The best measured method for the guidance (`face bench`, see [`MethodChoice::resolve`]).
+    Auto,
+    /// The trained network for the guidance.
+    Network,
+    /// Segments of recorded motion ([`crate::edit::retrieve`]).
+    Retrieval,
+    /// Linear interpolation.
+    Linear,
+    /// Cubic Hermite interpolation.
+    Cubic,
+}
+
+impl MethodChoice {
+    /// Every choice, in the order of [`MethodChoice::name`]'s list.
+    pub const ALL: [MethodChoice; 5] =
+        [MethodChoice::Auto, MethodChoice::Network, MethodChoice::Retrieval, MethodChoice::Linear, MethodChoice::Cubic];
+
+    /// The name on the command line and in the studio.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodChoice::Auto => "auto",
+            MethodChoice::Network => "network",
+            MethodChoice::Retrieval => "retrieval",
+            MethodChoice::Linear => "linear",
+            MethodChoice::Cubic => "cubic",
+        }
+    }
+
+    /// The choice named `name`, or an error listing the names.
+    pub fn parse(name: &str) -> Result<MethodChoice, FaceError> {
+        MethodChoice::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
+            FaceError::Invalid(format!(
+                "method '{name}': expected {}",
+                MethodChoice::ALL.map(MethodChoice::name).join(", ")
+            ))
+        })
+    }
+
+    /// The `auto` rule, from the face bench's tables (README): retrieval when unguided or guided by a
+    /// noisy take (the only fills that pass the plausibility test, and the noisy guide's best
+    /// error), the network for keys (lowest error) and visemes (retrieval cannot follow them), and the
+    /// network whenever the user gave weights. Other choices are returned as they are.
+    pub fn resolve(self, kind: ConstraintKind, weights_given: bool) -> MethodChoice {
+        match self {
+            MethodChoice::Auto if weights_given => MethodChoice::Network,
+            MethodChoice::Auto => match kind {
+                ConstraintKind::None | ConstraintKind::Noisy => MethodChoice::Retrieval,
+                ConstraintKind::Keyframes | ConstraintKind::Visemes => MethodChoice::Network,
+            },
+            m => m,
+        }
+    }
+}
+
+/// The groups speech moves, which viseme guidance (text, TextGrid, phoneme timings) drives when the
+/// edit names no groups: jaw, mouth, cheeks (and nose), tongue.
+pub const SPEECH_GROUPS: [Group; 4] = [Group::Jaw, Group::Mouth, Group::Cheeks, Group::Tongue];
+
+/// The shapes a guidance acts on when the edit names no groups: the speech groups for visemes,
+/// every shape otherwise (keys and a noisy take say something about the whole face).
+pub fn guided_channels(kind: ConstraintKind) -> [bool; NUM_ARKIT] {
+    match kind {
+        ConstraintKind::Visemes => std::array::from_fn(|c| SPEECH_GROUPS.iter().any(|g| g.contains(c))),
+        _ => [true; NUM_ARKIT],
+    }
+}
+
+/// Phoneme spans as viseme runs `(start_s, end_s, viseme)`; a phoneme with no viseme class is an
+/// error naming it and its time.
+pub fn viseme_runs(spans: &[PhonemeSpan]) -> Result<Vec<(f64, f64, Viseme)>, FaceError> {
+    spans
+        .iter()
+        .map(|s| {
+            phoneme_viseme(&s.phoneme).map(|v| (s.start_s, s.end_s, v)).ok_or_else(|| {
+                FaceError::Invalid(format!("phoneme '{}' at {:.3} s has no viseme class", s.phoneme, s.start_s))
+            })
+        })
+        .collect()
+}
+
+/// Seconds from the clip's first frame of a span written `4.0s..6.5s` (seconds) or `240f..390f`
+/// (frames of the clip itself); a span outside the clip is an error naming it.
+pub fn span_seconds(text: &str, clip: &BlendshapeClip) -> Result<(f64, f64), FaceError> {
+    let t0 = clip.times()[0];
+    let duration = clip.duration();
+    let (a, b) = match parse_span_spec(text).map_err(FaceError::Invalid)? {
+        SpanSpec::Seconds(a, b) => (a, b),
+        SpanSpec::Frames(a, b) => {
+            let n = clip.num_frames();
+            if a >= n {
+                return Err(FaceError::Invalid(format!(
+                    "mask '{text}' starts past the clip's last frame ({n} frames)"
+                )));
+            }
+            let end = clip.times().get(b).map_or(duration + 1.0 / clip.fps(), |t| t - t0);
+            (clip.times()[a] - t0, end)
+        }
+    };
+    if a >= duration {
+        return Err(FaceError::Invalid(format!("mask '{text}' lies outside the clip ({duration:.2} s long)")));
+    }
+    // A span in frames may end one frame past the last frame's time (it covers the last frame).
+    if b > duration + 1.0 / clip.fps() + 1e-9 {
+        return Err(FaceError::Invalid(format!(
+            "mask '{text}' runs past the clip's end ({duration:.2} s long); end it at {duration:.2}s at the latest"
+        )));
+    }
+    Ok((a, b))
+}
+
+/// The folder of the shared face captures (`face/neurosync` under `../shared/data` or
+/// `$INBETWEEN_DATA`), or `given` when the user named one.
+pub fn captures_dir(given: Option<&Path>) -> Result<PathBuf, FaceError> {
+    if let Some(p) = given {
+        return Ok(p.to_path_buf());
+    }
+    let root = inbetween_io::data::shared_data_dir().unwrap_or_else(|missing| missing);
+    let dir = root.join("face/neurosync");
+    if !dir.is_dir() {
+        return Err(FaceError::Invalid(format!(
+            "no face captures at {} (set INBETWEEN_DATA or pass --captures)",
+            dir.display()
+        )));
+    }
+    Ok(dir)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::arkit_index;
+
+    #[test]
+    fn auto_picks_per_guidance_and_weights_mean_the_network() {
+        use ConstraintKind::*;
+        let auto = MethodChoice::Auto;
+        assert_eq!(auto.resolve(None, false), MethodChoice::Retrieval);
+        assert_eq!(auto.resolve(Noisy, false), MethodChoice::Retrieval);
+        assert_eq!(auto.resolve(Keyframes, false), MethodChoice::Network);
+        assert_eq!(auto.resolve(Visemes, false), MethodChoice::Network);
+        assert_eq!(auto.resolve(None, true), MethodChoice::Network);
+        assert_eq!(MethodChoice::Cubic.resolve(Visemes, true), MethodChoice::Cubic);
+        assert_eq!(MethodChoice::parse("linear").unwrap(), MethodChoice::Linear);
+        let e = MethodChoice::parse("bezier").unwrap_err().to_string();
+        assert!(e.contains("'bezier'") && e.contains("auto, network, retrieval, linear, cubic"), "{e}");
+    }
+
+    #[test]
+    fn visemes_guide_the_speech_groups_and_other_guidance_the_whole_face() {
+        let v = guided_channels(ConstraintKind::Visemes);
+        for name in ["JawOpen", "MouthClose", "CheekPuff", "NoseSneerLeft", "TongueOut"] {
+            assert!(v[arkit_index(name).unwrap()], "{name}");
+        }
+        for name in ["EyeBlinkLeft", "EyeLookDownRight", "BrowInnerUp"] {
+            assert!(!v[arkit_index(name).unwrap()], "{name}");
+        }
+        assert_eq!(guided_channels(ConstraintKind::Noisy), [true; NUM_ARKIT]);
+    }
+
+    #[test]
+    fn spans_in_seconds_or_frames_and_bad_ones_named() {
+        let times: Vec<f64> = (0..600).map(|i| 10.0 + i as f64 / 60.0).collect();
+        let clip = BlendshapeClip::new(60.0, times, false, vec![], vec![0.0; 600 * NUM_ARKIT]).unwrap();
+        assert_eq!(span_seconds("1s..2s", &clip).unwrap(), (1.0, 2.0));
+        let (a, b) = span_seconds("60f..120f", &clip).unwrap();
+        assert!((a - 1.0).abs() < 1e-9 && (b - 2.0).abs() < 1e-9);
+        assert!(span_seconds("20s..21s", &clip).unwrap_err().to_string().contains("outside the clip"));
+        assert!(span_seconds("5s..30s", &clip).unwrap_err().to_string().contains("runs past the clip's end"));
+        assert!(span_seconds("700f..710f", &clip).unwrap_err().to_string().contains("past the clip's last frame"));
+        let e = viseme_runs(&[PhonemeSpan { start_s: 0.5, end_s: 0.6, phoneme: "QQ".into() }]).unwrap_err();
+        assert!(e.to_string().contains("phoneme 'QQ' at 0.500 s has no viseme class"), "{e}");
+    }
+}
