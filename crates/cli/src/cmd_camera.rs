@@ -48,9 +48,14 @@ pub struct GenerateArgs {
     #[arg(long, required_unless_present = "characters", conflicts_with = "characters")]
     pub scene: Option<PathBuf>,
     /// Two mocap takes (BVH, or ASF+AMC as .amc with its .asf beside it) as the scene's characters:
-    /// roots from their hips, shoulders from their upper-arm joints, metres, Y up.
+    /// roots from their hips, shoulders from their upper-arm joints (found by name on the common rigs,
+    /// else by the skeleton's shape), metres, Y up.
     #[arg(long, num_args = 2, value_names = ["A", "B"])]
     pub characters: Vec<PathBuf>,
+    /// With --characters: a roles file naming the joints whose role neither names nor shape settle
+    /// (JSON, role → joint name, e.g. {"left_upper_arm": "lShldrBend"}); applies to both takes.
+    #[arg(long, requires = "characters")]
+    pub roles: Option<PathBuf>,
     /// Keyframes JSON: {"keys": [{"frame", "camera": {"pa", "pb", "theta", "phi"}, "targets"?, "velocity"?}], "main"?}.
     #[arg(long)]
     pub keys: PathBuf,
@@ -209,7 +214,9 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
             let names: Vec<String> = a.characters.iter().map(|p| p.display().to_string()).collect();
             let takes: Vec<(&str, &inbetween_core::Motion)> =
                 names.iter().map(String::as_str).zip(motions.iter()).collect();
-            let (scene, notes) = inbetween_camera::dataset::scene_from_motions(&takes).map_err(anyhow::Error::msg)?;
+            let overrides = crate::cmd_io::read_roles(a.roles.as_deref())?;
+            let (scene, notes) =
+                inbetween_camera::dataset::scene_from_motions_with(&takes, &overrides).map_err(anyhow::Error::msg)?;
             for line in notes.lines {
                 println!("  {line}");
             }

@@ -2,6 +2,7 @@
 
 use anyhow::Context;
 use clap::Args;
+use inbetween_core::roles::{Role, RoleOverrides};
 use inbetween_core::units::{rest_pose_extent, LengthUnit, UnitChoice};
 use inbetween_core::{Motion, Skeleton};
 use std::fmt::Write as _;
@@ -18,6 +19,10 @@ pub struct InfoArgs {
     /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (printed with the reason).
     #[arg(long)]
     pub unit: Option<LengthUnit>,
+    /// A roles file naming the joints whose role neither names nor shape settle: JSON, role → joint
+    /// name (`{"left_upper_arm": "lShldrBend", "hips": "hip"}`).
+    #[arg(long)]
+    pub roles: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -62,9 +67,33 @@ pub fn info(a: InfoArgs) -> anyhow::Result<()> {
     writeln!(out, "unit:      {} ({})", unit.unit.describe(), crate::errors::with_flags(&unit.reason))?;
     let size = rest_pose_extent(&m.skeleton);
     writeln!(out, "rest pose: {size:.2} units = {:.1} cm tall (or wide)", size * unit.cm_per_unit())?;
+    let overrides = read_roles(a.roles.as_deref())?;
+    match inbetween_core::roles::find_motion_roles(&m, &overrides) {
+        Ok(r) => {
+            let found = r.scheme.map(|s| format!("names read as {}", s.label())).unwrap_or("no known names".into());
+            writeln!(
+                out,
+                "roles:     {} of {} ({found}; confidence {:.2})",
+                r.roles.len(),
+                Role::ALL.len(),
+                r.confidence()
+            )?;
+            write!(out, "{r}")?;
+        }
+        Err(e) => writeln!(out, "roles:     none: {}", crate::errors::with_flags(&e.to_string()))?,
+    }
     writeln!(out, "skeleton:")?;
     write_tree(&mut out, &m.skeleton)?;
     print_tolerating_closed_pipe(&out)
+}
+
+/// The roles file given with `--roles` (none: no overrides); errors name the file, line and column.
+pub(crate) fn read_roles(path: Option<&Path>) -> anyhow::Result<RoleOverrides> {
+    let Some(path) = path else { return Ok(RoleOverrides::default()) };
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading the roles file {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| {
+        format!("{}: expected a JSON object of role → joint name, e.g. {{\"left_hand\": \"lHand\"}}", path.display())
+    })
 }
 
 /// Prints `text`; a reader that stops early (`| head`) is not an error.

@@ -36,6 +36,7 @@ pub const OPTION_FLAGS: &[(&str, &str)] = &[
     ("models", "--models"),
     ("shared_motions", "--shared-motions"),
     ("data", "--data"),
+    ("roles", "--roles"),
 ];
 
 /// Library text with each `` `field` `` of [`OPTION_FLAGS`] written as its flag (other text,

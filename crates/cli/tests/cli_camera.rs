@@ -264,12 +264,48 @@ fn generate_takes_two_bvh_takes_as_the_characters() {
     let track: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&again).unwrap()).unwrap();
     assert!(track["style"].as_str().unwrap().starts_with("reference:"), "{}", track["style"]);
     assert_eq!(track["frames"].as_array().unwrap().len(), 81);
-    // A take without shoulders is refused, naming it; --scene and --characters exclude each other.
+    // Joints no scheme names are found by the skeleton's shape (issue 42) ...
     std::fs::write(&b, std::fs::read_to_string(&a).unwrap().replace("LeftArm", "Wing").replace("LeftShoulder", "Fin"))
         .unwrap();
-    let err =
-        fails(&inbetween(&["camera", "generate", "--characters", s(&a), s(&b), "--keys", s(&keys), "-o", s(&cam)]));
-    assert!(err.contains("b.bvh: no left/right shoulder joints found"), "{err}");
+    let out = generate(&["--style", "orbit", "-o", s(&cam)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("b.bvh: root Hips, shoulders Wing / RightArm (by shape)"), "{text}");
+    // ... every scheme by name (Daz Genesis: `lShldrBend`) ...
+    use inbetween_core::roles::fixtures::{chain, renamed, with_skeleton};
+    let walk = gait(&GaitParams { frames: 90, ..GaitParams::walk() });
+    let daz = with_skeleton(&walk, renamed(&walk.skeleton, inbetween_core::roles::Scheme::Daz));
+    std::fs::write(&b, inbetween_io::to_bvh_string(&daz)).unwrap();
+    let out = generate(&["--style", "orbit", "-o", s(&cam)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("shoulders lShldrBend / rShldrBend (by name (Daz Genesis))"), "{text}");
+    // ... a roles file wins (it applies to both takes: both on the Daz rig here) ...
+    std::fs::write(&a, inbetween_io::to_bvh_string(&daz)).unwrap();
+    let roles = d.join("roles.json");
+    std::fs::write(
+        &roles,
+        r#"{"left_clavicle": "rCollar", "left_upper_arm": "rShldrBend", "left_forearm": "rForearmBend",
+            "left_hand": "rHand", "right_clavicle": "lCollar", "right_upper_arm": "lShldrBend",
+            "right_forearm": "lForearmBend", "right_hand": "lHand"}"#,
+    )
+    .unwrap();
+    let out = generate(&["--style", "orbit", "-o", s(&cam), "--roles", s(&roles)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("shoulders rShldrBend / lShldrBend (by roles file)"), "{text}");
+    std::fs::write(&roles, r#"{"left_hand": "Wrist"}"#).unwrap();
+    let err = fails(&generate(&["--style", "orbit", "-o", s(&cam), "--roles", s(&roles)]));
+    assert!(err.contains("the roles file gives 'Wrist' for left_hand"), "{err}");
+    std::fs::write(&roles, r#"{"lefthand": "lHand"}"#).unwrap();
+    let err = fails(&generate(&["--style", "orbit", "-o", s(&cam), "--roles", s(&roles)]));
+    assert!(err.contains("roles.json") && err.contains("unknown role 'lefthand'"), "{err}");
+    // ... and a take that is no humanoid is refused, naming it, what is missing and --roles.
+    let tail = inbetween_core::Motion::new(chain(), 1.0 / 30.0, vec![0.0; 90 * chain().num_channels()]).unwrap();
+    std::fs::write(&b, inbetween_io::to_bvh_string(&tail)).unwrap();
+    let err = fails(&generate(&["--style", "orbit", "-o", s(&cam)]));
+    assert!(err.contains("b.bvh: not a humanoid skeleton") && err.contains("--roles"), "{err}");
+    // --scene and --characters exclude each other.
     let err = fails(&inbetween(&["camera", "generate", "--keys", s(&keys), "-o", s(&cam)]));
     assert!(err.contains("--scene") || err.contains("--characters"), "{err}");
 }

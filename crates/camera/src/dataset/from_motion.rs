@@ -1,56 +1,15 @@
 //! A scene from two (or more) mocap takes (issue 24): each character's root is its hips joint and its
-//! shoulders its upper-arm (or shoulder, clavicle) joints, in metres (the length unit inferred per
+//! shoulders its upper-arm joints, as [`inbetween_core::roles`] finds them on any rig (by name or by
+//! shape; a roles file settles the rest), in metres (the length unit inferred per
 //! file, as elsewhere), Y up as in BVH. Takes at other frame rates are resampled to the first one's;
 //! the scene lasts as long as the shortest take.
 
 use glam::DVec3;
+use inbetween_core::roles::{find_motion_roles, Role, RoleOverrides, Side};
 use inbetween_core::units::UnitChoice;
 use inbetween_core::{positions_clip, Motion};
 
 use super::scene::{CharacterTrack, Scene};
-
-/// Joint names (lower case, letters and digits only) tried for each shoulder, best first: the
-/// upper-arm joint sits at the shoulder; a clavicle or collar joint is a fallback.
-const LEFT: [&str; 11] = [
-    "leftarm",
-    "leftupperarm",
-    "lupperarm",
-    "ccbaselupperarm",
-    "lhumerus",
-    "larm",
-    "leftshoulder",
-    "lshoulder",
-    "ccbaselclavicle",
-    "lclavicle",
-    "leftcollar",
-];
-const RIGHT: [&str; 11] = [
-    "rightarm",
-    "rightupperarm",
-    "rupperarm",
-    "ccbaserupperarm",
-    "rhumerus",
-    "rarm",
-    "rightshoulder",
-    "rshoulder",
-    "ccbaserclavicle",
-    "rclavicle",
-    "rightcollar",
-];
-
-/// Hip joint names (same normalisation); the root joint when none matches (some rigs root at a
-/// ground bone, such as iClone's `RL_BoneRoot`).
-const HIPS: [&str; 5] = ["hips", "hip", "ccbasehip", "pelvis", "ccbasepelvis"];
-
-fn key(name: &str) -> String {
-    name.chars().filter(|c| c.is_ascii_alphanumeric()).map(|c| c.to_ascii_lowercase()).collect()
-}
-
-/// The joint of `motion` best matching `names` (first name wins).
-fn find(motion: &Motion, names: &[&str]) -> Option<usize> {
-    let keys: Vec<String> = motion.skeleton.joints().iter().map(|j| key(&j.name)).collect();
-    names.iter().find_map(|n| keys.iter().position(|k| k == n))
-}
 
 /// What [`scene_from_motions`] did beyond the obvious, for the user to read.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -60,6 +19,15 @@ pub struct SceneNotes {
 
 /// A scene of `takes` (name shown to the user, motion). Errors name the take and what was expected.
 pub fn scene_from_motions(takes: &[(&str, &Motion)]) -> Result<(Scene, SceneNotes), String> {
+    scene_from_motions_with(takes, &RoleOverrides::default())
+}
+
+/// [`scene_from_motions`] with joints named in a roles file (`roles`), for rigs whose names and
+/// shape leave a role open.
+pub fn scene_from_motions_with(
+    takes: &[(&str, &Motion)],
+    overrides: &RoleOverrides,
+) -> Result<(Scene, SceneNotes), String> {
     if takes.len() < 2 {
         return Err(format!("a camera scene needs two characters, got {}", takes.len()));
     }
@@ -73,16 +41,13 @@ pub fn scene_from_motions(takes: &[(&str, &Motion)]) -> Result<(Scene, SceneNote
     let mut notes = SceneNotes::default();
     let mut characters = Vec::new();
     for (name, motion) in takes {
-        let (l, r) = match (find(motion, &LEFT), find(motion, &RIGHT)) {
-            (Some(l), Some(r)) => (l, r),
-            _ => {
-                return Err(format!(
-                    "{name}: no left/right shoulder joints found; expected joints named like LeftArm / RightArm, \
-                     LeftShoulder / RightShoulder, lhumerus / rhumerus or CC_Base_L_Upperarm / CC_Base_R_Upperarm"
-                ))
-            }
-        };
-        let hips = find(motion, &HIPS).unwrap_or(0);
+        let roles = find_motion_roles(motion, overrides).map_err(|e| format!("{name}: {e}"))?;
+        let (hips, l, r) = (
+            roles.joint(Role::Hips),
+            roles.joint(Role::UpperArm(Side::Left)),
+            roles.joint(Role::UpperArm(Side::Right)),
+        );
+        let how = roles.how(Role::UpperArm(Side::Left)).map(|h| h.to_string()).unwrap_or_default();
         let unit = UnitChoice::resolve(None, &motion.skeleton);
         let m = unit.cm_per_unit() / 100.0;
         let pos = positions_clip(motion);
@@ -96,7 +61,7 @@ pub fn scene_from_motions(takes: &[(&str, &Motion)]) -> Result<(Scene, SceneNote
             at(i0, j).lerp(at(i1, j), w)
         };
         notes.lines.push(format!(
-            "{name}: root {}, shoulders {} / {}; {}",
+            "{name}: root {}, shoulders {} / {} (by {how}); {}",
             motion.skeleton.joint(hips).name,
             motion.skeleton.joint(l).name,
             motion.skeleton.joint(r).name,
@@ -154,15 +119,13 @@ mod tests {
     }
 
     #[test]
-    fn a_take_without_shoulders_is_refused_naming_it() {
-        let mut a = gait(&GaitParams { frames: 20, ..GaitParams::walk() });
-        let mut joints = a.skeleton.joints().to_vec();
-        for (i, j) in joints.iter_mut().enumerate() {
-            j.name = format!("bone{i}");
-        }
-        a.skeleton = inbetween_core::Skeleton::new(joints).unwrap();
+    fn a_take_that_is_no_humanoid_is_refused_naming_it_and_the_roles_file() {
+        let chain = inbetween_core::roles::fixtures::chain();
+        let frames = vec![0.0; 20 * chain.num_channels()];
+        let a = Motion::new(chain, 1.0 / 30.0, frames).unwrap();
         let b = gait(&GaitParams { frames: 20, ..GaitParams::walk() });
         let err = scene_from_motions(&[("odd.bvh", &a), ("b.bvh", &b)]).unwrap_err();
-        assert!(err.starts_with("odd.bvh: no left/right shoulder joints"), "{err}");
+        assert!(err.starts_with("odd.bvh: not a humanoid skeleton"), "{err}");
+        assert!(err.contains("left_upper_arm") && err.contains("`roles`"), "{err}");
     }
 }
