@@ -571,7 +571,7 @@ fn table2(results: &[ClipResult], cfg: &VideoBenchConfig) -> Table {
             format!("{directed}/{}", r.direction.len()),
             num(reached(&r.runs[0], r.target), 2),
             num(backward_pct(&r.runs[0]), 1),
-            num(backward_pct(&r.runs[1]), 1),
+            num(backward_pct(&r.runs[CONFIGS.iter().position(|c| *c == "w/o C_r").unwrap_or(0)]), 1),
             num(r.md_source, 4),
             num(md, 4),
             num(md / r.md_source.max(1e-12), 2),
