@@ -3,13 +3,18 @@
 
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
+use inbetween_core::cancel::Cancel;
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{positions_clip, Motion};
 use inbetween_io::fsutil::write_atomic;
+use inbetween_io::Progress;
 use inbetween_mocap::bench::{self, Protocol};
+use inbetween_mocap::codec::job::Version;
 use inbetween_mocap::codec::{self, Budget};
-use inbetween_mocap::dqn::{DqnConfig, TrainOptions};
-use inbetween_mocap::representation::JointFilter;
+use inbetween_mocap::dqn::{DqnConfig, TrainOptions, DEFAULT_POLICY_PATH};
+use inbetween_mocap::representation::{skip_first_frame, JointFilter};
+use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
+use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport, PositionError};
 use inbetween_render::StickOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -39,7 +44,7 @@ pub enum MocapCommand {
 pub struct TrainArgs {
     /// Policy file to write (burnpack weights; the card goes beside it as .json); the pretrained
     /// stage goes beside it as <stem>.pretrain.bpk.
-    #[arg(short, long, default_value = "out/sidql_cmu.bpk")]
+    #[arg(short, long, default_value = DEFAULT_POLICY_PATH)]
     pub output: PathBuf,
     /// Train on procedural gaits (our own data) instead of CMU takes.
     #[arg(long, conflicts_with = "all_takes")]
@@ -149,7 +154,7 @@ pub struct BudgetArgs {
     #[arg(long)]
     pub max_error: Option<String>,
     /// Longest gap between two keys, in seconds (bounds the search; -k widens it as needed).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = DEFAULT_MAX_GAP_S)]
     pub max_gap_s: f64,
     /// Joints to keep: `all`, `paper` (drop fingers, thumbs, toes) or comma-separated name parts to drop.
     #[arg(long, default_value = "all")]
@@ -178,14 +183,19 @@ impl BudgetArgs {
     }
 
     fn load(&self, path: &Path) -> anyhow::Result<Motion> {
-        let m = inbetween_io::load_motion(path).with_context(|| format!("reading {}", path.display()))?;
-        let m = if self.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
+        let m = load(path, self.skip_first)?;
         Ok(JointFilter::parse(&self.joints).apply(&m))
     }
 
     fn max_gap(&self, m: &Motion) -> usize {
-        ((self.max_gap_s / m.frame_time).round() as usize).max(1)
+        max_gap_frames(self.max_gap_s, m.frame_time)
     }
+}
+
+/// A clip from a file, without its first frame when asked (`--skip-first`).
+fn load(path: &Path, skip_first: bool) -> anyhow::Result<Motion> {
+    let m = inbetween_io::load_motion(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(if skip_first { skip_first_frame(m)? } else { m })
 }
 
 #[derive(Args)]
@@ -301,9 +311,9 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
 
 fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
-    let job = codec::job::CompressJob {
+    let job = CompressJob {
         budget: a.budget.budget()?,
-        version: a.format.as_deref().map(codec::job::Version::parse).transpose()?,
+        version: a.format.as_deref().map(Version::parse).transpose()?,
         segment_len: a.segment,
         max_gap: a.budget.max_gap(&m),
         unit: a.budget.unit(&m),
@@ -318,13 +328,18 @@ fn compress(a: CompressArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// An `.ibk` file decoded by the engine's `DecompressJob`.
+fn decompress_file(path: &Path) -> anyhow::Result<DecompressReport> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    DecompressJob
+        .run(&bytes, &Cancel::new(), &Progress::hidden())
+        .with_context(|| format!("decoding {}", path.display()))
+}
+
 fn decompress(a: DecompressArgs) -> anyhow::Result<()> {
-    let bytes = std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
-    let d = codec::read(&bytes).with_context(|| format!("decoding {}", a.input.display()))?;
-    let m = d.motion().with_context(|| format!("rebuilding the clip of {}", a.input.display()))?;
-    inbetween_io::write_bvh(&a.output, &m).with_context(|| format!("writing {}", a.output.display()))?;
-    println!("{} (the file keeps the source's unit)", LengthUnit::infer(d.skeleton()));
-    println!("{} → {} frames at {:.1} fps; wrote {}", d.describe(), m.num_frames(), m.fps(), a.output.display());
+    let r = decompress_file(&a.input)?;
+    inbetween_io::write_bvh(&a.output, &r.motion).with_context(|| format!("writing {}", a.output.display()))?;
+    println!("{r}; wrote {}", a.output.display());
     Ok(())
 }
 
@@ -332,39 +347,39 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
     let unit = a.budget.unit(&m);
     println!("{unit}");
-    let (rec, keys) = match &a.ibk {
+    let d = match &a.ibk {
         Some(p) => {
-            let d = codec::read(&std::fs::read(p).with_context(|| format!("reading {}", p.display()))?)
-                .with_context(|| format!("decoding {}", p.display()))?;
-            if *d.skeleton() != m.skeleton || d.num_frames() != m.num_frames() {
+            let d = decompress_file(p)?;
+            if *d.file.skeleton() != m.skeleton || d.frames != m.num_frames() {
                 bail!(
                     "{} does not match {} (skeleton or frame count differ; use the same --joints/--skip-first)",
                     p.display(),
                     a.input.display()
                 );
             }
-            let keys = match &d {
-                codec::IbkFile::Keys(k) => k.key_frames.len(),
-                codec::IbkFile::Samples(q) => q.header.num_frames,
-                // v4 stores every frame, as v3 does.
-                codec::IbkFile::Runtime(r) => r.poses.len(),
-            };
-            (d.motion()?, keys)
+            d
         }
         None => {
-            let c = codec::compress_in(&m, unit.clone(), a.budget.budget()?, a.budget.max_gap(&m))?;
-            (codec::decode(&c.bytes)?.reconstruct()?, c.keys.len())
+            // Keys only (version 2), as the preview shows them.
+            let job = CompressJob {
+                budget: a.budget.budget()?,
+                version: Some(Version::V2),
+                segment_len: None,
+                max_gap: a.budget.max_gap(&m),
+                unit: unit.clone(),
+            };
+            DecompressJob.run(job.run(&m)?.bytes(), &Cancel::new(), &Progress::hidden())?
         }
     };
-    let e = inbetween_core::position_error(&positions_clip(&m), &positions_clip(&rec));
-    let cm = unit.cm_per_unit();
+    let (rec, keys) = (&d.motion, d.stored_poses);
+    let e = PositionError::between(&positions_clip(&m), &positions_clip(rec), unit.cm_per_unit());
     let opts = StickOptions {
         labels: vec!["original".into(), format!("from {keys} keys")],
-        title: Some(format!("{} keys: mean {:.2} cm, max {:.2} cm", keys, e.mean * cm, e.max * cm)),
+        title: Some(format!("{keys} keys: {e}")),
         ..StickOptions::default()
     };
-    inbetween_render::render_motion_gif(&a.output, &[&m, &rec], &opts)?;
-    println!("{keys} keys; mean {:.3} cm, max {:.3} cm; wrote {}", e.mean * cm, e.max * cm, a.output.display());
+    inbetween_render::render_motion_gif(&a.output, &[&m, rec], &opts)?;
+    println!("{keys} keys; mean {:.3} cm, max {:.3} cm; wrote {}", e.mean_cm, e.max_cm, a.output.display());
     Ok(())
 }
 
@@ -374,7 +389,7 @@ impl BenchArgs {
         let policy = match (&self.model, self.train_episodes) {
             (Some(p), _) => bench::PolicyChoice::File(p.clone()),
             (None, 0) => bench::PolicyChoice::Committed,
-            (None, episodes) => bench::PolicyChoice::Train { episodes, output: PathBuf::from("out/sidql_cmu.bpk") },
+            (None, episodes) => bench::PolicyChoice::Train { episodes, output: PathBuf::from(DEFAULT_POLICY_PATH) },
         };
         bench::BenchConfig {
             data: self.data.clone(),
@@ -429,17 +444,14 @@ fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
     let data_choice = match (a.procedural, a.all_takes) {
-        (true, _) => inbetween_mocap::corpus::TrainingData::Procedural,
-        (false, true) => inbetween_mocap::corpus::TrainingData::CmuAll,
-        (false, false) => inbetween_mocap::corpus::TrainingData::CmuSplit,
+        (true, _) => inbetween_mocap::protocol::TrainingData::Procedural,
+        (false, true) => inbetween_mocap::protocol::TrainingData::CmuAll,
+        (false, false) => inbetween_mocap::protocol::TrainingData::CmuSplit,
     };
     let (windows, data) =
-        inbetween_mocap::corpus::training_set(data_choice, a.data.as_deref(), a.unit, a.seed, a.stride)?;
-    let base = match a.preset.as_str() {
-        "default" => TrainOptions::default(),
-        "quick" => TrainOptions::quick(),
-        "paper" => TrainOptions::paper(),
-        other => bail!("unknown preset '{other}'; expected default, paper or quick"),
+        inbetween_mocap::protocol::training_set(data_choice, a.data.as_deref(), a.unit, a.seed, a.stride)?;
+    let Some(base) = TrainOptions::preset(&a.preset) else {
+        bail!("unknown preset '{}'; expected default, paper or quick", a.preset)
     };
     if let Some(dir) = a.output.parent() {
         if !dir.as_os_str().is_empty() {
@@ -492,8 +504,7 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
 }
 
 fn stream_send(a: SendArgs) -> anyhow::Result<()> {
-    let m = inbetween_io::load_motion(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
-    let m = if a.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
+    let m = load(&a.input, a.skip_first)?;
     let opts = inbetween_mocap::stream::SendOptions {
         max_cm: codec::parse_length_cm(&a.max_error)?,
         lookahead: a.lookahead,
@@ -552,8 +563,7 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
         println!("joined mid-stream: the output's frame 0 is frame {} of the sender's clip", got.start_frame);
     }
     if let Some(r) = &a.reference {
-        let m = inbetween_io::load_motion(r).with_context(|| format!("reading {}", r.display()))?;
-        let m = if a.skip_first && m.num_frames() > 2 { m.crop(1, m.num_frames())? } else { m };
+        let m = load(r, a.skip_first)?;
         let unit = UnitChoice::resolve(a.unit, &m.skeleton);
         let e = inbetween_mocap::stream::compare(&got, &m, unit.cm_per_unit())
             .with_context(|| format!("comparing with {}", r.display()))?;

@@ -8,7 +8,7 @@
 //! the corpus folders' units are known; a clip from any other folder gets the unit inferred from
 //! its skeleton ([`LengthUnit::infer`]) unless the caller gives one.
 
-use crate::representation::SphericalMotion;
+use crate::codec::RAW_BYTES_PER_BONE;
 use crate::{MocapError, Result};
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::Motion;
@@ -215,57 +215,45 @@ fn asf_amc_pairs(dir: &Path) -> Result<Vec<(PathBuf, PathBuf)>> {
         .collect())
 }
 
-/// Which windows SIDQL trains on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TrainingData {
-    /// 24 procedural gaits (our own data).
-    Procedural,
-    /// The CMU training split of the bench protocol (its test split held out).
-    CmuSplit,
-    /// Every CMU take of the corpus (the committed policy; the bench's k-fold is its held-out score).
-    CmuAll,
+/// One take of the corpus at a protocol's frame rate (the codec bench on ACL's protocol), with
+/// its length unit and why.
+pub struct Take {
+    pub name: String,
+    pub source: &'static str,
+    pub motion: Motion,
+    pub unit: UnitChoice,
 }
 
-/// SIDQL's training windows and their description in words (written in the policy's card).
-pub fn training_set(
-    data_choice: TrainingData,
-    data: Option<&Path>,
-    unit: Option<LengthUnit>,
-    seed: u64,
-    stride: usize,
-) -> Result<(Vec<SphericalMotion>, String)> {
-    let protocol = crate::bench::Protocol { seed, ..crate::bench::Protocol::paper() };
-    if data_choice == TrainingData::Procedural {
-        let clips = crate::bench::procedural_clips(seed, 24);
-        let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-        let p = crate::bench::Protocol { skip_first_frame: false, ..protocol };
-        let windows = crate::bench::training_windows(&clips, &names, &p, stride)?;
-        let data = format!(
-            "{} procedural gaits (seed {seed}), {} windows of 60 frames at stride {stride}",
-            clips.len(),
-            windows.len()
-        );
-        return Ok((windows, data));
+impl Take {
+    /// ACL's raw size of the take: [`RAW_BYTES_PER_BONE`] per joint and frame.
+    pub fn raw_bytes(&self) -> usize {
+        RAW_BYTES_PER_BONE * self.motion.skeleton.len() * self.motion.num_frames()
     }
-    let dir = crate::bench::run::data_dir(data)?;
-    let clips = load(&dir, unit)?.clips;
-    let names: Vec<String> = clips.iter().map(|c| c.name.clone()).collect();
-    if data_choice == TrainingData::CmuAll {
-        let windows = crate::bench::training_windows(&clips, &names, &protocol, stride)?;
-        let data = format!(
-            "every CMU take of the corpus ({} takes), {} windows of 60 frames at stride {stride}",
-            clips.len(),
-            windows.len()
-        );
-        return Ok((windows, data));
+}
+
+/// The takes of `clips` (`units` beside them) at `fps` (the cgspeed T-pose frame dropped).
+pub fn takes(clips: &[Clip], units: &[UnitChoice], fps: f64) -> Result<Vec<Take>> {
+    clips
+        .iter()
+        .zip(units)
+        .map(|(c, u)| {
+            let m = if c.source == "cgspeed" && c.motion.num_frames() > 2 {
+                c.motion.crop(1, c.motion.num_frames())?
+            } else {
+                c.motion.clone()
+            };
+            Ok(Take { name: c.name.clone(), source: c.source, motion: m.resample(fps)?, unit: u.clone() })
+        })
+        .collect()
+}
+
+/// The data folder: `data`, else the shared corpus.
+pub fn data_dir(data: Option<&Path>) -> Result<PathBuf> {
+    match data {
+        Some(d) => Ok(d.to_path_buf()),
+        None => inbetween_io::data::shared_data_dir()
+            .map_err(|p| MocapError::Invalid(format!("no data at {} (give `data`)", p.display()))),
     }
-    let (train, test) = crate::bench::split_clips(&names, &protocol);
-    let windows = crate::bench::training_windows(&clips, &train, &protocol, stride)?;
-    let data = format!(
-        "CMU training split (seed {seed}) {train:?}, {} windows of 60 frames at stride {stride}; test split {test:?} held out",
-        windows.len()
-    );
-    Ok((windows, data))
 }
 
 #[cfg(test)]

@@ -113,8 +113,45 @@ pub trait SegmentModel: Sync {
     }
 }
 
+/// Joint position error of a rebuilt clip against its source, in cm: per frame the mean distance
+/// over joints, the mean of those over frames and the largest single joint distance.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PositionError {
+    pub per_frame_cm: Vec<f64>,
+    pub mean_cm: f64,
+    pub max_cm: f64,
+}
+
+impl PositionError {
+    /// Compares world joint positions `[frame][joint]` (file units, `cm_per_unit` cm each).
+    pub fn between(original: &[Vec<DVec3>], rebuilt: &[Vec<DVec3>], cm_per_unit: f64) -> PositionError {
+        let mut max_cm = 0.0f64;
+        let per_frame_cm: Vec<f64> = original
+            .iter()
+            .zip(rebuilt)
+            .map(|(fa, fb)| {
+                let mut sum = 0.0;
+                for (x, y) in fa.iter().zip(fb) {
+                    let d = x.distance(*y) * cm_per_unit;
+                    max_cm = max_cm.max(d);
+                    sum += d;
+                }
+                sum / fa.len().max(1) as f64
+            })
+            .collect();
+        let mean_cm = per_frame_cm.iter().sum::<f64>() / per_frame_cm.len().max(1) as f64;
+        PositionError { per_frame_cm, mean_cm, max_cm }
+    }
+}
+
+impl std::fmt::Display for PositionError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "mean {:.2} cm, max {:.2} cm", self.mean_cm, self.max_cm)
+    }
+}
+
 /// Mean angle error (radians), mean and max position error (cm) of one reconstruction.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ReconstructionError {
     pub mean_angle: f64,
     pub mean_cm: f64,

@@ -91,6 +91,17 @@ impl JointFilter {
     }
 }
 
+/// The clip without its first frame (the T-pose CMU cgspeed files start with); a clip of two
+/// frames or fewer is returned whole.
+pub fn skip_first_frame(motion: Motion) -> Result<Motion> {
+    let n = motion.num_frames();
+    if n > 2 {
+        Ok(motion.crop(1, n)?)
+    } else {
+        Ok(motion)
+    }
+}
+
 /// A clip in the paper's representation. Per-joint arrays are joint-major (`theta[j * n + f]`) so a
 /// segment's frames of one joint are contiguous.
 #[derive(Clone, Debug)]

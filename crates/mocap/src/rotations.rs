@@ -11,8 +11,8 @@ use inbetween_core::rotation::{angle_between, make_continuous};
 use inbetween_core::units::LengthUnit;
 use inbetween_core::{KeyframeSet, Motion, Pose, Skeleton};
 
-/// The local state of every joint at one frame: what a keyframe stores.
-#[derive(Clone, Debug, PartialEq)]
+/// The local state of every joint at one frame: what a keyframe stores (values and tangents).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct KeyPose {
     pub rotations: Vec<DQuat>,
     /// Body-frame angular velocities, rad/s.

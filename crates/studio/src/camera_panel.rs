@@ -10,7 +10,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use axum::body::Bytes;
 use axum::extract::{Query, State};
-use axum::Json;
+use axum::routing::post;
+use axum::{Json, Router};
 use glam::{DQuat, DVec3};
 use inbetween_camera::dataset::{scene_from_motions, Scene, BEHAVIOURS};
 use inbetween_camera::infer::{example_keys, GenerateJob, GenerateOptions, Keys, ReferenceClip, Style};
@@ -22,8 +23,10 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::answer;
-use crate::mocap_panel::utf8;
-use crate::server::AppState;
+use crate::state::Shared;
+use crate::upload::{clean_name, utf8};
+
+crate::state::panel_state!(AppState, camera, CameraState);
 
 /// The panel's scene, the first take waiting for its partner, a reference style, the weights.
 #[derive(Default)]
@@ -83,7 +86,7 @@ pub struct UploadQuery {
 
 /// `POST /api/camera/upload?name=…&slot=0|1`: a BVH take; the second one makes the scene.
 pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
-    let name: String = q.name.chars().filter(|c| !c.is_control() && *c != '/' && *c != '\\').take(200).collect();
+    let name = clean_name(&q.name);
     let slot = q.slot;
     let state = st.clone();
     let id = st.jobs.spawn("camera-scene", move |job| {
@@ -336,4 +339,17 @@ pub async fn generate(State(st): State<Arc<AppState>>, Json(req): Json<GenerateR
         Ok(json!({"ok": true, "message": msg, "trajectories": out, "key_hit_error": worst_hit}))
     });
     Ok(Json(answer(&st.jobs, id).await))
+}
+
+/// The panel's routes, nested under `/api/camera` by the server.
+pub fn router(shared: Arc<Shared>) -> Router {
+    Router::new()
+        .route("/open", post(open))
+        .route("/upload", post(upload))
+        .route("/reference", post(reference))
+        .route("/key_at", post(key_at))
+        .route("/toric", post(toric))
+        .route("/pose", post(pose))
+        .route("/generate", post(generate))
+        .with_state(AppState::new(shared))
 }

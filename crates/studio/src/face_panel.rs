@@ -12,7 +12,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use axum::body::Bytes;
 use axum::extract::{Query, State};
-use axum::Json;
+use axum::routing::{get, post};
+use axum::{Json, Router};
 use inbetween_face::data::{
     parse_curve_csv, parse_curve_json, parse_live_link, to_curve_csv_string, to_curve_json_string, to_live_link_string,
     BlendshapeClip, ARKIT_NAMES, MODEL_FPS, NUM_ARKIT,
@@ -31,9 +32,11 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::answer;
-use crate::mocap_panel::{utf8, UploadQuery};
 use crate::safety::{extension_of, list_under_root, resolve_under_root, Folder};
-use crate::server::AppState;
+use crate::state::Shared;
+use crate::upload::{clean_name, utf8, UploadQuery};
+
+crate::state::panel_state!(AppState, face, FaceState);
 
 /// The layout the take was read in, which export writes back.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -153,10 +156,6 @@ pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body
         opened(&state, name, layout, clip)
     });
     Ok(Json(answer(&st.jobs, id).await))
-}
-
-fn clean_name(name: &str) -> String {
-    name.chars().filter(|c| !c.is_control() && *c != '/' && *c != '\\').take(200).collect()
 }
 
 /// A take from its bytes, by extension: `.json` curves; `.csv` Live Link when its header is, else curves.
@@ -617,4 +616,17 @@ pub async fn history(State(st): State<Arc<AppState>>, Json(req): Json<StepReques
     }
     let message = format!("{}: version {} of {}", req.step, s.current, s.versions.len() - 1);
     Ok(Json(shown(&st, s, &format!("face-{}", req.step), message)))
+}
+
+/// The panel's routes, nested under `/api/face` by the server.
+pub fn router(shared: Arc<Shared>) -> Router {
+    Router::new()
+        .route("/corpus", get(corpus))
+        .route("/open", post(open_path))
+        .route("/upload", post(upload))
+        .route("/guide", post(guide))
+        .route("/edit", post(edit))
+        .route("/history", post(history))
+        .route("/pick", post(pick))
+        .with_state(AppState::new(shared))
 }

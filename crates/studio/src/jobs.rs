@@ -11,6 +11,7 @@ use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use inbetween_core::cancel::Cancel;
+use inbetween_io::Progress;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -156,6 +157,18 @@ pub async fn answer(jobs: &Jobs, id: u64) -> Value {
 impl Jobs {
     pub fn get(&self, id: u64) -> Option<Arc<Job>> {
         self.jobs.lock().unwrap_or_else(|p| p.into_inner()).get(&id).cloned()
+    }
+
+    /// A progress handle for an engine job run inside job `id`: each update of the engine's
+    /// phases becomes a `progress` event, at the share of the job `share(stage, fraction of the
+    /// stage)` gives. Hidden (counting only) when the job is gone.
+    pub fn engine_progress(&self, id: u64, share: impl Fn(&str, f64) -> f64 + Send + Sync + 'static) -> Progress {
+        match self.get(id) {
+            Some(job) => Progress::observed(move |stage, pos, len| {
+                job.progress(stage, share(stage, pos as f64 / len.max(1) as f64));
+            }),
+            None => Progress::hidden(),
+        }
     }
 
     /// Starts `work` on a blocking thread as a job of `kind`; returns its id at once. `work`'s

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use axum::extract::State;
-use axum::Json;
+use axum::routing::{get, post};
+use axum::{Json, Router};
 use inbetween_script::animate::{camera_track, Animation};
 use inbetween_script::compose::ComposeConfig;
 use inbetween_script::job::{story_session, RunJob, SceneJob};
@@ -23,7 +24,9 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::{answer, Job};
-use crate::server::AppState;
+use crate::state::Shared;
+
+crate::state::panel_state!(AppState, script, ScriptState);
 
 /// The options a session was made with; a run with other options starts a new session.
 #[derive(Debug, Clone, PartialEq)]
@@ -257,4 +260,9 @@ fn summary_line(anim: &Animation, resolved: &[String], kept_objects: usize, full
         anim.frames(),
         anim.fps
     )
+}
+
+/// The panel's routes, nested under `/api/script` by the server.
+pub fn router(shared: Arc<Shared>) -> Router {
+    Router::new().route("/stories", get(stories)).route("/run", post(run)).with_state(AppState::new(shared))
 }

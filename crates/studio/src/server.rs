@@ -1,11 +1,10 @@
-//! Configuration, start/stop and routes of the studio server.
+//! Start/stop and routes of the studio server: its own routes (the page, info, result files,
+//! jobs), each panel's router nested under `/api/<panel>`, and the safety layers around them all.
 
-use std::collections::HashMap;
 use std::convert::Infallible;
 use std::future::IntoFuture;
-use std::net::{IpAddr, Ipv4Addr, SocketAddr};
-use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
+use std::net::SocketAddr;
+use std::sync::Arc;
 
 use axum::body::{Body, Bytes};
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, Query, Request, State};
@@ -19,107 +18,12 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
-use crate::jobs::Jobs;
+use crate::state::Shared;
+pub use crate::state::{StudioConfig, DEFAULT_MAX_UPLOAD};
 use crate::{assets, camera_panel, face_panel, mocap_panel, safety, script_panel, video_panel};
 
-/// Default `--max-upload`: 512 MB.
-pub const DEFAULT_MAX_UPLOAD: u64 = 512 * 1000 * 1000;
-
-/// What `inbetween studio` was asked for.
-#[derive(Debug, Clone)]
-pub struct StudioConfig {
-    /// TCP port; 0 picks a free one.
-    pub port: u16,
-    /// Address to listen on (default 127.0.0.1).
-    pub listen: IpAddr,
-    /// The only folder whose files the client may name (the corpus list comes from it).
-    pub root: Option<PathBuf>,
-    /// Largest request body in bytes.
-    pub max_upload: u64,
-    /// Adds `POST /api/test/panic`, a route that panics, to test that the server keeps serving.
-    #[doc(hidden)]
-    pub test_routes: bool,
-}
-
-impl Default for StudioConfig {
-    fn default() -> StudioConfig {
-        StudioConfig {
-            port: 7878,
-            listen: IpAddr::V4(Ipv4Addr::LOCALHOST),
-            root: None,
-            max_upload: DEFAULT_MAX_UPLOAD,
-            test_routes: false,
-        }
-    }
-}
-
-/// What makes a lazy artifact's bytes.
-type MakeBytes = Box<dyn FnOnce() -> Vec<u8> + Send>;
-
-/// A result file: its bytes, or the function that makes them on the first download (files only
-/// offered for download, such as a story's BVH and .gltf, cost nothing until asked for).
-pub struct Artifact {
-    content_type: String,
-    bytes: std::sync::OnceLock<Arc<Vec<u8>>>,
-    make: Mutex<Option<MakeBytes>>,
-}
-
-impl Artifact {
-    fn bytes(&self) -> Arc<Vec<u8>> {
-        self.bytes
-            .get_or_init(|| {
-                let make = self.make.lock().unwrap_or_else(|p| p.into_inner()).take();
-                Arc::new(make.map(|f| f()).unwrap_or_default())
-            })
-            .clone()
-    }
-}
-
-/// Artifacts of the latest jobs, served at `/api/files/{name}`.
-pub type Files = Mutex<HashMap<String, Arc<Artifact>>>;
-
-/// Shared state of the server.
-pub struct AppState {
-    pub config: StudioConfig,
-    pub bound: SocketAddr,
-    pub jobs: Jobs,
-    pub files: Files,
-    pub script: script_panel::ScriptState,
-    pub mocap: mocap_panel::MocapState,
-    pub face: face_panel::FaceState,
-    pub video: video_panel::VideoState,
-    pub camera: camera_panel::CameraState,
-}
-
-impl AppState {
-    /// Stores an artifact; returns its URL (with a version so the browser never caches an old one).
-    pub fn put_file(&self, name: &str, content_type: &str, bytes: Vec<u8>, version: u64) -> String {
-        let bytes = std::sync::OnceLock::from(Arc::new(bytes));
-        self.put(name, Artifact { content_type: content_type.to_string(), bytes, make: Mutex::new(None) }, version)
-    }
-
-    /// Stores an artifact made by `make` on its first download; returns its URL.
-    pub fn put_lazy(
-        &self,
-        name: &str,
-        content_type: &str,
-        make: impl FnOnce() -> Vec<u8> + Send + 'static,
-        version: u64,
-    ) -> String {
-        let make: MakeBytes = Box::new(make);
-        let a = Artifact {
-            content_type: content_type.to_string(),
-            bytes: std::sync::OnceLock::new(),
-            make: Mutex::new(Some(make)),
-        };
-        self.put(name, a, version)
-    }
-
-    fn put(&self, name: &str, artifact: Artifact, version: u64) -> String {
-        self.files.lock().unwrap_or_else(|p| p.into_inner()).insert(name.to_string(), Arc::new(artifact));
-        format!("/api/files/{name}?v={version}")
-    }
-}
+/// The server's own handlers' state: the shared parts (each panel has its own, [`crate::state::Panel`]).
+type AppState = Shared;
 
 /// Errors as JSON with their status code.
 impl IntoResponse for StudioError {
@@ -164,40 +68,21 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/api/files/{*name}", get(file))
         .route("/api/jobs/{id}/events", get(events))
         .route("/api/jobs/{id}/cancel", post(cancel))
-        .route("/api/jobs/{id}", get(job_status))
-        .route("/api/script/stories", get(script_panel::stories))
-        .route("/api/script/run", post(script_panel::run))
-        .route("/api/mocap/corpus", get(mocap_panel::corpus))
-        .route("/api/mocap/open", post(mocap_panel::open_path))
-        .route("/api/mocap/upload", post(mocap_panel::upload))
-        .route("/api/mocap/keys", post(mocap_panel::keys))
-        .route("/api/mocap/compress", post(mocap_panel::compress))
-        .route("/api/face/corpus", get(face_panel::corpus))
-        .route("/api/face/open", post(face_panel::open_path))
-        .route("/api/face/upload", post(face_panel::upload))
-        .route("/api/face/guide", post(face_panel::guide))
-        .route("/api/face/edit", post(face_panel::edit))
-        .route("/api/face/history", post(face_panel::history))
-        .route("/api/face/pick", post(face_panel::pick))
-        .route("/api/video/corpus", get(video_panel::corpus))
-        .route("/api/video/open", post(video_panel::open_path))
-        .route("/api/video/upload", post(video_panel::upload))
-        .route("/api/video/generate", post(video_panel::generate))
-        .route("/api/camera/open", post(camera_panel::open))
-        .route("/api/camera/upload", post(camera_panel::upload))
-        .route("/api/camera/reference", post(camera_panel::reference))
-        .route("/api/camera/key_at", post(camera_panel::key_at))
-        .route("/api/camera/toric", post(camera_panel::toric))
-        .route("/api/camera/pose", post(camera_panel::pose))
-        .route("/api/camera/generate", post(camera_panel::generate));
+        .route("/api/jobs/{id}", get(job_status));
     if state.config.test_routes {
         app = app.route("/api/test/panic", post(test_panic));
     }
+    let app = app
+        .with_state(state.clone())
+        .nest("/api/script", script_panel::router(state.clone()))
+        .nest("/api/mocap", mocap_panel::router(state.clone()))
+        .nest("/api/face", face_panel::router(state.clone()))
+        .nest("/api/video", video_panel::router(state.clone()))
+        .nest("/api/camera", camera_panel::router(state.clone()));
     app.layer(DefaultBodyLimit::max(max))
         .layer(tower_http::limit::RequestBodyLimitLayer::new(max))
         .layer(middleware::from_fn_with_state(state.clone(), guard))
         .layer(tower_http::catch_panic::CatchPanicLayer::custom(panic_response))
-        .with_state(state)
 }
 
 fn panic_response(err: Box<dyn std::any::Any + Send + 'static>) -> Response {
@@ -241,8 +126,7 @@ struct FileQuery {
 }
 
 async fn file(State(st): State<Arc<AppState>>, UrlPath(name): UrlPath<String>, q: Query<FileQuery>) -> Response {
-    let found = st.files.lock().unwrap_or_else(|p| p.into_inner()).get(&name).cloned();
-    let Some(artifact) = found else {
+    let Some(artifact) = st.file(&name) else {
         return StudioError::NotFound(format!("no result file '{name}' (run the job first)")).into_response();
     };
     let ct = artifact.content_type.clone();
@@ -359,17 +243,7 @@ impl Drop for Studio {
 }
 
 fn state(config: StudioConfig, bound: SocketAddr) -> Arc<AppState> {
-    Arc::new(AppState {
-        config,
-        bound,
-        jobs: Jobs::default(),
-        files: Files::default(),
-        script: script_panel::ScriptState::default(),
-        mocap: mocap_panel::MocapState::default(),
-        face: face_panel::FaceState::default(),
-        video: video_panel::VideoState::default(),
-        camera: camera_panel::CameraState::default(),
-    })
+    Arc::new(Shared::new(config, bound))
 }
 
 fn bind(rt: &tokio::runtime::Runtime, config: &StudioConfig) -> Result<tokio::net::TcpListener> {

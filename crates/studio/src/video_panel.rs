@@ -12,7 +12,8 @@ use std::sync::{Arc, Mutex};
 
 use axum::body::Bytes;
 use axum::extract::{Query, State};
-use axum::Json;
+use axum::routing::{get, post};
+use axum::{Json, Router};
 use image::{imageops, RgbImage};
 use inbetween_io::Progress;
 use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, ProceduralKind, ReadOptions};
@@ -23,9 +24,11 @@ use serde_json::{json, Value};
 
 use crate::error::{Result, StudioError};
 use crate::jobs::{answer, Job};
-use crate::mocap_panel::UploadQuery;
 use crate::safety::{extension_of, list_under_root, resolve_under_root, Folder};
-use crate::server::AppState;
+use crate::state::Shared;
+use crate::upload::UploadQuery;
+
+crate::state::panel_state!(AppState, video, VideoState);
 
 /// The open clip and its analysis.
 struct Opened {
@@ -135,7 +138,7 @@ fn decode(path: &Path, shown: &str) -> Result<Clip> {
 
 /// `POST /api/video/upload?name=…`: an MP4 or GIF's bytes; decodes and analyses.
 pub async fn upload(State(st): State<Arc<AppState>>, q: Query<UploadQuery>, body: Bytes) -> Result<Json<Value>> {
-    let name: String = q.name.chars().filter(|c| !c.is_control() && *c != '/' && *c != '\\').take(200).collect();
+    let name = q.name();
     let state = st.clone();
     let id = st.jobs.spawn("video-open", move |job| {
         job.progress("decoding", 0.05);
@@ -350,4 +353,14 @@ fn export(st: &AppState, o: &Arc<Opened>, order: &[usize], v: u64) -> (String, S
     }
     let gif = urls.pop().unwrap_or_default();
     (urls.pop().unwrap_or_default(), gif)
+}
+
+/// The panel's routes, nested under `/api/video` by the server.
+pub fn router(shared: Arc<Shared>) -> Router {
+    Router::new()
+        .route("/corpus", get(corpus))
+        .route("/open", post(open_path))
+        .route("/upload", post(upload))
+        .route("/generate", post(generate))
+        .with_state(AppState::new(shared))
 }

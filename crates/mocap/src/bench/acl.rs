@@ -5,11 +5,11 @@
 //! Beside it: seekable single-pose decoding in µs, general-purpose compressors (gzip, zstd, xz)
 //! on the BVH text and on the raw floats, and the rate–error curve as a PNG.
 
-use super::Clip;
-use crate::codec::alloc::{self, Format, Options};
-use crate::codec::{v3, v4};
+use crate::codec::alloc::{self, Options};
+use crate::codec::{v3, RAW_BYTES_PER_BONE};
+pub use crate::corpus::{takes, Take};
 use crate::{MocapError, Result};
-use inbetween_core::units::{LengthUnit, UnitChoice};
+use inbetween_core::units::LengthUnit;
 use inbetween_core::Motion;
 use inbetween_io::report::{num, seconds_per_call, Report, Table};
 use inbetween_io::Progress;
@@ -24,8 +24,6 @@ pub const ACL_RATIO: f64 = 21.77;
 pub const ACL_MAX_CM: f64 = 0.0495;
 pub const ACL_P99_CM: f64 = 0.0089;
 pub const ACL_COMPRESS_MB_S: f64 = 14.0;
-/// Raw bytes per bone per sample: quaternion, translation, scale as f32.
-pub const RAW_BYTES_PER_BONE: usize = 40;
 
 /// What the ACL-protocol bench runs.
 #[derive(Clone, Debug)]
@@ -63,36 +61,6 @@ impl Default for AclConfig {
             acl_build_dir: None,
         }
     }
-}
-
-/// One take at the protocol's rate.
-pub struct Take {
-    pub name: String,
-    pub source: &'static str,
-    pub motion: Motion,
-    pub unit: UnitChoice,
-}
-
-impl Take {
-    pub fn raw_bytes(&self) -> usize {
-        RAW_BYTES_PER_BONE * self.motion.skeleton.len() * self.motion.num_frames()
-    }
-}
-
-/// The takes of `clips` at `fps` (the cgspeed T-pose frame dropped).
-pub fn takes(clips: &[Clip], units: &[UnitChoice], fps: f64) -> Result<Vec<Take>> {
-    clips
-        .iter()
-        .zip(units)
-        .map(|(c, u)| {
-            let m = if c.source == "cgspeed" && c.motion.num_frames() > 2 {
-                c.motion.crop(1, c.motion.num_frames())?
-            } else {
-                c.motion.clone()
-            };
-            Ok(Take { name: c.name.clone(), source: c.source, motion: m.resample(fps)?, unit: u.clone() })
-        })
-        .collect()
 }
 
 /// A group of takes at one bound.
@@ -230,72 +198,6 @@ fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<Tak
         pose_s,
         playback_s,
     })
-}
-
-/// One take compressed in `format` at `bound_cm` (the format's default segment length), with
-/// its timings on this thread: what the race against ACL ([`super::acl_race`]) runs.
-pub struct FormatResult {
-    pub bytes: usize,
-    pub errors: Vec<f64>,
-    pub compress_s: f64,
-    /// Seconds per pose at a random time and per playback pose (best of 5 rounds).
-    pub pose_s: f64,
-    pub playback_s: f64,
-}
-
-/// Best of `rounds` timings of `f`, seconds.
-fn best_of(rounds: usize, mut f: impl FnMut()) -> f64 {
-    f();
-    (0..rounds)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
-pub fn run_format(t: &Take, bound_cm: f64, format: Format, seek_poses: usize, seed: u64) -> Result<FormatResult> {
-    let opts = Options::with_format(bound_cm, format);
-    let start = Instant::now();
-    let c = alloc::compress_in(&t.motion, t.unit.clone(), &opts)?;
-    let compress_s = start.elapsed().as_secs_f64();
-    let mut rng =
-        rand_chacha::ChaCha8Rng::seed_from_u64(inbetween_core::seed::derive(seed, t.motion.num_frames() as u64));
-    let duration = (t.motion.num_frames() - 1) as f64 * t.motion.frame_time;
-    let times: Vec<f64> = (0..seek_poses.max(1)).map(|_| rng.random::<f64>() * duration).collect();
-    let ticks: Vec<f64> = (0..).map(|k| k as f64 / 60.0).take_while(|&t| t <= duration).collect();
-    let (pose_s, playback_s) = match format {
-        Format::V3 => {
-            let file = v3::File::open(&c.bytes)?;
-            let (mut pose, mut sc) = (inbetween_core::Pose::rest(&t.motion.skeleton), v3::Scratch::default());
-            let mut timed = |ts: &[f64]| {
-                best_of(5, || {
-                    for &time in ts {
-                        file.pose_at(time, &mut pose, &mut sc).expect("a valid file seeks");
-                    }
-                    std::hint::black_box(&pose);
-                }) / ts.len() as f64
-            };
-            (timed(&times), timed(&ticks))
-        }
-        Format::V4 => {
-            let clip = v4::Clip::open(&c.bytes).map_err(|e| MocapError::Codec(e.to_string()))?;
-            let mut ctx = v4::Context::new(&clip);
-            let n = clip.num_joints();
-            let (mut rot, mut tr) = (vec![[0f32; 4]; n], vec![[0f32; 3]; n]);
-            let mut timed = |ts: &[f64]| {
-                best_of(5, || {
-                    for &time in ts {
-                        clip.sample(&mut ctx, time, &mut rot, &mut tr).expect("buffers fit");
-                    }
-                    std::hint::black_box((&rot, &tr));
-                }) / ts.len() as f64
-            };
-            (timed(&times), timed(&ticks))
-        }
-    };
-    Ok(FormatResult { bytes: c.bytes.len(), errors: c.errors_cm, compress_s, pose_s, playback_s })
 }
 
 /// Runs the protocol: every group at every bound (timings single-threaded, so MB/s is per core).

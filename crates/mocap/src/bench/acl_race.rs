@@ -8,15 +8,18 @@
 //! ([`crate::codec::alloc::vertex_errors`]), beside our version 3 and version 4 files of the same
 //! takes. Without them the table holds our rows and the report says `skipped: ACL not built`.
 
-use super::acl::{Take, RAW_BYTES_PER_BONE};
-use crate::codec::alloc::{self, Format};
+use crate::codec::alloc::{self, Format, Options};
+use crate::codec::{v3, v4, RAW_BYTES_PER_BONE};
+use crate::corpus::Take;
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::{Motion, Pose};
 use inbetween_io::report::{num, Table};
+use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Instant;
 
 /// Where the ACL race's sources are looked for: `$INBETWEEN_ACL_RACE`, else `peers/acl-race`
 /// beside the data folder (`../shared/peers/acl-race` from the repository).
@@ -252,7 +255,7 @@ pub fn race(
             let mut errors = Vec::new();
             let (mut bytes, mut secs, mut pose, mut play) = (0, 0.0, 0.0, 0.0);
             for t in takes {
-                let r = super::acl::run_format(t, b, format, seek_poses, seed)?;
+                let r = run_format(t, b, format, seek_poses, seed)?;
                 bytes += r.bytes;
                 secs += r.compress_s;
                 pose += r.pose_s;
@@ -313,4 +316,70 @@ pub fn table(group: &str, rows: &[RaceRow], acl_note: &str) -> Table {
     t.note("speeds on one core: compress MB/s of raw (ACL: its own compression_time); random pose: two samples interpolated, context made once (ACL: acl_decode's best of 5 rounds of 2000 poses; ours: the same count, best of 3 rounds); playback: every 1/60 s from the start with one context (acl_decode does not time playback)".to_string());
     t.note(acl_note.to_string());
     t
+}
+
+/// One take compressed in `format` at `bound_cm` (the format's default segment length), with
+/// its timings on this thread: what the race against ACL runs.
+pub struct FormatResult {
+    pub bytes: usize,
+    pub errors: Vec<f64>,
+    pub compress_s: f64,
+    /// Seconds per pose at a random time and per playback pose (best of 5 rounds).
+    pub pose_s: f64,
+    pub playback_s: f64,
+}
+
+/// Best of `rounds` timings of `f`, seconds.
+fn best_of(rounds: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    (0..rounds)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+pub fn run_format(t: &Take, bound_cm: f64, format: Format, seek_poses: usize, seed: u64) -> Result<FormatResult> {
+    let opts = Options::with_format(bound_cm, format);
+    let start = Instant::now();
+    let c = alloc::compress_in(&t.motion, t.unit.clone(), &opts)?;
+    let compress_s = start.elapsed().as_secs_f64();
+    let mut rng =
+        rand_chacha::ChaCha8Rng::seed_from_u64(inbetween_core::seed::derive(seed, t.motion.num_frames() as u64));
+    let duration = (t.motion.num_frames() - 1) as f64 * t.motion.frame_time;
+    let times: Vec<f64> = (0..seek_poses.max(1)).map(|_| rng.random::<f64>() * duration).collect();
+    let ticks: Vec<f64> = (0..).map(|k| k as f64 / 60.0).take_while(|&t| t <= duration).collect();
+    let (pose_s, playback_s) = match format {
+        Format::V3 => {
+            let file = v3::File::open(&c.bytes)?;
+            let (mut pose, mut sc) = (inbetween_core::Pose::rest(&t.motion.skeleton), v3::Scratch::default());
+            let mut timed = |ts: &[f64]| {
+                best_of(5, || {
+                    for &time in ts {
+                        file.pose_at(time, &mut pose, &mut sc).expect("a valid file seeks");
+                    }
+                    std::hint::black_box(&pose);
+                }) / ts.len() as f64
+            };
+            (timed(&times), timed(&ticks))
+        }
+        Format::V4 => {
+            let clip = v4::Clip::open(&c.bytes).map_err(|e| MocapError::Codec(e.to_string()))?;
+            let mut ctx = v4::Context::new(&clip);
+            let n = clip.num_joints();
+            let (mut rot, mut tr) = (vec![[0f32; 4]; n], vec![[0f32; 3]; n]);
+            let mut timed = |ts: &[f64]| {
+                best_of(5, || {
+                    for &time in ts {
+                        clip.sample(&mut ctx, time, &mut rot, &mut tr).expect("buffers fit");
+                    }
+                    std::hint::black_box((&rot, &tr));
+                }) / ts.len() as f64
+            };
+            (timed(&times), timed(&ticks))
+        }
+    };
+    Ok(FormatResult { bytes: c.bytes.len(), errors: c.errors_cm, compress_s, pose_s, playback_s })
 }

@@ -18,7 +18,7 @@ use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_io::report::Report;
 use inbetween_io::Progress;
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Which SIDQL policy the bench scores.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,16 +119,8 @@ pub fn run(cfg: &BenchConfig, progress: &Progress) -> Result<BenchOutput> {
     Ok(BenchOutput { results, report, written })
 }
 
-/// The data folder: `data`, else the shared corpus.
-pub fn data_dir(data: Option<&Path>) -> Result<PathBuf> {
-    match data {
-        Some(d) => Ok(d.to_path_buf()),
-        None => inbetween_io::data::shared_data_dir()
-            .map_err(|p| MocapError::Invalid(format!("no data at {} (give `data`)", p.display()))),
-    }
-}
-
-pub use crate::corpus::{training_set, TrainingData};
+pub use crate::corpus::data_dir;
+pub use crate::protocol::{training_set, TrainingData};
 
 /// Deals the takes that have windows into `folds` groups: sorted, shuffled with `seed`, dealt in
 /// turn.

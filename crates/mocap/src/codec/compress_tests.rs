@@ -82,3 +82,25 @@ fn lengths_parse_with_units() {
     let e = parse_length_cm("1e9").unwrap_err().to_string();
     assert!(e.contains("'1e9' has no length unit") && e.contains("1e9cm"), "{e}");
 }
+
+#[test]
+fn decompress_job_rebuilds_every_frame_and_counts_what_the_file_stores() {
+    use crate::codec::job::{CompressJob, DecompressJob};
+    use inbetween_core::cancel::Cancel;
+    use inbetween_io::Progress;
+    let m = inbetween_core::procedural::gait(&inbetween_core::procedural::GaitParams {
+        frames: 40,
+        ..inbetween_core::procedural::GaitParams::walk()
+    });
+    let unit = inbetween_core::units::LengthUnit::infer(&m.skeleton);
+    for (budget, stored) in [(Budget::Keys(6), 6), (Budget::MaxErrorCm(1.0), 40)] {
+        let job = CompressJob { budget, version: None, segment_len: None, max_gap: 15, unit: unit.clone() };
+        let bytes = job.run(&m).unwrap().bytes().to_vec();
+        let r = DecompressJob.run(&bytes, &Cancel::new(), &Progress::hidden()).unwrap();
+        assert_eq!((r.stored_poses, r.frames, r.joints), (stored, 40, m.skeleton.len()), "{budget:?}");
+        assert_eq!(r.motion.num_frames(), 40);
+        assert!(r.to_string().contains("→ 40 frames at 30.0 fps"), "{r}");
+    }
+    let err = DecompressJob.run(b"not an ibk file", &Cancel::new(), &Progress::hidden()).unwrap_err();
+    assert!(!err.to_string().is_empty());
+}

@@ -1,13 +1,16 @@
-//! `CompressJob`: compress one clip into an `.ibk` file (ozz's job shape: inputs, `validate`, then
-//! `run`), choosing the file version from the budget and returning a report that prints itself.
-//! The command line only parses flags into the job.
+//! The codec's jobs (ozz's job shape: inputs, `validate`, then `run`, and a report that prints
+//! itself): [`CompressJob`] compresses one clip into an `.ibk` file, choosing the file version
+//! from the budget; [`DecompressJob`] rebuilds the clip of any `.ibk` file. The command line, the
+//! studio and Python only parse their inputs into a job.
 
 use super::alloc::{self, Format};
-use super::{Budget, Compressed};
-use crate::bench::acl::RAW_BYTES_PER_BONE;
+use super::{Budget, Compressed, IbkFile, RAW_BYTES_PER_BONE};
 use crate::{MocapError, Result};
-use inbetween_core::units::UnitChoice;
+use inbetween_core::cancel::Cancel;
+use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::Motion;
+use inbetween_io::Progress;
+use serde::Serialize;
 use std::fmt;
 
 /// Which file version a job writes.
@@ -146,5 +149,74 @@ impl fmt::Display for CompressReport {
                 )
             }
         }
+    }
+}
+
+/// Rebuild the whole clip of an `.ibk` file (any version this build reads).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DecompressJob;
+
+/// The decoded file and its clip.
+#[derive(Clone, Debug, Serialize)]
+pub struct DecompressReport {
+    /// What the file holds, in words.
+    pub description: String,
+    /// The `.ibk` version (1 to 4).
+    pub version: u16,
+    /// Poses the file stores: its keys (versions 1 and 2) or every frame (3 and 4).
+    pub stored_poses: usize,
+    pub frames: usize,
+    pub joints: usize,
+    pub fps: f64,
+    /// The length unit inferred from the skeleton (the file keeps the source's unit).
+    pub unit: String,
+    pub cm_per_unit: f64,
+    #[serde(skip)]
+    pub unit_choice: UnitChoice,
+    /// The rebuilt clip.
+    #[serde(skip)]
+    pub motion: Motion,
+    /// The decoded file.
+    #[serde(skip)]
+    pub file: IbkFile,
+}
+
+impl DecompressJob {
+    /// Checks the file's envelope (magic, version, checksum) before any work.
+    pub fn validate(&self, bytes: &[u8]) -> Result<()> {
+        super::check_envelope(bytes, super::OLDEST_VERSION, super::v4::VERSION).map(|_| ())
+    }
+
+    /// Decodes `bytes` and rebuilds every frame.
+    pub fn run(&self, bytes: &[u8], cancel: &Cancel, progress: &Progress) -> Result<DecompressReport> {
+        self.validate(bytes)?;
+        progress.phase(2, "decoding");
+        let file = super::read(bytes)?;
+        let version = super::check_envelope(bytes, super::OLDEST_VERSION, super::v4::VERSION)?.0;
+        cancel.check()?;
+        progress.inc(1);
+        let motion = file.motion()?;
+        progress.inc(1);
+        let unit_choice = LengthUnit::infer(file.skeleton());
+        Ok(DecompressReport {
+            description: file.describe(),
+            version,
+            stored_poses: file.stored_poses(),
+            frames: motion.num_frames(),
+            joints: motion.skeleton.len(),
+            fps: motion.fps(),
+            unit: unit_choice.unit.describe(),
+            cm_per_unit: unit_choice.cm_per_unit(),
+            unit_choice,
+            motion,
+            file,
+        })
+    }
+}
+
+impl fmt::Display for DecompressReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "{} (the file keeps the source's unit)", self.unit_choice)?;
+        write!(f, "{} → {} frames at {:.1} fps", self.description, self.frames, self.fps)
     }
 }

@@ -30,6 +30,8 @@ pub mod job;
 pub mod v3;
 pub mod v4;
 
+pub use job::{CompressJob, CompressReport, DecompressJob, DecompressReport, Version};
+
 use crate::rotations::{reconstruct_from_keys, KeyPose, RotationMotion};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
@@ -535,6 +537,15 @@ impl IbkFile {
         }
     }
 
+    /// The poses the file stores: its keys (versions 1 and 2) or every frame (versions 3 and 4).
+    pub fn stored_poses(&self) -> usize {
+        match self {
+            IbkFile::Keys(d) => d.key_frames.len(),
+            IbkFile::Samples(q) => q.header.num_frames,
+            IbkFile::Runtime(r) => r.poses.len(),
+        }
+    }
+
     /// What the file holds, in words (for the command line).
     pub fn describe(&self) -> String {
         match self {
@@ -638,6 +649,9 @@ fn read_key_frames(r: &mut Reader, num_keys: usize, num_frames: usize) -> Result
     }
     Ok(key_frames)
 }
+
+/// Raw bytes per bone per sample: quaternion, translation, scale as f32 (ACL's raw size).
+pub const RAW_BYTES_PER_BONE: usize = 40;
 
 /// Raw size of a clip as f32 channel values (the comparison baseline).
 pub fn raw_bytes(motion: &Motion) -> usize {

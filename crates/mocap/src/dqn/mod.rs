@@ -10,6 +10,6 @@ pub mod replay;
 pub mod train;
 
 pub use model::{DqnConfig, QNet, QRuntime};
-pub use options::TrainOptions;
+pub use options::{TrainOptions, DEFAULT_POLICY_PATH};
 pub use policy::{Finish, PolicyInfo, SidqlPolicy};
 pub use train::{train, TrainReport, Trained};

@@ -105,4 +105,17 @@ impl TrainOptions {
     pub fn quick() -> TrainOptions {
         TrainOptions { pretrain_steps: 600, episodes: 40, ..TrainOptions::default() }
     }
+
+    /// A preset by name: `default`, `paper` or `quick` (None for any other name).
+    pub fn preset(name: &str) -> Option<TrainOptions> {
+        match name {
+            "default" => Some(TrainOptions::default()),
+            "quick" => Some(TrainOptions::quick()),
+            "paper" => Some(TrainOptions::paper()),
+            _ => None,
+        }
+    }
 }
+
+/// Where `mocap train` and a bench that trains write the policy by default.
+pub const DEFAULT_POLICY_PATH: &str = "out/sidql_cmu.bpk";

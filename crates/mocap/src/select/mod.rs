@@ -11,11 +11,15 @@
 //!   left (SIDQL's pretraining targets).
 //! - [`refine`](mod@refine): moves each key of a set to the best frame between its neighbours until none
 //!   moves (beyond the paper); SIDQL finishes its keys with it.
-//! - [`error_bounded`]: the fewest keys keeping every frame's error under a bound, also exact.
+//! - [`error_bounded`](mod@error_bounded): the fewest keys keeping every frame's error under a bound, also exact.
 //! - [`sidql`](mod@sidql): the paper's deep Q-network policy (§4).
+//!
+//! [`job::SelectJob`] runs any of them (but the random baseline) on a clip, as the front ends do.
 
 pub mod cost_to_go;
+pub mod error_bounded;
 pub mod greedy;
+pub mod job;
 pub mod optimal;
 pub mod random;
 pub mod refine;
@@ -23,10 +27,9 @@ pub mod sidql;
 pub mod uniform;
 
 pub use cost_to_go::{angle_segment_costs, completion_values, cost_to_go};
+pub use error_bounded::error_bounded;
 pub use greedy::{greedy, greedy_cancellable, GreedyOrder};
-pub use optimal::{
-    error_bounded, optimal, optimal_spherical, optimal_spherical_cancellable, optimal_spherical_memo, OptimalMemo,
-};
+pub use optimal::{optimal, optimal_spherical, optimal_spherical_cancellable, optimal_spherical_memo, OptimalMemo};
 pub use random::random;
 pub use refine::refine_keys;
 pub use uniform::uniform;
