@@ -275,16 +275,11 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let channels = a.groups.as_deref().map(parse_groups).transpose().map_err(anyhow::Error::msg)?;
     let guide = guide_of(&a, &clip, &spans)?;
     let speech = SPEECH_GROUPS.map(|g| g.name()).join(", ");
-    if guide.kind() == ConstraintKind::Visemes {
-        match &a.groups {
-            Some(g) => {
-                eprintln!("note: --groups {g}: the visemes guide these groups (default: {speech}; the rest unguided)")
-            }
-            None => {
-                eprintln!("note: the visemes guide {speech}; eyes and brows are filled unguided (--groups overrides)")
-            }
-        }
-    }
+    // Said once the edit is written (an error stays the only line of a failed run).
+    let groups_note = (guide.kind() == ConstraintKind::Visemes).then(|| match &a.groups {
+        Some(g) => format!("note: --groups {g}: the visemes guide these groups (default: {speech}; the rest unguided)"),
+        None => format!("note: the visemes guide {speech}; eyes and brows are filled unguided (--groups overrides)"),
+    });
     let chosen = a.method.choice().resolve(guide.kind(), a.weights.is_some());
     let net = match chosen {
         MethodChoice::Network => Some(match &a.weights {
@@ -355,6 +350,9 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         }
     }
     set.commit().context("moving the edit's outputs into place")?;
+    if let Some(note) = groups_note {
+        println!("{note}");
+    }
     if !spreads.is_empty() {
         let list: Vec<String> = spreads.iter().map(|d| format!("{d:.4}")).collect();
         println!(
