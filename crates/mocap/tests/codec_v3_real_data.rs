@@ -2,7 +2,7 @@
 
 use inbetween_io::data::with_shared_data;
 use inbetween_mocap::bench::acl::{takes, AclConfig};
-use inbetween_mocap::codec::alloc::{compress_in, vertex_errors, Options};
+use inbetween_mocap::codec::v3_encode::{compress_in, vertex_errors, Options};
 use inbetween_mocap::codec::{read, v3};
 
 #[test]

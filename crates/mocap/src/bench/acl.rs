@@ -5,7 +5,7 @@
 //! Beside it: seekable single-pose decoding in µs, general-purpose compressors (gzip, zstd, xz)
 //! on the BVH text and on the raw floats, and the rate–error curve as a PNG.
 
-use crate::codec::alloc::{self, Options};
+use crate::codec::v3_encode::{self, Options};
 use crate::codec::{v3, RAW_BYTES_PER_BONE};
 pub use crate::corpus::{takes, Take};
 use crate::{MocapError, Result};
@@ -156,7 +156,7 @@ struct TakeResult {
 fn run_take(t: &Take, bound_cm: f64, cfg: &AclConfig, timed: bool) -> Result<TakeResult> {
     let opts = Options { segment_len: cfg.segment_len, ..Options::bound(bound_cm) };
     let start = Instant::now();
-    let c = alloc::compress_in(&t.motion, t.unit.clone(), &opts)?;
+    let c = v3_encode::compress_in(&t.motion, t.unit.clone(), &opts)?;
     let compress_s = start.elapsed().as_secs_f64();
     let errors = c.errors_cm.clone();
     let (mut decompress_s, mut pose_s, mut playback_s) = (0.0, 0.0, 0.0);
@@ -249,7 +249,7 @@ pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
                 raw_bytes: raw,
                 bytes: rs.iter().map(|r| r.bytes).sum(),
                 max_error_cm: rs.iter().map(|r| r.errors_max).fold(0.0, f64::max),
-                p99_error_cm: alloc::percentile(&mut errors, 0.99),
+                p99_error_cm: v3_encode::percentile(&mut errors, 0.99),
                 compress_mb_s: mb / secs(|r| r.compress_s).max(1e-12),
                 decompress_mb_s: if timed { mb / secs(|r| r.decompress_s).max(1e-12) } else { f64::NAN },
                 pose_us: if timed { seeks * 1e6 } else { f64::NAN },

@@ -5,10 +5,10 @@
 //! text (`.acl.sjson` version 5: local quaternions and translations in cm, bind translation =
 //! the skeleton offset, 3 cm virtual vertices), compresses it with ACL at the same bounds as ours,
 //! decodes every sample with ACL and scores ACL's output with **our** error metric
-//! ([`crate::codec::alloc::vertex_errors`]), beside our version 3 and version 4 files of the same
+//! ([`crate::codec::v3_encode::vertex_errors`]), beside our version 3 and version 4 files of the same
 //! takes. Without them the table holds our rows and the report says `skipped: ACL not built`.
 
-use crate::codec::alloc::{self, Format, Options};
+use crate::codec::v3_encode::{self, Format, Options};
 use crate::codec::{v3, v4, RAW_BYTES_PER_BONE};
 use crate::corpus::Take;
 use crate::{MocapError, Result};
@@ -155,7 +155,7 @@ fn run_acl(bin: &Path, work: &Path, t: &Take, bound_cm: f64) -> Result<AclTake> 
         work.join(format!("{stem}.stats.sjson")),
         work.join(format!("{stem}.f32")),
     );
-    std::fs::write(&src, acl_sjson(t, bound_cm, alloc::SHELL_CM)).map_err(|e| io(e, &src))?;
+    std::fs::write(&src, acl_sjson(t, bound_cm, v3_encode::SHELL_CM)).map_err(|e| io(e, &src))?;
     let o = Command::new(bin.join("acl_compressor"))
         .arg(format!("-acl={}", src.display()))
         .arg(format!("-out={}", out.display()))
@@ -215,7 +215,8 @@ fn run_acl(bin: &Path, work: &Path, t: &Take, bound_cm: f64) -> Result<AclTake> 
         })
         .collect();
     let decoded = Motion::from_poses(m.skeleton.clone(), m.frame_time, &poses)?;
-    let errors: Vec<f64> = alloc::vertex_errors(m, &decoded, cm, alloc::SHELL_CM).into_iter().map(|e| e * cm).collect();
+    let errors: Vec<f64> =
+        v3_encode::vertex_errors(m, &decoded, cm, v3_encode::SHELL_CM).into_iter().map(|e| e * cm).collect();
     Ok(AclTake { bytes, errors, compress_s, pose_us })
 }
 
@@ -245,7 +246,7 @@ pub fn race(
                 raw_bytes: raw,
                 bytes: rs.iter().map(|r| r.bytes).sum(),
                 max_cm: errors.iter().copied().fold(0.0, f64::max),
-                p99_cm: alloc::percentile(&mut errors, 0.99),
+                p99_cm: v3_encode::percentile(&mut errors, 0.99),
                 compress_mb_s: mb / rs.iter().map(|r| r.compress_s).sum::<f64>(),
                 pose_us: rs.iter().map(|r| r.pose_us).sum::<f64>() / rs.len() as f64,
                 playback_us: f64::NAN,
@@ -269,7 +270,7 @@ pub fn race(
                 raw_bytes: raw,
                 bytes,
                 max_cm: errors.iter().copied().fold(0.0, f64::max),
-                p99_cm: alloc::percentile(&mut errors, 0.99),
+                p99_cm: v3_encode::percentile(&mut errors, 0.99),
                 compress_mb_s: mb / secs,
                 pose_us: pose / n * 1e6,
                 playback_us: play / n * 1e6,
@@ -344,7 +345,7 @@ fn best_of(rounds: usize, mut f: impl FnMut()) -> f64 {
 pub fn run_format(t: &Take, bound_cm: f64, format: Format, seek_poses: usize, seed: u64) -> Result<FormatResult> {
     let opts = Options::with_format(bound_cm, format);
     let start = Instant::now();
-    let c = alloc::compress_in(&t.motion, t.unit.clone(), &opts)?;
+    let c = v3_encode::compress_in(&t.motion, t.unit.clone(), &opts)?;
     let compress_s = start.elapsed().as_secs_f64();
     let mut rng =
         rand_chacha::ChaCha8Rng::seed_from_u64(inbetween_core::seed::derive(seed, t.motion.num_frames() as u64));

@@ -3,7 +3,7 @@
 //! from the budget; [`DecompressJob`] rebuilds the clip of any `.ibk` file. The command line, the
 //! studio and Python only parse their inputs into a job.
 
-use super::alloc::{self, Format};
+use super::v3_encode::{self, Format};
 use super::{Budget, Compressed, IbkFile, RAW_BYTES_PER_BONE};
 use crate::{MocapError, Result};
 use inbetween_core::cancel::Cancel;
@@ -51,7 +51,7 @@ pub struct CompressJob {
 #[derive(Clone, Debug)]
 pub enum CompressReport {
     Keys { frames: usize, joints: usize, raw_bytes: usize, bytes_per_key: usize, compressed: Compressed },
-    Sampled { frames: usize, joints: usize, raw_bytes: usize, version: u16, compressed: alloc::Compressed },
+    Sampled { frames: usize, joints: usize, raw_bytes: usize, version: u16, compressed: v3_encode::Compressed },
 }
 
 impl CompressReport {
@@ -95,11 +95,11 @@ impl CompressJob {
         let raw_bytes = super::raw_bytes(motion);
         match (self.version(), &self.budget) {
             (Version::Sampled(format), Budget::MaxErrorCm(cm)) => {
-                let opts = alloc::Options {
+                let opts = v3_encode::Options {
                     segment_len: self.segment_len.unwrap_or(format.default_segment_len()),
-                    ..alloc::Options::with_format(*cm, format)
+                    ..v3_encode::Options::with_format(*cm, format)
                 };
-                let compressed = alloc::compress_in(motion, self.unit.clone(), &opts)?;
+                let compressed = v3_encode::compress_in(motion, self.unit.clone(), &opts)?;
                 Ok(CompressReport::Sampled { frames, joints, raw_bytes, version: format.version(), compressed })
             }
             (_, budget) => {

@@ -24,10 +24,10 @@
 //! known before keys are chosen ([`quantised_model`]): [`compress`] chooses keys against exactly
 //! what the decoder rebuilds, and its error bound holds for the decoded file.
 
-pub mod alloc;
 mod bits;
 pub mod job;
 pub mod v3;
+pub mod v3_encode;
 pub mod v4;
 
 pub use job::{CompressJob, CompressReport, DecompressJob, DecompressReport, Version};

@@ -26,7 +26,7 @@
 //!      (mode 2; its second frame uses the first-order residual)
 //! ```
 //! A value decodes to `q × step` exactly as the encoder computed it, so the encoder's error check
-//! ([`super::alloc`]) is the error of the decoded file. Rotation vectors become quaternions by the
+//! ([`super::v3_encode`]) is the error of the decoded file. Rotation vectors become quaternions by the
 //! exponential map; joints without rotation channels keep the identity, joints without position
 //! channels their skeleton offset.
 

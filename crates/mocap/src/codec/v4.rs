@@ -7,7 +7,7 @@
 //! it and turns files back into clips.
 //!
 //! Values decode in f32 (`base + u × scale`, rotation vectors through the polynomial
-//! [`inbetween_ibk::exp_map`]); the encoder ([`super::alloc`] with [`super::alloc::Format::V4`])
+//! [`inbetween_ibk::exp_map`]); the encoder ([`super::v3_encode`] with [`super::v3_encode::Format::V4`])
 //! searches its steps on exactly those values, so the bound holds for what the runtime returns
 //! (rotations normalised in f64 before the error is measured; the runtime's f32 quaternions are
 //! unit to within about 1e-7).
@@ -270,7 +270,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::codec::alloc::{compress, Format, Options};
+    use crate::codec::v3_encode::{compress, Format, Options};
     use inbetween_core::procedural::{gait, GaitParams};
     use rand::{Rng, SeedableRng};
 
