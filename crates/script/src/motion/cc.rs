@@ -9,34 +9,8 @@ use super::rig::{local_from_global, Rig, FPS};
 use glam::{DMat3, DQuat, DVec3};
 use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
+use inbetween_core::roles::{correspondence, find_motion_roles, RoleOverrides};
 use inbetween_core::{Motion, Pose, Skeleton};
-
-/// Standard joint ← Character Creator joint.
-pub const CC_MAP: &[(&str, &str)] = &[
-    ("Hips", "CC_Base_Hip"),
-    ("LeftUpLeg", "CC_Base_L_Thigh"),
-    ("LeftLeg", "CC_Base_L_Calf"),
-    ("LeftFoot", "CC_Base_L_Foot"),
-    ("LeftToeBase", "CC_Base_L_ToeBase"),
-    ("RightUpLeg", "CC_Base_R_Thigh"),
-    ("RightLeg", "CC_Base_R_Calf"),
-    ("RightFoot", "CC_Base_R_Foot"),
-    ("RightToeBase", "CC_Base_R_ToeBase"),
-    ("LowerBack", "CC_Base_Waist"),
-    ("Spine", "CC_Base_Spine01"),
-    ("Spine1", "CC_Base_Spine02"),
-    ("Neck", "CC_Base_NeckTwist01"),
-    ("Neck1", "CC_Base_NeckTwist02"),
-    ("Head", "CC_Base_Head"),
-    ("LeftShoulder", "CC_Base_L_Clavicle"),
-    ("LeftArm", "CC_Base_L_Upperarm"),
-    ("LeftForeArm", "CC_Base_L_Forearm"),
-    ("LeftHand", "CC_Base_L_Hand"),
-    ("RightShoulder", "CC_Base_R_Clavicle"),
-    ("RightArm", "CC_Base_R_Upperarm"),
-    ("RightForeArm", "CC_Base_R_Forearm"),
-    ("RightHand", "CC_Base_R_Hand"),
-];
 
 /// Rest-pose global positions (identity rotations).
 fn rest_positions(s: &Skeleton) -> Vec<DVec3> {
@@ -60,11 +34,12 @@ fn frame(a: DVec3, b: DVec3) -> Option<DMat3> {
 pub fn retarget_cc(src: &Motion, rig: &Rig, up_z: bool, drop_first: bool) -> Result<Clip, String> {
     let s = &src.skeleton;
     let t = &rig.skeleton;
-    let map: Vec<Option<usize>> =
-        t.joints().iter().map(|j| CC_MAP.iter().find(|(a, _)| *a == j.name).and_then(|(_, b)| s.find(b))).collect();
-    for (a, b) in CC_MAP {
-        if map[t.find(a).expect("standard joint")].is_none() {
-            return Err(format!("no joint {b} for {a}: not a Character Creator rig"));
+    // Roles, spine and neck chains; fingers and hip links are left to follow their parents.
+    let roles = find_motion_roles(src, &RoleOverrides::default()).map_err(|e| e.to_string())?;
+    let map = correspondence((t, &rig.roles), (s, &roles), false);
+    for (role, a) in &rig.roles.roles {
+        if map[a.joint].is_none() {
+            return Err(format!("no joint plays the {role} of the common rig's {}", a.name));
         }
     }
     let (rt, rs) = (rest_positions(t), rest_positions(s));

@@ -8,6 +8,7 @@ use crate::ScriptError;
 use glam::{DQuat, DVec3};
 use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
+use inbetween_core::roles::{correspondence, find_motion_roles, Role, RoleOverrides, Roles, Scheme, Side};
 use inbetween_core::{Motion, Pose, Skeleton};
 use std::path::Path;
 
@@ -75,46 +76,6 @@ pub fn read_index(path: &Path) -> Result<Vec<CmuTrial>, ScriptError> {
     Ok(out)
 }
 
-/// Standard joint name of a cgspeed joint: the MotionBuilder-style files use the standard names
-/// (fingers aside), the 3ds Max-friendly release (subjects 131–140) its own.
-fn standard_name(name: &str, max_style: bool) -> String {
-    let max_map: &[(&str, &str)] = &[
-        ("LeftHip", "LeftUpLeg"),
-        ("LeftKnee", "LeftLeg"),
-        ("LeftAnkle", "LeftFoot"),
-        ("LeftToe", "LeftToeBase"),
-        ("RightHip", "RightUpLeg"),
-        ("RightKnee", "RightLeg"),
-        ("RightAnkle", "RightFoot"),
-        ("RightToe", "RightToeBase"),
-        ("lowerback", "LowerBack"),
-        ("Chest", "Spine"),
-        ("Chest2", "Spine1"),
-        ("lowerneck", "Neck"),
-        ("Neck", "Neck1"),
-        ("LeftCollar", "LeftShoulder"),
-        ("LeftShoulder", "LeftArm"),
-        ("LeftElbow", "LeftForeArm"),
-        ("LeftWrist", "LeftHand"),
-        ("lhand", "LeftFingerBase"),
-        ("RightCollar", "RightShoulder"),
-        ("RightShoulder", "RightArm"),
-        ("RightElbow", "RightForeArm"),
-        ("RightWrist", "RightHand"),
-        ("rhand", "RightFingerBase"),
-    ];
-    if max_style {
-        if let Some((_, s)) = max_map.iter().find(|(m, _)| *m == name) {
-            return s.to_string();
-        }
-    }
-    match name {
-        "LFingers" => "LeftHandIndex1".into(),
-        "RFingers" => "RightHandIndex1".into(),
-        n => n.to_string(),
-    }
-}
-
 /// Rest direction of the bone a joint drives: its only child's offset (skipping zero-length
 /// links) or its end site; None for branching joints.
 fn bone_dir(s: &Skeleton, j: usize) -> Option<DVec3> {
@@ -135,32 +96,28 @@ fn bone_dir(s: &Skeleton, j: usize) -> Option<DVec3> {
     }
 }
 
-fn leg_length(s: &Skeleton, up: &str, leg: &str, foot: &str) -> Option<f64> {
-    let (_, l, f) = (s.find(up)?, s.find(leg)?, s.find(foot)?);
-    Some(s.joint(l).offset.length() + s.joint(f).offset.length())
+/// Thigh-to-knee plus knee-to-ankle length of the left leg (the shin's and foot's offsets).
+fn leg_length(s: &Skeleton, roles: &Roles) -> f64 {
+    let (shin, foot) = (roles.joint(Role::Shin(Side::Left)), roles.joint(Role::Foot(Side::Left)));
+    s.joint(shin).offset.length() + s.joint(foot).offset.length()
 }
 
-/// Retargets a cgspeed-layout clip onto the common skeleton: per joint, the global rotation is the
-/// source's times the rest-pose correction that maps the target bone onto the source bone; the
-/// root path is scaled by the leg-length ratio (which also converts units to metres), resampled to
-/// 30 fps, grounded (feet on y = 0) and normalised to start at the origin facing +Z.
+/// Retargets a clip of any humanoid rig onto the common skeleton: joints matched by their roles
+/// ([`correspondence`]: roles, spine and neck chains, hip links and the longest finger chain, else
+/// names; the cgspeed layouts of both CMU releases map joint for joint); per joint, the global
+/// rotation is the source's times the rest-pose correction that maps the target bone onto the
+/// source bone; the root path is scaled by the leg-length ratio (which also converts units to
+/// metres), resampled to 30 fps, grounded (feet on y = 0) and normalised to start at the origin
+/// facing +Z.
 pub fn retarget(src: &Motion, rig: &Rig) -> Result<Clip, String> {
     let s = &src.skeleton;
-    let max_style = s.find("LeftCollar").is_some() || s.find("LeftHip").is_some();
-    let names: Vec<String> = s.joints().iter().map(|j| standard_name(&j.name, max_style)).collect();
     let t = &rig.skeleton;
-    let map: Vec<Option<usize>> = t.joints().iter().map(|j| names.iter().position(|n| *n == j.name)).collect();
-    for need in ["Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightFoot", "LowerBack", "LeftArm", "RightArm"] {
-        if map[t.find(need).expect("standard joint")].is_none() {
-            return Err(format!("no joint maps to {need}: not a CMU/cgspeed layout"));
-        }
+    let roles = find_motion_roles(src, &RoleOverrides::default()).map_err(|e| e.to_string())?;
+    if roles.spine.is_empty() {
+        return Err("no spine joint between the hips and the arms".into());
     }
-    let src_leg = {
-        let find = |std: &str| names.iter().position(|n| n == std).map(|i| s.joint(i).name.clone()).unwrap_or_default();
-        leg_length(s, &find("LeftUpLeg"), &find("LeftLeg"), &find("LeftFoot")).ok_or("no left leg")?
-    };
-    let tgt_leg = leg_length(t, "LeftUpLeg", "LeftLeg", "LeftFoot").expect("standard leg");
-    let scale = tgt_leg / src_leg.max(1e-9);
+    let map = correspondence((t, &rig.roles), (s, &roles), true);
+    let scale = leg_length(t, &rig.roles) / leg_length(s, &roles).max(1e-9);
     let corr: Vec<DQuat> = (0..t.len())
         .map(|j| match (map[j], bone_dir(t, j)) {
             (Some(sj), Some(dt)) => bone_dir(s, sj).map(|ds| arc(dt, ds)).unwrap_or(DQuat::IDENTITY),
@@ -187,12 +144,13 @@ pub fn retarget(src: &Motion, rig: &Rig) -> Result<Clip, String> {
     super::grounding::grounded(rig, t, poses)
 }
 
-/// Reads a CMU BVH and retargets it: cgspeed layouts with [`retarget`], Character Creator
-/// (iClone) layouts with [`super::cc::retarget_cc`] (its first frame, a T-pose, dropped).
+/// Reads a CMU BVH and retargets it: Character Creator (iClone) rigs with
+/// [`super::cc::retarget_cc`] (its first frame, a T-pose, dropped), any other with [`retarget`].
 pub fn load_bvh(path: &Path, rig: &Rig) -> Result<Clip, ScriptError> {
     let m =
         inbetween_io::read_bvh(path).map_err(|e| ScriptError::Asset { path: path.into(), message: e.to_string() })?;
-    let result = if m.skeleton.find("CC_Base_Hip").is_some() {
+    let scheme = find_motion_roles(&m, &RoleOverrides::default()).ok().and_then(|r| r.scheme);
+    let result = if scheme == Some(Scheme::CharacterCreator) {
         super::cc::retarget_cc(&m, rig, false, true)
     } else {
         retarget(&m, rig)

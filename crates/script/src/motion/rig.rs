@@ -6,6 +6,7 @@ use glam::{DQuat, DVec3};
 use inbetween_core::clip::Clip;
 use inbetween_core::fk::{forward, GlobalPose};
 use inbetween_core::procedural::{standard_hip_height, standard_skeleton, CM_PER_CMU_UNIT};
+use inbetween_core::roles::{find_roles, Role, RoleOverrides, Roles, Side};
 use inbetween_core::units::scale_motion;
 use inbetween_core::{Motion, Pose, Skeleton};
 
@@ -41,6 +42,8 @@ pub struct Rig {
     pub arms: [[usize; 4]; 2],
     /// Rest height of the ankle (`Foot` joint) above the floor, metres.
     pub ankle_height: f64,
+    /// The skeleton's joint roles ([`inbetween_core::roles`]), where the indices above come from.
+    pub roles: Roles,
 }
 
 impl Rig {
@@ -48,8 +51,8 @@ impl Rig {
         Rig::of(skeleton())
     }
 
-    /// Indices on a skeleton with the standard joint names (panics on another layout: use
-    /// [`Rig::try_of`] for skeletons that did not come from this module).
+    /// Indices on the standard skeleton or another humanoid (panics on a skeleton without roles:
+    /// use [`Rig::try_of`] for skeletons that did not come from this module).
     pub fn of(skeleton: Skeleton) -> Rig {
         Rig::try_of(skeleton).unwrap_or_else(|e| panic!("{e}"))
     }
@@ -61,31 +64,33 @@ impl Rig {
             .map_err(|e| crate::error::ScriptError::Invalid(format!("{what} needs the common rig's joints: {e}")))
     }
 
-    /// Indices on a skeleton with the standard joint names, or which joint is missing.
+    /// Indices on a humanoid skeleton (its roles by name or shape, [`inbetween_core::roles`]), or
+    /// which role is missing.
     pub fn try_of(skeleton: Skeleton) -> Result<Rig, String> {
-        let f = |n: &str| {
-            skeleton.find(n).ok_or_else(|| {
-                format!("not the common rig: joint {n} missing (the skeleton has {} joints)", skeleton.joints().len())
+        let roles = find_roles(&skeleton, &RoleOverrides::default()).map_err(|e| format!("not the common rig: {e}"))?;
+        let f = |r: Role| {
+            roles.get(r).ok_or_else(|| {
+                format!("not the common rig: no {} joint (the skeleton has {} joints)", r.key(), skeleton.len())
             })
         };
-        let limb = |names: [&str; 4]| -> Result<[usize; 4], String> {
-            Ok([f(names[0])?, f(names[1])?, f(names[2])?, f(names[3])?])
-        };
-        let legs = [
-            limb(["LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase"])?,
-            limb(["RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"])?,
-        ];
-        let arms = [
-            limb(["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand"])?,
-            limb(["RightShoulder", "RightArm", "RightForeArm", "RightHand"])?,
-        ];
+        let limb = |r: [Role; 4]| -> Result<[usize; 4], String> { Ok([f(r[0])?, f(r[1])?, f(r[2])?, f(r[3])?]) };
+        let leg = |s: Side| limb([Role::Thigh(s), Role::Shin(s), Role::Foot(s), Role::Toe(s)]);
+        let arm = |s: Side| limb([Role::Clavicle(s), Role::UpperArm(s), Role::Forearm(s), Role::Hand(s)]);
+        let legs = [leg(Side::Left)?, leg(Side::Right)?];
+        let arms = [arm(Side::Left)?, arm(Side::Right)?];
         let (hips, lower_back, spine1, neck, head) =
-            (f("Hips")?, f("LowerBack")?, f("Spine1")?, f("Neck")?, f("Head")?);
+            (f(Role::Hips)?, f(Role::Spine)?, f(Role::Chest)?, f(Role::Neck)?, f(Role::Head)?);
         let mut rest = Pose::rest(&skeleton);
         rest.translations[hips] = DVec3::new(0.0, hip_height(), 0.0);
         let g = forward(&skeleton, &rest);
         let ankle_height = g.positions[legs[0][2]].y;
-        Ok(Rig { hips, lower_back, spine1, neck, head, legs, arms, ankle_height, skeleton })
+        Ok(Rig { hips, lower_back, spine1, neck, head, legs, arms, ankle_height, skeleton, roles })
+    }
+
+    /// The end of the hand's longest finger chain (`LeftHandIndex1`), or the hand itself.
+    pub fn fingertip(&self, side: Side) -> usize {
+        let hand = self.arms[usize::from(side == Side::Right)][3];
+        self.roles.fingertip(&self.skeleton, side).unwrap_or(hand)
     }
 
     /// True for the joints of the upper body: `LowerBack` and everything below it (§4.2, "joints

@@ -27,6 +27,7 @@ use std::path::Path;
 
 use glam::DVec3;
 use inbetween_core::fk::forward;
+use inbetween_core::roles::Side;
 use rand::Rng;
 
 use crate::animate::{animate_planned, AnimateConfig, Animation, ContactJoint, Setup, WalkCache};
@@ -232,11 +233,8 @@ pub fn contact_cost(anim: &Animation) -> (f64, usize) {
     for c in &anim.characters {
         let Ok(rig) = Rig::try_of(c.clip.skeleton().clone()) else { continue };
         let sk = &rig.skeleton;
-        let finger = |side: &str, hand: usize| {
-            sk.find(&format!("{side}HandIndex1")).or_else(|| sk.find(&format!("{side}FingerBase"))).unwrap_or(hand)
-        };
         let (lh, rh) = (rig.arms[0][3], rig.arms[1][3]);
-        let (lf, rf) = (finger("Left", lh), finger("Right", rh));
+        let (lf, rf) = (rig.fingertip(Side::Left), rig.fingertip(Side::Right));
         for s in &c.segments {
             for jc in &s.contacts {
                 let (a, b) = (jc.start.min(c.clip.num_frames()), jc.end.min(c.clip.num_frames()));

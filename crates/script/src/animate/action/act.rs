@@ -117,10 +117,8 @@ fn hand_contacts(
     let window = BlendParams { start: 0, end: None, blend_in: 10, blend_out: 0, looping: false, action_offset: 0 };
     // Hand length (wrist → finger), to put the fingers, not the wrist, on the keys.
     let g0 = forward(&rig.skeleton, &m.pose(0));
-    let finger = |side: &str| {
-        rig.skeleton.find(&format!("{side}HandIndex1")).or_else(|| rig.skeleton.find(&format!("{side}FingerBase")))
-    };
-    let hand_len = finger("Left").map(|f| (g0.positions[f] - g0.positions[rig.arms[0][3]]).length()).unwrap_or(0.1);
+    let finger = rig.roles.fingertip(&rig.skeleton, inbetween_core::roles::Side::Left);
+    let hand_len = finger.map(|f| (g0.positions[f] - g0.positions[rig.arms[0][3]]).length()).unwrap_or(0.1);
     let root = g0.positions[rig.hips];
     let mut ik = Vec::new();
     let mut jc = Vec::new();

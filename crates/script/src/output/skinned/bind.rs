@@ -2,6 +2,7 @@
 //! rig's joints and bound rigidly (see the parent module's doc).
 
 use super::*;
+use inbetween_core::roles::{find_roles, Role, RoleOverrides, Side};
 
 /// How one part is placed: Kenney segment `from → from + axis_k · len_k` onto the rig segment
 /// `to → to + axis_r · len_r`, scaled by `width` across it; then cut into spans along the rig
@@ -56,18 +57,6 @@ fn top_bottom(part: &KenneyPart) -> (Vec3, Vec3) {
 fn segment(a: Vec3, b: Vec3) -> (Vec3, f32) {
     let d = b - a;
     (d.normalize_or(Vec3::NEG_Y), d.length().max(1e-4))
-}
-
-/// Rig joints by name; an error names the ones missing.
-fn joints_named(skeleton: &Skeleton, names: &[&str]) -> Result<Vec<usize>, ScriptError> {
-    let missing: Vec<&str> = names.iter().copied().filter(|n| skeleton.find(n).is_none()).collect();
-    if !missing.is_empty() {
-        return Err(ScriptError::Invalid(format!(
-            "skinning needs the standard skeleton's joints; missing: {}",
-            missing.join(", ")
-        )));
-    }
-    Ok(names.iter().map(|n| skeleton.find(n).expect("checked above")).collect())
 }
 
 /// The farthest joint or end site below `j` (inclusive) from point `from`.
@@ -172,32 +161,37 @@ impl Builder {
     }
 }
 
-/// Retargets a Kenney character onto `skeleton` (standard joint names) in its bind pose (see the
-/// module comment). Needs a "torso" part; legs, arms and head are placed when present, any other
-/// part rides on the torso.
+/// Retargets a Kenney character onto `skeleton` (any humanoid: its joints found by their roles,
+/// [`inbetween_core::roles`]) in its bind pose (see the module comment). Needs a "torso" part;
+/// legs, arms and head are placed when present, any other part rides on the torso.
 pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBody, ScriptError> {
-    let names = [
-        "LowerBack",
-        "Spine1",
-        "Head",
-        "LeftUpLeg",
-        "LeftLeg",
-        "LeftFoot",
-        "RightUpLeg",
-        "RightLeg",
-        "RightFoot",
-        "LeftArm",
-        "LeftForeArm",
-        "LeftHand",
-        "RightArm",
-        "RightForeArm",
-        "RightHand",
-    ];
-    let j = joints_named(skeleton, &names)?;
-    let [lower_back, spine1, head, lul, ll, lf, rul, rl, rf, la, lfa, lh, ra, rfa, rh] = j[..] else {
-        unreachable!("15 names")
+    let roles = find_roles(skeleton, &RoleOverrides::default())
+        .map_err(|e| ScriptError::Invalid(format!("skinning needs a humanoid skeleton: {e}")))?;
+    let (l, r) = (Side::Left, Side::Right);
+    let j = |role: Role| roles.joint(role);
+    let (head, lul, ll, lf, rul, rl, rf) = (
+        j(Role::Head),
+        j(Role::Thigh(l)),
+        j(Role::Shin(l)),
+        j(Role::Foot(l)),
+        j(Role::Thigh(r)),
+        j(Role::Shin(r)),
+        j(Role::Foot(r)),
+    );
+    let (la, lfa, lh, ra, rfa, rh) = (
+        j(Role::UpperArm(l)),
+        j(Role::Forearm(l)),
+        j(Role::Hand(l)),
+        j(Role::UpperArm(r)),
+        j(Role::Forearm(r)),
+        j(Role::Hand(r)),
+    );
+    // The spine from its lowest joint up to the chest (`LowerBack`, `Spine`, `Spine1`).
+    let (lower_back, spine1) = match (roles.spine.first(), roles.spine.last()) {
+        (Some(&a), Some(&b)) => (a, b),
+        _ => return Err(ScriptError::Invalid("skinning needs a spine joint between the hips and the arms".into())),
     };
-    let spine = skeleton.find("Spine");
+    let middle: Vec<usize> = roles.spine.iter().copied().skip(1).take(roles.spine.len().saturating_sub(2)).collect();
     let (_, g) = bind_pose(skeleton);
     let p = |j: usize| g.positions[j].as_vec3();
     let bad = |m: String| ScriptError::Asset { path: ch.source.clone(), message: m };
@@ -216,10 +210,12 @@ pub fn bind_body(ch: &KenneyCharacter, skeleton: &Skeleton) -> Result<SkinnedBod
     let (torso_axis, torso_len) = segment(hip_mid, shoulder_mid);
     let (kt_axis, kt_len) = segment(kt_bot, kt_top);
     let mut torso_cuts = vec![(f32::MIN, lower_back)];
-    if let Some(s) = spine {
+    for &s in &middle {
         torso_cuts.push(((p(s) - hip_mid).dot(torso_axis), s));
     }
-    torso_cuts.push(((p(spine1) - hip_mid).dot(torso_axis), spine1));
+    if spine1 != lower_back {
+        torso_cuts.push(((p(spine1) - hip_mid).dot(torso_axis), spine1));
+    }
     let torso_pl = Placement {
         from: kt_bot,
         axis_k: kt_axis,
