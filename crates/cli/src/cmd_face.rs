@@ -7,7 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 
 use inbetween_core::cancel::Cancel;
 use inbetween_face::bench::{self, FaceBenchConfig};
-use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
+use inbetween_face::data::{is_live_link, read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
 use inbetween_face::infer::plan::{captures_dir, span_seconds, viseme_runs, MethodChoice, SPEECH_GROUPS};
@@ -446,12 +446,6 @@ fn edit_once(
     }
     println!("  curves {}", png.display());
     Ok((out, ms))
-}
-
-fn is_live_link(path: &Path) -> bool {
-    std::fs::read_to_string(path)
-        .map(|t| t.trim_start_matches('\u{feff}').trim_start().to_ascii_lowercase().starts_with("timecode"))
-        .unwrap_or(false)
 }
 
 fn kinds(arg: &str) -> anyhow::Result<Vec<ConstraintKind>> {

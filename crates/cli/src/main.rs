@@ -1,5 +1,6 @@
 //! `inbetween`: the command-line front end of every engine.
 
+mod cmd_batch;
 mod cmd_camera;
 mod cmd_face;
 mod cmd_io;
@@ -57,6 +58,11 @@ enum Command {
     Script(cmd_script::ScriptCommand),
     /// Local web studio (script, mocap, camera, face and video panels): serves http://127.0.0.1:7878/ until Ctrl-C.
     Studio(cmd_studio::StudioArgs),
+    /// One job over a whole folder, in shards for a cluster (Slurm job arrays, Kubernetes Indexed
+    /// Jobs; Dask through the Python package): mocap-compress, mocap-keys, video-analyse,
+    /// script-run, face-edit, and summary.
+    #[command(subcommand)]
+    Batch(cmd_batch::BatchCommand),
 }
 
 fn main() -> ExitCode {
@@ -85,5 +91,6 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Video(c) => cmd_video::run(c),
         Command::Script(c) => cmd_script::run(c),
         Command::Studio(a) => cmd_studio::run(a),
+        Command::Batch(c) => cmd_batch::run(c),
     }
 }

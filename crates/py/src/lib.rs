@@ -9,6 +9,7 @@
 use pyo3::prelude::*;
 
 mod arrays;
+mod batch;
 mod bench;
 mod camera;
 mod clip;
@@ -28,6 +29,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(runner::_panic_in_job, m)?)?;
     clip::register(m)?;
+    batch::register(m)?;
     bench::register(m)?;
     camera::register(m)?;
     ibk::register(m)?;

@@ -36,6 +36,22 @@ pub struct SceneJob {
     pub limits: ScriptLimits,
 }
 
+impl Default for SceneJob {
+    /// What `inbetween script scene` does without flags: seed 1, relation-first matching, a
+    /// furnished room of boxes, the default limits, written into `out/script`.
+    fn default() -> SceneJob {
+        SceneJob {
+            out_dir: PathBuf::from("out/script"),
+            seed: 1,
+            view: None,
+            models: None,
+            config: ComposeConfig::default(),
+            semantic: None,
+            limits: ScriptLimits::default(),
+        }
+    }
+}
+
 /// What a scene job wrote and found.
 #[derive(Debug)]
 pub struct SceneReport {
@@ -135,6 +151,21 @@ pub struct RunJob {
     /// Stages of the run as they start (solving the story, then each output); the CLI draws it,
     /// `Progress::hidden()` counts silently.
     pub progress: inbetween_io::Progress,
+}
+
+impl Default for RunJob {
+    /// What `inbetween script run` does without flags: optimised, the procedural motion library,
+    /// a 480-pixel preview GIF, no time limit, no progress drawn.
+    fn default() -> RunJob {
+        RunJob {
+            scene: SceneJob::default(),
+            optimize: true,
+            shared_motions: false,
+            gif_width: 480,
+            cancel: inbetween_core::cancel::Cancel::new(),
+            progress: inbetween_io::Progress::hidden(),
+        }
+    }
 }
 
 /// What a story job wrote and measured.

@@ -71,6 +71,14 @@ pub fn read_clip_limited(path: &std::path::Path, max_rows: usize) -> Result<Blen
     Ok(clip)
 }
 
+/// Whether the file at `path` is a Live Link Face CSV (its header starts with `Timecode`), so that an
+/// edit of it is written back in that layout rather than as a plain curve file.
+pub fn is_live_link(path: &std::path::Path) -> bool {
+    std::fs::read_to_string(path)
+        .map(|t| t.trim_start_matches('\u{feff}').trim_start().to_ascii_lowercase().starts_with("timecode"))
+        .unwrap_or(false)
+}
+
 /// Writes a clip as Live Link Face CSV when `live_link`, else in the plain curve format chosen by the
 /// extension (`.json` or CSV). Atomic, like every writer here.
 pub fn write_clip(path: &std::path::Path, clip: &BlendshapeClip, live_link: bool) -> Result<(), FaceError> {
