@@ -253,7 +253,7 @@ pub fn run(opts: &BenchOptions) -> Result<Report, BatchError> {
         std::thread::available_parallelism().map_or(0, |n| n.get())
     ));
     match &dask_python {
-        Ok(p) => runs_t.note(format!("Dask: inbetween.batch.map on a LocalCluster of single-threaded worker processes ({}); peak memory not measured per worker", p.display())),
+        Ok(_) => runs_t.note("Dask: inbetween.batch.map on a LocalCluster of single-threaded worker processes (the Python given as --python); peak memory not measured per worker"),
         Err(why) => runs_t.note(format!("Dask rows skipped: {why}")),
     };
     proj.note(

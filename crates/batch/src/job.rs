@@ -102,8 +102,8 @@ impl BatchJob {
         self.validate()?;
         let t = Instant::now();
         let all = self.manifest()?;
-        let mine: Vec<&Input> =
-            all.iter().enumerate().filter(|(i, _)| self.shard.contains(*i)).map(|(_, x)| x).collect();
+        let sizes: Vec<u64> = all.iter().map(|i| std::fs::metadata(&i.path).map_or(0, |m| m.len())).collect();
+        let mine: Vec<&Input> = self.shard.positions(&sizes).into_iter().map(|p| &all[p]).collect();
         std::fs::create_dir_all(&self.out_dir)
             .map_err(|source| BatchError::Io { path: self.out_dir.clone(), source })?;
         let done = results::done_in(&self.out_dir)?;

@@ -6,7 +6,7 @@
 use crate::manifest::{with_extension, Input};
 use crate::BatchError;
 use inbetween_core::cancel::Cancel;
-use inbetween_io::{write_atomic, OutputSet, Progress};
+use inbetween_io::{with_causes, write_atomic, OutputSet, Progress};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -163,23 +163,8 @@ pub struct Produced {
     pub report: serde_json::Value,
 }
 
-/// An engine error with every cause, as the CLI prints it (`a: b: c`).
-fn chain(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        let more = s.to_string();
-        if !text.contains(&more) {
-            text.push_str(": ");
-            text.push_str(&more);
-        }
-        source = s.source();
-    }
-    text
-}
-
 fn err(input: &Input, e: impl std::error::Error) -> String {
-    let text = chain(&e);
+    let text = with_causes(&e);
     // Engine errors usually name the file already; make sure the line does.
     if text.contains(&input.path.display().to_string()) {
         text
@@ -374,13 +359,13 @@ fn face_edit(
         .split(',')
         .map(|m| span_seconds(m.trim(), &clip))
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("mask '{mask}' on {}: {}", input.path.display(), chain(&e)))?;
+        .map_err(|e| format!("mask '{mask}' on {}: {}", input.path.display(), with_causes(&e)))?;
     // The unguided edit of `face edit --mask …` (no keys, take or visemes): the engine's auto rule.
     let kind = ConstraintKind::None;
     let method_name = options.method.as_deref().unwrap_or("auto");
     let choice = MethodChoice::parse(method_name).map_err(|e| e.to_string())?.resolve(kind, false);
     let net = match choice {
-        MethodChoice::Network => Some(inbetween_face::weights::committed(kind).map_err(|e| chain(&e))?),
+        MethodChoice::Network => Some(inbetween_face::weights::committed(kind).map_err(|e| with_causes(&e))?),
         _ => None,
     };
     let library = matches!(choice, MethodChoice::Retrieval)
@@ -411,7 +396,7 @@ fn face_edit(
         std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
     }
     let live_link = is_live_link(&input.path);
-    write_clip(&target, &outcome.clip, live_link).map_err(|e| chain(&e))?;
+    write_clip(&target, &outcome.clip, live_link).map_err(|e| with_causes(&e))?;
     Ok(serde_json::json!({
         "frames": clip.num_frames(),
         "fps": clip.measured_fps(),

@@ -3,7 +3,8 @@
 //! own, with nothing shared but the output folder.
 //!
 //! - [`manifest`]: the inputs in one stable order;
-//! - [`shard`]: which of them one process takes (`--shard i/n`, or the scheduler's variables);
+//! - [`shard`]: which of them one process takes (`--shard i/n`, or the scheduler's variables),
+//!   balanced by size;
 //! - [`kind`]: the jobs (`mocap-compress`, `mocap-keys`, `video-analyse`, `script-run`,
 //!   `face-edit`), each a thin call of an engine's public job;
 //! - [`results`]: one JSON line per input in `OUT/results-<i>.jsonl`;

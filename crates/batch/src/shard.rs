@@ -1,6 +1,7 @@
-//! Which inputs of a manifest one process runs: shard `i` of `n` takes the inputs at positions
-//! `i, i + n, i + 2n, …` of the manifest's stable order (round robin, so a folder sorted by size or
-//! by subject still spreads evenly).
+//! Which inputs of a manifest one process runs. Every shard computes the same split from the
+//! manifest alone: the inputs by size, largest first (ties in manifest order), each given to the
+//! shard with the fewest bytes so far (ties to the lower index), so shards finish close together
+//! when cost grows with size ([`split_by_size`]).
 //!
 //! The shard comes from `--shard i/n`, or from the scheduler that started the process: a Slurm job
 //! array (`SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_COUNT`, less `SLURM_ARRAY_TASK_MIN` when the
@@ -97,10 +98,27 @@ impl Shard {
         Ok(None)
     }
 
-    /// Whether the input at `position` of the manifest belongs to this shard.
-    pub fn contains(&self, position: usize) -> bool {
-        position % self.count == self.index
+    /// The manifest positions of this shard's inputs, in manifest order, given every input's size.
+    pub fn positions(&self, sizes: &[u64]) -> Vec<usize> {
+        let owner = split_by_size(sizes, self.count);
+        (0..sizes.len()).filter(|&i| owner[i] == self.index).collect()
     }
+}
+
+/// The shard of each input (by manifest position): largest first, each to the shard with the fewest
+/// bytes so far; the same on every machine for the same manifest and sizes.
+pub fn split_by_size(sizes: &[u64], count: usize) -> Vec<usize> {
+    let count = count.max(1);
+    let mut order: Vec<usize> = (0..sizes.len()).collect();
+    order.sort_by(|&a, &b| sizes[b].cmp(&sizes[a]).then(a.cmp(&b)));
+    let mut load = vec![0u128; count];
+    let mut owner = vec![0; sizes.len()];
+    for i in order {
+        let shard = (0..count).min_by_key(|&s| (load[s], s)).expect("at least one shard");
+        load[shard] += u128::from(sizes[i]) + 1;
+        owner[i] = shard;
+    }
+    owner
 }
 
 #[cfg(test)]
@@ -124,13 +142,24 @@ mod tests {
     }
 
     #[test]
-    fn every_position_in_exactly_one_shard() {
+    fn every_position_in_exactly_one_shard_and_bytes_balanced() {
+        let sizes: Vec<u64> = (0..40u64).map(|i| (i * 7919) % 97 + 1).collect();
         for n in 1..6 {
-            for pos in 0..40 {
-                let owners = (0..n).filter(|&i| Shard::new(i, n).unwrap().contains(pos)).count();
-                assert_eq!(owners, 1);
+            let mut seen = vec![0; sizes.len()];
+            let mut bytes = vec![0u64; n];
+            for (i, b) in bytes.iter_mut().enumerate() {
+                for p in Shard::new(i, n).unwrap().positions(&sizes) {
+                    seen[p] += 1;
+                    *b += sizes[p];
+                }
             }
+            assert!(seen.iter().all(|&c| c == 1), "{n} shards: {seen:?}");
+            let (lo, hi) = (*bytes.iter().min().unwrap(), *bytes.iter().max().unwrap());
+            assert!(hi - lo <= 97, "{n} shards: {bytes:?}");
         }
+        // One large input and three small: the large one alone.
+        assert_eq!(split_by_size(&[10, 100, 10, 10], 2), vec![1, 0, 1, 1]);
+        assert!(split_by_size(&[], 3).is_empty());
     }
 
     #[test]

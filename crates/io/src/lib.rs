@@ -33,6 +33,23 @@ pub use progress::Progress;
 use inbetween_core::Motion;
 use std::path::Path;
 
+/// An error and its sources as one line (`a: b: c`), as the CLI prints them; a source whose text the
+/// message already holds (thiserror messages often embed it) is not said twice. Front ends that
+/// report errors as text (result lines, Python exceptions) use it.
+pub fn with_causes(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        let part = s.to_string();
+        if !text.contains(&part) {
+            text.push_str(": ");
+            text.push_str(&part);
+        }
+        source = s.source();
+    }
+    text
+}
+
 /// Reads a whole file as UTF-8 text; invalid UTF-8 is a syntax error at the line where it occurs.
 pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
     let bytes = std::fs::read(path).map_err(|source| IoError::Io { path: path.to_path_buf(), source })?;

@@ -21,18 +21,7 @@ create_exception!(
 
 /// The error and its sources as one line, like the CLI's `Error: a: b: c`.
 pub fn message(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        let part = s.to_string();
-        // thiserror messages often embed their source already; do not say it twice.
-        if !text.contains(&part) {
-            text.push_str(": ");
-            text.push_str(&part);
-        }
-        source = s.source();
-    }
-    text
+    inbetween_io::with_causes(e)
 }
 
 /// An [`InbetweenError`] from any engine error, with `context` ("reading x.bvh") in front when given.
