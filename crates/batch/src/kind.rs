@@ -205,24 +205,14 @@ fn load_motion(input: &Input) -> Result<inbetween_core::Motion, String> {
 }
 
 fn mocap_compress(input: &Input, out: &Path, output: &str, options: &Options) -> Result<serde_json::Value, String> {
-    use inbetween_core::units::UnitChoice;
     use inbetween_mocap::codec::{Budget, CompressJob};
-    use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
     let motion = load_motion(input)?;
     let budget = match (options.max_error_cm, options.keys) {
         (Some(cm), _) => Budget::MaxErrorCm(cm),
         (None, Some(k)) => Budget::Keys(k),
         (None, None) => unreachable!("validated"),
     };
-    // What `inbetween mocap compress` does with the same bound: the engine's default longest gap,
-    // the unit inferred from the skeleton, the version the budget picks.
-    let job = CompressJob {
-        budget,
-        version: None,
-        segment_len: None,
-        max_gap: max_gap_frames(DEFAULT_MAX_GAP_S, motion.frame_time),
-        unit: UnitChoice::resolve(None, &motion.skeleton),
-    };
+    let job = CompressJob::for_motion(&motion, budget);
     let report = job.run(&motion).map_err(|e| err(input, e))?;
     write(out, output, report.bytes())?;
     Ok(serde_json::json!({

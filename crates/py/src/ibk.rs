@@ -66,7 +66,7 @@ pub fn compress_job(
         budget,
         version: version.map(Version::parse).transpose().map_err(|e| engine("", &e))?,
         segment_len,
-        max_gap: ((max_gap_s / clip.motion.frame_time).round() as usize).max(1),
+        max_gap: inbetween_mocap::select::job::max_gap_frames(max_gap_s, clip.motion.frame_time),
         unit: clip.unit.clone(),
     };
     job.validate().map_err(|e| engine("", &e))?;

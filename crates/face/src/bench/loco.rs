@@ -174,11 +174,7 @@ pub fn loco_table(
                 let other = r.random_range(margin..=n - len - margin);
                 let seg = Segment { start, end: start + len };
                 let mask = Mask::from_segments(n, &[seg], &[true; NUM_ARKIT]);
-                let outside = {
-                    let mut o = GapStats::of(&truth[..seg.start]);
-                    o.add(&GapStats::of(&truth[seg.end..]));
-                    o
-                };
+                let outside = GapStats::outside(&truth, seg);
                 for kind in kinds {
                     let guide = match kind {
                         ConstraintKind::Visemes => text_guide(seg)?,

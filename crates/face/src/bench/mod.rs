@@ -466,11 +466,7 @@ fn plausibility_tables(
                 let start = rng(s).random_range(margin..=n - len - margin);
                 let seg = Segment { start, end: start + len };
                 let mask = Mask::from_segments(n, &[seg], &[true; NUM_ARKIT]);
-                let outside = {
-                    let mut o = GapStats::of(&truth[..seg.start]);
-                    o.add(&GapStats::of(&truth[seg.end..]));
-                    o
-                };
+                let outside = GapStats::outside(&truth, seg);
                 for kind in kinds {
                     let guide = guide_for(kind, &truth, &mask, None, derive(s, 1));
                     let mut fills: Vec<(String, Vec<Frame>)> = vec![(real_label.clone(), truth.clone())];

@@ -269,6 +269,13 @@ pub struct GapStats {
 }
 
 impl GapStats {
+    /// The statistics of `frames` outside `seg` (the frames before it and after it, each run on its own).
+    pub fn outside(frames: &[Frame], seg: crate::edit::Segment) -> GapStats {
+        let mut o = GapStats::of(&frames[..seg.start]);
+        o.add(&GapStats::of(&frames[seg.end..]));
+        o
+    }
+
     /// The statistics of consecutive frames `frames`.
     pub fn of(frames: &[Frame]) -> GapStats {
         let (l, r) = (index("EyeBlinkLeft"), index("EyeBlinkRight"));

@@ -65,6 +65,19 @@ impl CompressReport {
 }
 
 impl CompressJob {
+    /// The job `mocap compress` runs for `motion` given only a budget: the version the budget picks,
+    /// the default segment length, the engine's longest gap between keys
+    /// ([`crate::select::job::DEFAULT_MAX_GAP_S`]) and the unit inferred from the skeleton.
+    pub fn for_motion(motion: &Motion, budget: Budget) -> CompressJob {
+        CompressJob {
+            budget,
+            version: None,
+            segment_len: None,
+            max_gap: crate::select::job::max_gap_frames(crate::select::job::DEFAULT_MAX_GAP_S, motion.frame_time),
+            unit: UnitChoice::resolve(None, &motion.skeleton),
+        }
+    }
+
     /// The version the job writes.
     pub fn version(&self) -> Version {
         match (self.version, &self.budget) {
