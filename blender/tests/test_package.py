@@ -1,0 +1,47 @@
+"""The built add-on and extension (scripts/build-blender-addon.sh): the add-on folder Blender loaded
+brings the engines in _vendor/, and the extension zip holds a manifest naming its wheel."""
+
+from __future__ import annotations
+
+import os
+import pathlib
+import tomllib
+import zipfile
+
+import pytest
+
+import addon_utils
+
+
+def test_the_loaded_add_on_brings_the_engines():
+    import inbetween
+
+    mod = next(m for m in addon_utils.modules() if m.__name__ == "inbetween_blender")
+    folder = pathlib.Path(mod.__file__).parent
+    if not (folder / "_vendor").is_dir():
+        pytest.skip(f"skipped: {folder} is a source folder, not a build (no _vendor/)")
+    assert pathlib.Path(inbetween.__file__).resolve().is_relative_to((folder / "_vendor").resolve())
+    assert inbetween.__version__ == ".".join(map(str, mod.bl_info["version"]))
+
+
+def test_extension_zip_names_its_wheel():
+    path = os.environ.get("INBETWEEN_ADDON_ZIP")
+    if not path:
+        pytest.skip("skipped: no INBETWEEN_ADDON_ZIP (set by crates/py/tests/blender.rs)")
+    with zipfile.ZipFile(path) as z:
+        names = set(z.namelist())
+        manifest = tomllib.loads(z.read("blender_manifest.toml").decode())
+        assert manifest["schema_version"] == "1.0.0" and manifest["type"] == "add-on"
+        assert manifest["id"] == "inbetween_blender" and manifest["blender_version_min"] == "4.2.0"
+        assert len(manifest["tagline"]) <= 64 and not manifest["tagline"].endswith(".")
+        assert pathlib.Path(path).name == f"inbetween_blender-{manifest['version']}.zip"
+        assert "__init__.py" in names and not any(n.startswith("_vendor/") for n in names)
+        (wheel,) = manifest["wheels"]
+        assert wheel.startswith("./wheels/") and wheel[2:] in names
+        assert manifest["platforms"] == ["linux-x64"]
+        import io
+
+        with zipfile.ZipFile(io.BytesIO(z.read(wheel[2:]))) as w:
+            inner = set(w.namelist())
+    assert {"inbetween/__init__.py", "inbetween/mocap.py", "inbetween/_native.abi3.so"} <= inner
+    assert any(n.endswith(".dist-info/RECORD") for n in inner)
