@@ -24,6 +24,13 @@ pub enum VideoError {
     /// the limit (a field of `VideoLimits`), so that a front end can name its own way to raise it.
     #[error("{subject}: {value} {what} is more than the limit of {limit} (VideoLimits::{field})")]
     Limit { subject: String, what: &'static str, value: u64, limit: u64, field: &'static str },
+    /// A clip read from `path` has more frames than [`VideoLimits::max_frames`](crate::pipeline::VideoLimits)
+    /// (decoding stops one frame past the limit).
+    #[error("{}: more than {limit} frames, the limit (VideoLimits::max_frames); read only the first frames with ReadOptions::max_frames", path.display())]
+    TooManyFrames { path: PathBuf, limit: usize },
+    /// A start frame past the clip's last frame (`frames` frames).
+    #[error("start frame {start} is outside the clip (frames 0..{})", frames.saturating_sub(1))]
+    StartOutside { start: usize, frames: usize },
     #[error(transparent)]
     Nn(#[from] inbetween_nn::NnError),
     /// The job's [`Cancel`](inbetween_core::cancel::Cancel) token was cancelled or its time limit passed.

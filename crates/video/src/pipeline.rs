@@ -374,11 +374,24 @@ pub fn resequence(
     count: usize,
     limits: &VideoLimits,
 ) -> Result<(Vec<SdpfPath>, f64), VideoError> {
+    resequence_with(analysis, start, params, count, limits, &analysis.cancel)
+}
+
+/// [`resequence`] under another token than the analysis's (a later request on an analysis kept
+/// open, as the studio's and [`ResequenceJob`](crate::job::ResequenceJob)'s are).
+pub fn resequence_with(
+    analysis: &Analysis,
+    start: usize,
+    params: &SdpfParams,
+    count: usize,
+    limits: &VideoLimits,
+    cancel: &Cancel,
+) -> Result<(Vec<SdpfPath>, f64), VideoError> {
     limits.check_request(params.length, analysis.graph.n, count)?;
     let t = Instant::now();
     let pmsm =
         Pmsm { backward: &analysis.motion.backward, embedder: &analysis.embedder, memo: Some(&analysis.pmsm_memo) };
-    let paths = several_with(&analysis.graph, &analysis.info, &pmsm, start, params, count, &analysis.cancel)?;
+    let paths = several_with(&analysis.graph, &analysis.info, &pmsm, start, params, count, cancel)?;
     Ok((paths, t.elapsed().as_secs_f64()))
 }
 
