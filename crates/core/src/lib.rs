@@ -2,7 +2,7 @@
 //! runtime pose clips ([`clip::Clip`]), rotations, forward kinematics, resampling and windowing,
 //! curves with an [`Interval`] domain and their adapters ([`curve`]), keyframe sets, interpolation,
 //! error metrics, joint roles on any humanoid rig ([`roles`]), length units, seeding ([`seed`]),
-//! cooperative cancellation and time limits ([`cancel`]), angle wrapping ([`angle`]) and Toric space
+//! cooperative cancellation and time limits ([`cancel`]), angle wrapping ([`angle`]), order statistics ([`stats`]) and Toric space
 //! for two-subject camera framing ([`toric`]).
 
 pub mod angle;
@@ -19,6 +19,7 @@ pub mod roles;
 pub mod rotation;
 pub mod seed;
 pub mod skeleton;
+pub mod stats;
 pub mod toric;
 pub mod units;
 

@@ -1,10 +1,10 @@
 //! The clip pools the networks train on: procedural clips (with exact viseme labels), or the
-//! training split of the real captures ([`crate::bench::TRAIN_FILES`]; split by file, so the
+//! training split of the real captures ([`crate::data::split::TRAIN_FILES`]; split by file, so the
 //! benchmark's held-out takes are never seen).
 
 use std::path::Path;
 
-use crate::bench::TRAIN_FILES;
+use crate::data::split::TRAIN_FILES;
 use crate::data::{read_live_link, FaceError};
 use crate::procedural;
 use crate::train::data::{ClipPool, TrainClip};

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 
 use inbetween_io::Progress;
 
-use crate::bench::clip_of;
 use crate::data::{FaceError, MODEL_FPS, NUM_ARKIT};
 use crate::edit::{ConstraintKind, Frame, Segment};
 use crate::infer::{EditJob, Guide, Inpainter, Method};
@@ -20,6 +19,15 @@ pub struct FaceDemo {
     pub files: Vec<PathBuf>,
     /// Mean squared error inside the occlusion, per method.
     pub mse: Vec<(String, f64)>,
+}
+
+impl std::fmt::Display for FaceDemo {
+    /// The demo's line: the masked MSE per method and the files.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mse: Vec<String> = self.mse.iter().map(|(m, e)| format!("{m} {e:.5}")).collect();
+        let files: Vec<String> = self.files.iter().map(|f| f.display().to_string()).collect();
+        write!(f, "face: 3 s occlusion of a procedural capture, masked MSE {} -> {}", mse.join(", "), files.join(", "))
+    }
 }
 
 /// Occlusion of the demo clip, seconds.
@@ -65,7 +73,7 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<FaceDemo, FaceE
     let mse: Vec<(String, f64)> = outs.iter().map(|(n, o)| (n.to_string(), mse(&truth, o, seg))).collect();
     std::fs::create_dir_all(dir).map_err(|source| FaceError::Io { file: dir.display().to_string(), source })?;
     let input = dir.join("face-demo-input.csv");
-    crate::data::write_curves(&input, &clip_of(&truth))?;
+    crate::data::write_curves(&input, &crate::data::BlendshapeClip::from_model_frames(&truth))?;
     let png = dir.join("face-demo.png");
     let title = format!(
         "3 s occlusion ({:.1}-{:.1} s) filled by our unguided network; dashed: cubic",

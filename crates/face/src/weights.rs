@@ -9,11 +9,24 @@ use std::path::{Path, PathBuf};
 
 use inbetween_nn::weights::Weights;
 
-use crate::bench::NetworkSet;
 use crate::data::FaceError;
 use crate::edit::{ConstraintKind, Frame};
 use crate::infer::Inpainter;
 use crate::model::runtime::{load_generator, GeneratorRuntime};
+
+/// A set of trained networks (one per constraint type) under one label.
+pub struct NetworkSet {
+    /// Label in the tables ("procedural", "real").
+    pub label: String,
+    /// The networks.
+    pub nets: Vec<Box<dyn Inpainter>>,
+}
+
+impl NetworkSet {
+    pub(crate) fn get(&self, kind: ConstraintKind) -> Option<&dyn Inpainter> {
+        self.nets.iter().find(|n| n.kind() == kind).map(|n| n.as_ref())
+    }
+}
 
 /// A loaded generator and the guidance it takes.
 pub struct Network {

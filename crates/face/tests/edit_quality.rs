@@ -7,7 +7,7 @@
 
 #![allow(clippy::needless_range_loop)] // channel indices name shapes in the messages
 
-use inbetween_face::bench::{TEST_FILES, TRAIN_FILES};
+use inbetween_face::data::split::{TEST_FILES, TRAIN_FILES};
 use inbetween_face::data::{read_live_link, BlendshapeClip, ARKIT_NAMES, MODEL_FPS, NUM_ARKIT};
 use inbetween_face::edit::MotionLibrary;
 use inbetween_face::infer::{EditOutcome, Guide, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};

@@ -120,7 +120,7 @@ fn unguided_retrieval_on_a_held_out_capture_blinks_whole_and_moves() {
     use inbetween_face::edit::{Frame, MotionLibrary, RetrievalOptions};
     use inbetween_face::infer::{EditJob, EditLimits, Guide, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
     with_shared_data("the held-out face capture", |data| {
-        let path = data.join("face/neurosync").join(inbetween_face::bench::TEST_FILES[0]);
+        let path = data.join("face/neurosync").join(inbetween_face::data::split::TEST_FILES[0]);
         let clip = read_live_link(&path).unwrap();
         let library = MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED);
         let run = |method: Method, seed: u64| {

@@ -1,8 +1,8 @@
 //! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), whole-or-none
 //! output sets ([`OutputSet`]), the error for inputs over a job's stated limits ([`LimitExceeded`]), locating
 //! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]), the
-//! bench/report harness ([`report`]: tables, reports, timings) and scaling runs ([`scale`]: a child's time
-//! and peak memory).
+//! bench/report harness ([`report`]: tables, reports, timings) scaling runs ([`scale`]: a child's time
+//! and peak memory) and UTF-8 decoding with the failing line ([`text`]).
 //!
 //! Every reader returns [`IoError`] on bad input (never panics); its message names the file, the
 //! 1-based line and what was expected there.
@@ -20,6 +20,7 @@ pub mod output_set;
 pub mod progress;
 pub mod report;
 pub mod scale;
+pub mod text;
 
 pub use asf::{parse_asf_amc, read_asf_amc};
 pub use bvh::{parse_bvh, read_bvh, to_bvh_string, write_bvh};
@@ -53,15 +54,11 @@ pub fn with_causes(e: &dyn std::error::Error) -> String {
 /// Reads a whole file as UTF-8 text; invalid UTF-8 is a syntax error at the line where it occurs.
 pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
     let bytes = std::fs::read(path).map_err(|source| IoError::Io { path: path.to_path_buf(), source })?;
-    String::from_utf8(bytes).map_err(|e| {
-        let valid = e.utf8_error().valid_up_to();
-        let line = 1 + e.as_bytes()[..valid].iter().filter(|&&b| b == b'\n').count();
-        IoError::Syntax {
-            file: path.display().to_string(),
-            line,
-            expected: "UTF-8 text".into(),
-            found: format!("invalid byte 0x{:02x}", e.as_bytes()[valid]),
-        }
+    text::utf8(bytes).map_err(|e| IoError::Syntax {
+        file: path.display().to_string(),
+        line: e.line,
+        expected: "UTF-8 text".into(),
+        found: format!("invalid byte 0x{:02x}", e.byte),
     })
 }
 

@@ -247,6 +247,31 @@ mod tests {
         assert!(uc5.contains(",all,4,0.0945,"), "{uc5}");
     }
 
+    /// The committed policy against uniform keys on every 60-frame window of the corpus (the
+    /// bench's protocol): never worse at K = 5, 10, 15.
+    #[test]
+    fn committed_policy_never_loses_to_uniform_keys_on_the_cmu_windows() {
+        use crate::dqn::SidqlPolicy;
+        inbetween_io::data::with_shared_data("SIDQL policy real-data test", |dir| {
+            let corpus = crate::corpus::load(&dir, None).unwrap();
+            let windows: Vec<_> =
+                corpus.clips.iter().flat_map(|c| clip_windows(c, &Protocol::paper()).unwrap()).collect();
+            assert!(windows.len() >= 100, "{} windows", windows.len());
+            let policy = SidqlPolicy::committed().unwrap();
+            let f = |rep: &SphericalMotion, k: usize| policy.select(rep, k);
+            let rows = evaluate("all", &windows, &[Method::Uc, Method::Sidql], &[5, 10, 15], 0, Some(&f)).unwrap();
+            for k in [5, 10, 15] {
+                let get = |m: Method| rows.iter().find(|r| r.method == m && r.k == k).unwrap().mean_angle_error;
+                assert!(
+                    get(Method::Sidql) <= get(Method::Uc),
+                    "K={k}: SIDQL {} vs UC {}",
+                    get(Method::Sidql),
+                    get(Method::Uc)
+                );
+            }
+        });
+    }
+
     #[test]
     fn sources_are_counted_by_name() {
         assert_eq!(describe_sources(&procedural_clips(3, 3)), "3 procedural");

@@ -11,6 +11,6 @@ fn main() {
     let mut rows = inbetween_nn::bench::lstm_throughput(&opts);
     // The same LSTM size stepped by the plain-Rust runtime layers (what camera inference uses).
     let (batch, frames) = if smoke { (2, 8) } else { (opts.batch, opts.frames) };
-    rows.push(inbetween_nn::runtime::lstm_runtime_throughput(opts.hidden, opts.d_input, batch, frames, 3));
+    rows.push(inbetween_nn::bench::lstm_runtime_throughput(opts.hidden, opts.d_input, batch, frames, 3));
     print!("{}", inbetween_nn::bench::table(&rows).to_text());
 }

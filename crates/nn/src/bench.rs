@@ -2,7 +2,8 @@
 //!
 //! [`lstm_throughput`] measures the blocks the engines use: a 256-unit [`FusedLstm`](crate::lstm::FusedLstm) stepping
 //! one trajectory and a batch of trajectories (inference, no autodiff), and a stacked
-//! [`BiLstm`](crate::lstm::BiLstm) forward + backward + Adam step (training). [`table`] lays the rows out.
+//! [`BiLstm`](crate::lstm::BiLstm) forward + backward + Adam step (training);
+//! [`lstm_runtime_throughput`] the same LSTM as plain-Rust [`runtime`] layers. [`table`] lays the rows out.
 
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};
@@ -10,6 +11,7 @@ use burn::tensor::{Device, Distribution, Tensor};
 
 use crate::backend;
 use crate::lstm::{BiLstmConfig, FusedLstmConfig, LstmState};
+use crate::runtime::{self, Dense, Lstm, LstmScratch};
 use inbetween_io::report::{num, Table};
 
 /// One measured quantity.
@@ -153,6 +155,33 @@ pub fn lstm_throughput(opts: &LstmBenchOptions) -> Vec<BenchRow> {
     ]
 }
 
+/// Frames per second of a plain-Rust `hidden`-unit [`Lstm`] (input `d_input`) stepping `batch`
+/// trajectories in lockstep, with a [`Dense`] `hidden → hidden` layer after it (a generator step's
+/// shape); the row for a `bench` table. Weights come from a seeded burn cell.
+pub fn lstm_runtime_throughput(hidden: usize, d_input: usize, batch: usize, frames: usize, repeats: usize) -> BenchRow {
+    let device = crate::backend::cpu();
+    let fused =
+        crate::backend::seeded_module(&device, 0, |d| crate::lstm::FusedLstmConfig::new(d_input, hidden).init(d));
+    let dense = crate::backend::seeded_module(&device, 1, |d| burn::nn::LinearConfig::new(hidden, hidden).init(d));
+    let (lstm, dense) = (Lstm::from_fused(&fused), Dense::from_linear(&dense));
+    let x: Vec<f32> = (0..batch * d_input).map(|i| ((i as f32) * 0.37).sin()).collect();
+    let mut state = runtime::LstmState::zeros(batch, hidden);
+    let mut scratch = LstmScratch::for_rows(&lstm, batch);
+    let mut y = vec![0.0; batch * hidden];
+    let secs = seconds_per_call(1, repeats, || {
+        for _ in 0..frames {
+            lstm.step(&x, &mut state, batch, &mut scratch);
+            dense.forward(&state.h, &mut y, batch);
+        }
+    });
+    BenchRow {
+        name: format!("runtime Lstm {hidden} units + Dense, {batch} trajectories"),
+        value: (frames * batch) as f64 / secs.max(1e-12),
+        unit: "frames/s".into(),
+        detail: format!("{frames} frames each, input {d_input}, plain Rust, one thread, no allocation per step"),
+    }
+}
+
 /// The rows as a report table (`.to_text()` for the terminal).
 pub fn table(rows: &[BenchRow]) -> Table {
     let mut t = Table::new("nn_bench", "nn blocks: throughput", &["case", "value", "unit", "detail"]);
@@ -165,6 +194,13 @@ pub fn table(rows: &[BenchRow]) -> Table {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn throughput_row_is_measured() {
+        let row = lstm_runtime_throughput(8, 4, 2, 5, 1);
+        assert!(row.value.is_finite() && row.value > 0.0, "{row:?}");
+        assert_eq!(row.unit, "frames/s");
+    }
 
     #[test]
     fn bench_runs_on_tiny_sizes_and_formats_a_table() {

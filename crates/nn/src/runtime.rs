@@ -24,7 +24,6 @@
 //! assert_eq!(state.h.len(), 8);
 //! ```
 
-use crate::bench::{seconds_per_call, BenchRow};
 use crate::lstm::FusedLstm;
 use burn::nn::Linear;
 use burn::tensor::Tensor;
@@ -181,33 +180,6 @@ impl Lstm {
                 state.h[r * hd + k] = o * c.tanh();
             }
         }
-    }
-}
-
-/// Frames per second of a plain-Rust `hidden`-unit [`Lstm`] (input `d_input`) stepping `batch`
-/// trajectories in lockstep, with a [`Dense`] `hidden → hidden` layer after it (a generator step's
-/// shape); the row for a `bench` table. Weights come from a seeded burn cell.
-pub fn lstm_runtime_throughput(hidden: usize, d_input: usize, batch: usize, frames: usize, repeats: usize) -> BenchRow {
-    let device = crate::backend::cpu();
-    let fused =
-        crate::backend::seeded_module(&device, 0, |d| crate::lstm::FusedLstmConfig::new(d_input, hidden).init(d));
-    let dense = crate::backend::seeded_module(&device, 1, |d| burn::nn::LinearConfig::new(hidden, hidden).init(d));
-    let (lstm, dense) = (Lstm::from_fused(&fused), Dense::from_linear(&dense));
-    let x: Vec<f32> = (0..batch * d_input).map(|i| ((i as f32) * 0.37).sin()).collect();
-    let mut state = LstmState::zeros(batch, hidden);
-    let mut scratch = LstmScratch::for_rows(&lstm, batch);
-    let mut y = vec![0.0; batch * hidden];
-    let secs = seconds_per_call(1, repeats, || {
-        for _ in 0..frames {
-            lstm.step(&x, &mut state, batch, &mut scratch);
-            dense.forward(&state.h, &mut y, batch);
-        }
-    });
-    BenchRow {
-        name: format!("runtime Lstm {hidden} units + Dense, {batch} trajectories"),
-        value: (frames * batch) as f64 / secs.max(1e-12),
-        unit: "frames/s".into(),
-        detail: format!("{frames} frames each, input {d_input}, plain Rust, one thread, no allocation per step"),
     }
 }
 
@@ -589,13 +561,6 @@ mod tests {
         let mut v = [-2.0f32, 0.0, 3.0];
         leaky_relu(&mut v, 0.01);
         assert_eq!(v, [-0.02, 0.0, 3.0]);
-    }
-
-    #[test]
-    fn throughput_row_is_measured() {
-        let row = lstm_runtime_throughput(8, 4, 2, 5, 1);
-        assert!(row.value.is_finite() && row.value > 0.0, "{row:?}");
-        assert_eq!(row.unit, "frames/s");
     }
 
     #[test]

@@ -293,16 +293,11 @@ fn legend_and_groups<'a>(
 /// Five-number summary (min, lower quartile, median, upper quartile, max) of `values`, with
 /// quartiles by linear interpolation between order statistics. `None` for no finite value.
 pub fn five_numbers(values: &[f64]) -> Option<[f64; 5]> {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    let v = inbetween_core::stats::sorted_finite(values);
     if v.is_empty() {
         return None;
     }
-    v.sort_by(f64::total_cmp);
-    let q = |p: f64| {
-        let pos = p * (v.len() - 1) as f64;
-        let (i, f) = (pos.floor() as usize, pos.fract());
-        v[i] + (v[(i + 1).min(v.len() - 1)] - v[i]) * f
-    };
+    let q = |p: f64| inbetween_core::stats::quantile_sorted(&v, p);
     Some([v[0], q(0.25), q(0.5), q(0.75), v[v.len() - 1]])
 }
 

@@ -3,7 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::bench::edit_one_sentence;
 use crate::compose::ComposeConfig;
 use crate::job::{run_scene, SceneJob};
 use crate::stories;
@@ -63,7 +62,7 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
     let db = crate::database::SceneDatabase::builtin(&cat, crate::job::DEFAULT_VARIATIONS, seed);
     let mut session = crate::session::Session::new(cat, db, ComposeConfig { seed, ..ComposeConfig::default() });
     session.update(stories::DEMO);
-    let edit = session.update(&edit_one_sentence(stories::DEMO));
+    let edit = session.update(&stories::edit_one_sentence(stories::DEMO));
     lines.push(format!(
         "script: after editing one sentence, {} objects kept their places and {} were placed anew in {:.1} ms",
         edit.kept,

@@ -62,6 +62,24 @@ pub struct SceneReport {
     pub seconds: f64,
 }
 
+impl SceneReport {
+    /// The one line a front end prints for the scene: objects, room, match score, violations, time.
+    pub fn summary(&self, source: &Path) -> String {
+        let scene = &self.composition.scene;
+        format!(
+            "{}: {} objects in a {:.1} m × {:.1} m {} (match score {:.2}, {} violations) in {:.1} ms",
+            source.display(),
+            scene.objects.len(),
+            scene.room.width,
+            scene.room.depth,
+            scene.room.name,
+            self.composition.match_score,
+            self.composition.violations.total(),
+            self.seconds * 1e3
+        )
+    }
+}
+
 /// The catalogue, with Kenney models when a folder is given.
 pub fn catalogue(models: Option<&Path>) -> Result<Catalogue, ScriptError> {
     let cat = builtin();
@@ -71,14 +89,29 @@ pub fn catalogue(models: Option<&Path>) -> Result<Catalogue, ScriptError> {
     }
 }
 
+/// A script named on a command line: `builtin:NAME` for a built-in one ([`crate::stories::all`]),
+/// else a file ([`read_script`]); with the name messages use for it.
+pub fn load_script(script: &str) -> Result<(String, PathBuf), ScriptError> {
+    if let Some(name) = script.strip_prefix("builtin:") {
+        let all = crate::stories::all();
+        let Some((_, text)) = all.iter().find(|(n, _)| *n == name) else {
+            let names: Vec<&str> = all.iter().map(|(n, _)| *n).collect();
+            return Err(ScriptError::Invalid(format!("no built-in script '{name}'; there are: {}", names.join(", "))));
+        };
+        return Ok((text.to_string(), PathBuf::from(script)));
+    }
+    let path = Path::new(script);
+    Ok((read_script(path)?, path.to_path_buf()))
+}
+
 /// Reads a script file: UTF-8 text with at least one sentence.
 pub fn read_script(path: &Path) -> Result<String, ScriptError> {
     let bytes = std::fs::read(path).map_err(|e| ScriptError::io(path, e))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
+    let text = inbetween_io::text::utf8(bytes).map_err(|e| {
         ScriptError::Invalid(format!(
             "{}: not UTF-8 text (byte {} is invalid); save the script as plain UTF-8",
             path.display(),
-            e.utf8_error().valid_up_to()
+            e.offset
         ))
     })?;
     if crate::script::split(&text).is_empty() {
@@ -186,6 +219,37 @@ pub struct RunReport {
     pub kept_characters: Vec<String>,
     /// Objects the optimisation could move in this run (the others kept their places).
     pub resolved_objects: Vec<String>,
+}
+
+impl RunReport {
+    /// The lines a front end prints for the run: objects, characters, frames, time and the
+    /// optimisation's costs before and after; after an edit (`watch`), what was solved again.
+    pub fn summary(&self, source: &Path) -> Vec<String> {
+        let (a, frames) = (&self.animation, self.animation.frames());
+        let mut lines = vec![format!(
+            "{}: {} objects, {} characters, {frames} frames ({:.1} s at {:.0} fps) in {:.2} s; collided boxes {} -> {}, mean contact distance {:.3} m -> {:.3} m",
+            source.display(),
+            a.scene.objects.len(),
+            a.characters.len(),
+            frames as f64 / a.fps,
+            a.fps,
+            self.seconds,
+            self.before.collided_boxes,
+            self.after.collided_boxes,
+            self.before.contact,
+            self.after.contact
+        )];
+        if !self.full {
+            let list = |v: &[String]| if v.is_empty() { "none".to_string() } else { v.join(", ") };
+            lines.push(format!(
+                "  edit re-solved characters: {} (kept as they were: {}); objects re-optimised: {}",
+                list(&self.resolved_characters),
+                list(&self.kept_characters),
+                list(&self.resolved_objects)
+            ));
+        }
+        lines
+    }
 }
 
 /// A story session for a job (see [`StorySession`]): its catalogue, the scene database, the

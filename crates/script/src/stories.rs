@@ -260,6 +260,26 @@ pub fn random_story(seed: u64) -> String {
     lines.join("\n") + "\n"
 }
 
+/// The story with one object added to its first scene sentence ("… near a bookshelf$" →
+/// "… near a bookshelf and a plant$"), the kind of edit users make while iterating.
+pub fn edit_one_sentence(text: &str) -> String {
+    let mut done = false;
+    let mut lines: Vec<String> = Vec::new();
+    for line in text.lines() {
+        match line.find('$') {
+            Some(i) if !done && !line.trim_start().starts_with('#') => {
+                lines.push(format!("{} and a plant{}", &line[..i], &line[i..]));
+                done = true;
+            }
+            _ => lines.push(line.to_string()),
+        }
+    }
+    if !done {
+        lines.push("There is a plant$".into());
+    }
+    lines.join("\n") + "\n"
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

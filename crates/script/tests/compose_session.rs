@@ -174,7 +174,7 @@ fn the_per_scene_figure_texts_are_the_captions_lines() {
 fn the_bench_edit_changes_exactly_one_sentence_of_the_demo() {
     let mut s = session();
     s.update(stories::DEMO);
-    let u = s.update(&inbetween_script::bench::edit_one_sentence(stories::DEMO));
+    let u = s.update(&inbetween_script::stories::edit_one_sentence(stories::DEMO));
     assert_eq!(u.changed_sentences.len(), 1);
     assert!(u
         .composition

@@ -15,12 +15,14 @@ use inbetween_io::Progress;
 use rand::Rng;
 
 use super::plausibility::{self, window_features, GapStats};
-use super::{guide_for, Library, NetworkSet, PLAUSIBILITY_GAPS_S, TEST_FILES, TRAIN_FILES};
+use super::{guide_for, Library, PLAUSIBILITY_GAPS_S};
+use crate::data::split::{TEST_FILES, TRAIN_FILES};
 use crate::data::{read_live_link, BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT};
 use crate::edit::{ConstraintKind, Frame, Mask, MotionLibrary, RetrievalOptions, Segment};
 use crate::infer::plan::viseme_runs;
 use crate::infer::{EditJob, Guide, Method};
 use crate::visemes::text_to_phonemes;
+use crate::weights::NetworkSet;
 
 /// Words spoken in the text edits (a span of `s` seconds speaks the first `2.5·s` of them, at
 /// least two).

@@ -15,6 +15,7 @@
 pub mod bezier;
 pub mod loco;
 pub mod plausibility;
+pub mod timing;
 
 use std::path::{Path, PathBuf};
 
@@ -23,45 +24,18 @@ use inbetween_io::report::{num, seconds_per_call, Report, Table};
 use inbetween_io::Progress;
 use rand::Rng;
 
+use crate::data::split::{TEST_FILES, TRAIN_FILES};
 use crate::data::{read_live_link, BlendshapeClip, FaceError, ARKIT_NAMES, MODEL_FPS, NUM_ARKIT};
 use crate::edit::constraints::{noisy_guide, sample_keyframes, TrackerNoise};
 use crate::edit::distances::{distances, DISTANCE_NAMES, NUM_DISTANCES};
 use crate::edit::{ConstraintKind, Frame, Mask, MotionLibrary, RetrievalOptions, Segment};
-use crate::infer::{EditJob, Guide, Inpainter, KeyPose, Method};
+use crate::infer::{EditJob, Guide, KeyPose, Method};
 use crate::procedural;
 use crate::visemes::Viseme;
-
-/// Held-out capture files (relative to `face/neurosync/`): one file of each emotion that has two or
-/// more takes, so every emotion is still seen in training.
-pub const TEST_FILES: [&str; 2] =
-    ["livelink/Fearful/MySlate_162_iPhone_cal.csv", "livelink/Sad/MySlate_168_iPhone_cal.csv"];
-
-/// Training capture files: every Live Link capture not in [`TEST_FILES`].
-pub const TRAIN_FILES: [&str; 6] = [
-    "livelink/Angry/MySlate_164_iPhone_cal.csv",
-    "livelink/Angry/MySlate_165_iPhone_cal.csv",
-    "livelink/Angry/MySlate_166_iPhone_cal.csv",
-    "livelink/Fearful/MySlate_161_iPhone_cal.csv",
-    "livelink/Happy/Happy.csv",
-    "livelink/Sad/MySlate_167_iPhone_cal.csv",
-];
+use crate::weights::NetworkSet;
 
 /// Gap lengths of the held-out evaluation, seconds.
 pub const GAPS_S: [f64; 4] = [0.5, 1.0, 2.0, 3.0];
-
-/// A set of trained networks (one per constraint type) under one label.
-pub struct NetworkSet {
-    /// Label in the tables ("procedural", "real").
-    pub label: String,
-    /// The networks.
-    pub nets: Vec<Box<dyn Inpainter>>,
-}
-
-impl NetworkSet {
-    fn get(&self, kind: ConstraintKind) -> Option<&dyn Inpainter> {
-        self.nets.iter().find(|n| n.kind() == kind).map(|n| n.as_ref())
-    }
-}
 
 /// What to run.
 pub struct FaceBenchConfig {
@@ -145,13 +119,6 @@ impl Acc {
     }
 }
 
-/// A 25 fps clip of the given frames (times from 0).
-pub fn clip_of(frames: &[Frame]) -> BlendshapeClip {
-    let times = (0..frames.len()).map(|f| f as f64 / MODEL_FPS).collect();
-    BlendshapeClip::new(MODEL_FPS, times, false, vec![], frames.iter().flatten().copied().collect())
-        .expect("frames make a valid clip")
-}
-
 /// The guide a test edit gets, drawn from the truth.
 fn guide_for(kind: ConstraintKind, truth: &[Frame], mask: &Mask, visemes: Option<&[Viseme]>, seed: u64) -> Guide {
     let mut r = rng(seed);
@@ -163,7 +130,9 @@ fn guide_for(kind: ConstraintKind, truth: &[Frame], mask: &Mask, visemes: Option
                 .map(|(f, k)| KeyPose { time_s: f as f64 / MODEL_FPS, shapes: k.iter().copied().enumerate().collect() })
                 .collect(),
         ),
-        ConstraintKind::Noisy => Guide::Noisy(clip_of(&noisy_guide(&mut r, truth, &TrackerNoise::default()))),
+        ConstraintKind::Noisy => {
+            Guide::Noisy(BlendshapeClip::from_model_frames(&noisy_guide(&mut r, truth, &TrackerNoise::default())))
+        }
         ConstraintKind::Visemes => Guide::Visemes(viseme_runs(visemes.expect("viseme labels"))),
     }
 }
@@ -491,7 +460,7 @@ fn plausibility_tables(
         // Table 4 protocol: whole 10 s windows masked, guidance only.
         let window = (10.0 * MODEL_FPS) as usize;
         for (w, chunk) in truth.chunks_exact(window).enumerate() {
-            let wclip = clip_of(chunk);
+            let wclip = BlendshapeClip::from_model_frames(chunk);
             let mask = Mask::all(chunk.len());
             let seg = Segment { start: 0, end: chunk.len() };
             let s = derive(derive(cfg.seed, 800 + ci as u64), w as u64);
@@ -600,7 +569,7 @@ fn table4(
         let all = truth_clip.arkit_frames();
         for (w, chunk) in all.chunks_exact(window).enumerate() {
             let truth = chunk.to_vec();
-            let clip = clip_of(&truth);
+            let clip = BlendshapeClip::from_model_frames(&truth);
             let mask = Mask::all(truth.len());
             let labels = visemes.map(|v| &v[w * window..(w + 1) * window]);
             let guide = guide_for(kind, &truth, &mask, labels, derive(s, w as u64));

@@ -24,6 +24,15 @@ pub struct BlendshapeClip {
 }
 
 impl BlendshapeClip {
+    /// A clip of ARKit frames at the model's rate ([`super::MODEL_FPS`], times from 0): what the
+    /// networks and the generators produce. Panics on no frame or a non-finite weight.
+    pub fn from_model_frames(frames: &[[f32; NUM_ARKIT]]) -> Self {
+        let fps = super::MODEL_FPS;
+        let times = (0..frames.len()).map(|f| f as f64 / fps).collect();
+        Self::new(fps, times, false, vec![], frames.iter().flatten().copied().collect())
+            .expect("frames make a valid clip")
+    }
+
     /// Builds a clip from frame-major values (`times.len() * num_channels` of them, channels in the
     /// layout above) and checks every invariant.
     pub fn new(

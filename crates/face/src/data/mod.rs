@@ -17,6 +17,7 @@ pub mod curves;
 pub mod livelink;
 mod names;
 mod resample;
+pub mod split;
 pub(crate) mod text;
 
 pub use crate::error::{Column, FaceError};

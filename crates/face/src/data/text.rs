@@ -9,12 +9,9 @@ use std::path::Path;
 pub(crate) fn read_text(path: &Path) -> Result<String, FaceError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| FaceError::Io { file: file.clone(), source })?;
-    String::from_utf8(bytes).map_err(|e| FaceError::File {
+    inbetween_io::text::utf8(bytes).map_err(|e| FaceError::File {
         file,
-        message: format!(
-            "not UTF-8 text (invalid byte at offset {}); expected a text file",
-            e.utf8_error().valid_up_to()
-        ),
+        message: format!("not UTF-8 text (invalid byte at offset {}); expected a text file", e.offset),
     })
 }
 

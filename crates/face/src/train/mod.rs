@@ -1,6 +1,7 @@
 //! Training one face network (§3.3): the losses ([`losses`]), batches ([`data`]) and the GAN
 //! objective ([`objective`]) on the shared training loop, with checkpoints, bit-identical resume,
-//! a time limit and progress; [`save_face_weights`] writes the generator with its card.
+//! a time limit and progress; [`save_face_weights`] writes the generator with its card. [`TrainJob`]
+//! trains a set of networks the way `inbetween face train` does.
 //!
 //! ```no_run
 //! use inbetween_face::edit::ConstraintKind;
@@ -13,6 +14,7 @@
 //! ```
 
 pub mod data;
+pub mod job;
 pub mod losses;
 pub mod objective;
 
@@ -34,6 +36,7 @@ use crate::edit::ConstraintKind;
 use crate::model::generator::{FaceWeightsConfig, Generator, GeneratorConfig, WEIGHTS_FORMAT, WEIGHTS_KIND};
 
 pub use data::{ClipPool, TrainClip};
+pub use job::{TrainData, TrainJob, TrainReport};
 pub use losses::LossWeights;
 pub use objective::EpochLosses;
 
@@ -181,6 +184,9 @@ pub enum TrainError {
     /// The training loop, a checkpoint or a weights file failed.
     #[error(transparent)]
     Nn(#[from] NnError),
+    /// The clips could not be read, or the output refused ([`TrainJob`]).
+    #[error(transparent)]
+    Data(#[from] crate::data::FaceError),
 }
 
 /// What a run did.

@@ -131,11 +131,11 @@ pub fn decode_text(bytes: &[u8], file: &str) -> Result<String, FaceError> {
         [0xFE, 0xFF, rest @ ..] => utf16(rest, true),
         _ => {
             let bytes = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
-            String::from_utf8(bytes.to_vec()).map_err(|e| FaceError::File {
+            inbetween_io::text::utf8(bytes.to_vec()).map_err(|e| FaceError::File {
                 file: file.into(),
                 message: format!(
                     "not UTF-8 text (invalid byte at offset {}); expected UTF-8, or UTF-16 with a byte-order mark",
-                    e.utf8_error().valid_up_to()
+                    e.offset
                 ),
             })
         }

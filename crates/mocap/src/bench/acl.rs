@@ -249,7 +249,7 @@ pub fn measure(cfg: &AclConfig, progress: &Progress) -> Result<AclResults> {
                 raw_bytes: raw,
                 bytes: rs.iter().map(|r| r.bytes).sum(),
                 max_error_cm: rs.iter().map(|r| r.errors_max).fold(0.0, f64::max),
-                p99_error_cm: v3_encode::percentile(&mut errors, 0.99),
+                p99_error_cm: inbetween_core::stats::percentile(&mut errors, 0.99),
                 compress_mb_s: mb / secs(|r| r.compress_s).max(1e-12),
                 decompress_mb_s: if timed { mb / secs(|r| r.decompress_s).max(1e-12) } else { f64::NAN },
                 pose_us: if timed { seeks * 1e6 } else { f64::NAN },

@@ -32,6 +32,14 @@ pub enum PolicyChoice {
     Train { episodes: usize, output: PathBuf },
 }
 
+impl PolicyChoice {
+    /// Train here with this many fine-tuning epochs and save the policy where `mocap train` does
+    /// ([`crate::dqn::DEFAULT_POLICY_PATH`]).
+    pub fn train(episodes: usize) -> PolicyChoice {
+        PolicyChoice::Train { episodes, output: PathBuf::from(crate::dqn::DEFAULT_POLICY_PATH) }
+    }
+}
+
 /// The take-level k-fold: takes dealt into `folds` groups (seeded shuffle); for each, a policy
 /// is trained on the other groups' takes (windows at `stride`) with `train` and scored on the
 /// group's windows.

@@ -5,11 +5,13 @@
 
 use super::v3_encode::{self, Format};
 use super::{Budget, Compressed, IbkFile, RAW_BYTES_PER_BONE};
-use crate::{MocapError, Result};
+use crate::{MocapError, PositionError, Result};
 use inbetween_core::cancel::Cancel;
+use inbetween_core::positions_clip;
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::Motion;
 use inbetween_io::Progress;
+use inbetween_render::StickOptions;
 use serde::Serialize;
 use std::fmt;
 
@@ -224,6 +226,27 @@ impl DecompressJob {
             motion,
             file,
         })
+    }
+}
+
+impl DecompressReport {
+    /// `original` and the clip rebuilt from this file's stored poses, overlaid in one GIF at `path`,
+    /// titled with the joints' position error of the rebuilt clip (cm, through `unit`); returns it.
+    pub fn preview_gif(
+        &self,
+        original: &Motion,
+        unit: &UnitChoice,
+        path: &std::path::Path,
+    ) -> std::result::Result<PositionError, inbetween_render::RenderError> {
+        let keys = self.stored_poses;
+        let e = PositionError::between(&positions_clip(original), &positions_clip(&self.motion), unit.cm_per_unit());
+        let opts = StickOptions {
+            labels: vec!["original".into(), format!("from {keys} keys")],
+            title: Some(format!("{keys} keys: {e}")),
+            ..StickOptions::default()
+        };
+        inbetween_render::render_motion_gif(path, &[original, &self.motion], &opts)?;
+        Ok(e)
     }
 }
 

@@ -161,17 +161,8 @@ pub fn compress_in(motion: &Motion, unit: UnitChoice, opts: &Options) -> Result<
             opts.bound_cm
         )));
     }
-    let p99_error_cm = percentile(&mut errors.clone(), 0.99);
+    let p99_error_cm = inbetween_core::stats::percentile(&mut errors.clone(), 0.99);
     Ok(Compressed { bytes, quantised: decoded, max_error_cm, p99_error_cm, errors_cm: errors, unit })
-}
-
-/// The `p` quantile (nearest rank) of `v` (reordered).
-pub fn percentile(v: &mut [f64], p: f64) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let i = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
-    *v.select_nth_unstable_by(i, f64::total_cmp).1
 }
 
 /// Virtual-vertex errors (file units) of `decoded` against `source`, one per joint and frame:

@@ -253,31 +253,6 @@ mod tests {
         assert!(refined_better > 0, "refinement moved no key on 8 windows");
     }
 
-    /// The committed policy against uniform keys on every 60-frame window of the corpus (the
-    /// bench's protocol): never worse at K = 5, 10, 15.
-    #[test]
-    fn committed_policy_never_loses_to_uniform_keys_on_the_cmu_windows() {
-        use crate::bench::{clip_windows, evaluate, Method, Protocol};
-        inbetween_io::data::with_shared_data("SIDQL policy real-data test", |dir| {
-            let corpus = crate::corpus::load(&dir, None).unwrap();
-            let windows: Vec<_> =
-                corpus.clips.iter().flat_map(|c| clip_windows(c, &Protocol::paper()).unwrap()).collect();
-            assert!(windows.len() >= 100, "{} windows", windows.len());
-            let policy = SidqlPolicy::committed().unwrap();
-            let f = |rep: &SphericalMotion, k: usize| policy.select(rep, k);
-            let rows = evaluate("all", &windows, &[Method::Uc, Method::Sidql], &[5, 10, 15], 0, Some(&f)).unwrap();
-            for k in [5, 10, 15] {
-                let get = |m: Method| rows.iter().find(|r| r.method == m && r.k == k).unwrap().mean_angle_error;
-                assert!(
-                    get(Method::Sidql) <= get(Method::Uc),
-                    "K={k}: SIDQL {} vs UC {}",
-                    get(Method::Sidql),
-                    get(Method::Uc)
-                );
-            }
-        });
-    }
-
     #[test]
     fn a_file_of_another_model_is_refused_by_name() {
         let dir = tempfile::tempdir().unwrap();

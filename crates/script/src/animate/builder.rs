@@ -8,9 +8,9 @@ use inbetween_core::fk::forward;
 use inbetween_core::motion::interpolate_pose;
 use inbetween_core::Pose;
 
-use super::action::walk::WalkCache;
-use super::plan::Ctx;
-use super::{CarriedProp, JointContact, Segment, WalkChoice, WalkInfo};
+use super::context::Ctx;
+use super::routes::{WalkCache, WalkChoice, WalkInfo};
+use super::{CarriedProp, JointContact, Segment};
 use crate::layout::grid::Grid;
 use crate::motion::ik::{ground_feet, solve_limb, Limb};
 use crate::motion::locomotion::place_clip;
@@ -227,5 +227,5 @@ pub(crate) fn placed(clip: &Clip, at: [f32; 2], heading: f64) -> Vec<Pose> {
 }
 
 /// Why the motion helpers cannot fail on the builder's clips (they are built on, or filtered to,
-/// [`super::plan::Ctx::rig`]).
+/// [`super::context::Ctx::rig`]).
 pub(crate) const ON_RIG: &str = "the builder's clips are on the common rig";

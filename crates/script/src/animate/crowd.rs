@@ -1,7 +1,7 @@
 //! Several characters in one room (beyond the paper, which animates its characters one by one):
 //! prioritised planning with a space-time reservation of every character's root.
 //!
-//! Every character is first built on its own timeline ([`super::plan::build_character`]). Each
+//! Every character is first built on its own timeline ([`super::character::build_character`]). Each
 //! character's reservation is its root (x, z) at every frame, held at its last position after its
 //! timeline ends, so standing, sitting and acting in place reserve space as much as walking.
 //! [`separate`] then repairs the earliest frame where two roots come closer than
@@ -10,14 +10,15 @@
 //! frames), takes a detour around the others' standing spots (A* on its grid with those spots
 //! blocked), or both, the earliest arrival that keeps the distance from the start of that wait
 //! until its next walk starts (or, after its last walk, for good). The character is rebuilt with
-//! that choice from the action that makes the changed walk on ([`super::plan::rebuild`]: the
+//! that choice from the action that makes the changed walk on ([`super::character::rebuild`]: the
 //! timeline before it is kept, so a repair costs the rest of the story, not all of it) and the next
 //! conflict is repaired; each repair clears every frame up to the end of
 //! its window, so the loop ends. A conflict no choice solves (a character standing where another
 //! must go) stays, and a note gives the pair, the frame and the distance.
 
-use super::action::walk::{route, WalkCache};
-use super::plan::{rebuild, CharacterInput, CharacterPlan, Ctx};
+use super::character::{rebuild, CharacterInput, CharacterPlan};
+use super::context::Ctx;
+use super::routes::{route, WalkCache, WalkChoice};
 use super::{Animation, PASSING_DISTANCE};
 use crate::motion::rig::{Rig, FPS};
 use crate::motion::WalkParams;
@@ -32,25 +33,6 @@ const WAIT_STEP: usize = 10;
 /// Extra margin around another character's standing spot when searching a detour, metres (the
 /// walk cuts corners of the grid route a little).
 const DETOUR_MARGIN: f32 = 0.15;
-
-/// How one walk of a timeline is made: wait `wait` frames in place first, then follow `route`
-/// (None: the A* route on the character's grid).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub(crate) struct WalkChoice {
-    pub wait: usize,
-    pub route: Option<Vec<[f32; 2]>>,
-}
-
-/// One walk as built: frames `[wait_start, walk_start)` wait, `[walk_start, end)` walk.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct WalkInfo {
-    pub wait_start: usize,
-    pub walk_start: usize,
-    pub end: usize,
-    /// The route walked (its first point is where the character stood).
-    pub route: Vec<[f32; 2]>,
-    pub params: WalkParams,
-}
 
 /// The closest two characters' roots come over an animation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -223,13 +205,7 @@ fn walk_roots(ctx: &Ctx, cache: &mut WalkCache, route: &[[f32; 2]], params: &Wal
 
 /// New walk choices for character `x` that clear its conflict at frame `f` (see the module
 /// comment), or None when no wait up to [`MAX_WAIT`] and no detour does.
-fn improve(
-    ctx: &Ctx,
-    plans: &[CharacterPlan],
-    x: usize,
-    f: usize,
-    cache: &mut WalkCache,
-) -> Option<Vec<super::WalkChoice>> {
+fn improve(ctx: &Ctx, plans: &[CharacterPlan], x: usize, f: usize, cache: &mut WalkCache) -> Option<Vec<WalkChoice>> {
     let p = &plans[x];
     // Standing where it started, before its first walk: only the other character can move.
     let w = p.walks.iter().rposition(|w| w.wait_start <= f)?;
@@ -285,7 +261,7 @@ fn improve(
     };
     // The earliest arrival that clears the whole window; else the change whose first close
     // pass comes latest, when that is past the current one.
-    let mut partial: Option<(usize, super::WalkChoice)> = None;
+    let mut partial: Option<(usize, WalkChoice)> = None;
     for extra in (0..=MAX_WAIT).step_by(WAIT_STEP) {
         let d = cur.wait + extra;
         let mut options: Vec<(Route, &[[f32; 2]])> = Vec::new();
@@ -296,7 +272,7 @@ fn improve(
             options.push((Some(r.clone()), roots.as_slice()));
         }
         for (route, roots) in options {
-            let choice = super::WalkChoice { wait: d, route };
+            let choice = WalkChoice { wait: d, route };
             match first_close(d, roots) {
                 None => return Some(with_choice(p, w, choice)),
                 // A partial clear only when it gains at least a second and the plan stays short
@@ -316,10 +292,10 @@ fn improve(
 }
 
 /// `p`'s walk choices with walk `w`'s replaced.
-fn with_choice(p: &CharacterPlan, w: usize, c: super::WalkChoice) -> Vec<super::WalkChoice> {
+fn with_choice(p: &CharacterPlan, w: usize, c: WalkChoice) -> Vec<WalkChoice> {
     let mut all = p.input.choices.clone();
     if all.len() <= w {
-        all.resize(w + 1, super::WalkChoice::default());
+        all.resize(w + 1, WalkChoice::default());
     }
     all[w] = c;
     all

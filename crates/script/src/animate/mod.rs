@@ -43,18 +43,22 @@
 pub(crate) mod action;
 pub(crate) mod builder;
 pub(crate) mod camera;
+pub(crate) mod character;
+pub(crate) mod context;
 pub mod crowd;
 pub(crate) mod plan;
 mod props;
+pub(crate) mod routes;
 pub(crate) mod spots;
 
 pub use action::sit::GRIP_ABOVE;
-pub(crate) use action::walk::WalkCache;
 pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
+pub(crate) use character::{Actions, CharacterPlan};
+pub(crate) use context::Setup;
 pub use crowd::{min_clearance, Clearance};
-pub(crate) use crowd::{WalkChoice, WalkInfo};
-pub(crate) use plan::{animate_planned, characters, Actions, CharacterPlan, Setup};
+pub(crate) use plan::{animate_planned, characters};
 pub use props::{carried_from, moves, object_pose, slide_offset, CarriedProp, PutDown, Slide};
+pub(crate) use routes::WalkCache;
 
 use std::collections::HashMap;
 

@@ -149,9 +149,10 @@ enum Face {
     Same,
 }
 
-/// A candidate pose for one item.
+/// A candidate placement of one item: where it stands, how it is turned, what it rests on, and the
+/// penalty of the candidate rule that proposed it.
 #[derive(Debug, Clone, Copy)]
-struct Pose {
+struct Placement {
     position: [f32; 3],
     yaw: f32,
     /// Item index it rests on.
@@ -269,7 +270,7 @@ impl<'a, R: Rng> Solver<'a, R> {
         }
     }
 
-    fn object(&self, i: usize, pose: &Pose) -> PlacedObject {
+    fn object(&self, i: usize, pose: &Placement) -> PlacedObject {
         let it = &self.p.items[i];
         PlacedObject {
             label: it.label.clone(),
@@ -317,7 +318,7 @@ impl<'a, R: Rng> Solver<'a, R> {
         }
         if let Some((position, yaw)) = item.pinned {
             let support = self.support_at(i, position, yaw);
-            self.poses[i] = Some(self.object(i, &Pose { position, yaw, support, penalty: 0.0 }));
+            self.poses[i] = Some(self.object(i, &Placement { position, yaw, support, penalty: 0.0 }));
             return;
         }
         let live = self.live_relations(i);
@@ -454,7 +455,7 @@ impl<'a, R: Rng> Solver<'a, R> {
             return None;
         }
         let probe =
-            PlacedObject { position, yaw, ..self.object(i, &Pose { position, yaw, support: None, penalty: 0.0 }) };
+            PlacedObject { position, yaw, ..self.object(i, &Placement { position, yaw, support: None, penalty: 0.0 }) };
         self.poses
             .iter()
             .enumerate()
@@ -463,7 +464,7 @@ impl<'a, R: Rng> Solver<'a, R> {
             .map(|(j, _)| j)
     }
 
-    fn candidates(&mut self, i: usize, live: &[LayoutConstraint]) -> Vec<Pose> {
+    fn candidates(&mut self, i: usize, live: &[LayoutConstraint]) -> Vec<Placement> {
         let item = &self.p.items[i];
         let mut out = Vec::new();
         if let Some(h) = item.hint.clone() {
@@ -479,14 +480,14 @@ impl<'a, R: Rng> Solver<'a, R> {
                 let support = self.support_at(i, position, h.yaw);
                 if self.rests(i, position, h.yaw, support) {
                     let penalty = if k == 0 { -1.0 } else { 2.0 * (d[0].hypot(d[1])) };
-                    out.push(Pose { position, yaw: h.yaw, support, penalty });
+                    out.push(Placement { position, yaw: h.yaw, support, penalty });
                     // The same place turned to whatever the item stands in front of.
                     let faces =
                         live.iter().filter(|c| c.active == i && c.relation == Relation::InFrontOf && self.faces(i));
                     for c in faces {
                         let Some(a) = &self.poses[c.anchor] else { continue };
                         let face = (a.position[0] - position[0]).atan2(a.position[2] - position[2]);
-                        out.push(Pose { position, yaw: face, support, penalty: penalty + 0.5 });
+                        out.push(Placement { position, yaw: face, support, penalty: penalty + 0.5 });
                     }
                 }
             }
@@ -540,7 +541,7 @@ impl<'a, R: Rng> Solver<'a, R> {
                 for _ in 0..24 {
                     let pose = self.random_floor_pose(i);
                     let y = (self.p.room.height - item.size[1]).max(0.0);
-                    out.push(Pose { position: [pose.position[0], y, pose.position[2]], ..pose });
+                    out.push(Placement { position: [pose.position[0], y, pose.position[2]], ..pose });
                 }
             }
         }
@@ -554,11 +555,11 @@ impl<'a, R: Rng> Solver<'a, R> {
         // A seat the script puts in front of something may stand anywhere it fits, turned to it.
         if let Some(a) = live.iter().find(|c| c.active == i && c.relation == Relation::InFrontOf && self.faces(i)) {
             if let Some(anchor) = &self.poses[a.anchor] {
-                let turned: Vec<Pose> = out
+                let turned: Vec<Placement> = out
                     .iter()
                     .map(|p| {
                         let face = (anchor.position[0] - p.position[0]).atan2(anchor.position[2] - p.position[2]);
-                        Pose { yaw: face, penalty: p.penalty + 0.5, ..*p }
+                        Placement { yaw: face, penalty: p.penalty + 0.5, ..*p }
                     })
                     .collect();
                 out.extend(turned);
@@ -591,8 +592,11 @@ impl<'a, R: Rng> Solver<'a, R> {
         match it.support {
             Support::Floor | Support::Surface => position[1].abs() <= EPS,
             Support::Wall => {
-                let probe =
-                    PlacedObject { position, yaw, ..self.object(i, &Pose { position, yaw, support, penalty: 0.0 }) };
+                let probe = PlacedObject {
+                    position,
+                    yaw,
+                    ..self.object(i, &Placement { position, yaw, support, penalty: 0.0 })
+                };
                 let [hx, hz] = probe.half_extents_xz();
                 let [x, _, z] = position;
                 position[1] > 0.0 && [x - hx, r.width - x - hx, z - hz, r.depth - z - hz].iter().any(|g| g.abs() <= EPS)
@@ -612,7 +616,7 @@ impl<'a, R: Rng> Solver<'a, R> {
     }
 
     /// Poses with the item's back against each wall, facing into the room, at base height `y`.
-    fn wall_candidates(&mut self, i: usize, y: f32, per_wall: usize, penalty: f32, out: &mut Vec<Pose>) {
+    fn wall_candidates(&mut self, i: usize, y: f32, per_wall: usize, penalty: f32, out: &mut Vec<Placement>) {
         let [w, _, d] = self.p.items[i].size;
         let r = &self.p.room;
         // (yaw, wall length, along → world x/z)
@@ -635,13 +639,13 @@ impl<'a, R: Rng> Solver<'a, R> {
                     2 => (d / 2.0, t),
                     _ => (r.width - d / 2.0, t),
                 };
-                out.push(Pose { position: [x, y, z], yaw, support: None, penalty });
+                out.push(Placement { position: [x, y, z], yaw, support: None, penalty });
             }
         }
     }
 
     /// A random floor pose facing one of the four axes (turned towards the room centre).
-    fn random_floor_pose(&mut self, i: usize) -> Pose {
+    fn random_floor_pose(&mut self, i: usize) -> Placement {
         let r = &self.p.room;
         let [w, _, d] = self.p.items[i].size;
         let m = w.max(d) / 2.0;
@@ -659,11 +663,11 @@ impl<'a, R: Rng> Solver<'a, R> {
         } else {
             HALF
         };
-        Pose { position: [x, 0.0, z], yaw, support: None, penalty: 0.0 }
+        Placement { position: [x, 0.0, z], yaw, support: None, penalty: 0.0 }
     }
 
     /// Random interior poses; `wall_weight` per metre between the item's back and the nearest wall.
-    fn interior_candidates(&mut self, i: usize, n: usize, wall_weight: f32, out: &mut Vec<Pose>) {
+    fn interior_candidates(&mut self, i: usize, n: usize, wall_weight: f32, out: &mut Vec<Placement>) {
         for _ in 0..n {
             let mut p = self.random_floor_pose(i);
             p.penalty += wall_weight * self.back_gap(i, &p);
@@ -672,7 +676,7 @@ impl<'a, R: Rng> Solver<'a, R> {
     }
 
     /// Distance from the item's back to the wall behind it.
-    fn back_gap(&self, i: usize, p: &Pose) -> f32 {
+    fn back_gap(&self, i: usize, p: &Placement) -> f32 {
         let r = &self.p.room;
         let d = self.p.items[i].size[2] / 2.0;
         let f = geom::forward(p.yaw);
@@ -692,7 +696,7 @@ impl<'a, R: Rng> Solver<'a, R> {
     }
 
     /// Poses on top of placed surface items, where the footprint fits.
-    fn surface_candidates(&mut self, i: usize, per_surface: usize, out: &mut Vec<Pose>) {
+    fn surface_candidates(&mut self, i: usize, per_surface: usize, out: &mut Vec<Placement>) {
         let [w, _, d] = self.p.items[i].size;
         let surfaces: Vec<(usize, PlacedObject)> = self
             .poses
@@ -705,7 +709,7 @@ impl<'a, R: Rng> Solver<'a, R> {
             for _ in 0..per_surface {
                 let l = [self.random_within(s.size[0], w), self.random_within(s.size[2], d)];
                 let c = geom::to_world(geom::center(&s), s.yaw, l);
-                out.push(Pose { position: [c[0], s.top(), c[1]], yaw: s.yaw, support: Some(j), penalty: 0.0 });
+                out.push(Placement { position: [c[0], s.top(), c[1]], yaw: s.yaw, support: Some(j), penalty: 0.0 });
             }
         }
     }
@@ -722,7 +726,7 @@ impl<'a, R: Rng> Solver<'a, R> {
 
     /// Poses beside `other` on all four sides at a few gaps and the four yaws (for relations whose
     /// other end is already placed, scored by the relation test).
-    fn around(&mut self, i: usize, other: &PlacedObject, out: &mut Vec<Pose>) {
+    fn around(&mut self, i: usize, other: &PlacedObject, out: &mut Vec<Placement>) {
         let [w, _, d] = self.p.items[i].size;
         let y = self.rest_height(i);
         let (ow, od) = (other.size[0] / 2.0, other.size[2] / 2.0);
@@ -738,14 +742,21 @@ impl<'a, R: Rng> Solver<'a, R> {
                     [-(ow + h[0] + gap), 0.0],
                 ] {
                     let p = geom::to_world(geom::center(other), other.yaw, l);
-                    out.push(Pose { position: [p[0], y, p[1]], yaw, support: None, penalty: gap });
+                    out.push(Placement { position: [p[0], y, p[1]], yaw, support: None, penalty: gap });
                 }
             }
         }
     }
 
     /// Poses that make `rel` hold against the placed `anchor` (item `j`).
-    fn relation_candidates(&mut self, i: usize, rel: Relation, j: usize, anchor: &PlacedObject, out: &mut Vec<Pose>) {
+    fn relation_candidates(
+        &mut self,
+        i: usize,
+        rel: Relation,
+        j: usize,
+        anchor: &PlacedObject,
+        out: &mut Vec<Placement>,
+    ) {
         let item = &self.p.items[i];
         let [w, h, d] = item.size;
         let (aw, ad) = (anchor.size[0] / 2.0, anchor.size[2] / 2.0);
@@ -753,7 +764,7 @@ impl<'a, R: Rng> Solver<'a, R> {
         let at = |l: [f32; 2]| geom::to_world(ac, anchor.yaw, l);
         let base = self.rest_height(i);
         let mut push = |p: [f32; 2], y: f32, yaw: f32, support: Option<usize>, penalty: f32| {
-            out.push(Pose { position: [p[0], y, p[1]], yaw, support, penalty });
+            out.push(Placement { position: [p[0], y, p[1]], yaw, support, penalty });
         };
         match rel {
             Relation::On | Relation::Under | Relation::In => {
@@ -894,7 +905,7 @@ impl<'a, R: Rng> Solver<'a, R> {
         offsets: &[f32],
         face: Face,
         penalty: f32,
-        out: &mut Vec<Pose>,
+        out: &mut Vec<Placement>,
     ) {
         let [w, _, d] = self.p.items[i].size;
         let y = self.rest_height(i);
@@ -923,7 +934,7 @@ impl<'a, R: Rng> Solver<'a, R> {
                     let out_by = a_n + h_n + g;
                     let l = [n[0] * out_by + t[0] * along, n[1] * out_by + t[1] * along];
                     let p = geom::to_world(geom::center(anchor), anchor.yaw, l);
-                    out.push(Pose {
+                    out.push(Placement {
                         position: [p[0], y, p[1]],
                         yaw,
                         support: None,
@@ -935,7 +946,7 @@ impl<'a, R: Rng> Solver<'a, R> {
     }
 
     /// Poses that put item `i` at `place`.
-    fn place_candidates(&mut self, i: usize, place: RoomPlace, out: &mut Vec<Pose>) {
+    fn place_candidates(&mut self, i: usize, place: RoomPlace, out: &mut Vec<Placement>) {
         let [w, _, d] = self.p.items[i].size;
         let y = self.rest_height(i);
         let (rw, rd) = (self.p.room.width, self.p.room.depth);
@@ -947,11 +958,11 @@ impl<'a, R: Rng> Solver<'a, R> {
             RoomPlace::Middle => {
                 for k in 0..4 {
                     let yaw = k as f32 * QUARTER;
-                    out.push(Pose { position: [rw / 2.0, y, rd / 2.0], yaw, support: None, penalty: 0.0 });
+                    out.push(Placement { position: [rw / 2.0, y, rd / 2.0], yaw, support: None, penalty: 0.0 });
                     for _ in 0..3 {
                         let j = [self.rng.random_range(-0.4..0.4), self.rng.random_range(-0.4..0.4)];
                         let position = [rw / 2.0 + j[0], y, rd / 2.0 + j[1]];
-                        out.push(Pose { position, yaw, support: None, penalty: 0.3 * j[0].hypot(j[1]) });
+                        out.push(Placement { position, yaw, support: None, penalty: 0.3 * j[0].hypot(j[1]) });
                     }
                 }
             }
@@ -963,7 +974,7 @@ impl<'a, R: Rng> Solver<'a, R> {
                         let h = half(yaw);
                         let x = if cx == 0.0 { h[0] } else { rw - h[0] };
                         let z = if cz == 0.0 { h[1] } else { rd - h[1] };
-                        out.push(Pose { position: [x, y, z], yaw, support: None, penalty: 0.0 });
+                        out.push(Placement { position: [x, y, z], yaw, support: None, penalty: 0.0 });
                     }
                 }
             }
@@ -974,7 +985,7 @@ impl<'a, R: Rng> Solver<'a, R> {
                 for side in [-1.0f32, 1.0] {
                     for g in [0.05, 0.2, 0.4] {
                         let x = door[0] + side * (DOOR_ZONE[0] + h[0] + g);
-                        out.push(Pose { position: [x, y, rd - h[1]], yaw: HALF, support: None, penalty: g });
+                        out.push(Placement { position: [x, y, rd - h[1]], yaw: HALF, support: None, penalty: g });
                     }
                 }
             }
@@ -985,7 +996,12 @@ impl<'a, R: Rng> Solver<'a, R> {
                 for t in [0.5, 0.45, 0.55, 0.4, 0.6, 0.35, 0.65, 0.3, 0.7] {
                     let c = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
                     for yaw in [pa.yaw, pb.yaw, line, line + QUARTER] {
-                        out.push(Pose { position: [c[0], y, c[1]], yaw, support: None, penalty: (t - 0.5f32).abs() });
+                        out.push(Placement {
+                            position: [c[0], y, c[1]],
+                            yaw,
+                            support: None,
+                            penalty: (t - 0.5f32).abs(),
+                        });
                     }
                 }
             }

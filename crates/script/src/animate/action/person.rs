@@ -5,7 +5,7 @@
 
 use super::{Step, Verb};
 use crate::animate::builder::Builder;
-use crate::animate::plan::Person;
+use crate::animate::character::Person;
 use crate::animate::spots::{dist2, heading_to, SPOT_MARGIN};
 use crate::animate::{contacts_of, PASSING_DISTANCE};
 use crate::catalogue::ContactKind;

@@ -1,57 +1,14 @@
 //! Walking (§4.3 route + locomotion, NSM's role in the paper): an A* route on the character's
 //! grid to where it is going, walked with foot locking ([`crate::motion::walk_route`]) after
-//! waiting as the crowd repair says ([`super::super::WalkChoice`]); [`WalkCache`] keeps walks
-//! already made, as the optimiser re-animates many nearly equal scenes.
-
-use std::collections::HashMap;
-
-use inbetween_core::clip::Clip;
+//! waiting as the crowd repair says ([`crate::animate::routes::WalkChoice`]); walks already made come
+//! from the [`crate::animate::routes::WalkCache`].
 
 use super::Step;
 use crate::animate::builder::Builder;
+use crate::animate::routes::{route, WalkInfo};
 use crate::animate::spots::{heading_to, stand_point};
-use crate::animate::WalkInfo;
-use crate::layout::{geom, grid::Grid};
-use crate::motion::{walk_route, MotionLibrary, WalkParams};
-
-/// Walks already generated, by route and parameters (a disturbed scene often leaves a route as
-/// it was).
-#[derive(Default)]
-pub(crate) struct WalkCache {
-    walks: HashMap<Vec<u64>, Clip>,
-}
-
-impl WalkCache {
-    pub fn walk(&mut self, route: &[[f32; 2]], lib: &MotionLibrary, p: &WalkParams) -> Clip {
-        let mut key: Vec<u64> = route.iter().map(|q| ((q[0].to_bits() as u64) << 32) | q[1].to_bits() as u64).collect();
-        key.push(p.speed.unwrap_or(-1.0).to_bits());
-        key.push(p.initial_heading.unwrap_or(9.0).to_bits());
-        key.push(p.final_heading.unwrap_or(9.0).to_bits());
-        key.push(p.verb.bytes().fold(0u64, |h, b| h.wrapping_mul(131).wrapping_add(b as u64)));
-        key.push(p.lock_feet as u64);
-        if let Some(m) = self.walks.get(&key) {
-            return m.clone();
-        }
-        let m = walk_route(route, lib, p);
-        self.walks.insert(key, m.clone());
-        m
-    }
-}
-
-/// A walking route on `grid` from `from` to `to`: when an end lies on a blocked cell (next to a
-/// seat, just stood up) the route goes through the nearest free cell.
-pub(crate) fn route(grid: &Grid, from: [f32; 2], to: [f32; 2]) -> Option<Vec<[f32; 2]>> {
-    let free = |p: [f32; 2]| if grid.is_free_at(p) { Some(p) } else { grid.nearest_free(p).map(|c| grid.center(c)) };
-    let (s, g) = (free(from)?, free(to)?);
-    let mut path = grid.astar(s, g)?;
-    if s != from {
-        path.insert(0, from);
-    }
-    if g != to {
-        path.push(to);
-    }
-    Some(path)
-}
+use crate::layout::geom;
+use crate::motion::WalkParams;
 
 impl Builder<'_> {
     /// A locomotion verb ("walks to the desk", "runs"): stands up if seated, then walks to the
@@ -85,7 +42,7 @@ impl Builder<'_> {
     }
 
     /// Walks along a route to `to`, turning to `final_heading`, after waiting in place as this
-    /// walk's [`crate::animate::WalkChoice`] says.
+    /// walk's [`crate::animate::routes::WalkChoice`] says.
     pub fn walk(&mut self, to: [f32; 2], final_heading: f64, verb: &str, speed: Option<f64>) {
         self.walk_on(to, final_heading, verb, speed, false);
     }
