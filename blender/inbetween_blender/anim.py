@@ -86,7 +86,9 @@ def _read(points) -> Dict[str, np.ndarray]:
     return out
 
 
-def replace_range(fc, frames: np.ndarray, values: np.ndarray, left: np.ndarray, right: np.ndarray) -> int:
+def replace_range(
+    fc, frames: np.ndarray, values: np.ndarray, left: np.ndarray, right: np.ndarray, interpolation: str = "BEZIER"
+) -> int:
     """Replaces the keys of `fc` on `frames[0] … frames[-1]` by Bezier keys at `frames` with
     `values` and FREE handles at `left`/`right` ((K, 2): frame, value). Keys outside are kept as
     they are; the first new key keeps the old key's left handle there and the last the old key's
@@ -110,7 +112,7 @@ def replace_range(fc, frames: np.ndarray, values: np.ndarray, left: np.ndarray, 
         "co": np.stack([frames, values], axis=1).astype(np.float64),
         "handle_left": np.array(left, dtype=np.float64),
         "handle_right": np.array(right, dtype=np.float64),
-        "interpolation": np.full(k, interp["BEZIER"], dtype=np.int32),
+        "interpolation": np.full(k, interp[interpolation], dtype=np.int32),
         "easing": np.full(k, _enum_values("easing")["AUTO"], dtype=np.int32),
         "type": np.full(k, _enum_values("type")["KEYFRAME"], dtype=np.int32),
         "amplitude": np.full(k, 0.8),
