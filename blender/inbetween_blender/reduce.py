@@ -253,7 +253,7 @@ class ReduceJob:
                     f"{len(switched)} bones switched from Euler to quaternion rotation (the new action keys "
                     "rotation_mode; set the mode back to play the original)"
                 )
-            keys = yield from enginefractions(
+            keys = yield from engine_fractions(
                 call_engine(engine.select_keys, self.cancel, clip, o.engine_method(), bound, o.keys or None),
                 0.25,
                 0.55,
