@@ -4,10 +4,9 @@ another action, from text or a TextGrid), N variants as N actions; frames outsid
 `bpy.ops.inbetween.import_live_link` / `export_live_link`: Live Link Face CSV onto and from such a
 mesh (the engine's reader and writer)."""
 
-from __future__ import annotations
 
 import threading
-from typing import Dict, List, Optional
+from typing import Dict, List
 
 import numpy as np
 

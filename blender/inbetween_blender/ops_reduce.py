@@ -1,7 +1,6 @@
 """`bpy.ops.inbetween.reduce_keys`: the armature's action reduced to the fewest keys that keep every
 bone within a bound in cm (measured in Blender), or to a key count."""
 
-from __future__ import annotations
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty

@@ -2,7 +2,6 @@
 engine's `RunJob`), imported with Blender's own glTF importer into a new collection, its shot
 camera made the scene camera."""
 
-from __future__ import annotations
 
 import os
 import tempfile

@@ -1,7 +1,6 @@
 """Panels and menu entries: the 3D View's N-panel (tab "inbetween"), the Graph Editor's and the Dope
 Sheet's Key menus. Settings live on the scene (`scene.inbetween`) so the panel keeps them."""
 
-from __future__ import annotations
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
