@@ -13,6 +13,7 @@
 pub mod bench;
 pub mod codec;
 pub mod corpus;
+pub mod dcc;
 pub mod demo;
 pub mod dqn;
 mod error;
@@ -33,5 +34,5 @@ pub use prepared::PreparedClip;
 pub use rebuild::{ReconstructJob, ReconstructReport};
 pub use reconstruct::{reconstruct_spherical, SphericalReconstruction};
 pub use representation::{JointFilter, SphericalMotion};
-pub use rotations::RotationMotion;
+pub use rotations::{RotationCurve, RotationMotion};
 pub use select::job::{SelectJob, SelectReport, Selector};

@@ -4,7 +4,7 @@
 
 use crate::metrics::PositionError;
 use crate::prepared::PreparedClip;
-use crate::rotations::reconstruct_poses;
+use crate::rotations::{reconstruct_poses, RotationCurve};
 use crate::{MocapError, Result};
 use inbetween_core::cancel::Cancel;
 use inbetween_core::{forward, KeyframeSet, Motion, Pose};
@@ -17,12 +17,16 @@ use std::fmt;
 pub struct ReconstructJob {
     /// Key frames; the clip's first and last frames are added when missing.
     pub keys: Vec<usize>,
+    /// How rotations are interpolated between keys (the engine's Hermite, or what a DCC's
+    /// quaternion Bezier curves play back).
+    pub curve: RotationCurve,
 }
 
 /// The rebuilt clip and how far it is from its source.
 #[derive(Clone, Debug, Serialize)]
 pub struct ReconstructReport {
     pub keys: KeyframeSet,
+    pub curve: RotationCurve,
     /// Joint position error against the source, cm.
     pub error: PositionError,
     /// The rebuilt local poses, one per frame (write them with [`ReconstructReport::motion`]).
@@ -44,7 +48,7 @@ impl ReconstructJob {
     /// Rebuilds `clip` from its poses at the job's keys.
     pub fn run(&self, clip: &PreparedClip, cancel: &Cancel, progress: &Progress) -> Result<ReconstructReport> {
         let keys = self.key_set(clip.num_frames())?;
-        rebuild(clip, keys, cancel, progress)
+        rebuild(clip, keys, self.curve, cancel, progress)
     }
 }
 
@@ -52,6 +56,7 @@ impl ReconstructJob {
 pub(crate) fn rebuild(
     clip: &PreparedClip,
     keys: KeyframeSet,
+    curve: RotationCurve,
     cancel: &Cancel,
     progress: &Progress,
 ) -> Result<ReconstructReport> {
@@ -66,14 +71,14 @@ pub(crate) fn rebuild(
     let frames = keys.frames();
     let key_poses: Vec<_> = frames.iter().map(|&f| clip.rotations.frames[f].clone()).collect();
     let skeleton = &clip.motion.skeleton;
-    let poses = reconstruct_poses(skeleton, clip.motion.frame_time, frames, &key_poses)?;
+    let poses = reconstruct_poses(skeleton, clip.motion.frame_time, frames, &key_poses, curve)?;
     cancel.check()?;
     progress.inc(1);
     use rayon::prelude::*;
     let rebuilt: Vec<_> = poses.par_iter().map(|p| forward(skeleton, p).positions).collect();
     let error = PositionError::between(&clip.positions, &rebuilt, clip.unit.cm_per_unit());
     progress.inc(1);
-    Ok(ReconstructReport { keys, error, poses })
+    Ok(ReconstructReport { keys, curve, error, poses })
 }
 
 impl ReconstructReport {

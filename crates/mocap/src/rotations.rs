@@ -6,7 +6,7 @@
 use crate::metrics::{Scratch, SegmentCost, SegmentModel};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
-use inbetween_core::interp::{angular_velocity, hermite_quat, hermite_vec3};
+use inbetween_core::interp::{angular_velocity, hermite, hermite_quat, hermite_vec3};
 use inbetween_core::rotation::{angle_between, make_continuous};
 use inbetween_core::units::LengthUnit;
 use inbetween_core::{KeyframeSet, Motion, Pose, Skeleton};
@@ -31,6 +31,61 @@ pub struct RotationMotion {
     /// Source global positions, frame-major.
     pub positions: Vec<DVec3>,
     pub cm_per_unit: f64,
+}
+
+/// How the rotations between two key poses are evaluated. Translations are a cubic Hermite per
+/// component in both (Eq. 12–13).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RotationCurve {
+    /// Kim, Kim & Shin's cumulative quaternion Hermite ([`hermite_quat`]): exact on the rotation
+    /// manifold, the engine's own output (BVH, `.ibk`).
+    #[default]
+    Hermite,
+    /// A cubic Hermite per quaternion component (x, y, z, w) with the component derivatives
+    /// `q̇ = ½ q ⊗ (0, ω)` at both keys, then normalised: what a DCC evaluates from four Bezier
+    /// F-curves whose handles lie a third of the segment along each tangent (Blender's pose bones in
+    /// quaternion mode, quaternion curves in Maya and Unreal). Keys chosen with it keep their bound
+    /// on what such a DCC plays back; [`crate::dcc::bezier_keys`] gives the handles.
+    QuaternionBezier,
+}
+
+impl RotationCurve {
+    pub fn name(self) -> &'static str {
+        match self {
+            RotationCurve::Hermite => "hermite",
+            RotationCurve::QuaternionBezier => "quaternion_bezier",
+        }
+    }
+
+    /// Parses a curve's name (`hermite`, `quaternion_bezier`).
+    pub fn parse(s: &str) -> Result<RotationCurve> {
+        match s {
+            "hermite" => Ok(RotationCurve::Hermite),
+            "quaternion_bezier" => Ok(RotationCurve::QuaternionBezier),
+            _ => Err(MocapError::Invalid(format!("curve '{s}': expected 'hermite' or 'quaternion_bezier'"))),
+        }
+    }
+}
+
+/// The derivative of a unit quaternion's components turning at body-frame angular velocity `w`
+/// (rad/s): `q̇ = ½ q ⊗ (w, 0)`.
+pub fn quat_component_rate(q: DQuat, w: DVec3) -> DQuat {
+    q * DQuat::from_xyzw(w.x, w.y, w.z, 0.0) * 0.5
+}
+
+/// [`RotationCurve::QuaternionBezier`] between `q0` (derivative `d0`, per second) and `q1` (`d1`)
+/// over `h` seconds at fraction `u`: a cubic Hermite per component, normalised. The components are
+/// taken as stored (no sign flip): a DCC interpolates the curves it holds.
+pub fn hermite_quat_components(q0: DQuat, d0: DQuat, q1: DQuat, d1: DQuat, h: f64, u: f64) -> DQuat {
+    let c = |a: f64, da: f64, b: f64, db: f64| hermite(a, da, b, db, h, u);
+    DQuat::from_xyzw(
+        c(q0.x, d0.x, q1.x, d1.x),
+        c(q0.y, d0.y, q1.y, d1.y),
+        c(q0.z, d0.z, q1.z, d1.z),
+        c(q0.w, d0.w, q1.w, d1.w),
+    )
+    .normalize()
 }
 
 /// Central difference step around frame f: the frames it spans.
@@ -100,13 +155,112 @@ impl RotationMotion {
     pub fn reconstruct(&self, keys: &KeyframeSet) -> Result<Motion> {
         reconstruct_from_keys(&self.skeleton, self.frame_time, keys.frames(), &self.key_poses(keys))
     }
+
+    /// The clip as a segment model whose in-betweens follow `curve`, a segment feasible only where
+    /// no joint's local rotation is further than `max_angle_rad` from the source (when given).
+    pub fn along(&self, curve: RotationCurve, max_angle_rad: Option<f64>) -> CurveModel<'_> {
+        CurveModel { motion: self, curve, max_angle_rad }
+    }
+
+    /// One in-between's cost and its largest local rotation error (radians).
+    fn frame_cost_along(
+        &self,
+        curve: RotationCurve,
+        a: usize,
+        b: usize,
+        f: usize,
+        s: &mut Scratch,
+    ) -> (SegmentCost, f64) {
+        let nj = self.skeleton.len();
+        let h = (b - a) as f64 * self.frame_time;
+        let u = (f - a) as f64 / (b - a) as f64;
+        let mut cost = SegmentCost::default();
+        let mut angle_max = 0.0f64;
+        interpolate_pose_into(&self.frames[a], &self.frames[b], h, u, curve, &mut s.locals, &mut s.translations);
+        forward_into(&self.skeleton, &s.locals, &s.translations, &mut s.positions, &mut s.rotations);
+        for j in 0..nj {
+            if self.skeleton.joint(j).rotation_order().is_some() {
+                let angle = angle_between(s.locals[j], self.frames[f].rotations[j]);
+                cost.angle_sum += angle;
+                angle_max = angle_max.max(angle);
+            }
+            let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
+            cost.cm_sum += d;
+            cost.cm_max = cost.cm_max.max(d);
+        }
+        (cost, angle_max)
+    }
 }
 
-/// Local pose at fraction `u` of a segment `h` seconds long between key poses `k0` and `k1`.
-pub fn interpolate_pose_into(k0: &KeyPose, k1: &KeyPose, h: f64, u: f64, rot: &mut [DQuat], trans: &mut [DVec3]) {
+/// A [`RotationMotion`] whose in-betweens follow one [`RotationCurve`]: the segment model of the
+/// error-bounded search when the bound is on the rebuilt clip (or on a DCC's playback of it).
+pub struct CurveModel<'a> {
+    pub motion: &'a RotationMotion,
+    pub curve: RotationCurve,
+    /// Largest local rotation error of any joint a feasible segment may have, radians.
+    pub max_angle_rad: Option<f64>,
+}
+
+impl SegmentModel for CurveModel<'_> {
+    fn num_frames(&self) -> usize {
+        self.motion.num_frames()
+    }
+
+    fn num_joints(&self) -> usize {
+        self.motion.num_joints()
+    }
+
+    fn angle_terms_per_frame(&self) -> usize {
+        self.motion.angle_terms_per_frame()
+    }
+
+    fn scratch(&self) -> Scratch {
+        self.motion.scratch()
+    }
+
+    fn frame_cost(&self, a: usize, b: usize, f: usize, s: &mut Scratch) -> SegmentCost {
+        self.motion.frame_cost_along(self.curve, a, b, f, s).0
+    }
+
+    /// Rejects a segment at its first frame over `max_cm` or over the angle bound.
+    fn segment_cost_within(&self, a: usize, b: usize, max_cm: f64, s: &mut Scratch) -> Option<SegmentCost> {
+        let max_angle = self.max_angle_rad.unwrap_or(f64::INFINITY);
+        let mid = (a + b) / 2;
+        let mut acc = SegmentCost::default();
+        for d in 0..b - a {
+            let right = mid + d;
+            let left = mid.checked_sub(d).filter(|_| d > 0);
+            for f in [Some(right), left].into_iter().flatten().filter(|&f| f > a && f < b) {
+                let (c, angle) = self.motion.frame_cost_along(self.curve, a, b, f, s);
+                if c.cm_max > max_cm || angle > max_angle {
+                    return None;
+                }
+                acc = acc.combine(c);
+            }
+        }
+        Some(acc)
+    }
+}
+
+/// Local pose at fraction `u` of a segment `h` seconds long between key poses `k0` and `k1`, the
+/// rotations along `curve`.
+pub fn interpolate_pose_into(
+    k0: &KeyPose,
+    k1: &KeyPose,
+    h: f64,
+    u: f64,
+    curve: RotationCurve,
+    rot: &mut [DQuat],
+    trans: &mut [DVec3],
+) {
     for j in 0..rot.len() {
-        rot[j] =
-            hermite_quat(k0.rotations[j], k0.angular_velocities[j], k1.rotations[j], k1.angular_velocities[j], h, u);
+        let (q0, w0, q1, w1) = (k0.rotations[j], k0.angular_velocities[j], k1.rotations[j], k1.angular_velocities[j]);
+        rot[j] = match curve {
+            RotationCurve::Hermite => hermite_quat(q0, w0, q1, w1, h, u),
+            RotationCurve::QuaternionBezier => {
+                hermite_quat_components(q0, quat_component_rate(q0, w0), q1, quat_component_rate(q1, w1), h, u)
+            }
+        };
         trans[j] = hermite_vec3(k0.translations[j], k0.velocities[j], k1.translations[j], k1.velocities[j], h, u);
     }
 }
@@ -134,16 +288,18 @@ pub fn reconstruct_from_keys(
     frames: &[usize],
     keys: &[KeyPose],
 ) -> Result<Motion> {
-    let poses = reconstruct_poses(skeleton, frame_time, frames, keys)?;
+    let poses = reconstruct_poses(skeleton, frame_time, frames, keys, RotationCurve::Hermite)?;
     Ok(Motion::from_poses(skeleton.clone(), frame_time, &poses)?)
 }
 
-/// The local poses of [`reconstruct_from_keys`], before they are written as channels.
+/// The local poses of a clip rebuilt from keys at `frames`, the rotations along `curve` (those of
+/// [`reconstruct_from_keys`] with [`RotationCurve::Hermite`]).
 pub fn reconstruct_poses(
     skeleton: &Skeleton,
     frame_time: f64,
     frames: &[usize],
     keys: &[KeyPose],
+    curve: RotationCurve,
 ) -> Result<Vec<Pose>> {
     if frames.len() < 2 || frames.len() != keys.len() || frames[0] != 0 || frames.windows(2).any(|w| w[0] >= w[1]) {
         return Err(MocapError::Invalid(format!(
@@ -169,7 +325,7 @@ pub fn reconstruct_poses(
             } else {
                 let h = (b - a) as f64 * frame_time;
                 let u = (f - a) as f64 / (b - a) as f64;
-                interpolate_pose_into(&keys[s], &keys[s + 1], h, u, &mut pose.rotations, &mut pose.translations);
+                interpolate_pose_into(&keys[s], &keys[s + 1], h, u, curve, &mut pose.rotations, &mut pose.translations);
             }
             pose
         })
@@ -202,22 +358,9 @@ impl SegmentModel for RotationMotion {
         }
     }
 
+    /// In-betweens along [`RotationCurve::Hermite`], the engine's own output.
     fn frame_cost(&self, a: usize, b: usize, f: usize, s: &mut Scratch) -> SegmentCost {
-        let nj = self.skeleton.len();
-        let h = (b - a) as f64 * self.frame_time;
-        let u = (f - a) as f64 / (b - a) as f64;
-        let mut cost = SegmentCost::default();
-        interpolate_pose_into(&self.frames[a], &self.frames[b], h, u, &mut s.locals, &mut s.translations);
-        forward_into(&self.skeleton, &s.locals, &s.translations, &mut s.positions, &mut s.rotations);
-        for j in 0..nj {
-            if self.skeleton.joint(j).rotation_order().is_some() {
-                cost.angle_sum += angle_between(s.locals[j], self.frames[f].rotations[j]);
-            }
-            let d = s.positions[j].distance(self.positions[f * nj + j]) * self.cm_per_unit;
-            cost.cm_sum += d;
-            cost.cm_max = cost.cm_max.max(d);
-        }
-        cost
+        self.frame_cost_along(RotationCurve::Hermite, a, b, f, s).0
     }
 }
 

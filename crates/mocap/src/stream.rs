@@ -21,7 +21,7 @@
 
 use crate::codec::{quantised_model, read_scaled_key, read_skeleton, write_scaled_key, write_skeleton, Reader};
 use crate::metrics::SegmentModel;
-use crate::rotations::{interpolate_pose_into, KeyPose, RotationMotion};
+use crate::rotations::{interpolate_pose_into, KeyPose, RotationCurve, RotationMotion};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::units::{LengthUnit, UnitChoice};
@@ -363,6 +363,7 @@ impl Rebuild {
                         &key,
                         h,
                         (f - a) as f64 / (frame - a) as f64,
+                        RotationCurve::Hermite,
                         &mut p.rotations,
                         &mut p.translations,
                     );

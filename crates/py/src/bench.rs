@@ -2,8 +2,9 @@
 //! functions of this crate, minus the Python argument and result conversion, the worker thread
 //! and the GIL), timed in Rust, so the bench can put the two side by side on the same input.
 
-use crate::clip::Clip;
+use crate::clip::{Clip, FaceClip};
 use crate::errors::{invalid, JobError};
+use crate::face::{self, EditRequest, SpanArg};
 use crate::{ibk, mocap};
 use inbetween_core::cancel::Cancel;
 use inbetween_io::Progress;
@@ -14,6 +15,7 @@ use std::time::Instant;
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_bench_rust, m)?)?;
     m.add_function(wrap_pyfunction!(_bench_sample_rust, m)?)?;
+    m.add_function(wrap_pyfunction!(_bench_face_rust, m)?)?;
     Ok(())
 }
 
@@ -45,7 +47,7 @@ fn _bench_rust(
             Box::new(move || mocap::select(clip, &job, &cancel, &progress).map(|_| ()))
         }
         "reconstruct" => {
-            let job = ReconstructJob { keys: keys.unwrap_or_default() };
+            let job = ReconstructJob { keys: keys.unwrap_or_default(), ..ReconstructJob::default() };
             Box::new(move || mocap::reconstruct(clip, &job, &cancel, &progress).map(|_| ()))
         }
         "compress" => {
@@ -82,4 +84,39 @@ fn _bench_sample_rust(py: Python<'_>, data: Vec<u8>, times: Vec<f64>) -> PyResul
         Ok::<f64, String>(t.elapsed().as_secs_f64() * 1e9 / times.len().max(1) as f64)
     })
     .map_err(invalid)
+}
+
+/// Milliseconds of each of `repeats` runs of `face.edit`'s work ([`face::edit`]: the job prepared
+/// and run `variants` times from `seed`) on `clip` over `spans` (seconds), unguided or with
+/// `keys_json`, called from Rust.
+#[pyfunction]
+#[pyo3(signature = (clip, spans, repeats, variants=1, seed=1, keys_json=None))]
+fn _bench_face_rust(
+    py: Python<'_>,
+    clip: PyRef<'_, FaceClip>,
+    spans: Vec<(f64, f64)>,
+    repeats: usize,
+    variants: usize,
+    seed: u64,
+    keys_json: Option<String>,
+) -> PyResult<Vec<f64>> {
+    let request = EditRequest {
+        spans: spans.into_iter().map(|(a, b)| SpanArg::Seconds(a, b)).collect(),
+        keys_json,
+        method: "auto".into(),
+        variants,
+        seed,
+        ..EditRequest::default()
+    };
+    let input = &clip.clip;
+    py.detach(|| {
+        (0..repeats)
+            .map(|_| {
+                let t = Instant::now();
+                face::edit(input, &request, &Cancel::new(), &Progress::hidden())
+                    .map(|_| t.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect::<Result<Vec<f64>, JobError>>()
+    })
+    .map_err(JobError::into_py)
 }

@@ -30,19 +30,61 @@ def test_keys_to_one_cm_measured_in_python(take):
     # Joint positions of both clips, by their own forward kinematics, measured here.
     err = np.linalg.norm(rec.clip.positions_cm() - take.positions_cm(), axis=-1)
     print(f"{n} keys: planned max {keys.report['planned']['max_cm']:.3f} cm, rebuilt max {err.max():.3f} cm")
-    # The search bounds the spherical model (the paper's Eq. 15-18) to 1 cm ...
-    assert keys.report["planned"]["max_cm"] <= 1.0
-    # ... and the rebuilt clip's error is what the engine reports. The rotation reconstruction
-    # exceeds the bound on this take (1.41 cm at frame ~240: the engine's, not Python's, gap).
+    # The bound holds on the rebuilt clip, measured here on every joint of every frame (the
+    # float32 arrays' rounding aside), and is what the engine reports.
+    assert err.max() <= 1.0 + 1e-3, err.max()
     assert err.max() == pytest.approx(rec.max_error_cm, abs=1e-3)
     assert err.mean() == pytest.approx(rec.mean_error_cm, abs=1e-3)
-    assert err.mean() < 0.2 and err.max() < 2.0, (err.mean(), err.max())
+    assert err.mean() < 0.2, err.mean()
     assert rec.max_error_cm == pytest.approx(keys.reconstruction.max_error_cm, rel=1e-9)
     assert rec.error_per_frame_cm.shape == (take.num_frames,)
     # Fewer keys by K: a worse fit, never a crash.
     few = mocap.select_keys(take, k=4)
     assert len(few) == 4 and few.method == "optimal"
     assert few.reconstruction.mean_error_cm > keys.reconstruction.mean_error_cm
+
+
+def _bezier(x, y, frame):
+    """A cubic Bezier's value at `frame`, found as a DCC finds it: solve x(s) = frame, then y(s)."""
+    lo, hi = 0.0, 1.0
+    b = lambda c, s: (1 - s) ** 3 * c[0] + 3 * (1 - s) ** 2 * s * c[1] + 3 * (1 - s) * s * s * c[2] + s**3 * c[3]
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if b(x, mid) < frame else (lo, mid)
+    return b(np.asarray(y), 0.5 * (lo + hi))
+
+
+def test_quaternion_bezier_keys_and_handles_play_back_within_the_bound(take):
+    clip = take.crop(0, 240)
+    keys = mocap.select_keys(clip, max_error_cm=1.0, max_error_deg=5.0, curve="quaternion_bezier")
+    rec = mocap.reconstruct(clip, keys)  # the keys' own curve
+    assert rec.report["curve"] == "quaternion_bezier"
+    err = np.linalg.norm(rec.clip.positions_cm() - clip.positions_cm(), axis=-1)
+    assert err.max() <= 1.0 + 1e-3, err.max()
+    h = mocap.bezier_handles(clip, keys)
+    n, j = len(keys), len(clip.joints)
+    assert list(h.frames) == list(keys.frames)
+    assert h.rotations.shape == h.rotations_left.shape == (n, j, 4) and h.translations_cm.shape == (n, j, 3)
+    assert np.all(h.left_frames < h.frames) and np.all(h.right_frames > h.frames)
+    # Evaluate every joint's four component curves as a DCC would, normalise, compare to the
+    # engine's rebuilt rotations (a quaternion and its negative are one rotation).
+    want = rec.clip.rotations
+    worst = 0.0
+    for s in range(n - 1):
+        a, b = h.frames[s], h.frames[s + 1]
+        x = [a, h.right_frames[s], h.left_frames[s + 1], b]
+        for f in range(a, b + 1, 3):
+            q = np.stack(
+                [_bezier(x, [h.rotations[s, :, c], h.rotations_right[s, :, c], h.rotations_left[s + 1, :, c], h.rotations[s + 1, :, c]], f) for c in range(4)],
+                axis=-1,
+            )
+            q /= np.linalg.norm(q, axis=-1, keepdims=True)
+            worst = max(worst, float(np.max(1.0 - np.abs(np.sum(q * want[f], axis=-1)))))
+    assert worst < 1e-5, worst
+    with pytest.raises(InbetweenError, match="curve 'slerp'"):
+        mocap.select_keys(clip, max_error_cm=1.0, curve="slerp")
+    with pytest.raises(InbetweenError, match="degrees"):
+        mocap.select_keys(clip, max_error_deg=float("nan"))
 
 
 @pytest.mark.parametrize("method", ["greedy", "uniform", "sidql"])

@@ -8,7 +8,7 @@
 use crate::metrics::{ErrorMeasure, ReconstructionError, SegmentModel, SegmentTable};
 use crate::prepared::PreparedClip;
 use crate::rebuild::{rebuild, ReconstructReport};
-use crate::rotations::KeyPose;
+use crate::rotations::{KeyPose, RotationCurve};
 use crate::{MocapError, Result};
 use inbetween_core::cancel::Cancel;
 use inbetween_core::KeyframeSet;
@@ -92,13 +92,26 @@ pub struct SelectJob {
     pub k: Option<usize>,
     /// Largest position error of any joint in any frame, cm (error-bounded).
     pub bound_cm: Option<f64>,
+    /// Largest local rotation error of any joint in any frame, degrees (error-bounded; with or
+    /// without `bound_cm`).
+    pub bound_deg: Option<f64>,
     /// Longest gap between two keys of an error-bounded search, seconds.
     pub max_gap_s: f64,
+    /// How the reconstruction (and the error-bounded search's bound) evaluates rotations between
+    /// keys: the engine's Hermite, or a DCC's quaternion Bezier curves.
+    pub curve: RotationCurve,
 }
 
 impl Default for SelectJob {
     fn default() -> SelectJob {
-        SelectJob { method: Selector::Optimal, k: None, bound_cm: None, max_gap_s: DEFAULT_MAX_GAP_S }
+        SelectJob {
+            method: Selector::Optimal,
+            k: None,
+            bound_cm: None,
+            bound_deg: None,
+            max_gap_s: DEFAULT_MAX_GAP_S,
+            curve: RotationCurve::Hermite,
+        }
     }
 }
 
@@ -106,8 +119,9 @@ impl Default for SelectJob {
 #[derive(Clone, Debug, Serialize)]
 pub struct SelectReport {
     pub method: Selector,
-    /// The bound of an error-bounded search, cm.
+    /// The bounds of an error-bounded search, cm and degrees.
     pub bound_cm: Option<f64>,
+    pub bound_deg: Option<f64>,
     /// Milliseconds the selection took (the reconstruction not included).
     pub select_ms: f64,
     /// The key poses in key order: local rotations with their body-frame angular velocities
@@ -128,11 +142,18 @@ impl SelectJob {
             let k = self.k.ok_or_else(|| MocapError::Invalid(format!("method '{name}' needs K")))?;
             super::check_k(n, k)?;
         } else {
-            let b = self
-                .bound_cm
-                .ok_or_else(|| MocapError::Invalid(format!("method '{name}' needs an error bound in cm")))?;
-            if !(b.is_finite() && b > 0.0) {
-                return Err(MocapError::Invalid(format!("error bound {b} cm: expected a positive number of cm")));
+            if self.bound_cm.is_none() && self.bound_deg.is_none() {
+                return Err(MocapError::Invalid(format!("method '{name}' needs an error bound in cm (or degrees)")));
+            }
+            for (b, unit) in [(self.bound_cm, "cm"), (self.bound_deg, "degrees")] {
+                match b {
+                    Some(b) if !(b.is_finite() && b > 0.0) => {
+                        return Err(MocapError::Invalid(format!(
+                            "error bound {b} {unit}: expected a positive number of {unit}"
+                        )))
+                    }
+                    _ => {}
+                }
             }
             if n < 2 {
                 return Err(MocapError::Invalid(format!("a clip of {n} frames has no segments")));
@@ -157,10 +178,18 @@ impl SelectJob {
         cancel.check()?;
         // The planned error beside the reconstruction (rayon's pool).
         let (planned, reconstruction) =
-            rayon::join(|| clip.rep.error(&keys), || rebuild(clip, keys.clone(), cancel, progress));
+            rayon::join(|| clip.rep.error(&keys), || rebuild(clip, keys.clone(), self.curve, cancel, progress));
         let reconstruction = reconstruction?;
         let key_poses = clip.rotations.key_poses(&keys);
-        Ok(SelectReport { method: self.method, bound_cm: self.bound_cm, select_ms, key_poses, planned, reconstruction })
+        Ok(SelectReport {
+            method: self.method,
+            bound_cm: self.bound_cm,
+            bound_deg: self.bound_deg,
+            select_ms,
+            key_poses,
+            planned,
+            reconstruction,
+        })
     }
 
     fn keys(&self, clip: &PreparedClip, cancel: &Cancel, progress: &Progress) -> Result<KeyframeSet> {
@@ -186,10 +215,16 @@ impl SelectJob {
             // Windows of at most 64 frames on a longer take (the policy's range), each window's
             // keyings kept with the clip for the next K.
             Selector::Sidql => clip.sidql()?.as_mut().expect("made by sidql()").keys(k)?,
+            // The bound holds on the rebuilt clip: segments are measured along the job's curve
+            // (the reconstruction the report gives, or a DCC's playback), not on the spherical
+            // model the other selectors plan with.
             Selector::ErrorBounded => {
-                let b = self.bound_cm.expect("validated");
+                // Infeasible segments are stored at an infinite cm: a finite stand-in when only degrees bound.
+                let b = self.bound_cm.unwrap_or(f64::MAX);
                 let max_gap = max_gap_frames(self.max_gap_s, clip.motion.frame_time).min(n - 1);
-                let table = SegmentTable::bounded(&clip.rep, max_gap, b);
+                let model = clip.rotations.along(self.curve, self.bound_deg.map(f64::to_radians));
+                let table = SegmentTable::bounded(&model, max_gap, b);
+                cancel.check()?;
                 super::error_bounded(&table, b, ErrorMeasure::Angle)?
             }
         };
@@ -211,7 +246,11 @@ impl SelectReport {
             Selector::Greedy => format!("greedy K={k}"),
             Selector::Sidql => format!("SIDQL K={k}"),
             Selector::Optimal => format!("optimal K={k}"),
-            Selector::ErrorBounded => format!("fewest keys under {} cm: K={k}", self.bound_cm.unwrap_or(f64::NAN)),
+            Selector::ErrorBounded => match (self.bound_cm, self.bound_deg) {
+                (Some(cm), Some(deg)) => format!("fewest keys under {cm} cm and {deg}°: K={k}"),
+                (None, Some(deg)) => format!("fewest keys under {deg}°: K={k}"),
+                (cm, _) => format!("fewest keys under {} cm: K={k}", cm.unwrap_or(f64::NAN)),
+            },
         }
     }
 }
@@ -273,12 +312,13 @@ mod tests {
     }
 
     #[test]
-    fn error_bounded_keeps_the_planned_error_under_its_bound_with_fewer_keys_for_a_looser_one() {
+    fn error_bounded_keeps_the_rebuilt_error_under_its_bound_with_fewer_keys_for_a_looser_one() {
         let clip = walk(120);
         let job = |b| SelectJob { method: Selector::ErrorBounded, bound_cm: Some(b), ..SelectJob::default() };
         let tight = run(&clip, job(0.5));
         let loose = run(&clip, job(3.0));
-        assert!(tight.planned.max_cm <= 0.5 && loose.planned.max_cm <= 3.0);
+        let measured = |r: &SelectReport| r.reconstruction.error.max_cm;
+        assert!(measured(&tight) <= 0.5 + 1e-9 && measured(&loose) <= 3.0 + 1e-9);
         assert!(loose.keys().len() < tight.keys().len(), "{} vs {}", loose.keys().len(), tight.keys().len());
         assert!(tight.label().starts_with("fewest keys under 0.5 cm: K="));
         let json = serde_json::to_value(&tight).unwrap();
@@ -286,10 +326,42 @@ mod tests {
         assert_eq!(json["reconstruction"]["keys"]["frames"].as_array().unwrap().len(), tight.keys().len());
         assert_eq!(json["key_poses"].as_array().unwrap().len(), tight.keys().len());
         // The job's reconstruction is ReconstructJob's on the same keys.
-        let rebuilt = ReconstructJob { keys: tight.keys().frames().to_vec() }
+        let rebuilt = ReconstructJob { keys: tight.keys().frames().to_vec(), ..ReconstructJob::default() }
             .run(&clip, &Cancel::new(), &Progress::hidden())
             .unwrap();
         assert_eq!(rebuilt.error, tight.reconstruction.error);
+    }
+
+    #[test]
+    fn an_angle_bound_holds_on_every_joint_alone_or_beside_a_length_bound() {
+        let clip = walk(120);
+        let deg = |cm: Option<f64>, deg: f64| SelectJob {
+            method: Selector::ErrorBounded,
+            bound_cm: cm,
+            bound_deg: Some(deg),
+            curve: RotationCurve::QuaternionBezier,
+            ..SelectJob::default()
+        };
+        for job in [deg(None, 2.0), deg(Some(1.0), 2.0)] {
+            let r = run(&clip, job.clone());
+            let poses = &r.reconstruction.poses;
+            let mut worst = 0.0f64;
+            for (f, pose) in poses.iter().enumerate() {
+                for (j, q) in pose.rotations.iter().enumerate() {
+                    if clip.motion.skeleton.joint(j).rotation_order().is_some() {
+                        let a = inbetween_core::rotation::angle_between(*q, clip.rotations.frames[f].rotations[j]);
+                        worst = worst.max(a.to_degrees());
+                    }
+                }
+            }
+            assert!(worst <= 2.0 + 1e-6, "{worst}°");
+            if job.bound_cm.is_some() {
+                assert!(r.reconstruction.error.max_cm <= 1.0 + 1e-9);
+                assert!(r.label().contains("1 cm and 2°"), "{}", r.label());
+            }
+        }
+        let loose = run(&clip, deg(None, 20.0));
+        assert!(loose.keys().len() < run(&clip, deg(None, 2.0)).keys().len());
     }
 
     #[test]
@@ -301,6 +373,7 @@ mod tests {
         let bound = |b| SelectJob { method: Selector::ErrorBounded, bound_cm: Some(b), ..SelectJob::default() };
         assert!(err(bound(-1.0)).contains("expected a positive number of cm"));
         assert!(err(SelectJob { max_gap_s: 0.0, ..bound(1.0) }).contains("max_gap_s"));
+        assert!(err(SelectJob { bound_deg: Some(f64::NAN), ..bound(1.0) }).contains("positive number of degrees"));
         assert_eq!(Selector::parse("bound").unwrap(), Selector::ErrorBounded);
         assert!(Selector::parse("magic").unwrap_err().to_string().contains("expected uniform, greedy"));
         let cancel = Cancel::new();

@@ -13,9 +13,13 @@ from . import _native
 from ._native import Clip, InbetweenError
 from ._progress import Callback, progress_callback
 
-__all__ = ["Keys", "Reconstruction", "select_keys", "reconstruct", "bezier_handles", "METHODS"]
+__all__ = ["Keys", "Reconstruction", "BezierHandles", "select_keys", "reconstruct", "bezier_handles", "METHODS", "CURVES"]
 
 METHODS = ("optimal", "error_bounded", "greedy", "sidql", "uniform")
+#: How rotations are evaluated between keys: "hermite" (the engine's own, on the rotation
+#: manifold) or "quaternion_bezier" (a cubic per quaternion component, normalised: what a DCC plays
+#: back from Bezier F-curves with the handles of `bezier_handles`, e.g. Blender's quaternion mode).
+CURVES = ("hermite", "quaternion_bezier")
 
 
 @dataclass(frozen=True)
@@ -72,28 +76,37 @@ def select_keys(
     clip: Clip,
     max_error_cm: Optional[float] = None,
     *,
+    max_error_deg: Optional[float] = None,
     k: Optional[int] = None,
     method: Optional[str] = None,
+    curve: str = "hermite",
     max_gap_s: Optional[float] = None,
     progress: Optional[Callback] = None,
 ) -> Keys:
     """Keyframes of `clip` by the mocap engine's `SelectJob`.
 
-    Give `max_error_cm` (the fewest keys keeping every joint of every frame within it;
-    method "error_bounded") or `k` keys (method "optimal" unless `method` names "greedy", "sidql"
-    or "uniform"). The clip is rebuilt from the keys (quaternion Hermite rotations, cubic Hermite
-    translations) and the error measured on it."""
+    Give `max_error_cm` and/or `max_error_deg` (the fewest keys keeping every joint of every frame
+    within them, positions in cm and local rotations in degrees, measured on the clip rebuilt
+    along `curve`; method "error_bounded") or `k` keys (method "optimal" unless `method` names
+    "greedy", "sidql" or "uniform"). The clip is rebuilt from the keys (rotations along `curve`,
+    cubic Hermite translations) and the error measured on it. For keys a DCC will play back with
+    Bezier curves, pass `curve="quaternion_bezier"` and hand the keys to `bezier_handles`."""
+    bounded = max_error_cm is not None or max_error_deg is not None
     if method is None:
-        method = "error_bounded" if max_error_cm is not None else "optimal"
+        method = "error_bounded" if bounded else "optimal"
     if method not in METHODS and method not in ("bound", "error-bounded"):
         raise InbetweenError(f"method {method!r}: expected one of {', '.join(METHODS)}")
+    if curve not in CURVES:
+        raise InbetweenError(f"curve {curve!r}: expected one of {', '.join(CURVES)}")
     if method in ("error_bounded", "bound", "error-bounded"):
-        if max_error_cm is None or k is not None:
-            raise InbetweenError(f"method {method!r} takes max_error_cm (a bound in cm), not k")
-    elif k is None or max_error_cm is not None:
+        if not bounded or k is not None:
+            raise InbetweenError(f"method {method!r} takes max_error_cm and/or max_error_deg (bounds), not k")
+    elif k is None or bounded:
         raise InbetweenError(f"method {method!r} takes k (the number of keys, ends included), not max_error_cm")
     with progress_callback(progress, "choosing keys") as cb:
-        frames, poses, report_json, text, rebuilt = _native.mocap_select(clip, method, k, max_error_cm, max_gap_s, cb)
+        frames, poses, report_json, text, rebuilt = _native.mocap_select(
+            clip, method, k, max_error_cm, max_gap_s, cb, max_error_deg, curve
+        )
     report = json.loads(report_json)
     rec = report["reconstruction"]
     return Keys(
@@ -109,13 +122,60 @@ def select_keys(
     )
 
 
-def reconstruct(clip: Clip, keys: "Keys | Sequence[int] | np.ndarray", *, progress: Optional[Callback] = None) -> Reconstruction:
-    """`clip` rebuilt from its poses at `keys` (a `Keys`, or frame indices; the first and last
-    frames are added when missing) by the mocap engine's `ReconstructJob`."""
+def _frames(keys: "Keys | Sequence[int] | np.ndarray") -> list:
     frames = keys.frames if isinstance(keys, Keys) else keys
     arr = np.asarray(frames)
     if arr.ndim != 1 or arr.dtype.kind not in "iu":
         raise InbetweenError(f"keys: expected frame indices, int [K]; got dtype {arr.dtype} shape {list(arr.shape)}")
+    return [int(f) for f in arr]
+
+
+def reconstruct(
+    clip: Clip,
+    keys: "Keys | Sequence[int] | np.ndarray",
+    *,
+    curve: Optional[str] = None,
+    progress: Optional[Callback] = None,
+) -> Reconstruction:
+    """`clip` rebuilt from its poses at `keys` (a `Keys`, or frame indices; the first and last
+    frames are added when missing) by the mocap engine's `ReconstructJob`, rotations along `curve`
+    (by default the one `keys` were chosen with, else "hermite")."""
+    if curve is None:
+        curve = keys.report["reconstruction"]["curve"] if isinstance(keys, Keys) else "hermite"
+    if curve not in CURVES:
+        raise InbetweenError(f"curve {curve!r}: expected one of {', '.join(CURVES)}")
+    frames = _frames(keys)
     with progress_callback(progress, "reconstructing") as cb:
-        rebuilt, report_json, text = _native.mocap_reconstruct(clip, [int(f) for f in arr], cb)
+        rebuilt, report_json, text = _native.mocap_reconstruct(clip, frames, cb, curve)
     return _reconstruction(rebuilt, json.loads(report_json), text)
+
+
+@dataclass(frozen=True)
+class BezierHandles:
+    """Keys as a DCC's Bezier F-curves hold them: per key a value and a left and a right handle
+    for each quaternion component (x, y, z, w) and each translation axis of every joint. A DCC
+    evaluating these curves (handles "free" or "aligned", never "auto"; quaternions normalised)
+    plays back exactly `reconstruct(clip, keys, curve="quaternion_bezier")`."""
+
+    #: Key frames, int64 `[K]`.
+    frames: np.ndarray
+    #: Each key's left and right handle times, frames (fractional), float64 `[K]`.
+    left_frames: np.ndarray
+    right_frames: np.ndarray
+    #: Local rotations (x, y, z, w), signs continuous along each joint, float64 `[K, J, 4]`, and
+    #: their handles' values.
+    rotations: np.ndarray
+    rotations_left: np.ndarray
+    rotations_right: np.ndarray
+    #: Local translations (rest offsets plus channels), cm, float64 `[K, J, 3]`, and handles.
+    translations_cm: np.ndarray
+    translations_left_cm: np.ndarray
+    translations_right_cm: np.ndarray
+
+
+def bezier_handles(clip: Clip, keys: "Keys | Sequence[int] | np.ndarray") -> BezierHandles:
+    """The Bezier keys (values and handles) that make a DCC's own curve evaluation reproduce the
+    engine's "quaternion_bezier" in-betweens of `clip` at `keys` (choose the keys with
+    `select_keys(..., curve="quaternion_bezier")` for the bound to hold on the DCC's playback)."""
+    d = _native.mocap_bezier(clip, _frames(keys))
+    return BezierHandles(frames=np.asarray(d.pop("frames"), dtype=np.int64), **d)
