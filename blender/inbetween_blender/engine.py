@@ -7,7 +7,6 @@ import inspect
 import os
 import sys
 
-import numpy as np
 
 VENDOR = os.path.join(os.path.dirname(__file__), "_vendor")
 
@@ -44,41 +43,23 @@ def _has(fn, name: str) -> bool:
         return False
 
 
-def select_keys(clip, method: str, bound_cm, k, progress=None):
+def select_keys(clip, method: str, bound_cm, k, progress=None, bound_deg=None):
     """Key frames of `clip` chosen for Blender's curve: `inbetween.mocap.select_keys` with
-    `curve="quaternion_bezier"`, so the engine's bound holds on what Blender plays."""
-    inbetween = require()
+    `curve="quaternion_bezier"`, so the engine's bounds (cm, and degrees when given) hold on what
+    Blender plays for quaternion bones."""
     from .jobs import JobError
 
-    mocap = inbetween.mocap
-    if _has(mocap.select_keys, "curve"):
-        kwargs = {"method": method, "progress": progress, "curve": CURVE}
-        if bound_cm is not None:
-            kwargs["max_error_cm"] = bound_cm
-        else:
-            kwargs["k"] = k
-        return mocap.select_keys(clip, **kwargs)
-    native = inbetween._native
-    if not hasattr(native, "mocap_bezier"):
-        raise JobError(f"the inbetween package {inbetween.__version__} has no Blender curve; update it")
-    # A package whose Python layer predates the curve option: the same job through its module.
-    import json
-
-    frames, poses, report_json, text, rebuilt = native.mocap_select(
-        clip, method, k, bound_cm, None, progress or None, None, CURVE
-    )
-    report = json.loads(report_json)
-    return mocap.Keys(
-        frames=np.asarray(frames, dtype=np.int64),
-        rotations=poses["rotations"],
-        angular_velocities=poses["angular_velocities"],
-        translations_cm=poses["translations_cm"],
-        velocities_cm_s=poses["velocities_cm_s"],
-        method=report["method"],
-        reconstruction=mocap._reconstruction(rebuilt, report["reconstruction"], str(rebuilt)),
-        report=report,
-        text=text,
-    )
+    mocap = require().mocap
+    if not _has(mocap.select_keys, "curve"):
+        raise JobError("this inbetween package has no Blender curve (select_keys(curve=...)); update it")
+    kwargs = {"method": method, "progress": progress, "curve": CURVE}
+    if bound_cm is not None:
+        kwargs["max_error_cm"] = bound_cm
+        if bound_deg:
+            kwargs["max_error_deg"] = bound_deg
+    else:
+        kwargs["k"] = k
+    return mocap.select_keys(clip, **kwargs)
 
 
 def bezier_handles(clip, frames) -> dict:
@@ -86,12 +67,7 @@ def bezier_handles(clip, frames) -> dict:
     bezier_handles`): `frames`, `left_frames`, `right_frames` `[K]`; `rotations`,
     `rotations_left`, `rotations_right` `[K, J, 4]` (x, y, z, w); `translations_cm`,
     `translations_left_cm`, `translations_right_cm` `[K, J, 3]`."""
-    inbetween = require()
-    keys = [int(f) for f in frames]
-    fn = getattr(inbetween.mocap, "bezier_handles", None)
-    out = fn(clip, keys) if fn is not None else inbetween._native.mocap_bezier(clip, keys)
-    if isinstance(out, dict):
-        return out
+    out = require().mocap.bezier_handles(clip, [int(f) for f in frames])
     return {name: getattr(out, name) for name in _BEZIER_FIELDS}
 
 

@@ -254,7 +254,9 @@ class ReduceJob:
                     "rotation_mode; set the mode back to play the original)"
                 )
             keys = yield from engine_fractions(
-                call_engine(engine.select_keys, self.cancel, clip, o.engine_method(), bound, o.keys or None),
+                call_engine(
+                    engine.select_keys, self.cancel, clip, o.engine_method(), bound, o.keys or None, bound_deg=o.max_error_deg
+                ),
                 0.25,
                 0.55,
                 "choosing keys",
