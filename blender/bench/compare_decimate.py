@@ -107,7 +107,7 @@ def screenshot(ob, action, bone, path):
     with bpy.context.temp_override(window=win, area=area, region=region):
         bpy.ops.object.mode_set(mode="POSE")
         for pb in ob.pose.bones:
-            pb.bone.select = pb.name == bone
+            pb.bone.select = pb.name == bone  # Blender 3.x/4.x (the bench runs on Debian's 3.4)
         for fc in action.fcurves:
             fc.hide = f'"{bone}"' not in fc.data_path or "rotation" not in fc.data_path
             fc.select = not fc.hide

@@ -14,42 +14,81 @@ import bpy
 Channels = Dict[Tuple[str, int], "bpy.types.FCurve"]
 
 
-def _channelbag(ob, action, create: bool):
-    """5.x: the channelbag of the object's slot in `action` (None on 3.x/4.x)."""
-    if hasattr(action, "fcurves"):
+def _slot(owner, action, create: bool):
+    """5.x: the slot of `action` that animates `owner` (the assigned slot's identifier, else one
+    named for `owner`, else the only one); made and assigned when `create` and none exists."""
+    ad = owner.animation_data
+    assigned = ad.action_slot if ad is not None and ad.action == action else None
+    if assigned is not None:
+        return assigned
+    ident = ad.action_slot.identifier if ad is not None and ad.action_slot is not None else None
+    for slot in action.slots:
+        if slot.identifier == ident or slot.name_display == owner.name:
+            return slot
+    if len(action.slots) == 1:
+        return action.slots[0]
+    if not create:
         return None
+    slot = action.slots.new(owner.id_type, owner.name)
+    if ad is not None and ad.action == action:
+        ad.action_slot = slot
+    return slot
+
+
+def _channelbag(owner, action, create: bool):
+    """5.x: the channelbag of `owner`'s slot in `action` (layered actions; None when it has none)."""
     from bpy_extras import anim_utils
 
-    slot = ob.animation_data.action_slot if ob.animation_data else None
+    slot = _slot(owner, action, create)
     if slot is None:
-        raise RuntimeError(f"{ob.name}: the action {action.name!r} has no slot for it")
+        return None
     if create:
         return anim_utils.action_ensure_channelbag_for_slot(action, slot)
     return anim_utils.action_get_channelbag_for_slot(action, slot)
 
 
-def fcurves(ob, action):
-    """The F-curves of `action` that animate `ob` (empty when none)."""
+def fcurves(owner, action):
+    """The F-curves of `action` that animate `owner` (an object, or a mesh's shape key block);
+    `Action.fcurves` on 3.x/4.x, the slot's channelbag on 5.x (empty when none)."""
     if hasattr(action, "fcurves"):
         return action.fcurves
-    bag = _channelbag(ob, action, create=False)
+    bag = _channelbag(owner, action, create=False)
     return bag.fcurves if bag is not None else []
 
 
-def channels(ob, action) -> Channels:
-    return {(fc.data_path, fc.array_index): fc for fc in fcurves(ob, action)}
+def channels(owner, action) -> Channels:
+    return {(fc.data_path, fc.array_index): fc for fc in fcurves(owner, action)}
 
 
-def new_fcurve(ob, action, data_path: str, index: int, group: Optional[str]):
-    """A new F-curve in `action` for `ob`, in the named group (a bone's name by convention)."""
+def new_fcurve(owner, action, data_path: str, index: int, group: Optional[str]):
+    """A new F-curve in `action` for `owner`, in the named group (a bone's name by convention)."""
     if hasattr(action, "fcurves"):
         return action.fcurves.new(data_path, index=index, action_group=group or "")
-    bag = _channelbag(ob, action, create=True)
+    bag = _channelbag(owner, action, create=True)
     fc = bag.fcurves.new(data_path, index=index)
     if group:
         grp = bag.groups.get(group) or bag.groups.new(group)
         fc.group = grp
     return fc
+
+
+def remove_fcurve(owner, action, fc) -> None:
+    if hasattr(action, "fcurves"):
+        action.fcurves.remove(fc)
+    else:
+        _channelbag(owner, action, create=False).fcurves.remove(fc)
+
+
+def bone_selected(pose_bone) -> bool:
+    """A pose bone's selection: `PoseBone.select` on 5.x, `Bone.select` before."""
+    return bool(pose_bone.select if hasattr(pose_bone, "select") else pose_bone.bone.select)
+
+
+def select_bone(pose_bone, state: bool) -> None:
+    if hasattr(pose_bone, "select"):
+        pose_bone.select = state
+    else:
+        pose_bone.bone.select = state
 
 
 def _enum_values(prop: str) -> Dict[str, int]:
@@ -142,10 +181,3 @@ def replace_range(
         points.foreach_set(f, arr.ravel().astype(np.int32 if arr.dtype.kind == "i" else np.float32))
     fc.update()
     return int(len(removed))
-
-
-def remove_fcurve(ob, action, fc) -> None:
-    if hasattr(action, "fcurves"):
-        action.fcurves.remove(fc)
-    else:
-        _channelbag(ob, action, create=False).fcurves.remove(fc)

@@ -217,7 +217,7 @@ class ReduceJob:
         except RigError as e:
             raise JobError(str(e)) from None
         chans = anim.channels(ob, action)
-        selected = {pb.name for pb in ob.pose.bones if pb.bone.select} if o.selected_only else None
+        selected = {pb.name for pb in ob.pose.bones if anim.bone_selected(pb)} if o.selected_only else None
         if selected is not None and not selected:
             raise JobError(f"{ob.name}: no bones selected (pose mode), or turn off 'Selected bones'")
         todo, notes = self._channels(rig, chans, selected)

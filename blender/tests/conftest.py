@@ -12,8 +12,8 @@ import pathlib
 import numpy as np
 import pytest
 
-import addon_utils
-import bpy
+import bpy  # first: in the bpy module, addon_utils is importable only after it
+import addon_utils  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 ADDON = "inbetween_blender"
@@ -91,10 +91,17 @@ def world_points(ob, frames, tails: bool = True) -> np.ndarray:
     return np.array(out) * cm
 
 
+def curves(action) -> list:
+    """Every F-curve of an action: `Action.fcurves` on 3.x/4.x, every channelbag's on 5.x."""
+    if hasattr(action, "fcurves"):
+        return list(action.fcurves)
+    return [fc for layer in action.layers for strip in layer.strips for bag in strip.channelbags for fc in bag.fcurves]
+
+
 def keyframes(action) -> dict:
     """(data path, index) -> (N, 6) co, left and right handles of every key."""
     out = {}
-    for fc in action.fcurves:
+    for fc in curves(action):
         n = len(fc.keyframe_points)
         arrs = []
         for f in ("co", "handle_left", "handle_right"):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import keyframes
+from conftest import curves, keyframes
 
 
 @pytest.fixture(autouse=True)
@@ -23,6 +23,7 @@ def face_mesh(seconds: float = 8.0, seed: int = 3, with_keys: bool = True):
     """A plane with the 52 ARKit shape keys (ARKit's own lower-case names) keyed every frame from
     the face engine's procedural capture at 25 fps."""
     import inbetween
+    from inbetween_blender import anim
 
     clip, _ = inbetween.face.synth(seconds, seed=seed)
     sc = bpy.context.scene
@@ -42,7 +43,7 @@ def face_mesh(seconds: float = 8.0, seed: int = 3, with_keys: bool = True):
     w = clip.weights
     frames = np.arange(1, len(w) + 1, dtype=np.float32)
     for i, n in enumerate(names):
-        fc = act.fcurves.new(f'key_blocks["{n}"].value', index=0)
+        fc = anim.new_fcurve(keys, act, f'key_blocks["{n}"].value', 0, None)
         fc.keyframe_points.add(len(frames))
         fc.keyframe_points.foreach_set("co", np.stack([frames, w[:, i]], 1).ravel())
         fc.keyframe_points.foreach_set("interpolation", np.ones(len(frames), dtype=np.int32))  # LINEAR
@@ -51,7 +52,7 @@ def face_mesh(seconds: float = 8.0, seed: int = 3, with_keys: bool = True):
 
 
 def values(action, frames):
-    return {fc.data_path: np.array([fc.evaluate(f) for f in frames]) for fc in action.fcurves}
+    return {fc.data_path: np.array([fc.evaluate(f) for f in frames]) for fc in curves(action)}
 
 
 def test_unguided_inpaint_changes_only_the_range_and_makes_variants():
@@ -80,7 +81,7 @@ def test_unguided_inpaint_changes_only_the_range_and_makes_variants():
 def test_keyframes_inside_the_range_guide_the_fill():
     ob, clip = face_mesh()
     act = ob.data.shape_keys.animation_data.action
-    jaw = next(fc for fc in act.fcurves if fc.data_path == 'key_blocks["jawOpen"].value')
+    jaw = next(fc for fc in curves(act) if fc.data_path == 'key_blocks["jawOpen"].value')
     # Keep only two keys inside 60-110 on the jaw; the target at 85 is wide open.
     for kp in reversed(list(jaw.keyframe_points)):
         if 60 < kp.co[0] < 110 and kp.co[0] not in (70, 85):
@@ -89,7 +90,7 @@ def test_keyframes_inside_the_range_guide_the_fill():
     jaw.update()
     assert bpy.ops.inbetween.face_inpaint(frame_start=60, frame_end=110, guide="KEYS") == {"FINISHED"}
     new = ob.data.shape_keys.animation_data.action
-    fc = next(fc for fc in new.fcurves if fc.data_path == 'key_blocks["jawOpen"].value')
+    fc = next(fc for fc in curves(new) if fc.data_path == 'key_blocks["jawOpen"].value')
     print(f"\njawOpen at the key (85): {fc.evaluate(85):.3f} (key 0.9)")
     assert abs(fc.evaluate(85) - 0.9) < 0.05
     assert new["inbetween_face"]["guidance"] == "keyframes"

@@ -10,7 +10,8 @@ import zipfile
 
 import pytest
 
-import addon_utils
+import bpy  # noqa: F401  (first: in the bpy module addon_utils comes with it)
+import addon_utils  # noqa: E402
 
 
 def test_the_loaded_add_on_brings_the_engines():

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import bpy
-from conftest import data_dir, import_bvh, keyframes, need, world_points
+from conftest import curves, data_dir, import_bvh, keyframes, need, world_points
 
 BOUND_SLACK = 1e-3  # cm: float32 curve storage
 
@@ -58,7 +58,7 @@ def test_cmu_take_at_1cm_is_within_the_bound_on_every_frame(take):
     assert r["key_frames_after"] < r["key_frames_before"] / 4
     # Every reduced curve is Bezier with FREE handles, keys on the same frames across bones.
     key_sets = set()
-    for fc in reduced.fcurves:
+    for fc in curves(reduced):
         if "rotation" in fc.data_path or fc.data_path.endswith("location"):
             kp = fc.keyframe_points
             key_sets.add(tuple(round(k.co[0]) for k in kp))
@@ -108,9 +108,9 @@ def test_frame_range_leaves_the_rest_untouched(take):
     assert err[inside].max() <= 1.0 + BOUND_SLACK
     # Keys outside keep their frames and values, and each curve evaluates as before there (the
     # importer's stale auto handles on its LINEAR keys may be recomputed; they shape nothing).
-    orig_curves = {(fc.data_path, fc.array_index): fc for fc in original.fcurves}
+    orig_curves = {(fc.data_path, fc.array_index): fc for fc in curves(original)}
     outside = np.concatenate([np.arange(1, 300, 0.25), np.arange(600.25, 994.01, 0.25)])
-    for fc in reduced.fcurves:
+    for fc in curves(reduced):
         c = (fc.data_path, fc.array_index)
         new_keys, ref = keyframes(reduced)[c], keys_before[c]
         out_new = new_keys[(new_keys[:, 0] < 300) | (new_keys[:, 0] > 600), :2]
@@ -129,8 +129,10 @@ def test_selected_bones_only(take):
     original = ob.animation_data.action
     keys_before = keyframes(original)
     picked = {"LeftHip", "LeftKnee", "LeftAnkle"}
-    for b in ob.data.bones:
-        b.select = b.name in picked
+    from inbetween_blender import anim
+
+    for pb in ob.pose.bones:
+        anim.select_bone(pb, pb.name in picked)
     assert bpy.ops.inbetween.reduce_keys(max_error_cm=1.0, selected_only=True) == {"FINISHED"}
     reduced = ob.animation_data.action
     changed = {c for c, k in keyframes(reduced).items() if not np.array_equal(k, keys_before[c])}
@@ -146,7 +148,7 @@ def test_quaternion_bones_get_quaternion_curves(take):
     assert bpy.ops.inbetween.reduce_keys(max_error_cm=1.0) == {"FINISHED"}
     reduced = ob.animation_data.action
     assert all(pb.rotation_mode == "QUATERNION" for pb in ob.pose.bones)
-    assert any(fc.data_path.endswith("rotation_quaternion") for fc in reduced.fcurves)
+    assert any(fc.data_path.endswith("rotation_quaternion") for fc in curves(reduced))
     err = measure(ob, original, reduced, frames_of(original))
     r = reduced["inbetween_reduce"]
     print(f"\nquaternion bones: {r['key_frames_after']} keys, max {err.max():.4f} cm, rounds {r['rounds']}")
@@ -207,8 +209,10 @@ def _same(a, b):
 def test_bad_inputs_report_an_error_and_change_nothing(take, setup, kwargs, words):
     if setup == "take":
         ob = import_bvh(take)
-        for b in ob.data.bones:
-            b.select = False
+        from inbetween_blender import anim
+
+        for pb in ob.pose.bones:
+            anim.select_bone(pb, False)
     elif setup == "mesh":
         bpy.ops.mesh.primitive_cube_add()
     elif setup == "bare":
