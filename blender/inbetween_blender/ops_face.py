@@ -42,6 +42,19 @@ def arkit_map(keys, names: List[str]) -> Dict[int, str]:
     return {i: by_lower[n.lower()] for i, n in enumerate(names) if n.lower() in by_lower}
 
 
+def arkit_names(inbetween) -> List[str]:
+    """The face engine's 52 ARKit shape names, in its channel order (a clip's `names`)."""
+    return list(inbetween.FaceClip.from_arrays(np.zeros((2, 52), np.float32), 25.0).names)
+
+
+def _animated_face(ob):
+    """The mesh's shape keys and their action, or an error in words."""
+    keys = _shape_keys(ob)
+    if keys.animation_data is None or keys.animation_data.action is None:
+        raise JobError(f"{ob.name}: the shape keys have no action")
+    return keys, keys.animation_data.action
+
+
 def _path(name: str) -> str:
     return f'key_blocks["{name}"].value'
 
@@ -57,11 +70,8 @@ class FaceJob:
         self.summary = ""
 
     def check(self):
-        keys = _shape_keys(self.ob)
-        ad = keys.animation_data
-        if ad is None or ad.action is None:
-            raise JobError(f"{self.ob.name}: the shape keys have no action to inpaint")
-        lo, hi = (int(round(v)) for v in ad.action.frame_range)
+        keys, action = _animated_face(self.ob)
+        lo, hi = (int(round(v)) for v in action.frame_range)
         a, b = self.p["frame_start"], self.p["frame_end"]
         if not (lo <= a < b <= hi):
             raise JobError(f"frames {a}–{b}: expected a range inside the action's {lo}–{hi}, end after start")
@@ -74,7 +84,7 @@ class FaceJob:
             raise JobError("guide TEXT: the text to speak is empty")
         if g == "VISEMES" and not self.p["visemes"]:
             raise JobError("guide VISEMES: no TextGrid / phoneme file given")
-        return keys, ad.action, (lo, hi), (a, b)
+        return keys, action, (lo, hi), (a, b)
 
     def _sample(self, action, names, mapping, lo, hi) -> np.ndarray:
         curves = {fc.data_path: fc for fc in anim.fcurves(self.ob.data.shape_keys, action)}
@@ -91,7 +101,7 @@ class FaceJob:
         if not hasattr(getattr(inbetween, "face", None), "edit"):
             raise JobError(f"the inbetween package {inbetween.__version__} has no face.edit; update it")
         keys, action, (lo, hi), (a, b) = self.check()
-        names = list(inbetween.FaceClip.from_arrays(np.zeros((2, 52), np.float32), 25.0).names)
+        names = arkit_names(inbetween)
         mapping = arkit_map(keys, names)
         if not mapping:
             raise JobError(f"{self.ob.name}: none of the shape keys has an ARKit name (eyeBlinkLeft, jawOpen, …)")
@@ -269,12 +279,9 @@ class INBETWEEN_OT_export_live_link(bpy.types.Operator, ExportHelper):
         try:
             inbetween = engine.require()
             ob = context.active_object
-            keys = _shape_keys(ob)
-            if keys.animation_data is None or keys.animation_data.action is None:
-                raise JobError(f"{ob.name}: the shape keys have no action")
-            names = list(inbetween.FaceClip.from_arrays(np.zeros((2, 52), np.float32), 25.0).names)
+            keys, action = _animated_face(ob)
+            names = arkit_names(inbetween)
             mapping = arkit_map(keys, names)
-            action = keys.animation_data.action
             lo, hi = (int(round(v)) for v in action.frame_range)
             sc = context.scene
             fps = sc.render.fps / sc.render.fps_base

@@ -17,6 +17,16 @@ METHOD_ITEMS = [
     ("UNIFORM", "Uniform", "Evenly spaced keys"),
 ]
 
+ROTATION_ITEMS = [
+    ("KEEP", "Keep Mode", "Euler bones keep Euler curves (keys are added where they leave the bound)"),
+    (
+        "QUATERNION",
+        "Quaternion",
+        "Euler bones get quaternion curves, the engine's own curve (fewest keys); their rotation mode is switched "
+        "to quaternion, and keyed so in the new action",
+    ),
+]
+
 
 class INBETWEEN_OT_reduce_keys(JobOperator, bpy.types.Operator):
     """Reduce the active armature's keys to a bound in cm on the bones (or a key count); the result
@@ -60,19 +70,7 @@ class INBETWEEN_OT_reduce_keys(JobOperator, bpy.types.Operator):
         description="Also keep the tails of end bones (finger, toe and head tips) within the bound",
         default=True,
     )
-    rotation: EnumProperty(
-        name="Rotation",
-        items=[
-            ("KEEP", "Keep Mode", "Euler bones keep Euler curves (keys are added where they leave the bound)"),
-            (
-                "QUATERNION",
-                "Quaternion",
-                "Euler bones get quaternion curves, the engine's own curve (fewest keys); their rotation mode is "
-                "switched to quaternion, and keyed so in the new action",
-            ),
-        ],
-        default="KEEP",
-    )
+    rotation: EnumProperty(name="Rotation", items=ROTATION_ITEMS, default="KEEP")
     new_action: BoolProperty(
         name="New Action",
         description="Write the result to a new action and keep the original (off: replace it)",
@@ -107,19 +105,16 @@ class INBETWEEN_OT_reduce_keys(JobOperator, bpy.types.Operator):
         layout = self.layout
         layout.use_property_split = True
         col = layout.column()
-        col.prop(self, "max_error_cm")
-        col.prop(self, "max_error_deg")
-        col.prop(self, "keys")
-        col.prop(self, "method")
-        col.prop(self, "use_frame_range")
+        draw_props(col, self, ("max_error_cm", "max_error_deg", "keys", "method", "use_frame_range"))
         sub = col.column(align=True)
         sub.active = self.use_frame_range
-        sub.prop(self, "frame_start")
-        sub.prop(self, "frame_end")
-        col.prop(self, "selected_only")
-        col.prop(self, "include_tails")
-        col.prop(self, "rotation")
-        col.prop(self, "new_action")
+        draw_props(sub, self, ("frame_start", "frame_end"))
+        draw_props(col, self, ("selected_only", "include_tails", "rotation", "new_action"))
+
+
+def draw_props(layout, data, names) -> None:
+    for name in names:
+        layout.prop(data, name)
 
 
 CLASSES = (INBETWEEN_OT_reduce_keys,)

@@ -5,7 +5,7 @@ Sheet's Key menus. Settings live on the scene (`scene.inbetween`) so the panel k
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from .ops_reduce import METHOD_ITEMS
+from .ops_reduce import METHOD_ITEMS, ROTATION_ITEMS, draw_props
 
 
 class InbetweenSettings(bpy.types.PropertyGroup):
@@ -17,18 +17,24 @@ class InbetweenSettings(bpy.types.PropertyGroup):
         name="Scene Range Only", description="Reduce only the scene's frame range (the preview range when set)"
     )
     selected_only: BoolProperty(name="Selected Bones")
+    include_tails: BoolProperty(name="Bound Tails", default=True)
+    rotation: EnumProperty(name="Rotation", items=ROTATION_ITEMS, default="KEEP")
     new_action: BoolProperty(name="New Action", default=True)
+
+
+#: The panel's settings, in order.
+SETTINGS = (
+    "max_error_cm", "max_error_deg", "keys", "method", "use_preview_range", "selected_only", "include_tails",
+    "rotation", "new_action",
+)
 
 
 def reduce_button(layout, context):
     s = context.scene.inbetween
     op = layout.operator("inbetween.reduce_keys", icon="IPO_BEZIER")
-    op.max_error_cm = s.max_error_cm
-    op.max_error_deg = s.max_error_deg
-    op.keys = s.keys
-    op.method = s.method
-    op.selected_only = s.selected_only
-    op.new_action = s.new_action
+    for name in SETTINGS:
+        if name != "use_preview_range":
+            setattr(op, name, getattr(s, name))
     if s.use_preview_range:
         sc = context.scene
         op.use_frame_range = True
@@ -51,14 +57,7 @@ class INBETWEEN_PT_reduce(bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         s = context.scene.inbetween
-        col = layout.column()
-        col.prop(s, "max_error_cm")
-        col.prop(s, "max_error_deg")
-        col.prop(s, "keys")
-        col.prop(s, "method")
-        col.prop(s, "use_preview_range")
-        col.prop(s, "selected_only")
-        col.prop(s, "new_action")
+        draw_props(layout.column(), s, SETTINGS)
         reduce_button(layout, context)
 
 
@@ -67,20 +66,18 @@ class INBETWEEN_PT_reduce_graph(INBETWEEN_PT_reduce):
 
 
 class INBETWEEN_PT_scene(bpy.types.Panel):
-    bl_label = "Scene, Camera, Face"
+    bl_label = "Scene and Face"
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = "inbetween"
 
     def draw(self, context):
         col = self.layout.column()
-        for idname, icon in (
-            ("inbetween.text_to_scene", "TEXT"),
-            ("inbetween.camera_from_armatures", "CAMERA_DATA"),
-            ("inbetween.face_inpaint", "SHAPEKEY_DATA"),
-        ):
-            if hasattr(bpy.types, "INBETWEEN_OT_" + idname.split(".")[1]):
-                col.operator(idname, icon=icon)
+        col.operator("inbetween.text_to_scene", icon="TEXT")
+        col.operator("inbetween.face_inpaint", icon="SHAPEKEY_DATA")
+        row = col.row(align=True)
+        row.operator("inbetween.import_live_link", text="Import Live Link", icon="IMPORT")
+        row.operator("inbetween.export_live_link", text="Export Live Link", icon="EXPORT")
 
 
 def menu_entry(self, context):

@@ -46,3 +46,16 @@ def test_extension_zip_names_its_wheel():
             inner = set(w.namelist())
     assert {"inbetween/__init__.py", "inbetween/mocap.py", "inbetween/_native.abi3.so"} <= inner
     assert any(n.endswith(".dist-info/RECORD") for n in inner)
+
+
+def test_operators_panels_and_menus_are_registered():
+    for op in ("reduce_keys", "text_to_scene", "face_inpaint", "import_live_link", "export_live_link"):
+        assert hasattr(bpy.ops.inbetween, op), op
+        assert getattr(bpy.ops.inbetween, op).get_rna_type().bl_rna.identifier == f"INBETWEEN_OT_{op}"
+    for panel in ("INBETWEEN_PT_reduce", "INBETWEEN_PT_reduce_graph", "INBETWEEN_PT_scene"):
+        assert hasattr(bpy.types, panel), panel
+    from inbetween_blender import ui
+
+    for menu in ui.MENUS:
+        assert ui.menu_entry in getattr(bpy.types, menu)._dyn_ui_initialize()
+    assert bpy.context.scene.inbetween.max_error_cm == 1.0

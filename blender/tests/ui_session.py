@@ -87,7 +87,7 @@ def step():
             f"{STATS['slices']} slices, the longest {STATS['max_slice_s']:.3f} s (the add-on's hold on the main "
             f"loop); main-loop ticks {len(gaps)}, longest gap {max(gaps):.3f} s (slice plus the window's redraw)"
         )
-        say("rounds (engine bound cm, keys, measured cm):", [tuple(h) for h in act["inbetween_reduce"]["history"]])
+        say("rounds (key frames, max cm, max degrees):", [tuple(h) for h in act["inbetween_reduce"]["history"]])
         if STATS["slices"] < 5 or STATS["max_slice_s"] > 0.5:
             fail(f"the modal run held the main loop {STATS['max_slice_s']:.2f} s at once")
         with override():
