@@ -135,3 +135,71 @@ def test_bad_inputs_report_an_error_and_change_nothing(setup, kwargs, words):
         bpy.ops.inbetween.face_inpaint(**kwargs)
     assert words in str(e.value) and "Traceback" not in str(e.value), str(e.value)
     assert sorted(a.name for a in bpy.data.actions) == acts
+
+
+def test_a_noisy_take_in_another_action_guides_the_fill():
+    ob, clip = face_mesh()
+    keys = ob.data.shape_keys
+    take = keys.animation_data.action.copy()
+    take.name = "noisy take"
+    rng = np.random.default_rng(7)
+    for fc in curves(take):
+        n = len(fc.keyframe_points)
+        co = np.zeros(2 * n, dtype=np.float32)
+        fc.keyframe_points.foreach_get("co", co)
+        co[1::2] = np.clip(co[1::2] + rng.normal(0, 0.08, n), 0, 1)
+        fc.keyframe_points.foreach_set("co", co)
+        fc.update()
+    r = bpy.ops.inbetween.face_inpaint(frame_start=60, frame_end=110, guide="TAKE", take="noisy take")
+    assert r == {"FINISHED"}
+    assert keys.animation_data.action["inbetween_face"]["guidance"] == "noisy"
+
+
+TEXTGRID = """File type = "ooTextFile"
+Object class = "TextGrid"
+
+xmin = 0
+xmax = 8
+tiers? <exists>
+size = 1
+item []:
+    item [1]:
+        class = "IntervalTier"
+        name = "phones"
+        xmin = 0
+        xmax = 8
+        intervals: size = 6
+        intervals [1]:
+            xmin = 0
+            xmax = 2.4
+            text = ""
+        intervals [2]:
+            xmin = 2.4
+            xmax = 2.6
+            text = "HH"
+        intervals [3]:
+            xmin = 2.6
+            xmax = 2.9
+            text = "AH"
+        intervals [4]:
+            xmin = 2.9
+            xmax = 3.1
+            text = "L"
+        intervals [5]:
+            xmin = 3.1
+            xmax = 3.5
+            text = "OW"
+        intervals [6]:
+            xmin = 3.5
+            xmax = 8
+            text = ""
+"""
+
+
+def test_a_textgrid_guides_the_mouth(tmp_path):
+    ob, _ = face_mesh()
+    path = tmp_path / "hello.TextGrid"
+    path.write_text(TEXTGRID)
+    r = bpy.ops.inbetween.face_inpaint(frame_start=55, frame_end=95, guide="VISEMES", visemes=str(path))
+    assert r == {"FINISHED"}
+    assert ob.data.shape_keys.animation_data.action["inbetween_face"]["guidance"] == "visemes"
