@@ -328,7 +328,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         && is_live_link(&a.input);
     // Every variant's clip, PNG and GIF appear together or not at all.
     let mut set = OutputSet::new();
-    let mut first: Option<Vec<inbetween_face::edit::Frame>> = None;
+    let mut first: Option<inbetween_face::infer::EditOutcome> = None;
     let mut spreads = Vec::new();
     for k in 1..=a.variants {
         job.seed = a.seed + u64::from(k - 1);
@@ -345,8 +345,8 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
             named(&a.out).display(),
         );
         match &first {
-            None => first = Some(out.after.clone()),
-            Some(f) => spreads.push(mean_abs_difference(f, &out.after, &out.mask.segments())),
+            None => first = Some(out),
+            Some(f) => spreads.push(out.mean_abs_difference(f)),
         }
     }
     set.commit().context("moving the edit's outputs into place")?;
@@ -372,24 +372,6 @@ fn variant_path(p: &Path, k: u32) -> PathBuf {
         None => format!("{stem}-{k}"),
     };
     p.with_file_name(name)
-}
-
-/// Mean absolute difference of two edits over the frames of `segs`, every channel.
-fn mean_abs_difference(
-    a: &[inbetween_face::edit::Frame],
-    b: &[inbetween_face::edit::Frame],
-    segs: &[inbetween_face::edit::Segment],
-) -> f64 {
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for s in segs {
-        for f in s.start..s.end.min(a.len()).min(b.len()) {
-            for (x, y) in a[f].iter().zip(&b[f]) {
-                sum += (x - y).abs() as f64;
-                n += 1;
-            }
-        }
-    }
-    sum / n.max(1) as f64
 }
 
 /// One edit: runs the job, stages its clip, PNG and (with --gif) GIF under `named` paths.

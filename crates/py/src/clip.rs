@@ -62,8 +62,10 @@ fn read_clip(py: Python<'_>, path: PathBuf, unit: Option<&str>) -> PyResult<Clip
 /// Reads a face clip: Live Link Face CSV, curve CSV or curve JSON.
 #[pyfunction]
 fn read_face_clip(py: Python<'_>, path: PathBuf) -> PyResult<FaceClip> {
-    let clip = py.detach(|| inbetween_face::data::read_clip(&path)).map_err(|e| engine("", &e))?;
-    Ok(FaceClip { clip, source: path.display().to_string() })
+    let (clip, live_link) = py
+        .detach(|| inbetween_face::data::read_clip(&path).map(|c| (c, inbetween_face::data::is_live_link(&path))))
+        .map_err(|e| engine("", &e))?;
+    Ok(FaceClip { clip, source: path.display().to_string(), live_link })
 }
 
 fn stick_options(title: Option<String>, width: u32, height: u32, max_frames: usize) -> StickOptions {
@@ -341,6 +343,8 @@ pub fn file_label(source: &str) -> String {
 pub struct FaceClip {
     pub clip: BlendshapeClip,
     pub source: String,
+    /// Written as Live Link Face CSV by default (read from one, made from arrays or by an edit of one).
+    pub live_link: bool,
 }
 
 #[pymethods]
@@ -393,13 +397,37 @@ impl FaceClip {
         let times: Vec<f64> = (0..s[0]).map(|i| i as f64 / fps).collect();
         let clip = BlendshapeClip::new(fps, times, false, Vec::new(), values)
             .map_err(|e| engine("FaceClip.from_arrays", &e))?;
-        Ok(FaceClip { clip, source: "arrays".into() })
+        Ok(FaceClip { clip, source: "arrays".into(), live_link: true })
     }
 
-    /// Writes the clip: Live Link Face CSV when `live_link`, else curve CSV or JSON by extension.
-    #[pyo3(signature = (path, live_link=true))]
-    fn write(&self, py: Python<'_>, path: PathBuf, live_link: bool) -> PyResult<()> {
+    /// Writes the clip (atomically): Live Link Face CSV when `live_link`, else curve CSV or JSON by
+    /// extension. By default (`None`) a `.json` path gets curve JSON, a CSV path the layout the clip
+    /// came in (Live Link for a Live Link capture, an edit of one, or arrays; curve CSV for a curve file).
+    #[pyo3(signature = (path, live_link=None))]
+    fn write(&self, py: Python<'_>, path: PathBuf, live_link: Option<bool>) -> PyResult<()> {
+        let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        let live_link = live_link.unwrap_or(self.live_link && !json);
         py.detach(|| inbetween_face::data::write_clip(&path, &self.clip, live_link)).map_err(|e| engine("", &e))
+    }
+
+    /// Every channel's name, in the column order of `values`: the 52 ARKit shapes, then the 9 head
+    /// and eye rotations when the capture has them, then any extra columns.
+    #[getter]
+    fn channel_names(&self) -> Vec<String> {
+        self.clip.channel_names().iter().map(|s| s.to_string()).collect()
+    }
+
+    /// Every channel, float32 `[T, C]` (a new array; `weights` is its first 52 columns).
+    #[getter]
+    fn values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let (t, c) = (self.clip.num_frames(), self.clip.num_channels());
+        PyArray1::from_vec(py, self.clip.values().to_vec()).reshape([t, c])
+    }
+
+    /// Seconds from the first frame to the last.
+    #[getter]
+    fn duration_s(&self) -> f64 {
+        self.clip.duration()
     }
 
     /// A face-drawing GIF of the clip (or, with `compare`, both side by side). Returns the path.

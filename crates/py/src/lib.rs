@@ -14,6 +14,7 @@ mod bench;
 mod camera;
 mod clip;
 mod errors;
+mod face;
 mod ibk;
 mod mocap;
 mod runner;
@@ -32,6 +33,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     batch::register(m)?;
     bench::register(m)?;
     camera::register(m)?;
+    face::register(m)?;
     ibk::register(m)?;
     mocap::register(m)?;
     script::register(m)?;

@@ -293,7 +293,7 @@ pub struct EditRequest {
     pub start_s: f64,
     pub end_s: f64,
     /// `none`, `keys`, `noisy` (the uploaded guide), `visemes` (the uploaded phonemes) or `text`.
-    #[serde(default = "none")]
+    #[serde(default = "default_constraint")]
     pub constraint: String,
     /// Words spoken over the span (constraint `text`).
     #[serde(default)]
@@ -307,33 +307,37 @@ pub struct EditRequest {
     pub groups: String,
     /// `auto` (the face bench's best: retrieval unguided or noisy, the network otherwise), `network`,
     /// `retrieval`, `linear` or `cubic`.
-    #[serde(default = "auto")]
+    #[serde(default = "default_method")]
     pub method: String,
-    #[serde(default = "one")]
+    #[serde(default = "default_seed")]
     pub seed: u64,
     /// Fills made with seeds `seed`, `seed + 1`, … (1 to [`MAX_VARIANTS`]); the first becomes the new
     /// version and [`pick`] swaps in another.
-    #[serde(default = "one_u32")]
+    #[serde(default = "default_variants")]
     pub variants: u32,
 }
 
 /// Most fills one edit request makes.
 pub const MAX_VARIANTS: u32 = 6;
 
-fn one_u32() -> u32 {
-    1
-}
-
-fn none() -> String {
+/// An edit without a constraint is unguided.
+fn default_constraint() -> String {
     "none".into()
 }
+/// Every group, the face engine's default split (see `groups`).
 fn default_groups() -> String {
     "default".into()
 }
-fn auto() -> String {
+/// The face engine's rule picks the method.
+fn default_method() -> String {
     "auto".into()
 }
-fn one() -> u64 {
+/// The CLI's `face edit --seed` default.
+fn default_seed() -> u64 {
+    1
+}
+/// One fill.
+fn default_variants() -> u32 {
     1
 }
 
@@ -517,33 +521,12 @@ fn fill(
     .run()
     .map_err(face_err)?;
     // The masked error against what was there, at the model rate.
-    let (mut sq, mut count) = (0.0f64, 0usize);
-    for f in 0..out.mask.frames() {
-        for c in 0..NUM_ARKIT {
-            if out.mask.erased(f, c) {
-                sq += f64::from(out.after[f][c] - out.before[f][c]).powi(2);
-                count += 1;
-            }
-        }
-    }
+    let mse = out.masked_mse();
     // Rows the edit changed, and the changed columns there.
-    let (old, new) = (clip.values(), out.clip.values());
-    let stride = clip.num_channels();
-    let changed_rows: Vec<usize> = (0..clip.num_frames())
-        .filter(|f| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride])
-        .collect();
-    let rows = match (changed_rows.first(), changed_rows.last()) {
-        (Some(a), Some(b)) => (*a, b + 1),
-        _ => (0, 0),
-    };
-    let mut changed = [false; NUM_ARKIT];
-    for f in rows.0..rows.1 {
-        for (c, ch) in changed.iter_mut().enumerate() {
-            *ch |= old[f * stride + c] != new[f * stride + c];
-        }
-    }
+    let (rows, changed) = out.changed(clip);
+    let rows = (rows.start, rows.end);
     let model_frames = out.mask.segments().iter().map(|s| s.len()).sum::<usize>();
-    Ok(Fill { clip: out.clip, mse: sq / count.max(1) as f64, model_frames, rows, changed })
+    Ok(Fill { clip: out.clip, mse, model_frames, rows, changed })
 }
 
 #[derive(Deserialize)]

@@ -148,6 +148,60 @@ pub struct EditOutcome {
     pub keys: Vec<(usize, Frame)>,
 }
 
+impl EditOutcome {
+    /// Mean squared difference between the edit and what was there, over the erased entries at the
+    /// model rate (blendshape weight², how much the fill departs from the input it replaced).
+    pub fn masked_mse(&self) -> f64 {
+        let (mut sq, mut count) = (0.0f64, 0usize);
+        for f in 0..self.mask.frames() {
+            for c in 0..NUM_ARKIT {
+                if self.mask.erased(f, c) {
+                    sq += f64::from(self.after[f][c] - self.before[f][c]).powi(2);
+                    count += 1;
+                }
+            }
+        }
+        sq / count.max(1) as f64
+    }
+
+    /// The rows of `input` (the clip the job edited) that the edit changed, `first..last + 1`
+    /// (`0..0` when none), and the ARKit shapes changed there.
+    pub fn changed(&self, input: &BlendshapeClip) -> (std::ops::Range<usize>, [bool; NUM_ARKIT]) {
+        let (old, new) = (input.values(), self.clip.values());
+        let stride = input.num_channels();
+        let differs = |f: &usize| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride];
+        let first = (0..input.num_frames()).find(differs);
+        let last = (0..input.num_frames()).rev().find(differs);
+        let rows = match (first, last) {
+            (Some(a), Some(b)) => a..b + 1,
+            _ => 0..0,
+        };
+        let mut shapes = [false; NUM_ARKIT];
+        for f in rows.clone() {
+            for (c, ch) in shapes.iter_mut().enumerate() {
+                *ch |= old[f * stride + c] != new[f * stride + c];
+            }
+        }
+        (rows, shapes)
+    }
+
+    /// Mean absolute difference from `other` (another variant of the same edit) over the edited
+    /// frames at the model rate, every shape (blendshape weight, 0..1): how far two variants lie apart.
+    pub fn mean_abs_difference(&self, other: &EditOutcome) -> f64 {
+        let (a, b) = (&self.after, &other.after);
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for s in self.mask.segments() {
+            for f in s.start..s.end.min(a.len()).min(b.len()) {
+                for (x, y) in a[f].iter().zip(&b[f]) {
+                    sum += f64::from((x - y).abs());
+                    n += 1;
+                }
+            }
+        }
+        sum / n.max(1) as f64
+    }
+}
+
 fn invalid(m: impl Into<String>) -> FaceError {
     FaceError::Invalid(m.into())
 }

@@ -38,7 +38,7 @@ def read(path: PathLike, unit: Optional[str] = None) -> Union[Clip, FaceClip]:
     return _native.read_clip(path, unit)
 
 
-from . import camera, ibk, mocap, script  # noqa: E402  (they import the names above)
+from . import camera, face, ibk, mocap, script  # noqa: E402  (they import the names above)
 
 __all__ = [
     "Clip",
@@ -49,6 +49,7 @@ __all__ = [
     "mocap",
     "ibk",
     "camera",
+    "face",
     "script",
     "__version__",
 ]

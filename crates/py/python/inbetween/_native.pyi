@@ -83,7 +83,13 @@ class FaceClip:
     def weights(self) -> npt.NDArray[np.float32]: ...
     @staticmethod
     def from_arrays(weights: npt.ArrayLike, fps: float) -> FaceClip: ...
-    def write(self, path: _Path, live_link: bool = True) -> None: ...
+    @property
+    def channel_names(self) -> List[str]: ...
+    @property
+    def values(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def duration_s(self) -> float: ...
+    def write(self, path: _Path, live_link: Optional[bool] = None) -> None: ...
     def preview(self, path: _Path, compare: Optional[FaceClip] = None, progress: _Progress = None) -> str: ...
     def _repr_png_(self) -> bytes: ...
     def __len__(self) -> int: ...
@@ -127,8 +133,13 @@ def mocap_select(
     bound_cm: Optional[float] = None,
     max_gap_s: Optional[float] = None,
     progress: _Progress = None,
+    bound_deg: Optional[float] = None,
+    curve: Optional[str] = None,
 ) -> Tuple[List[int], Dict[str, npt.NDArray[np.float32]], str, str, Clip]: ...
-def mocap_reconstruct(clip: Clip, keys: List[int], progress: _Progress = None) -> Tuple[Clip, str, str]: ...
+def mocap_reconstruct(
+    clip: Clip, keys: List[int], progress: _Progress = None, curve: Optional[str] = None
+) -> Tuple[Clip, str, str]: ...
+def mocap_bezier(clip: Clip, keys: List[int]) -> Dict[str, Any]: ...
 def camera_generate(
     keys_json: str,
     characters: Optional[Tuple[Clip, Clip]] = None,
@@ -141,6 +152,29 @@ def camera_generate(
     gif: Optional[str] = None,
     progress: _Progress = None,
 ) -> Dict[str, Any]: ...
+def face_edit(
+    clip: FaceClip,
+    spans: List[Tuple[float, float] | str],
+    keys_json: Optional[str] = None,
+    keys_path: Optional[_Path] = None,
+    guide: Optional[FaceClip] = None,
+    guide_path: Optional[_Path] = None,
+    text: Optional[str] = None,
+    text_span: Optional[Tuple[float, float] | str] = None,
+    visemes_path: Optional[_Path] = None,
+    phonemes: Optional[List[Tuple[float, float, str]]] = None,
+    tier: Optional[str] = None,
+    groups: Optional[str] = None,
+    method: str = "auto",
+    weights: Optional[_Path] = None,
+    library: Optional[List[FaceClip]] = None,
+    variants: int = 1,
+    seed: int = 1,
+    max_rows: Optional[int] = None,
+    max_mask_s: Optional[float] = None,
+    progress: _Progress = None,
+) -> List[Tuple[FaceClip, Dict[str, Any]]]: ...
+def face_synth(seconds: float = 10.0, seed: int = 1) -> Tuple[FaceClip, List[Tuple[float, float, str]]]: ...
 def script_run(
     text: str,
     out_dir: Optional[str] = None,
@@ -149,4 +183,25 @@ def script_run(
     shared_motions: Optional[bool] = None,
     progress: _Progress = None,
 ) -> Dict[str, Any]: ...
+def batch_run_input(job: str, path: _Path, root: _Path, out: _Path, options: str) -> str: ...
+def batch_extensions(job: str) -> List[str]: ...
+def _bench_rust(
+    what: str,
+    clip: Clip,
+    repeats: int,
+    method: Optional[str] = None,
+    k: Optional[int] = None,
+    bound_cm: Optional[float] = None,
+    keys: Optional[List[int]] = None,
+    max_error_cm: Optional[float] = None,
+) -> List[float]: ...
+def _bench_sample_rust(data: bytes, times: List[float]) -> float: ...
+def _bench_face_rust(
+    clip: FaceClip,
+    spans: List[Tuple[float, float]],
+    repeats: int,
+    variants: int = 1,
+    seed: int = 1,
+    keys_json: Optional[str] = None,
+) -> List[float]: ...
 def _panic_in_job() -> None: ...
