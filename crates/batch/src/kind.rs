@@ -296,7 +296,7 @@ fn script_run(
     options: &Options,
     cancel: &Cancel,
 ) -> Result<serde_json::Value, String> {
-    use inbetween_script::job::{read_script, run_story, RunJob};
+    use inbetween_script::jobs::{read_script, run_story, RunJob};
     let text = read_script(&input.path).map_err(|e| err(input, e))?;
     let target = out.join(output);
     let mut set = OutputSet::new();

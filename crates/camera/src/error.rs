@@ -16,6 +16,13 @@ pub enum CameraError {
     Toric(#[from] toric::ToricError),
     #[error("model: {0}")]
     Model(String),
+    /// What was asked cannot be had: an unknown style name, a card without the style's code, a
+    /// reference clip or two takes that cannot make what is asked of them.
+    #[error("{0}")]
+    Request(String),
+    /// A motion file that could not be read.
+    #[error(transparent)]
+    Motion(#[from] inbetween_io::IoError),
     #[error("{0}")]
     Weights(#[from] inbetween_nn::NnError),
     /// An input over one of the job's stated limits (the error names the limit's field).

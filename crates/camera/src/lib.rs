@@ -2,7 +2,8 @@
 //! Wang & Chen, "Camera Keyframing with Style and Control" (ACM TOG 40(6), 2021).
 //!
 //! Pipeline (one module per stage): [`toric`] space ↔ camera poses, cinematic [`features`] (Eq. 1–2),
-//! the synthetic [`dataset`] (scenes + four behaviours), the three networks in [`model`], [`train`],
+//! the synthetic [`dataset`] (scenes + four behaviours), the three networks in [`model`], [`train`]
+//! (run as a [`TrainJob`]),
 //! loading trained [`weights`], inference with keyframes in [`infer`] (plain-Rust networks, one
 //! [`infer::Rollout`], [`infer::GenerateJob`], the causal mode), exports ([`gltf`], [`preview`]) and
 //! the [`bench`](mod@bench).
@@ -20,9 +21,11 @@ pub mod infer;
 pub mod model;
 pub mod preview;
 pub mod train;
+pub mod train_job;
 pub mod weights;
 
 pub use error::CameraError;
+pub use train_job::{TrainJob, TrainReport};
 
 use std::path::Path;
 

@@ -3,9 +3,9 @@
 //! codes computed once at save time), loaded into the plain-Rust networks; and where training may
 //! write (never over the committed weights unless asked).
 
-use crate::dataset::Behaviour;
+use crate::dataset::{Behaviour, Scene};
 use crate::infer::style::{behaviour_code, BEHAVIOUR_STYLE_SCENES, BEHAVIOUR_STYLE_SEED};
-use crate::infer::{FastModel, NamedStyle, Style};
+use crate::infer::{FastModel, NamedStyle, ReferenceClip, Style};
 use crate::model::{CameraModel, ModelConfig};
 use crate::train::TrainSummary;
 use crate::CameraError;
@@ -79,6 +79,34 @@ impl CameraWeights {
     /// The style code of `behaviour` (main character on the left).
     pub fn style(&self, behaviour: Behaviour) -> Option<Style> {
         behaviour_code(&self.styles, behaviour)
+    }
+
+    /// The style code of the behaviour named `name` (direct, relative, side or orbit); an error
+    /// naming the behaviours when the name is none of them, or the card when it holds no code for it.
+    pub fn named_style(&self, name: &str) -> Result<Style, CameraError> {
+        let b = Behaviour::parse(name)
+            .ok_or_else(|| CameraError::Request(format!("unknown style `{name}` (direct, relative, side, orbit)")))?;
+        self.behaviour_style(b)
+    }
+
+    /// [`CameraWeights::style`], or an error naming the behaviour the card holds no code for.
+    pub fn behaviour_style(&self, b: Behaviour) -> Result<Style, CameraError> {
+        self.style(b)
+            .ok_or_else(|| CameraError::Request(format!("the weights card has no style code for `{}`", b.name())))
+    }
+
+    /// The style of a reference clip at `path`: our JSON ([`ReferenceClip`]), or a glTF / GLB camera
+    /// animation over `scene`'s characters; the style's name is `reference:<path>`.
+    pub fn reference_style(&self, path: &Path, scene: &Scene) -> Result<Style, CameraError> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+        let clip: ReferenceClip = if matches!(ext.as_deref(), Some("gltf" | "glb")) {
+            let bytes = std::fs::read(path).map_err(|source| CameraError::Io { path: path.into(), source })?;
+            crate::infer::reference_from_gltf(&bytes, &path.display().to_string(), scene, &Default::default())
+                .map_err(CameraError::Request)?
+        } else {
+            crate::read_json(path)?
+        };
+        Ok(Style { name: format!("reference:{}", path.display()), code: clip.style(&self.model, path)? })
     }
 }
 

@@ -4,9 +4,10 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_camera::bench;
 use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
-use inbetween_camera::infer::{GenerateJob, GenerateLimits, GenerateOptions, Keys, ReferenceClip, Style};
-use inbetween_camera::train::{self, TrainConfig, TrainEvent};
+use inbetween_camera::infer::{GenerateJob, GenerateLimits, GenerateOptions, Keys, Style};
+use inbetween_camera::train::TrainConfig;
 use inbetween_camera::weights::{self, CameraWeights};
+use inbetween_camera::TrainJob;
 use inbetween_core::cancel::Cancel;
 use inbetween_io::{LimitExceeded, OutputSet};
 use std::path::{Path, PathBuf};
@@ -118,45 +119,48 @@ pub struct SceneArgs {
 pub struct TrainArgs {
     /// Where the trained weights go (burnpack; its JSON card, with the style codes, is written
     /// beside it). The committed weights folder is refused unless --overwrite-committed.
-    #[arg(short, long, default_value = "out/camera/camera.bpk")]
+    #[arg(short, long, default_value = TrainJob::DEFAULT_OUT)]
     pub out: PathBuf,
     /// Allow OUT inside crates/camera/weights/ (replacing the committed weights on purpose).
     #[arg(long)]
     pub overwrite_committed: bool,
     /// Checkpoint folder: saved every epoch, and training resumes from it when it holds one.
-    #[arg(long, default_value = "out/camera-train")]
+    #[arg(long, default_value = TrainJob::DEFAULT_CHECKPOINTS)]
     pub checkpoints: PathBuf,
     /// Epochs (the paper: 200).
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = TRAIN.epochs)]
     pub epochs: usize,
     /// Optimiser steps per epoch (the learning rate decays ×0.97 per epoch).
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = TRAIN.iters_per_epoch)]
     pub iters_per_epoch: usize,
     /// Batch size (the paper: 1024).
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = TRAIN.batch)]
     pub batch: usize,
     /// Procedural scenes in the training set (8 filmed sequences each).
-    #[arg(long, default_value_t = 96)]
+    #[arg(long, default_value_t = TRAIN.scenes)]
     pub scenes: usize,
     /// Stop after this many minutes (the running epoch is finished and saved).
     #[arg(long)]
     pub minutes: Option<f64>,
     /// Initial learning rate (decays ×0.97 per epoch).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = TRAIN.lr)]
     pub lr: f64,
     /// When resuming, restart the learning-rate schedule at --lr instead of where it had decayed to.
     #[arg(long)]
     pub restart_lr: bool,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = TRAIN.seed)]
     pub seed: u64,
     /// LSTM / FC width (the paper: 256).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = TRAIN.model.hidden)]
     pub hidden: usize,
     /// Stop with an error after this many seconds, writing no weights (checkpoints of finished
     /// epochs stay, so a rerun resumes). Unlike --minutes, which ends training early and saves it.
     #[arg(long)]
     pub time_limit: Option<f64>,
 }
+
+/// The engine's training settings, the flags' defaults.
+static TRAIN: std::sync::LazyLock<TrainConfig> = std::sync::LazyLock::new(TrainConfig::default);
 
 pub fn run(c: CameraCommand) -> anyhow::Result<()> {
     match c {
@@ -175,24 +179,6 @@ fn load_weights(path: Option<&Path>) -> anyhow::Result<CameraWeights> {
     }
 }
 
-/// A behaviour's style code, as stored in the weights card.
-fn behaviour_style(w: &CameraWeights, behaviour: Behaviour) -> anyhow::Result<Style> {
-    w.style(behaviour).with_context(|| format!("the weights card has no style code for `{}`", behaviour.name()))
-}
-
-/// The style of a reference clip: our JSON, or a glTF / GLB camera animation over `scene`'s characters.
-fn reference_style(w: &CameraWeights, path: &Path, scene: &Scene) -> anyhow::Result<Style> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
-    let clip: ReferenceClip = if matches!(ext.as_deref(), Some("gltf" | "glb")) {
-        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-        inbetween_camera::infer::reference_from_gltf(&bytes, &path.display().to_string(), scene, &Default::default())
-            .map_err(anyhow::Error::msg)?
-    } else {
-        inbetween_camera::read_json(path)?
-    };
-    Ok(Style { name: format!("reference:{}", path.display()), code: clip.style(&w.model, path)? })
-}
-
 fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
@@ -206,21 +192,12 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
     let (scene, scene_name) = match &a.scene {
         Some(p) => (Scene::load(p)?, p.display().to_string()),
         None => {
-            let motions = a
-                .characters
-                .iter()
-                .map(|p| inbetween_io::load_motion(p).map_err(anyhow::Error::from))
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            let names: Vec<String> = a.characters.iter().map(|p| p.display().to_string()).collect();
-            let takes: Vec<(&str, &inbetween_core::Motion)> =
-                names.iter().map(String::as_str).zip(motions.iter()).collect();
-            let overrides = crate::cmd_io::read_roles(a.roles.as_deref())?;
-            let (scene, notes) =
-                inbetween_camera::dataset::scene_from_motions_with(&takes, &overrides).map_err(anyhow::Error::msg)?;
+            let roles = crate::cmd_io::read_roles(a.roles.as_deref())?;
+            let (scene, notes, name) = inbetween_camera::dataset::scene_from_files(&a.characters, &roles)?;
             for line in notes.lines {
                 println!("  {line}");
             }
-            (scene, names.join(" + "))
+            (scene, name)
         }
     };
     LimitExceeded::check_count(scene_name, scene.num_frames(), limits.max_frames, "frames", "max_frames")?;
@@ -235,15 +212,12 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
     let runs: Vec<(Style, PathBuf)> = if a.all_styles {
         BEHAVIOURS
             .iter()
-            .map(|b| Ok((behaviour_style(&w, *b)?, with_suffix(&a.out, b.name()))))
-            .collect::<anyhow::Result<_>>()?
+            .map(|b| Ok((w.behaviour_style(*b)?, with_suffix(&a.out, b.name()))))
+            .collect::<Result<_, inbetween_camera::CameraError>>()?
     } else if let Some(r) = &a.reference {
-        vec![(reference_style(&w, r, &scene)?, a.out.clone())]
+        vec![(w.reference_style(r, &scene)?, a.out.clone())]
     } else {
-        let name = a.style.clone().unwrap_or_else(|| "relative".into());
-        let b = Behaviour::parse(&name)
-            .with_context(|| format!("unknown style `{name}` (direct, relative, side, orbit)"))?;
-        vec![(behaviour_style(&w, b)?, a.out.clone())]
+        vec![(w.named_style(a.style.as_deref().unwrap_or(Behaviour::Relative.name()))?, a.out.clone())]
     };
     // Every track, glTF and preview of the run appear together at the end, or none.
     let mut set = OutputSet::new();
@@ -313,9 +287,7 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn run_train(a: TrainArgs) -> anyhow::Result<()> {
-    // Refuse before hours of training, not after.
-    weights::check_output(&a.out, a.overwrite_committed)?;
-    let mut cfg = TrainConfig {
+    let mut config = TrainConfig {
         seed: a.seed,
         scenes: a.scenes,
         epochs: a.epochs,
@@ -325,37 +297,17 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         lr: a.lr,
         ..TrainConfig::default()
     };
-    if a.restart_lr {
-        cfg.lr_decay_from = train::epochs_done(&a.checkpoints)?;
-    }
-    cfg.model.hidden = a.hidden;
-    let bar = inbetween_io::Progress::new((cfg.epochs * cfg.iters_per_epoch) as u64, "training");
-    let mut report = |e: TrainEvent| match e {
-        TrainEvent::Iteration { epoch, iter, loss } => {
-            bar.set_position((epoch * cfg.iters_per_epoch + iter + 1) as u64);
-            bar.set_message(format!("loss {loss:.4}"));
-        }
-        TrainEvent::Epoch { epoch, loss, lr, seconds } => {
-            bar.println(format!("epoch {:>3}  loss {loss:.5}  lr {lr:.2e}  {seconds:.0} s", epoch + 1));
-        }
+    config.model.hidden = a.hidden;
+    let job = TrainJob {
+        config,
+        out: a.out,
+        overwrite_committed: a.overwrite_committed,
+        checkpoints: a.checkpoints,
+        restart_lr: a.restart_lr,
     };
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
-    let (model, summary) = train::train_cancellable(&cfg, Some(&a.checkpoints), &mut report, &cancel)?;
-    bar.finish();
-    // The weights and their card appear together, or neither.
-    let mut set = OutputSet::new();
-    let staged = set.file(&a.out).with_context(|| format!("preparing {}", a.out.display()))?;
-    set.file(&a.out.with_extension("json")).with_context(|| format!("preparing {}", a.out.display()))?;
-    weights::save(&model, &summary, &staged, a.overwrite_committed)?;
-    set.commit().with_context(|| format!("moving the weights to {}", a.out.display()))?;
-    println!(
-        "trained {} epochs ({} iterations) in {:.1} min, final loss {:.4}; weights: {}",
-        summary.epochs_done,
-        summary.iterations,
-        summary.seconds / 60.0,
-        summary.final_loss,
-        a.out.display()
-    );
+    job.validate()?;
+    println!("{}", job.run(&cancel, &inbetween_io::Progress::new(0, "training"))?);
     Ok(())
 }
 

@@ -7,17 +7,17 @@ use clap::{Args, Subcommand, ValueEnum};
 
 use inbetween_core::cancel::Cancel;
 use inbetween_face::bench::{self, FaceBenchConfig};
-use inbetween_face::data::{is_live_link, read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
+use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
-use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
-use inbetween_face::infer::plan::{captures_dir, span_seconds, viseme_runs, MethodChoice, SPEECH_GROUPS};
-use inbetween_face::infer::{
-    read_keys, EditJob, EditLimits, Guide, Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
+use inbetween_face::edit::{ConstraintKind, RetrievalOptions};
+use inbetween_face::infer::plan::{
+    captures_dir, keeps_live_link, retrieval_library, span_seconds, viseme_runs, MethodChoice, SPEECH_GROUPS,
 };
-use inbetween_face::preview::{span_flags, write_edit_gif, write_edit_png, CurvePreview};
-use inbetween_face::train::{save_face_weights, train_face_cancellable, FaceTrainConfig};
+use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide, Inpainter, Method};
+use inbetween_face::preview::{write_outcome_gif, write_outcome_png};
+use inbetween_face::train::{TrainData, TrainJob};
 use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, PhonemeSpan};
-use inbetween_face::{corpus, procedural, weights};
+use inbetween_face::{procedural, weights};
 use inbetween_io::{OutputSet, Progress};
 
 use crate::errors;
@@ -154,35 +154,35 @@ pub struct TrainArgs {
     pub data: DataArg,
     /// Output folder: <kind>.bpk + <kind>.json per network. The committed folder is refused unless
     /// --overwrite-committed.
-    #[arg(short, long, default_value = "out/face")]
+    #[arg(short, long, default_value_os_t = TRAIN.out.clone())]
     pub out: PathBuf,
     #[arg(long)]
     pub overwrite_committed: bool,
     /// Checkpoint folder (one subfolder per network); training resumes from it.
-    #[arg(long, default_value = "out/face-train")]
+    #[arg(long, default_value_os_t = TRAIN.checkpoints.clone())]
     pub checkpoints: PathBuf,
     /// Minutes per network (the running epoch is finished and saved).
     #[arg(long)]
     pub minutes: Option<f64>,
-    #[arg(long, default_value_t = 40)]
+    #[arg(long, default_value_t = TRAIN.epochs)]
     pub epochs: usize,
-    #[arg(long, default_value_t = 25)]
+    #[arg(long, default_value_t = TRAIN.steps_per_epoch)]
     pub steps_per_epoch: usize,
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = TRAIN.batch)]
     pub batch: usize,
     /// Frames per training window at 25 fps.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = TRAIN.window)]
     pub window: usize,
     /// Procedural clips (with --data procedural).
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = TrainJob::PROCEDURAL_CLIPS)]
     pub clips: usize,
     /// Hidden units per direction (paper: 128).
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = TRAIN.d_hidden)]
     pub hidden: usize,
     /// Captures folder (default: ../shared/data/face/neurosync or $INBETWEEN_DATA/face/neurosync).
     #[arg(long)]
     pub captures: Option<PathBuf>,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = TRAIN.seed)]
     pub seed: u64,
     /// Stop with an error after this many seconds over all networks, writing no weights (checkpoints
     /// of finished epochs stay, so a rerun resumes). Unlike --minutes, which ends each network's
@@ -190,6 +190,9 @@ pub struct TrainArgs {
     #[arg(long)]
     pub time_limit: Option<f64>,
 }
+
+/// The engine's training job, the flags' defaults.
+static TRAIN: std::sync::LazyLock<TrainJob> = std::sync::LazyLock::new(TrainJob::default);
 
 #[derive(Args)]
 pub struct BenchArgs {
@@ -254,19 +257,6 @@ fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow
     })
 }
 
-/// The clips of `--library` at the model rate, or the default procedural library.
-fn retrieval_library(files: &[PathBuf], max_rows: usize) -> anyhow::Result<MotionLibrary> {
-    if files.is_empty() {
-        return Ok(MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED));
-    }
-    let mut lib = MotionLibrary::default();
-    for f in files {
-        let clip = read_clip_limited(f, max_rows)?.resample(MODEL_FPS).with_context(|| format!("{}", f.display()))?;
-        lib.push(clip.arkit_frames());
-    }
-    Ok(lib)
-}
-
 fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
     let limits = EditLimits { max_rows: a.max_rows, max_mask_s: a.max_mask_seconds };
@@ -323,12 +313,10 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         guide_file,
         library: library.as_ref(),
     };
-    let live_link = a.input.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
-        && !a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
-        && is_live_link(&a.input);
+    let live_link = keeps_live_link(&a.input, &a.out);
     // Every variant's clip, PNG and GIF appear together or not at all.
     let mut set = OutputSet::new();
-    let mut first: Option<inbetween_face::infer::EditOutcome> = None;
+    let mut first: Option<Vec<inbetween_face::edit::Frame>> = None;
     let mut spreads = Vec::new();
     for k in 1..=a.variants {
         job.seed = a.seed + u64::from(k - 1);
@@ -345,8 +333,8 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
             named(&a.out).display(),
         );
         match &first {
-            None => first = Some(out),
-            Some(f) => spreads.push(out.mean_abs_difference(f)),
+            None => first = Some(out.after.clone()),
+            Some(f) => spreads.push(mean_abs_difference(f, &out.after, &out.mask.segments())),
         }
     }
     set.commit().context("moving the edit's outputs into place")?;
@@ -374,6 +362,24 @@ fn variant_path(p: &Path, k: u32) -> PathBuf {
     p.with_file_name(name)
 }
 
+/// Mean absolute difference of two edits over the frames of `segs`, every channel.
+fn mean_abs_difference(
+    a: &[inbetween_face::edit::Frame],
+    b: &[inbetween_face::edit::Frame],
+    segs: &[inbetween_face::edit::Segment],
+) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for s in segs {
+        for f in s.start..s.end.min(a.len()).min(b.len()) {
+            for (x, y) in a[f].iter().zip(&b[f]) {
+                sum += (x - y).abs() as f64;
+                n += 1;
+            }
+        }
+    }
+    sum / n.max(1) as f64
+}
+
 /// One edit: runs the job, stages its clip, PNG and (with --gif) GIF under `named` paths.
 fn edit_once(
     a: &EditArgs,
@@ -390,36 +396,14 @@ fn edit_once(
     let staged = |set: &mut OutputSet, p: &Path| set.file(p).with_context(|| format!("preparing {}", p.display()));
     let out_path = named(&a.out);
     write_clip(&staged(set, &out_path)?, &out.clip, live_link)?;
-    let segs = out.mask.segments();
     let png = named(&a.png.clone().unwrap_or_else(|| a.out.with_extension("png")));
     let title = format!("{} · {} · {}", a.input.display(), method.name(), job.guide.kind().name());
-    let preview = CurvePreview {
-        title: &title,
-        fps: MODEL_FPS,
-        before: &out.before,
-        after: &out.after,
-        spans: &segs,
-        keys: &out.keys,
-        extra: None,
-        n_curves: 6,
-    };
-    write_edit_png(&staged(set, &png)?, &preview).with_context(|| format!("writing {}", png.display()))?;
+    write_outcome_png(&staged(set, &png)?, &out, &title).with_context(|| format!("writing {}", png.display()))?;
     cancel.check()?;
     if let Some(gif) = a.gif.as_deref().map(named) {
-        let first = segs.iter().map(|s| s.start).min().unwrap_or(0).saturating_sub(25);
-        let last = (segs.iter().map(|s| s.end).max().unwrap_or(0) + 25).min(out.before.len());
-        let local: Vec<_> =
-            segs.iter().map(|s| inbetween_face::edit::Segment { start: s.start - first, end: s.end - first }).collect();
-        let progress = Progress::new((last - first) as u64, "face gif");
-        write_edit_gif(
-            &staged(set, &gif)?,
-            MODEL_FPS,
-            &[("original", &out.before[first..last]), ("edited", &out.after[first..last])],
-            None,
-            &span_flags(last - first, &local),
-            &progress,
-        )
-        .with_context(|| format!("writing {}", gif.display()))?;
+        let progress = Progress::new(0, "face gif");
+        write_outcome_gif(&staged(set, &gif)?, &out, &progress)
+            .with_context(|| format!("writing {}", gif.display()))?;
         progress.finish();
         cancel.check()?;
     }
@@ -430,68 +414,27 @@ fn edit_once(
     Ok((out, ms))
 }
 
-fn kinds(arg: &str) -> anyhow::Result<Vec<ConstraintKind>> {
-    if arg == "all" {
-        return Ok(ConstraintKind::ALL.to_vec());
-    }
-    arg.split(',')
-        .map(|k| {
-            ConstraintKind::from_name(k.trim())
-                .with_context(|| format!("unknown network kind '{k}' (unguided, keyframes, noisy, visemes or all)"))
-        })
-        .collect()
-}
-
 fn run_train(a: TrainArgs) -> anyhow::Result<()> {
-    let kinds = kinds(&a.kind)?;
-    for k in &kinds {
-        weights::check_output(&a.out.join(weights::committed_file(*k)), a.overwrite_committed)?;
-    }
-    let pool = match a.data {
-        DataArg::Procedural => corpus::procedural_pool(a.clips, 20.0, a.seed)?,
-        DataArg::Real => corpus::real_pool(&captures_dir(a.captures.as_deref())?)?,
+    let job = TrainJob {
+        kinds: TrainJob::parse_kinds(&a.kind).map_err(anyhow::Error::msg)?,
+        data: match a.data {
+            DataArg::Procedural => TrainData::Procedural { clips: a.clips },
+            DataArg::Real => TrainData::Real { captures: a.captures },
+        },
+        out: a.out,
+        overwrite_committed: a.overwrite_committed,
+        checkpoints: a.checkpoints,
+        epochs: a.epochs,
+        steps_per_epoch: a.steps_per_epoch,
+        batch: a.batch,
+        window: a.window,
+        d_hidden: a.hidden,
+        seed: a.seed,
+        time_limit_s: a.minutes.map(|m| m * 60.0),
     };
+    job.validate()?;
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
-    let device = inbetween_nn::backend::cpu_autodiff();
-    // Every network's weights and card appear together at the end, or none.
-    let mut set = OutputSet::new();
-    let mut trained = Vec::new();
-    for kind in kinds {
-        if a.data == DataArg::Real && kind == ConstraintKind::Visemes {
-            println!("visemes: skipped, the real captures have no phoneme labels");
-            continue;
-        }
-        let mut cfg = FaceTrainConfig::new(kind);
-        cfg.epochs = a.epochs;
-        cfg.steps_per_epoch = a.steps_per_epoch;
-        cfg.batch = a.batch;
-        cfg.window = a.window;
-        cfg.d_hidden = a.hidden;
-        cfg.seed = a.seed;
-        cfg.time_limit_s = a.minutes.map(|m| m * 60.0);
-        cfg.checkpoint_dir = Some(a.checkpoints.join(kind.name()));
-        let progress = Progress::new((cfg.epochs * cfg.steps_per_epoch) as u64, &format!("train {}", kind.name()));
-        let report = train_face_cancellable(&cfg, &pool, &progress, &device, &cancel)?;
-        progress.finish();
-        let out = a.out.join(weights::committed_file(kind));
-        let staged = set.file(&out).with_context(|| format!("preparing {}", out.display()))?;
-        set.file(&out.with_extension("json")).with_context(|| format!("preparing {}", out.display()))?;
-        save_face_weights(&report, &staged)?;
-        let f = report.final_losses();
-        trained.push(format!(
-            "{}: {} steps in {:.1} min, final generator loss {:.4} (reconstruction {:.4}); weights {}",
-            kind.name(),
-            report.steps,
-            report.seconds / 60.0,
-            f.generator,
-            f.rec,
-            out.display()
-        ));
-    }
-    set.commit().with_context(|| format!("moving the weights into {}", a.out.display()))?;
-    for line in trained {
-        println!("{line}");
-    }
+    println!("{}", job.run(&cancel, &Progress::new(0, "train"))?);
     Ok(())
 }
 

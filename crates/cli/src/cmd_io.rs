@@ -2,10 +2,9 @@
 
 use anyhow::Context;
 use clap::Args;
-use inbetween_core::roles::{Role, RoleOverrides};
-use inbetween_core::units::{rest_pose_extent, LengthUnit, UnitChoice};
-use inbetween_core::{Motion, Skeleton};
-use std::fmt::Write as _;
+use inbetween_core::roles::RoleOverrides;
+use inbetween_core::units::{LengthUnit, UnitChoice};
+use inbetween_core::Motion;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -56,35 +55,9 @@ fn load(file: &Path, asf: Option<&Path>) -> anyhow::Result<Motion> {
 
 pub fn info(a: InfoArgs) -> anyhow::Result<()> {
     let m = load(&a.file, a.asf.as_deref())?;
-    let mut out = String::new();
-    writeln!(out, "file:      {}", a.file.display())?;
-    writeln!(out, "joints:    {}", m.skeleton.len())?;
-    writeln!(out, "channels:  {}", m.num_channels())?;
-    writeln!(out, "frames:    {}", m.num_frames())?;
-    writeln!(out, "fps:       {:.3} (frame time {} s)", m.fps(), m.frame_time)?;
-    writeln!(out, "duration:  {:.3} s", m.duration())?;
     let unit = UnitChoice::resolve(a.unit, &m.skeleton);
-    writeln!(out, "unit:      {} ({})", unit.unit.describe(), crate::errors::with_flags(&unit.reason))?;
-    let size = rest_pose_extent(&m.skeleton);
-    writeln!(out, "rest pose: {size:.2} units = {:.1} cm tall (or wide)", size * unit.cm_per_unit())?;
-    let overrides = read_roles(a.roles.as_deref())?;
-    match inbetween_core::roles::find_motion_roles(&m, &overrides) {
-        Ok(r) => {
-            let found = r.scheme.map(|s| format!("names read as {}", s.label())).unwrap_or("no known names".into());
-            writeln!(
-                out,
-                "roles:     {} of {} ({found}; confidence {:.2})",
-                r.roles.len(),
-                Role::ALL.len(),
-                r.confidence()
-            )?;
-            write!(out, "{r}")?;
-        }
-        Err(e) => writeln!(out, "roles:     none: {}", crate::errors::with_flags(&e.to_string()))?,
-    }
-    writeln!(out, "skeleton:")?;
-    write_tree(&mut out, &m.skeleton)?;
-    print_tolerating_closed_pipe(&out)
+    let text = inbetween_io::info::describe_motion(&a.file, &m, &unit, &read_roles(a.roles.as_deref())?);
+    print_tolerating_closed_pipe(&crate::errors::with_flags(&text))
 }
 
 /// The roles file given with `--roles` (none: no overrides); errors name the file, line and column.
@@ -103,35 +76,6 @@ fn print_tolerating_closed_pipe(text: &str) -> anyhow::Result<()> {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(()),
     }
-}
-
-/// One line per joint, indented by depth: name, offset, channels.
-fn write_tree(out: &mut String, s: &Skeleton) -> std::fmt::Result {
-    let mut depth = vec![0usize; s.len()];
-    let mut stack = vec![0usize];
-    while let Some(j) = stack.pop() {
-        let joint = s.joint(j);
-        if let Some(p) = joint.parent {
-            depth[j] = depth[p] + 1;
-        }
-        let channels: Vec<&str> = joint.channels.iter().map(|c| c.name()).collect();
-        let end =
-            joint.end_site.map(|e| format!("  end site ({:.3}, {:.3}, {:.3})", e.x, e.y, e.z)).unwrap_or_default();
-        writeln!(
-            out,
-            "  {}{}  offset ({:.3}, {:.3}, {:.3})  [{}] {}{end}",
-            "  ".repeat(depth[j]),
-            joint.name,
-            joint.offset.x,
-            joint.offset.y,
-            joint.offset.z,
-            channels.len(),
-            channels.join(" "),
-        )?;
-        let children: Vec<usize> = s.children(j).collect();
-        stack.extend(children.into_iter().rev());
-    }
-    Ok(())
 }
 
 pub fn convert(a: ConvertArgs) -> anyhow::Result<()> {

@@ -5,17 +5,17 @@ use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 use inbetween_core::cancel::Cancel;
 use inbetween_core::units::{LengthUnit, UnitChoice};
-use inbetween_core::{positions_clip, Motion};
+use inbetween_core::Motion;
 use inbetween_io::fsutil::write_atomic;
 use inbetween_io::Progress;
 use inbetween_mocap::bench::{self, Protocol};
 use inbetween_mocap::codec::job::Version;
 use inbetween_mocap::codec::{self, Budget};
-use inbetween_mocap::dqn::{DqnConfig, TrainOptions, DEFAULT_POLICY_PATH};
+use inbetween_mocap::dqn::{TrainJob, TrainOptions, DEFAULT_POLICY_PATH};
+use inbetween_mocap::protocol::TrainingData;
 use inbetween_mocap::representation::{skip_first_frame, JointFilter};
 use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
-use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport, PositionError};
-use inbetween_render::StickOptions;
+use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -80,7 +80,7 @@ pub struct TrainArgs {
     #[arg(long)]
     pub gamma: Option<f64>,
     /// Stride of the training windows (overlapping windows give more training data).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = TrainJob::default().stride)]
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -261,7 +261,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub unit: Option<LengthUnit>,
     /// Window stride in frames (60 = non-overlapping windows, as in the paper).
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = Protocol::paper().stride)]
     pub stride: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -269,9 +269,9 @@ pub struct BenchArgs {
     /// CMU take of the corpus), unless --train-episodes is given.
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Train SIDQL here first, on the CMU training split (pretraining, then this many fine-tuning
-    /// epochs; saved as out/sidql_cmu.bpk).
-    #[arg(long, default_value_t = 0, conflicts_with = "model")]
+    #[arg(long, default_value_t = 0, conflicts_with = "model", help = format!(
+        "Train SIDQL here first, on the CMU training split (pretraining, then this many fine-tuning epochs; saved as {DEFAULT_POLICY_PATH})"
+    ))]
     pub train_episodes: usize,
     /// Also report codec compression at these max errors (cm), on the full-rate clips.
     #[arg(long, value_delimiter = ',', default_value = "1,0.1")]
@@ -292,7 +292,7 @@ pub struct BenchArgs {
     pub acl_segment: usize,
     /// Take-level k-fold of SIDQL: a policy trained per fold on the other takes, every window
     /// scored once held out (0 skips it; a few CPU minutes at 5).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = bench::run::KFoldConfig::default().folds)]
     pub folds: usize,
 }
 
@@ -371,15 +371,8 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
             DecompressJob.run(job.run(&m)?.bytes(), &Cancel::new(), &Progress::hidden())?
         }
     };
-    let (rec, keys) = (&d.motion, d.stored_poses);
-    let e = PositionError::between(&positions_clip(&m), &positions_clip(rec), unit.cm_per_unit());
-    let opts = StickOptions {
-        labels: vec!["original".into(), format!("from {keys} keys")],
-        title: Some(format!("{keys} keys: {e}")),
-        ..StickOptions::default()
-    };
-    inbetween_render::render_motion_gif(&a.output, &[&m, rec], &opts)?;
-    println!("{keys} keys; mean {:.3} cm, max {:.3} cm; wrote {}", e.mean_cm, e.max_cm, a.output.display());
+    let e = d.preview_gif(&m, &unit, &a.output)?;
+    println!("{} keys; mean {:.3} cm, max {:.3} cm; wrote {}", d.stored_poses, e.mean_cm, e.max_cm, a.output.display());
     Ok(())
 }
 
@@ -389,7 +382,7 @@ impl BenchArgs {
         let policy = match (&self.model, self.train_episodes) {
             (Some(p), _) => bench::PolicyChoice::File(p.clone()),
             (None, 0) => bench::PolicyChoice::Committed,
-            (None, episodes) => bench::PolicyChoice::Train { episodes, output: PathBuf::from(DEFAULT_POLICY_PATH) },
+            (None, episodes) => bench::PolicyChoice::train(episodes),
         };
         bench::BenchConfig {
             data: self.data.clone(),
@@ -443,63 +436,30 @@ fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
 }
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
-    let data_choice = match (a.procedural, a.all_takes) {
-        (true, _) => inbetween_mocap::protocol::TrainingData::Procedural,
-        (false, true) => inbetween_mocap::protocol::TrainingData::CmuAll,
-        (false, false) => inbetween_mocap::protocol::TrainingData::CmuSplit,
-    };
-    let (windows, data) =
-        inbetween_mocap::protocol::training_set(data_choice, a.data.as_deref(), a.unit, a.seed, a.stride)?;
     let Some(base) = TrainOptions::preset(&a.preset) else {
         bail!("unknown preset '{}'; expected default, paper or quick", a.preset)
     };
-    if let Some(dir) = a.output.parent() {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir)?;
-        }
-    }
-    println!("training on {data}");
-    let checkpoint_dir = a.output.with_extension("ckpt");
-    let opts = TrainOptions {
-        pretrain_steps: a.pretrain_steps.unwrap_or(base.pretrain_steps),
-        episodes: a.episodes.unwrap_or(base.episodes),
-        lr: a.lr.unwrap_or(base.lr),
-        gamma: a.gamma.unwrap_or(base.gamma),
-        seed: a.seed,
-        checkpoint: Some(a.output.clone()),
-        checkpoint_dir: Some(checkpoint_dir.clone()),
-        time_limit_s: a.time_limit_min.map(|m| m * 60.0),
-        data,
-        ..base
+    let job = TrainJob {
+        data: match (a.procedural, a.all_takes) {
+            (true, _) => TrainingData::Procedural,
+            (false, true) => TrainingData::CmuAll,
+            (false, false) => TrainingData::CmuSplit,
+        },
+        data_dir: a.data,
+        unit: a.unit,
+        stride: a.stride,
+        options: TrainOptions {
+            pretrain_steps: a.pretrain_steps.unwrap_or(base.pretrain_steps),
+            episodes: a.episodes.unwrap_or(base.episodes),
+            lr: a.lr.unwrap_or(base.lr),
+            gamma: a.gamma.unwrap_or(base.gamma),
+            seed: a.seed,
+            time_limit_s: a.time_limit_min.map(|m| m * 60.0),
+            ..base
+        },
+        output: a.output,
     };
-    let trained = inbetween_mocap::dqn::train(&windows, &DqnConfig::default(), &opts)?;
-    let r = &trained.report;
-    if let Some(from) = &r.resumed_from {
-        println!("resumed from {}", from.display());
-    }
-    if r.stopped_early {
-        println!("stopped at the time limit; run the same command again to resume from {}", checkpoint_dir.display());
-    }
-    println!(
-        "pretraining: {} steps in {:.0} s; loss per {} steps {:?}",
-        r.pretrain_steps,
-        r.pretrain_seconds,
-        r.pretrain_block,
-        r.pretrain_loss.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>()
-    );
-    println!(
-        "fine-tuning: {} epochs, {} updates in {:.0} s; loss per {} epochs {:?}; return per episode {:?}",
-        r.episodes,
-        r.updates,
-        r.finetune_seconds,
-        r.curve_block,
-        r.loss_curve.iter().map(|l| format!("{l:.4}")).collect::<Vec<_>>(),
-        r.return_curve.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>()
-    );
-    println!("wrote {}", a.output.display());
-    if trained.finetuned.is_some() {
-        println!("wrote {} (pretrained stage)", inbetween_mocap::dqn::train::pretrain_path(&a.output).display());
-    }
+    println!("{}", job.run(&Cancel::new(), &Progress::hidden())?);
     Ok(())
 }
 
@@ -513,22 +473,8 @@ fn stream_send(a: SendArgs) -> anyhow::Result<()> {
         unit: a.unit,
     };
     let r = inbetween_mocap::stream::send(&a.addr, &m, &opts)?;
-    let secs = m.duration().max(1e-9);
     println!("{}", crate::errors::with_flags(&r.unit.to_string()));
-    println!(
-        "sent {} keys for {} frames in {:.2} s: {} bytes ({:.0} B/s) vs {} raw bytes ({:.0} B/s), {:.1}x less; added latency mean {:.0} ms, max {:.0} ms; {} reconnects",
-        r.keys,
-        r.frames,
-        r.seconds,
-        r.bytes_sent,
-        r.bytes_sent as f64 / secs,
-        r.raw_bytes,
-        r.raw_bytes as f64 / secs,
-        r.raw_bytes as f64 / r.bytes_sent as f64,
-        r.mean_latency_ms,
-        r.max_latency_ms,
-        r.reconnects
-    );
+    println!("{r}");
     Ok(())
 }
 
@@ -547,18 +493,7 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
         got.check_complete().context("no frame was rebuilt, so nothing was written")?;
     }
     inbetween_io::write_bvh(&a.output, &got.motion)?;
-    println!(
-        "received {} keys ({} bytes, {} sessions, {}), emitted {} frames (frames {}..{} of the sender's {}-frame clip); wrote {}",
-        got.keys,
-        got.bytes,
-        got.sessions,
-        if got.complete { "complete" } else { "incomplete" },
-        got.motion.num_frames(),
-        got.start_frame,
-        got.start_frame + got.motion.num_frames(),
-        got.clip_frames,
-        a.output.display()
-    );
+    println!("{got}; wrote {}", a.output.display());
     if got.start_frame > 0 {
         println!("joined mid-stream: the output's frame 0 is frame {} of the sender's clip", got.start_frame);
     }
@@ -568,15 +503,7 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
         let e = inbetween_mocap::stream::compare(&got, &m, unit.cm_per_unit())
             .with_context(|| format!("comparing with {}", r.display()))?;
         println!("{unit}");
-        println!(
-            "error vs {} frames {}..{}: mean {:.3} cm, max {:.3} cm over {} frames",
-            r.display(),
-            e.start_frame,
-            e.start_frame + e.frames,
-            e.mean_cm,
-            e.max_cm,
-            e.frames
-        );
+        println!("error vs {} {e}", r.display());
     }
     got.check_complete().with_context(|| {
         format!("the {} frames received were kept in {}", got.motion.num_frames(), a.output.display())

@@ -20,15 +20,15 @@ pub struct PreviewArgs {
     /// GIF frame rate; frames are skipped to keep real-time playback (default: the file's rate).
     #[arg(long)]
     pub fps: Option<f64>,
-    #[arg(long, default_value_t = 480)]
+    #[arg(long, default_value_t = StickOptions::default().width)]
     pub width: u32,
-    #[arg(long, default_value_t = 360)]
+    #[arg(long, default_value_t = StickOptions::default().height)]
     pub height: u32,
     /// A second motion file overlaid in another colour (e.g. a reconstruction of FILE).
     #[arg(long)]
     pub compare: Option<PathBuf>,
     /// Most frames in a GIF (longer clips are stepped through).
-    #[arg(long, default_value_t = 150)]
+    #[arg(long, default_value_t = StickOptions::default().max_frames)]
     pub max_frames: usize,
     /// Title drawn in the top-left corner (default: the file name).
     #[arg(long)]

@@ -7,10 +7,10 @@ use clap::{Args, Subcommand, ValueEnum};
 use inbetween_io::Progress;
 
 use crate::errors;
+use inbetween_script::builtin_scripts;
 use inbetween_script::compose::{ComposeConfig, Matcher};
-use inbetween_script::job::{read_script, run_scene, RunJob, SceneJob};
+use inbetween_script::jobs::{load_script, run_scene, RunJob, SceneJob};
 use inbetween_script::limits::ScriptLimits;
-use inbetween_script::stories;
 
 #[derive(Subcommand)]
 pub enum ScriptCommand {
@@ -45,9 +45,9 @@ pub struct SceneArgs {
     /// (see `inbetween script stories`).
     pub script: String,
     /// Output folder.
-    #[arg(short, long, default_value = "out/script")]
+    #[arg(short, long, default_value_os_t = SceneJob::default().out_dir)]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = SceneJob::default().seed)]
     pub seed: u64,
     /// Camera of the perspective preview: front, back, left, right, top (default: the script's
     /// last "camera …" command, else front).
@@ -111,7 +111,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub shared_motions: bool,
     /// Width of the preview GIF in pixels (at most 480).
-    #[arg(long, default_value_t = 480)]
+    #[arg(long, default_value_t = RunJob::default().gif_width)]
     pub gif_width: u32,
     /// Also write story_skinned.gltf (+ story_skinned.png): every character as a skinned Kenney
     /// blocky character (found next to --models or in ../shared/data); story.gltf keeps the stick
@@ -168,20 +168,6 @@ pub fn run(c: ScriptCommand) -> anyhow::Result<()> {
     }
 }
 
-/// The script's text and the name messages use for it.
-fn load(script: &str) -> anyhow::Result<(String, PathBuf)> {
-    if let Some(name) = script.strip_prefix("builtin:") {
-        let all = stories::all();
-        let text = all.iter().find(|(n, _)| *n == name).map(|(_, t)| t.to_string()).with_context(|| {
-            let names: Vec<&str> = all.iter().map(|(n, _)| *n).collect();
-            format!("no built-in script '{name}'; there are: {}", names.join(", "))
-        })?;
-        return Ok((text, PathBuf::from(script)));
-    }
-    let path = Path::new(script);
-    Ok((read_script(path)?, path.to_path_buf()))
-}
-
 fn scene_job(a: &SceneArgs) -> SceneJob {
     let matcher = match a.matcher {
         MatcherArg::Relation => Matcher::RelationFirst,
@@ -216,35 +202,15 @@ fn run_job(a: &RunArgs) -> RunJob {
     }
 }
 
-fn print_run(source: &Path, r: &inbetween_script::job::RunReport, shown: &dyn Fn(&Path) -> PathBuf) {
+fn print_run(source: &Path, r: &inbetween_script::jobs::RunReport, shown: &dyn Fn(&Path) -> PathBuf) {
     for d in &r.scene.diagnostics {
         eprintln!("warning: {}: {d}", source.display());
     }
     for n in &r.animation.notes {
         eprintln!("note: {}: {n}", source.display());
     }
-    let frames = r.animation.frames();
-    println!(
-        "{}: {} objects, {} characters, {frames} frames ({:.1} s at {:.0} fps) in {:.2} s; collided boxes {} -> {}, mean contact distance {:.3} m -> {:.3} m",
-        source.display(),
-        r.animation.scene.objects.len(),
-        r.animation.characters.len(),
-        frames as f64 / r.animation.fps,
-        r.animation.fps,
-        r.seconds,
-        r.before.collided_boxes,
-        r.after.collided_boxes,
-        r.before.contact,
-        r.after.contact
-    );
-    if !r.full {
-        let list = |v: &[String]| if v.is_empty() { "none".to_string() } else { v.join(", ") };
-        println!(
-            "  edit re-solved characters: {} (kept as they were: {}); objects re-optimised: {}",
-            list(&r.resolved_characters),
-            list(&r.kept_characters),
-            list(&r.resolved_objects)
-        );
+    for line in r.summary(source) {
+        println!("{line}");
     }
     for f in &r.files {
         println!("  wrote {}", shown(f).display());
@@ -262,7 +228,7 @@ fn moved(staging: &Path, out: &Path, p: &Path) -> PathBuf {
 /// `--skinned` outputs are a second set, written after (a missing asset folder leaves the story's
 /// outputs in place and writes none of the skinned ones).
 fn run_story(a: RunArgs) -> anyhow::Result<()> {
-    let (text, source) = load(&a.scene.script)?;
+    let (text, source) = load_script(&a.scene.script)?;
     let cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
         .map_err(anyhow::Error::msg)
         .context("--time-limit")?;
@@ -272,7 +238,7 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
     job.scene.out_dir = staging.clone();
     job.cancel = cancel;
     job.progress = Progress::new(6, "script run");
-    let report = inbetween_script::job::run_story(&text, &source, &job)
+    let report = inbetween_script::jobs::run_story(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
     set.commit().with_context(|| format!("moving the outputs into {}", a.scene.out.display()))?;
     print_run(&source, &report, &|p: &Path| moved(&staging, &a.scene.out, p));
@@ -289,11 +255,11 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
 /// `--skinned`: the skinned Kenney outputs into `dir`, beside the story's.
 fn skinned(
     a: &RunArgs,
-    r: &inbetween_script::job::RunReport,
+    r: &inbetween_script::jobs::RunReport,
     dir: &Path,
 ) -> anyhow::Result<inbetween_script::output::skinned::SkinnedStory> {
     let models = a.scene.models.as_deref();
-    let cat = inbetween_script::job::catalogue(models)?;
+    let cat = inbetween_script::jobs::catalogue(models)?;
     inbetween_script::output::skinned::write_skinned_story(dir, &r.animation, &cat, models)
         .context("writing the skinned characters")
 }
@@ -310,7 +276,7 @@ fn print_skinned(s: &inbetween_script::output::skinned::SkinnedStory, shown: &dy
 fn watch(a: WatchArgs) -> anyhow::Result<()> {
     let path = PathBuf::from(&a.run.scene.script);
     println!("watching {} (Ctrl-C to stop)", path.display());
-    inbetween_script::job::watch(&path, &run_job(&a.run), a.max_runs, |outcome| match outcome {
+    inbetween_script::jobs::watch(&path, &run_job(&a.run), a.max_runs, |outcome| match outcome {
         Ok(r) => {
             print_run(&path, &r, &|p: &Path| p.to_path_buf());
             if a.run.skinned {
@@ -327,24 +293,13 @@ fn watch(a: WatchArgs) -> anyhow::Result<()> {
 }
 
 fn scene(a: SceneArgs) -> anyhow::Result<()> {
-    let (text, source) = load(&a.script)?;
+    let (text, source) = load_script(&a.script)?;
     let job = scene_job(&a);
     let report = run_scene(&text, &source, &job).with_context(|| format!("composing {}", source.display()))?;
     for d in &report.diagnostics {
         eprintln!("warning: {}: {d}", source.display());
     }
-    let scene = &report.composition.scene;
-    println!(
-        "{}: {} objects in a {:.1} m × {:.1} m {} (match score {:.2}, {} violations) in {:.1} ms",
-        source.display(),
-        scene.objects.len(),
-        scene.room.width,
-        scene.room.depth,
-        scene.room.name,
-        report.composition.match_score,
-        report.composition.violations.total(),
-        report.seconds * 1e3
-    );
+    println!("{}", report.summary(&source));
     for f in &report.files {
         println!("  wrote {}", f.display());
     }
@@ -352,7 +307,7 @@ fn scene(a: SceneArgs) -> anyhow::Result<()> {
 }
 
 fn parse(a: ParseArgs) -> anyhow::Result<()> {
-    let (text, source) = load(&a.script)?;
+    let (text, source) = load_script(&a.script)?;
     let cat = inbetween_script::catalogue::builtin::builtin();
     let parsed = inbetween_script::parse::parse_script(&text, &cat);
     for s in &parsed.sentences {
@@ -366,7 +321,7 @@ fn parse(a: ParseArgs) -> anyhow::Result<()> {
 }
 
 fn list_stories(a: StoriesArgs) -> anyhow::Result<()> {
-    let all = stories::all();
+    let all = builtin_scripts::all();
     match a.name {
         Some(name) => {
             let (_, text) =
@@ -385,11 +340,7 @@ fn list_stories(a: StoriesArgs) -> anyhow::Result<()> {
 
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
     use inbetween_script::bench::{run, BenchConfig};
-    let cfg = if a.quick {
-        BenchConfig { seed: a.seed, repeats: 2, anneal_iterations: 5 }
-    } else {
-        BenchConfig { seed: a.seed, ..BenchConfig::default() }
-    };
+    let cfg = if a.quick { BenchConfig::quick(a.seed) } else { BenchConfig { seed: a.seed, ..BenchConfig::default() } };
     let progress = Progress::new(1, "script bench");
     let files =
         run(&a.out, &cfg, &progress).with_context(|| format!("writing the script bench to {}", a.out.display()))?;
@@ -405,13 +356,13 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    // The demo story with its directions k times (stories::scaled_demo), limits raised to fit (a
+    // The demo story with its directions k times (builtin_scripts::scaled_demo), limits raised to fit (a
     // story of 100× the demo is over the default limits on purpose).
     crate::scale::run(&a, "script", "script run at multiples of the demo story's directions", |k, exe, work| {
-        let text = stories::scaled_demo(k);
+        let text = builtin_scripts::scaled_demo(k);
         let input = work.join(format!("story-{k}.txt"));
         std::fs::write(&input, &text).with_context(|| format!("writing {}", input.display()))?;
-        let sentences = inbetween_script::script::split(&text).len();
+        let sentences = inbetween_script::sentences::split(&text).len();
         let big = (100 * k.max(1)).to_string();
         let mut command = std::process::Command::new(exe);
         command.args(["script".as_ref(), "run".as_ref(), input.as_os_str(), "-o".as_ref()]);

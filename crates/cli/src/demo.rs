@@ -45,25 +45,10 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     )];
     lines.extend(inbetween_mocap::demo::run(&a.out, &steps)?);
     lines.extend(inbetween_camera::demo::run(&a.out, &steps)?);
-    let face = inbetween_face::demo::run(&a.out, a.seed, &Progress::hidden())?;
+    lines.push(inbetween_face::demo::run(&a.out, a.seed, &Progress::hidden())?.to_string());
     steps.inc(1);
-    let mse: Vec<String> = face.mse.iter().map(|(m, e)| format!("{m} {e:.5}")).collect();
-    lines.push(format!(
-        "face: 3 s occlusion of a procedural capture, masked MSE {} -> {}",
-        mse.join(", "),
-        face.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
-    ));
-    let video = inbetween_video::demo::run(&a.out, a.seed, &Progress::hidden())?;
+    lines.push(inbetween_video::demo::run(&a.out, a.seed, &Progress::hidden())?.to_string());
     steps.inc(1);
-    lines.push(format!(
-        "video: procedural clip resequenced from frame {}: {} frames, M_D {:.4} (source {:.4}), Δo {:.3} -> {}",
-        inbetween_video::demo::START,
-        video.order.len(),
-        video.md.0,
-        video.md.1,
-        video.delta_o,
-        video.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
-    ));
     lines.extend(inbetween_script::demo::run(&a.out, a.seed)?);
     steps.inc(1);
     steps.finish();

@@ -317,6 +317,44 @@ pub fn write_edit_png(path: &Path, preview: &CurvePreview<'_>) -> Result<Vec<usi
     Ok(plot.curves.iter().filter_map(|c| crate::data::arkit_index(&c.name)).collect())
 }
 
+/// Frames shown before and after the spans in an edit's GIF (1 s at the model rate).
+pub const GIF_MARGIN_FRAMES: usize = 25;
+
+/// An edit's curve plot at `path` ([`write_edit_png`]): the six most-changed curves at the model
+/// rate, the spans shaded, the keys dotted, under `title`.
+pub fn write_outcome_png(path: &Path, out: &crate::infer::EditOutcome, title: &str) -> Result<(), RenderError> {
+    let segs = out.mask.segments();
+    let preview = CurvePreview {
+        title,
+        fps: crate::data::MODEL_FPS,
+        before: &out.before,
+        after: &out.after,
+        spans: &segs,
+        keys: &out.keys,
+        extra: None,
+        n_curves: 6,
+    };
+    write_edit_png(path, &preview).map(|_| ())
+}
+
+/// An edit's schematic face at `path` ([`write_edit_gif`]), original beside edited, over its spans
+/// and [`GIF_MARGIN_FRAMES`] either side; `progress` counts the frames.
+pub fn write_outcome_gif(path: &Path, out: &crate::infer::EditOutcome, progress: &Progress) -> Result<(), RenderError> {
+    let segs = out.mask.segments();
+    let first = segs.iter().map(|s| s.start).min().unwrap_or(0).saturating_sub(GIF_MARGIN_FRAMES);
+    let last = (segs.iter().map(|s| s.end).max().unwrap_or(0) + GIF_MARGIN_FRAMES).min(out.before.len());
+    let local: Vec<Segment> = segs.iter().map(|s| Segment { start: s.start - first, end: s.end - first }).collect();
+    progress.set_length((last - first) as u64);
+    write_edit_gif(
+        path,
+        crate::data::MODEL_FPS,
+        &[("original", &out.before[first..last]), ("edited", &out.after[first..last])],
+        None,
+        &span_flags(last - first, &local),
+        progress,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

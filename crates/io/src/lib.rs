@@ -1,8 +1,9 @@
 //! File formats: BVH, ASF/AMC, and the shared file helpers: atomic writes ([`write_atomic`]), whole-or-none
 //! output sets ([`OutputSet`]), the error for inputs over a job's stated limits ([`LimitExceeded`]), locating
 //! shared data ([`data`]), the progress bar every long job uses ([`progress::Progress`]), the
-//! bench/report harness ([`report`]: tables, reports, timings) scaling runs ([`scale`]: a child's time
-//! and peak memory) and UTF-8 decoding with the failing line ([`text`]).
+//! bench/report harness ([`report`]: tables, reports, timings), scaling runs ([`scale`]: a child's time
+//! and peak memory), UTF-8 decoding with the failing line ([`text`]) and a motion file described in
+//! words ([`info`]).
 //!
 //! Every reader returns [`IoError`] on bad input (never panics); its message names the file, the
 //! 1-based line and what was expected there.
@@ -13,6 +14,7 @@ pub mod data;
 mod error;
 pub mod fsutil;
 pub mod gltf_buffer;
+pub mod info;
 mod lexer;
 pub mod limits;
 pub mod motion_gltf;

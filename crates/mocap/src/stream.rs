@@ -140,6 +140,29 @@ pub struct SendReport {
     pub mean_latency_ms: f64,
     pub max_latency_ms: f64,
     pub reconnects: usize,
+    /// Length of the clip sent, seconds (the rates are per second of clip).
+    pub clip_seconds: f64,
+}
+
+impl std::fmt::Display for SendReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let secs = self.clip_seconds.max(1e-9);
+        write!(
+            f,
+            "sent {} keys for {} frames in {:.2} s: {} bytes ({:.0} B/s) vs {} raw bytes ({:.0} B/s), {:.1}x less; added latency mean {:.0} ms, max {:.0} ms; {} reconnects",
+            self.keys,
+            self.frames,
+            self.seconds,
+            self.bytes_sent,
+            self.bytes_sent as f64 / secs,
+            self.raw_bytes,
+            self.raw_bytes as f64 / secs,
+            self.raw_bytes as f64 / self.bytes_sent as f64,
+            self.mean_latency_ms,
+            self.max_latency_ms,
+            self.reconnects
+        )
+    }
 }
 
 fn connect(addr: &str, retries: usize) -> Result<TcpStream> {
@@ -183,6 +206,7 @@ pub fn send(addr: &str, motion: &Motion, opts: &SendOptions) -> Result<SendRepor
         mean_latency_ms: 0.0,
         max_latency_ms: 0.0,
         reconnects: 0,
+        clip_seconds: motion.duration(),
     };
     let start = Instant::now();
     let mut conn = connect(addr, opts.retries)?;
@@ -325,6 +349,24 @@ pub struct Received {
     pub sessions: usize,
     /// Problems met on the way (broken connections, bad messages), for the log.
     pub warnings: Vec<String>,
+}
+
+impl std::fmt::Display for Received {
+    /// What arrived and what was rebuilt, and where in the sender's clip it starts.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "received {} keys ({} bytes, {} sessions, {}), emitted {} frames (frames {}..{} of the sender's {}-frame clip)",
+            self.keys,
+            self.bytes,
+            self.sessions,
+            if self.complete { "complete" } else { "incomplete" },
+            self.motion.num_frames(),
+            self.start_frame,
+            self.start_frame + self.motion.num_frames(),
+            self.clip_frames
+        )
+    }
 }
 
 struct Rebuild {
@@ -473,6 +515,20 @@ pub struct StreamError {
     pub frames: usize,
     pub mean_cm: f64,
     pub max_cm: f64,
+}
+
+impl std::fmt::Display for StreamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "frames {}..{}: mean {:.3} cm, max {:.3} cm over {} frames",
+            self.start_frame,
+            self.start_frame + self.frames,
+            self.mean_cm,
+            self.max_cm,
+            self.frames
+        )
+    }
 }
 
 /// Compares `received` with the sender's clip `reference` (same skeleton), frame

@@ -5,7 +5,7 @@ use crate::clip::Clip;
 use crate::errors::{ctx, invalid, JobError};
 use crate::runner::run_job;
 use inbetween_core::units::UnitChoice;
-use inbetween_script::job::{run_story, RunJob};
+use inbetween_script::jobs::{run_story, RunJob};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::path::{Path, PathBuf};

@@ -15,15 +15,15 @@ use std::time::Instant;
 use inbetween_io::report::{num, seconds_per_call, Report, Table};
 use inbetween_io::Progress;
 
+use crate::builtin_scripts;
 use crate::catalogue::builtin::builtin;
 use crate::compose::{compose, ComposeConfig, ComposeInput};
 use crate::database::SceneDatabase;
-use crate::job::DEFAULT_VARIATIONS;
+use crate::jobs::DEFAULT_VARIATIONS;
 use crate::matching;
 use crate::parse::{parse_script, parse_sentence};
-use crate::script::split;
-use crate::session::Session;
-use crate::stories;
+use crate::scene_session::Session;
+use crate::sentences::split;
 use crate::ScriptError;
 
 /// Settings of the bench.
@@ -54,7 +54,7 @@ pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<Pat
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, cfg.seed);
     let compose_cfg = ComposeConfig { seed: cfg.seed, ..ComposeConfig::default() };
-    let all = stories::all();
+    let all = builtin_scripts::all();
     progress.phase(all.len() as u64 + 5, "script bench");
 
     let mut speed = Table::new(
@@ -162,8 +162,8 @@ pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<Pat
 
     // Incremental edits on the demo story: change one character's target sentence.
     let mut session = Session::new(cat.clone(), db.clone(), compose_cfg.clone());
-    let first = session.update(stories::DEMO);
-    let edited = stories::edit_one_sentence(stories::DEMO);
+    let first = session.update(builtin_scripts::DEMO);
+    let edited = builtin_scripts::edit_one_sentence(builtin_scripts::DEMO);
     let t = Instant::now();
     let second = session.update(&edited);
     let update_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -245,7 +245,7 @@ fn story_table(
     let mut inv = invariant_table();
     let pins = HashMap::new();
     let mut demo_curves = None;
-    for (name, text) in stories::all() {
+    for (name, text) in builtin_scripts::all() {
         let start = Instant::now();
         let parsed = parse_script(text, cat);
         let c = compose(&ComposeInput { parsed: &parsed, catalogue: cat, database: db, pins: &pins }, compose_cfg);
@@ -277,10 +277,10 @@ fn story_table(
         }
         invariant_row(&mut inv, name, &crate::invariants::check(&o.animation, cat, &c.relations));
     }
-    // Random stories from the lexicon (stories::random_story), optimised the same way.
+    // Random stories from the lexicon (builtin_scripts::random_story), optimised the same way.
     let mut clean = 0;
     for seed in 0..RANDOM_STORIES {
-        let text = stories::random_story(seed);
+        let text = builtin_scripts::random_story(seed);
         let parsed = parse_script(&text, cat);
         let c = compose(&ComposeInput { parsed: &parsed, catalogue: cat, database: db, pins: &pins }, compose_cfg);
         let o = optimize(&c, cat, &lib, &acfg, &ocfg);
@@ -292,7 +292,7 @@ fn story_table(
         }
     }
     inv.note(format!(
-        "{clean} of {RANDOM_STORIES} random stories (stories::random_story, seeds 0-{}) keep every invariant; those that do not have their own row",
+        "{clean} of {RANDOM_STORIES} random stories (builtin_scripts::random_story, seeds 0-{}) keep every invariant; those that do not have their own row",
         RANDOM_STORIES - 1
     ));
     inv.note(format!(
@@ -417,7 +417,7 @@ fn invariant_row(t: &mut Table, name: &str, r: &crate::invariants::Report) {
 pub const DEMO_CHARACTER_EDIT: (&str, &str) =
     ("Tom walks slowly to the sofa and sits on it.", "Tom walks to the table and sits on the sofa.");
 
-/// Times an edit of one character's sentence in a [`StorySession`](crate::story::StorySession)
+/// Times an edit of one character's sentence in a [`StorySession`](crate::story_session::StorySession)
 /// (the demo, [`DEMO_CHARACTER_EDIT`]) against the full run, and says what was re-solved.
 fn story_edit_note(
     cat: &crate::catalogue::Catalogue,
@@ -427,11 +427,11 @@ fn story_edit_note(
     acfg: &crate::animate::AnimateConfig,
     ocfg: &crate::optimize::OptimizeConfig,
 ) -> String {
-    use crate::story::StorySession;
+    use crate::story_session::StorySession;
     let mut session =
         StorySession::new(cat.clone(), db.clone(), compose_cfg.clone(), lib.clone(), acfg.clone(), Some(ocfg.clone()));
-    let full = session.update(stories::DEMO);
-    let edited = stories::DEMO.replace(DEMO_CHARACTER_EDIT.0, DEMO_CHARACTER_EDIT.1);
+    let full = session.update(builtin_scripts::DEMO);
+    let edited = builtin_scripts::DEMO.replace(DEMO_CHARACTER_EDIT.0, DEMO_CHARACTER_EDIT.1);
     let edit = session.update(&edited);
     let same = session.update(&edited);
     format!(

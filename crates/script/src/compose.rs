@@ -16,7 +16,7 @@ use crate::layout::{self, LayoutConstraint, LayoutItem, LayoutPlace, LayoutProbl
 use crate::matching::{self, MatchMap};
 use crate::parse::ParsedScript;
 use crate::scene::{Origin, PlacedObject, Room, Scene};
-use crate::script::SentenceKind;
+use crate::sentences::SentenceKind;
 use crate::ssg::{Command, NodeId, Place, PlaceNode, Relation, Ssg};
 
 /// Which matcher picks the database sub-graphs.

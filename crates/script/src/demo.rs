@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::builtin_scripts;
 use crate::compose::ComposeConfig;
-use crate::job::{run_scene, SceneJob};
-use crate::stories;
+use crate::jobs::{run_scene, SceneJob};
 use crate::ScriptError;
 
 /// Runs the demo into `<dir>/script`; returns the lines the CLI prints.
@@ -20,7 +20,7 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         config: ComposeConfig { seed, ..ComposeConfig::default() },
         semantic: None,
     };
-    let report = run_scene(stories::DEMO, &PathBuf::from("builtin:demo"), &job)?;
+    let report = run_scene(builtin_scripts::DEMO, &PathBuf::from("builtin:demo"), &job)?;
     let c = &report.composition;
     let mut lines = vec![format!(
         "script: the built-in story → {} objects in a {:.1} m × {:.1} m {}, {} relations, {} layout violations, {:.1} ms -> {}",
@@ -37,7 +37,7 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         lines.push(format!("script: note: {d}"));
     }
     // Part 2: the characters act in the scene, after the joint optimisation (§4.3).
-    let run = crate::job::RunJob {
+    let run = crate::jobs::RunJob {
         scene: SceneJob { out_dir: out.join("story"), ..job.clone() },
         optimize: true,
         shared_motions: false,
@@ -45,7 +45,7 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         cancel: Default::default(),
         progress: inbetween_io::Progress::hidden(),
     };
-    let story = crate::job::run_story(stories::DEMO, &PathBuf::from("builtin:demo"), &run)?;
+    let story = crate::jobs::run_story(builtin_scripts::DEMO, &PathBuf::from("builtin:demo"), &run)?;
     lines.push(format!(
         "script: {} characters animated, {} frames ({:.1} s); joint optimisation C {:.3} -> {:.3}, mean contact distance {:.3} m -> {:.3} m -> {}",
         story.animation.characters.len(),
@@ -58,11 +58,11 @@ pub fn run(dir: &Path, seed: u64) -> Result<Vec<String>, ScriptError> {
         out.join("story").display()
     ));
     // The editing loop: one sentence changed, everything else stays.
-    let cat = crate::job::catalogue(None)?;
-    let db = crate::database::SceneDatabase::builtin(&cat, crate::job::DEFAULT_VARIATIONS, seed);
-    let mut session = crate::session::Session::new(cat, db, ComposeConfig { seed, ..ComposeConfig::default() });
-    session.update(stories::DEMO);
-    let edit = session.update(&stories::edit_one_sentence(stories::DEMO));
+    let cat = crate::jobs::catalogue(None)?;
+    let db = crate::database::SceneDatabase::builtin(&cat, crate::jobs::DEFAULT_VARIATIONS, seed);
+    let mut session = crate::scene_session::Session::new(cat, db, ComposeConfig { seed, ..ComposeConfig::default() });
+    session.update(builtin_scripts::DEMO);
+    let edit = session.update(&builtin_scripts::edit_one_sentence(builtin_scripts::DEMO));
     lines.push(format!(
         "script: after editing one sentence, {} objects kept their places and {} were placed anew in {:.1} ms",
         edit.kept,

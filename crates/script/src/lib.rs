@@ -3,7 +3,7 @@
 //!
 //! The folders follow the paper's pipeline (Fig. 2). Part 1, text → semantic scene graph →
 //! furnished scene (§3.2, §4.1):
-//! - [`script`]: the user's text split into scene descriptions (ending in `$`), character
+//! - [`sentences`]: the user's text split into scene descriptions (ending in `$`), character
 //!   directions and verbal commands (§3.2);
 //! - [`parse`]: tokenising, POS tagging, lemmatising and the rules that turn tags into a
 //!   [`ssg::Ssg`], the semantic scene graph (the paper uses CoreNLP dependencies; we use tags +
@@ -13,8 +13,8 @@
 //! - [`matching`]: SSG matching, relation-first (Algorithm 1) and the LDS object-first baseline;
 //! - [`layout`]: placing objects so relations hold without interpenetration, inside the room,
 //!   reachable;
-//! - [`compose`]: matching + layout → a furnished [`scene::Scene`]; [`session`] re-solves only
-//!   what an edit touches;
+//! - [`compose`]: matching + layout → a furnished [`scene::Scene`]; [`scene_session`] re-solves
+//!   only what an edit touches;
 //! - [`semantic`] (and `embed`, feature `embeddings`): words outside the synonym tables read
 //!   through sentence embeddings.
 //!
@@ -27,17 +27,19 @@
 //!   pick up, act on an object), several characters kept apart, camera shots;
 //! - [`optimize`]: Algorithm 2, the collision and contact costs (Eq. 1–3) minimised by annealing
 //!   over object positions and heights (Eq. 4);
-//! - [`story`]: the editing loop of part 2, re-animating only the characters an edit touches and
+//! - [`story_session`]: the editing loop of part 2, re-animating only the characters an edit touches and
 //!   re-optimising only their objects (above both [`animate`] and [`optimize`]).
 //!
 //! Both parts write through [`output`] (scene JSON, glTF with boxes, meshes, animated skeletons
-//! or skinned characters, BVH, PNG and GIF previews); [`job`] runs them for the CLI, [`bench`]
-//! measures them, [`demo`] and [`stories`] hold the built-in texts.
+//! or skinned characters, BVH, PNG and GIF previews); [`jobs`] runs them for the front ends
+//! ([`jobs::SceneJob`], [`jobs::RunJob`]), [`bench`] measures them, [`demo`] and [`builtin_scripts`] hold the
+//! built-in texts.
 //!
 //! Units: metres, Y up, the floor at y = 0 (glTF's convention).
 
 pub mod animate;
 pub mod bench;
+pub mod builtin_scripts;
 pub mod catalogue;
 pub mod compose;
 pub mod database;
@@ -47,7 +49,7 @@ pub mod embed;
 pub mod error;
 pub mod fidelity;
 pub mod invariants;
-pub mod job;
+pub mod jobs;
 pub mod layout;
 pub mod limits;
 pub mod matching;
@@ -56,11 +58,10 @@ pub mod optimize;
 pub mod output;
 pub mod parse;
 pub mod scene;
-pub mod script;
+pub mod scene_session;
 pub mod semantic;
-pub mod session;
+pub mod sentences;
 pub mod ssg;
-pub mod stories;
-pub mod story;
+pub mod story_session;
 
 pub use error::ScriptError;

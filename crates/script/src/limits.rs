@@ -7,7 +7,7 @@ use inbetween_io::LimitExceeded;
 
 use crate::catalogue::Catalogue;
 use crate::parse::parse_script;
-use crate::script::SentenceKind;
+use crate::sentences::SentenceKind;
 
 /// The limits of a story job. The defaults let every built-in story and far longer ones through.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,7 +59,7 @@ impl ScriptLimits {
     ) -> Result<crate::parse::ParsedScript, LimitExceeded> {
         let words = text.split_whitespace().count();
         LimitExceeded::check_count(source, words, self.max_words, "words", "max_words")?;
-        let sentences = crate::script::split(text).len();
+        let sentences = crate::sentences::split(text).len();
         LimitExceeded::check_count(source, sentences, self.max_sentences, "sentences", "max_sentences")?;
         let parsed = parse_script(text, cat);
         let mut names: Vec<String> = Vec::new();
@@ -107,7 +107,7 @@ mod tests {
     #[test]
     fn every_builtin_story_is_within_the_default_limits() {
         let cat = cat();
-        for (name, text) in crate::stories::all() {
+        for (name, text) in crate::builtin_scripts::all() {
             ScriptLimits::default().check_text(text, name, &cat).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
     }

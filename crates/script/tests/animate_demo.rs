@@ -5,6 +5,7 @@ use std::collections::HashMap;
 
 use inbetween_core::fk::forward;
 use inbetween_script::animate::{animate, camera_pose, AnimateConfig, Animation};
+use inbetween_script::builtin_scripts;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput, Composition};
 use inbetween_script::database::SceneDatabase;
@@ -13,12 +14,11 @@ use inbetween_script::motion::ik::PELVIS_ABOVE_SEAT;
 use inbetween_script::motion::rig::Rig;
 use inbetween_script::motion::MotionLibrary;
 use inbetween_script::parse::parse_script;
-use inbetween_script::stories;
 
 fn demo() -> (Composition, Animation) {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
-    let parsed = parse_script(stories::DEMO, &cat);
+    let parsed = parse_script(builtin_scripts::DEMO, &cat);
     let comp = compose(
         &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
         &ComposeConfig::default(),
@@ -163,7 +163,7 @@ fn every_builtin_story_animates() {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let lib = MotionLibrary::procedural(0);
-    for (name, text) in stories::all() {
+    for (name, text) in builtin_scripts::all() {
         let parsed = parse_script(text, &cat);
         let comp = compose(
             &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },

@@ -9,6 +9,7 @@ use inbetween_core::fk::forward;
 use inbetween_script::animate::{
     animate, carried_from, contacts_of, object_pose, AnimateConfig, Animation, ContactJoint,
 };
+use inbetween_script::builtin_scripts;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::catalogue::ContactKind;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput};
@@ -16,7 +17,6 @@ use inbetween_script::database::SceneDatabase;
 use inbetween_script::motion::{MotionLibrary, Rig};
 use inbetween_script::optimize::contact_cost;
 use inbetween_script::parse::parse_script;
-use inbetween_script::stories;
 
 fn animated(text: &str) -> Animation {
     let cat = builtin();
@@ -31,7 +31,7 @@ fn animated(text: &str) -> Animation {
 
 #[test]
 fn fig1_eve_fetches_the_microphone_and_sings_with_it_in_her_hand() {
-    let anim = animated(stories::FIG1);
+    let anim = animated(builtin_scripts::FIG1);
     let cat = builtin();
     let eve = &anim.characters[0];
     let mic = anim.scene.objects.iter().position(|o| o.category == "microphone").expect("a microphone");
@@ -96,7 +96,7 @@ fn a_prop_used_in_place_is_not_carried_and_a_picked_up_one_is_carried_once() {
 
 #[test]
 fn the_story_gltf_moves_a_carried_prop() {
-    let anim = animated(stories::FIG1);
+    let anim = animated(builtin_scripts::FIG1);
     let cat = builtin();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("story.gltf");

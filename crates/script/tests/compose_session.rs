@@ -3,12 +3,12 @@
 
 use std::collections::HashMap;
 
+use inbetween_script::builtin_scripts;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput, Matcher};
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::parse::parse_script;
-use inbetween_script::session::Session;
-use inbetween_script::stories;
+use inbetween_script::scene_session::Session;
 
 fn session() -> Session {
     let cat = builtin();
@@ -20,7 +20,7 @@ fn session() -> Session {
 fn every_builtin_story_composes_without_layout_violations() {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
-    for (name, text) in stories::all() {
+    for (name, text) in builtin_scripts::all() {
         let parsed = parse_script(text, &cat);
         let c = compose(
             &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
@@ -50,7 +50,7 @@ fn named_objects_and_relations_reach_the_scene() {
 
 #[test]
 fn composition_is_deterministic() {
-    let text = stories::DEMO;
+    let text = builtin_scripts::DEMO;
     let a = session().update(text).composition.scene;
     let b = session().update(text).composition.scene;
     assert_eq!(serde_json::to_string(&a).unwrap(), serde_json::to_string(&b).unwrap());
@@ -60,7 +60,7 @@ fn composition_is_deterministic() {
 fn an_unchanged_re_run_gives_the_same_scene_supports_included() {
     // Every object is pinned on the re-run; one resting on a surface pinned after it (the demo's
     // furnishing book on the desk) must still find its support.
-    for (name, text) in stories::all() {
+    for (name, text) in builtin_scripts::all() {
         let mut s = session();
         let first = s.update(text).composition.scene;
         let again = s.update(text).composition;
@@ -138,7 +138,7 @@ fn relation_first_matching_scores_at_least_object_first_on_the_captions() {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let mut better_or_equal = 0;
-    let all = stories::all();
+    let all = builtin_scripts::all();
     for (_, text) in &all {
         let parsed = parse_script(text, &cat);
         let score = |m| {
@@ -156,14 +156,14 @@ fn relation_first_matching_scores_at_least_object_first_on_the_captions() {
 #[test]
 fn the_per_scene_figure_texts_are_the_captions_lines() {
     let norm = |t: &str| t.lines().map(str::trim).filter(|l| !l.is_empty()).map(String::from).collect::<Vec<_>>();
-    let fig5 = norm(stories::FIG5);
-    let fig7 = norm(stories::FIG7);
-    for part in [stories::FIG5_GALLERY, stories::FIG5_MEETING_ROOM] {
+    let fig5 = norm(builtin_scripts::FIG5);
+    let fig7 = norm(builtin_scripts::FIG7);
+    for part in [builtin_scripts::FIG5_GALLERY, builtin_scripts::FIG5_MEETING_ROOM] {
         for l in norm(part) {
             assert!(fig5.iter().any(|f| f.contains(&l) || l.contains(f.as_str())), "{l}");
         }
     }
-    for part in [stories::FIG7_BOXING, stories::FIG7_WORKSHOP, stories::FIG7_MUSIC_ROOM] {
+    for part in [builtin_scripts::FIG7_BOXING, builtin_scripts::FIG7_WORKSHOP, builtin_scripts::FIG7_MUSIC_ROOM] {
         for l in norm(part) {
             assert!(fig7.contains(&l), "{l}");
         }
@@ -173,8 +173,8 @@ fn the_per_scene_figure_texts_are_the_captions_lines() {
 #[test]
 fn the_bench_edit_changes_exactly_one_sentence_of_the_demo() {
     let mut s = session();
-    s.update(stories::DEMO);
-    let u = s.update(&inbetween_script::stories::edit_one_sentence(stories::DEMO));
+    s.update(builtin_scripts::DEMO);
+    let u = s.update(&inbetween_script::builtin_scripts::edit_one_sentence(builtin_scripts::DEMO));
     assert_eq!(u.changed_sentences.len(), 1);
     assert!(u
         .composition

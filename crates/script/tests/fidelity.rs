@@ -6,7 +6,7 @@
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::fidelity::{corpus, run, scores};
-use inbetween_script::job::DEFAULT_VARIATIONS;
+use inbetween_script::jobs::DEFAULT_VARIATIONS;
 use inbetween_script::motion::MotionLibrary;
 
 /// Runs the corpus stories of one phrase type; asserts at least `floor` percent of their checks

@@ -5,14 +5,14 @@
 use std::collections::HashMap;
 
 use inbetween_script::animate::AnimateConfig;
+use inbetween_script::builtin_scripts::DEMO;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput};
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::motion::MotionLibrary;
 use inbetween_script::optimize::{optimize, OptimizeConfig};
 use inbetween_script::parse::parse_script;
-use inbetween_script::stories::DEMO;
-use inbetween_script::story::StorySession;
+use inbetween_script::story_session::StorySession;
 
 const ITERATIONS: usize = 20;
 
@@ -88,7 +88,7 @@ fn editing_one_characters_sentence_re_solves_only_that_character_and_its_objects
     let builds: HashMap<&str, usize> = second.character_builds.iter().map(|(n, b)| (n.as_str(), *b)).collect();
     assert_eq!(builds["Eve"], 0);
     assert!(builds["Tom"] >= 1);
-    let eve = |u: &inbetween_script::story::StoryUpdate| {
+    let eve = |u: &inbetween_script::story_session::StoryUpdate| {
         u.animation.characters.iter().find(|c| c.name == "Eve").unwrap().clone()
     };
     assert!(eve(&first).clip == eve(&second).clip, "Eve's motion changed");

@@ -7,15 +7,15 @@ mod common;
 use common::run_job;
 
 use inbetween_script::animate::AnimateConfig;
+use inbetween_script::builtin_scripts::{all, random_story};
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::ComposeConfig;
 use inbetween_script::database::SceneDatabase;
 use inbetween_script::invariants::{check, Report};
-use inbetween_script::job::{run_story, RunJob, DEFAULT_VARIATIONS};
+use inbetween_script::jobs::{run_story, RunJob, DEFAULT_VARIATIONS};
 use inbetween_script::motion::MotionLibrary;
 use inbetween_script::optimize::OptimizeConfig;
-use inbetween_script::stories::{all, random_story};
-use inbetween_script::story::StorySession;
+use inbetween_script::story_session::StorySession;
 
 fn job(out: &std::path::Path) -> RunJob {
     run_job(out, true)

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use inbetween_script::animate::crowd::root_track;
 use inbetween_script::animate::{animate, animate_scene, min_clearance, AnimateConfig, Animation, PASSING_DISTANCE};
+use inbetween_script::builtin_scripts;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, query_graph, ComposeConfig, ComposeInput};
 use inbetween_script::database::SceneDatabase;
@@ -13,7 +14,6 @@ use inbetween_script::motion::MotionLibrary;
 use inbetween_script::optimize::{optimize, OptimizeConfig};
 use inbetween_script::parse::parse_script;
 use inbetween_script::scene::{Origin, PlacedObject, Room, Scene};
-use inbetween_script::stories;
 
 /// An object of a catalogue category at (x, z) turned by `yaw`, on the floor.
 fn object(label: &str, category: &str, x: f32, z: f32, yaw: f32) -> PlacedObject {
@@ -144,7 +144,7 @@ fn every_builtin_story_keeps_its_characters_apart() {
     let db = SceneDatabase::builtin(&cat, 2, 7);
     let lib = MotionLibrary::procedural(0);
     let mut pairs = 0;
-    for (name, text) in stories::all() {
+    for (name, text) in builtin_scripts::all() {
         let parsed = parse_script(text, &cat);
         let comp = compose(
             &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
@@ -172,8 +172,8 @@ fn every_builtin_story_keeps_its_characters_apart() {
 fn night_of_the_living_dead_keeps_its_characters_apart_after_the_optimisation() {
     // The bench's setting (seed 1, the annealing re-animates every state it tries).
     let cat = builtin();
-    let db = SceneDatabase::builtin(&cat, inbetween_script::job::DEFAULT_VARIATIONS, 1);
-    let parsed = parse_script(stories::NIGHT_OF_THE_LIVING_DEAD, &cat);
+    let db = SceneDatabase::builtin(&cat, inbetween_script::jobs::DEFAULT_VARIATIONS, 1);
+    let parsed = parse_script(builtin_scripts::NIGHT_OF_THE_LIVING_DEAD, &cat);
     let comp = compose(
         &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
         &ComposeConfig { seed: 1, ..ComposeConfig::default() },

@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 
 use inbetween_script::animate::{animate_scene, AnimateConfig};
+use inbetween_script::builtin_scripts;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::compose::{compose, ComposeConfig, ComposeInput, Composition};
 use inbetween_script::database::SceneDatabase;
@@ -12,12 +13,11 @@ use inbetween_script::optimize::{costs, optimize, optimize_scene, plot_costs, Op
 use inbetween_script::parse::parse_script;
 use inbetween_script::scene::{Origin, PlacedObject, Room, Scene};
 use inbetween_script::ssg::{Action, CharacterNode, ObjectNode, Relation, Ssg};
-use inbetween_script::stories;
 
 fn demo() -> Composition {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, 2, 7);
-    let parsed = parse_script(stories::DEMO, &cat);
+    let parsed = parse_script(builtin_scripts::DEMO, &cat);
     compose(
         &ComposeInput { parsed: &parsed, catalogue: &cat, database: &db, pins: &HashMap::new() },
         &ComposeConfig::default(),

@@ -1,10 +1,10 @@
 //! The paper's captions against the built-in catalogue (synonyms such as couch → sofa,
 //! modernchair → chair, compounds such as "boxing ring", room names).
 
+use inbetween_script::builtin_scripts;
 use inbetween_script::catalogue::builtin::builtin;
 use inbetween_script::parse::parse_script;
 use inbetween_script::ssg::{Relation, Ssg};
-use inbetween_script::stories;
 
 fn find<'a>(p: &'a inbetween_script::parse::ParsedScript, text: &str) -> &'a Ssg {
     &p.sentences.iter().find(|s| s.raw.at.text == text).unwrap_or_else(|| panic!("{text}")).ssg
@@ -13,7 +13,7 @@ fn find<'a>(p: &'a inbetween_script::parse::ParsedScript, text: &str) -> &'a Ssg
 #[test]
 fn fig1_with_builtin_catalogue() {
     let cat = builtin();
-    let p = parse_script(stories::FIG1, &cat);
+    let p = parse_script(builtin_scripts::FIG1, &cat);
     assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
     let g = find(&p, "In the room, an organized office desk is near a bed");
     assert_eq!(g.room.as_deref(), Some("room"));
@@ -30,13 +30,13 @@ fn fig1_with_builtin_catalogue() {
 #[test]
 fn figure_scenes_with_builtin_catalogue() {
     let cat = builtin();
-    let p = parse_script(stories::FIG5, &cat);
+    let p = parse_script(builtin_scripts::FIG5, &cat);
     let g = find(&p, "Tom sits on a modernchair");
     let target = g.characters[0].actions[0].target.unwrap();
     assert_eq!(g.objects[target].category, cat.resolve("modernchair").unwrap().name);
     assert_eq!(find(&p, "In a gallery there is a horsesculpture and a oilpainting").room.as_deref(), Some("gallery"));
 
-    let p = parse_script(stories::FIG7, &cat);
+    let p = parse_script(builtin_scripts::FIG7, &cat);
     let g = find(&p, "There is a boxing ring above which a boxingbag hangs");
     assert_eq!(g.relations.len(), 1);
     assert_eq!(g.relations[0].relation, Relation::Above);

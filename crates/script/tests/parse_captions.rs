@@ -2,10 +2,10 @@
 
 mod parse_common;
 
+use inbetween_script::builtin_scripts;
 use inbetween_script::parse::{parse_script, ParsedScript};
-use inbetween_script::script::SentenceKind;
+use inbetween_script::sentences::SentenceKind;
 use inbetween_script::ssg::{Action, Command, Relation, Ssg};
-use inbetween_script::stories;
 use parse_common::paper_catalogue;
 
 fn parse(text: &str) -> ParsedScript {
@@ -49,7 +49,7 @@ fn act(verb: &str, prep: Option<&str>, target: Option<&str>, manner: &[&str]) ->
 
 #[test]
 fn fig1_interface_example() {
-    let p = parse(stories::FIG1);
+    let p = parse(builtin_scripts::FIG1);
     let kinds: Vec<SentenceKind> = p.sentences.iter().map(|s| s.raw.kind).collect();
     use SentenceKind as K;
     assert_eq!(kinds, [K::Direction, K::Scene, K::Command, K::Direction]);
@@ -80,7 +80,7 @@ fn fig1_interface_example() {
 
 #[test]
 fn fig5_gallery_and_meeting_room_scenes() {
-    let p = parse(stories::FIG5);
+    let p = parse(builtin_scripts::FIG5);
     let g = ssg(&p, "In a gallery there is a horsesculpture and a oilpainting");
     assert_eq!(g.room.as_deref(), Some("gallery"));
     assert_eq!(cats(g), ["horsesculpture", "oilpainting"]);
@@ -99,7 +99,7 @@ fn fig5_gallery_and_meeting_room_scenes() {
 
 #[test]
 fn fig5_susan_and_tom_directions() {
-    let p = parse(stories::FIG5);
+    let p = parse(builtin_scripts::FIG5);
     let g = ssg(&p, "Susan stands in the front of oilpainting and is looking at it");
     assert_eq!(
         acts(g, "Susan"),
@@ -131,14 +131,14 @@ fn fig5_susan_and_tom_directions() {
 
 #[test]
 fn fig6_film_line() {
-    let p = parse(stories::FIG6);
+    let p = parse(builtin_scripts::FIG6);
     let g = ssg(&p, "The man walks unbelievably to the road");
     assert_eq!(acts(g, "the man"), [act("walk", Some("to"), Some("road"), &["unbelievably"])]);
 }
 
 #[test]
 fn fig7_boxing_workshop_music_scenes() {
-    let p = parse(stories::FIG7);
+    let p = parse(builtin_scripts::FIG7);
     let g = ssg(&p, "There is a boxing ring above which a boxingbag hangs");
     assert_eq!(cats(g), ["boxingring", "boxingbag"]);
     assert_eq!(rels(g), [(Relation::Above, "boxingbag", "boxingring")]);
@@ -168,7 +168,7 @@ fn fig7_boxing_workshop_music_scenes() {
 
 #[test]
 fn fig7_actions() {
-    let p = parse(stories::FIG7);
+    let p = parse(builtin_scripts::FIG7);
     assert_eq!(acts(ssg(&p, "Mary is punching boxingbag"), "Mary"), [act("punch", None, Some("boxingbag"), &[])]);
     assert_eq!(acts(ssg(&p, "Mary is drinking soda"), "Mary"), [act("drink", None, Some("soda"), &[])]);
     assert_eq!(acts(ssg(&p, "Worker is sawing the wood"), "Worker"), [act("saw", None, Some("wood"), &[])]);
@@ -195,7 +195,7 @@ fn fig7_actions() {
 
 #[test]
 fn every_builtin_text_parses() {
-    for (name, text) in stories::all() {
+    for (name, text) in builtin_scripts::all() {
         let p = parse(text);
         assert!(!p.sentences.is_empty(), "{name}");
         for s in &p.sentences {
@@ -212,7 +212,7 @@ fn every_builtin_text_parses() {
 
 #[test]
 fn demo_and_film_script() {
-    let p = parse(stories::DEMO);
+    let p = parse(builtin_scripts::DEMO);
     assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
     let scenes = p.sentences.iter().filter(|s| s.raw.kind == SentenceKind::Scene).count();
     assert!((2..=3).contains(&scenes));
@@ -225,7 +225,7 @@ fn demo_and_film_script() {
         [act("walk", Some("to"), Some("sofa"), &["slowly"]), act("sit", Some("on"), Some("sofa"), &[])]
     );
 
-    let p = parse(stories::NIGHT_OF_THE_LIVING_DEAD);
+    let p = parse(builtin_scripts::NIGHT_OF_THE_LIVING_DEAD);
     assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
     let merged = p.merged();
     assert!(merged.commands.contains(&Command::Time { time: "night".into(), sentence: 3 }));

@@ -1,6 +1,6 @@
 //! Splitting a script into sentences (§3.2): `$` scenes, commands, directions, line numbers.
 
-use inbetween_script::script::{command_parts, split, SentenceKind};
+use inbetween_script::sentences::{command_parts, split, SentenceKind};
 
 #[test]
 fn empty_and_comment_only_scripts_have_no_sentences() {
@@ -86,7 +86,7 @@ fn commands() {
 
 mod never_panics {
     use inbetween_script::parse::parse_script;
-    use inbetween_script::script::split;
+    use inbetween_script::sentences::split;
     use proptest::prelude::*;
 
     proptest! {

@@ -6,7 +6,7 @@ use inbetween_script::parse::{
     lemmatize, lemmatize_noun, lemmatize_verb, number_value, parse_script, parse_sentence, suggestions, tag, tokenize,
     Tag,
 };
-use inbetween_script::script::split;
+use inbetween_script::sentences::split;
 use inbetween_script::ssg::Relation;
 use parse_common::paper_catalogue;
 

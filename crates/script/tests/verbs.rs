@@ -6,7 +6,7 @@ use common::run_job;
 
 use inbetween_core::fk::forward;
 use inbetween_script::animate::verb_has_motion;
-use inbetween_script::job::{run_story, RunJob};
+use inbetween_script::jobs::{run_story, RunJob};
 use inbetween_script::motion::rig::Rig;
 use inbetween_script::motion::MotionLibrary;
 use inbetween_script::parse::lexicon::VERBS;

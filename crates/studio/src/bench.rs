@@ -16,22 +16,10 @@ use serde_json::Value;
 use crate::browser::{available, tree_rss_bytes, Browser};
 use crate::error::{Result, StudioError};
 use crate::{Studio, StudioConfig};
+use inbetween_core::stats::median;
 
 /// Page size of the screenshots.
 pub const VIEW: (u32, u32) = (1280, 760);
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
-}
 
 /// One row: median, min, max of `v` (ms), the job's own server time median, and the goal.
 fn row(t: &mut Table, what: &str, v: &mut [f64], server: &mut [f64], goal: &str) {

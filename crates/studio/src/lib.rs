@@ -1,7 +1,7 @@
 //! `inbetween studio`: a local web studio where a story or a mocap take is run, seen in 3D and
 //! edited (issue 23), a face capture is masked and refilled, a clip is resequenced and a camera is keyed between two
 //! characters (issue 24). The server is axum on tokio; every job calls an engine's public library
-//! API (the script engine's [`inbetween_script::animate::incremental::StorySession`], the mocap
+//! API (the script engine's [`inbetween_script::story_session::StorySession`], the mocap
 //! engine's key selectors and `.ibk` codec) on a blocking thread; results reach the page as JSON,
 //! glTF and BVH (forms three.js reads), progress as server-sent events.
 //!

@@ -14,11 +14,11 @@ use axum::routing::{get, post};
 use axum::{Json, Router};
 use inbetween_script::animate::{camera_track, Animation};
 use inbetween_script::compose::ComposeConfig;
-use inbetween_script::job::{story_session, RunJob, SceneJob};
+use inbetween_script::jobs::{story_session, RunJob, SceneJob};
 use inbetween_script::limits::ScriptLimits;
 use inbetween_script::output;
 use inbetween_script::output::skinned::SkinnedBody;
-use inbetween_script::story::StorySession;
+use inbetween_script::story_session::StorySession;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -54,7 +54,7 @@ pub struct ScriptState {
 /// `GET /api/script/stories`: the built-in texts by name.
 pub async fn stories() -> Json<Value> {
     let list: Vec<Value> =
-        inbetween_script::stories::all().into_iter().map(|(name, text)| json!({"name": name, "text": text})).collect();
+        inbetween_script::builtin_scripts::all().into_iter().map(|(name, text)| json!({"name": name, "text": text})).collect();
     Json(json!({"stories": list, "default": "demo"}))
 }
 
@@ -81,7 +81,7 @@ fn kenney_furniture() -> Option<PathBuf> {
 
 /// `POST /api/script/run`: starts a story job.
 pub async fn run(State(st): State<Arc<AppState>>, Json(req): Json<RunRequest>) -> Result<Json<Value>> {
-    if inbetween_script::script::split(&req.text).is_empty() {
+    if inbetween_script::sentences::split(&req.text).is_empty() {
         return Err(StudioError::BadRequest(
             "the script is empty: write sentences such as \"In the room, a desk is near a bed$\"".into(),
         ));

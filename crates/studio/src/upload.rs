@@ -30,13 +30,8 @@ pub fn clean_name(name: &str) -> String {
 
 /// The upload as text, or an error naming the file, the line and the first byte that is not UTF-8.
 pub fn utf8(name: &str, bytes: &[u8]) -> Result<String> {
-    String::from_utf8(bytes.to_vec()).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        StudioError::Engine(format!(
-            "{name}:{}: expected UTF-8 text, found byte 0x{:02x}",
-            1 + bytes[..at].iter().filter(|&&b| b == b'\n').count(),
-            bytes[at]
-        ))
+    inbetween_io::text::utf8(bytes.to_vec()).map_err(|e| {
+        StudioError::Engine(format!("{name}:{}: expected UTF-8 text, found byte 0x{:02x}", e.line, e.byte))
     })
 }
 

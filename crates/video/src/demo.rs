@@ -28,6 +28,22 @@ pub struct VideoDemo {
 pub const FRAMES: usize = 48;
 pub const START: usize = 6;
 
+impl std::fmt::Display for VideoDemo {
+    /// The demo's line: the new order's length, M_D beside the source's, Δo and the files.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let files: Vec<String> = self.files.iter().map(|f| f.display().to_string()).collect();
+        write!(
+            f,
+            "video: procedural clip resequenced from frame {START}: {} frames, M_D {:.4} (source {:.4}), Δo {:.3} -> {}",
+            self.order.len(),
+            self.md.0,
+            self.md.1,
+            self.delta_o,
+            files.join(", ")
+        )
+    }
+}
+
 /// Run the demo into `dir` (`video-demo-source.gif`, `video-demo.gif`, `video-demo.sheet.png`).
 pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<VideoDemo, VideoError> {
     let clip = procedural_clip(ProceduralKind::Mixed, FRAMES, 192, 108, seed);

@@ -22,6 +22,19 @@ pub fn scene_from_motions(takes: &[(&str, &Motion)]) -> Result<(Scene, SceneNote
     scene_from_motions_with(takes, &RoleOverrides::default())
 }
 
+/// The scene of two mocap files (BVH, or ASF+AMC as `.amc` with its `.asf` beside it) as its
+/// characters, with the roles `overrides` names; also the scene's name (the files joined by ` + `).
+pub fn scene_from_files(
+    paths: &[std::path::PathBuf],
+    overrides: &RoleOverrides,
+) -> Result<(Scene, SceneNotes, String), crate::CameraError> {
+    let motions = paths.iter().map(|p| inbetween_io::load_motion(p)).collect::<Result<Vec<_>, _>>()?;
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let takes: Vec<(&str, &Motion)> = names.iter().map(String::as_str).zip(motions.iter()).collect();
+    let (scene, notes) = scene_from_motions_with(&takes, overrides).map_err(crate::CameraError::Request)?;
+    Ok((scene, notes, names.join(" + ")))
+}
+
 /// [`scene_from_motions`] with joints named in a roles file (`roles`), for rigs whose names and
 /// shape leave a role open.
 pub fn scene_from_motions_with(

@@ -5,10 +5,12 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::data::{BlendshapeClip, FaceError, NUM_ARKIT};
+use crate::data::{read_clip_limited, BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT};
 use crate::edit::groups::Group;
 use crate::edit::mask::{parse_span_spec, SpanSpec};
 use crate::edit::ConstraintKind;
+use crate::edit::MotionLibrary;
+use crate::infer::{DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
 use crate::visemes::{phoneme_viseme, PhonemeSpan, Viseme};
 
 /// How an edit is asked to fill, before [`MethodChoice::resolve`] applies the `auto` rule.
@@ -66,6 +68,30 @@ impl MethodChoice {
             m => m,
         }
     }
+}
+
+/// The library retrieval draws from: the clips in `files` at the model rate (each at most `max_rows`
+/// rows), or the procedural library ([`DEFAULT_LIBRARY_S`] seconds, seed [`DEFAULT_LIBRARY_SEED`])
+/// when none is given.
+pub fn retrieval_library(files: &[PathBuf], max_rows: usize) -> Result<MotionLibrary, FaceError> {
+    if files.is_empty() {
+        return Ok(MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED));
+    }
+    let mut lib = MotionLibrary::default();
+    for f in files {
+        let clip = read_clip_limited(f, max_rows)?
+            .resample(MODEL_FPS)
+            .map_err(|e| FaceError::File { file: f.display().to_string(), message: e.to_string() })?;
+        lib.push(clip.arkit_frames());
+    }
+    Ok(lib)
+}
+
+/// Whether an edit of `input` written to `out` keeps the Live Link Face layout: a Live Link CSV in,
+/// and not a `.json` curve file out.
+pub fn keeps_live_link(input: &Path, out: &Path) -> bool {
+    let ext = |p: &Path, e: &str| p.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
+    ext(input, "csv") && !ext(out, "json") && crate::data::is_live_link(input)
 }
 
 /// The groups speech moves, which viseme guidance (text, TextGrid, phoneme timings) drives when the

@@ -64,7 +64,7 @@ impl TrainOptions {
 const PRETRAIN_EPOCH: usize = 100;
 
 /// What a run did.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct TrainReport {
     pub pretrain_steps: usize,
     /// Mean pretraining loss per epoch of [`PRETRAIN_EPOCH`] steps.

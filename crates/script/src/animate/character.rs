@@ -213,7 +213,7 @@ mod tests {
         let db = SceneDatabase::builtin(&cat, 2, 7);
         let text = format!(
             "{}Eve walks to the sofa.\nTom walks to the desk.\nEve walks to the bookshelf.\n",
-            crate::stories::DEMO
+            crate::builtin_scripts::DEMO
         );
         let parsed = parse_script(&text, &cat);
         let comp = compose(

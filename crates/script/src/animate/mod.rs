@@ -34,7 +34,7 @@
 //! a later character's grid blocks where earlier ones end up. [`crowd`] then keeps every pair of
 //! roots [`PASSING_DISTANCE`] apart at every frame, standing and sitting included (prioritised
 //! planning over space-time reservations: waits and detours, the later character yielding
-//! first), and notes what it cannot solve. [`crate::story::StorySession`] (above this module and
+//! first), and notes what it cannot solve. [`crate::story_session::StorySession`] (above this module and
 //! the optimiser) re-solves only the characters (and the objects they touch) an edit changes.
 //!
 //! Segments are joined with a short cross-fade. Camera commands become [`CameraShot`]s and
@@ -234,7 +234,7 @@ pub const PASSING_DISTANCE: f32 = 0.5;
 
 /// Whether a verb lemma as the parser gives it (with its particles in `manner`: "get" + "up") has
 /// motion in `lib`: locomotion, sitting, standing up, turning and lying are built, any other verb
-/// needs a clip ([`crate::story::StorySession::check_verbs`] refuses a script with one that has
+/// needs a clip ([`crate::story_session::StorySession::check_verbs`] refuses a script with one that has
 /// none).
 pub fn verb_has_motion(verb: &str, manner: &[String], lib: &MotionLibrary) -> bool {
     let a = crate::ssg::Action {

@@ -432,7 +432,7 @@ pub(crate) fn optimize_scene_in(
 /// The annealing of Algorithm 2 from `scene` (animated as `anim0`, with costs `before`), moving
 /// only the objects in `movable`; `animate` animates a disturbed scene, or refuses it (None: the
 /// move is rejected like one that breaks the layout). The incremental editor
-/// ([`crate::story`]) restricts `movable` to the objects of the characters it
+/// ([`crate::story_session`]) restricts `movable` to the objects of the characters it
 /// re-solves.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn anneal(

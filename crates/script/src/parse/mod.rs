@@ -20,7 +20,7 @@ pub use token::{tokenize, Token};
 
 use crate::catalogue::Catalogue;
 use crate::error::Diagnostic;
-use crate::script::{split, RawSentence, SentenceKind};
+use crate::sentences::{split, RawSentence, SentenceKind};
 use crate::ssg::Ssg;
 
 /// One sentence and its graph. Nodes carry `sentence = raw.at.sentence - 1`.

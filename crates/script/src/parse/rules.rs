@@ -8,7 +8,7 @@ use super::tag::{known_noun, tag, Tag, Tagged};
 use super::token::tokenize;
 use crate::catalogue::Catalogue;
 use crate::error::{Diagnostic, SentenceRef};
-use crate::script::{command_parts, RawSentence, SentenceKind, CAMERA_VIEWS, TIMES, WEATHERS};
+use crate::sentences::{command_parts, RawSentence, SentenceKind, CAMERA_VIEWS, TIMES, WEATHERS};
 use crate::ssg::{Action, CharacterNode, Command, NodeId, ObjectNode, Place, PlaceNode, Relation, RelationNode, Ssg};
 
 /// What carries over from one sentence to the next: who "he"/"she" is, what "it" is.

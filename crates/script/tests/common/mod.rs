@@ -2,7 +2,7 @@
 //! a part).
 #![allow(dead_code)]
 
-use inbetween_script::job::{RunJob, SceneJob};
+use inbetween_script::jobs::{RunJob, SceneJob};
 use inbetween_script::scene::{Origin, PlacedObject};
 use serde_json::Value;
 

@@ -1,4 +1,4 @@
-//! Incremental story editing (beyond the paper; part 1's [`crate::session`] does the same for the
+//! Incremental story editing (beyond the paper; part 1's [`crate::scene_session`] does the same for the
 //! scene). It sits above both [`crate::animate`] and [`crate::optimize`], which it drives: a
 //! [`StorySession`] keeps the previous run's per-character timelines and its optimised
 //! scene, and a new version of the script re-solves only what the edit touches.
@@ -34,7 +34,7 @@ use crate::layout::{geom, grid};
 use crate::motion::MotionLibrary;
 use crate::optimize::{anneal, costs, movable_objects, optimize_scene_in, CostCurves, Costs, OptimizeConfig};
 use crate::scene::{PlacedObject, Scene};
-use crate::session::{Session, Update};
+use crate::scene_session::{Session, Update};
 use crate::ssg::Ssg;
 use crate::ScriptError;
 use inbetween_core::cancel::{Cancel, Cancelled};

@@ -10,9 +10,9 @@ use crate::error::Diagnostic;
 use crate::limits::ScriptLimits;
 use crate::output;
 use crate::scene::Scene;
-use crate::session::Session;
+use crate::scene_session::Session;
 use crate::ssg::Ssg;
-use crate::story::StorySession;
+use crate::story_session::StorySession;
 use crate::ScriptError;
 
 /// Variations per hand-authored room in the default database.
@@ -89,11 +89,11 @@ pub fn catalogue(models: Option<&Path>) -> Result<Catalogue, ScriptError> {
     }
 }
 
-/// A script named on a command line: `builtin:NAME` for a built-in one ([`crate::stories::all`]),
+/// A script named on a command line: `builtin:NAME` for a built-in one ([`crate::builtin_scripts::all`]),
 /// else a file ([`read_script`]); with the name messages use for it.
 pub fn load_script(script: &str) -> Result<(String, PathBuf), ScriptError> {
     if let Some(name) = script.strip_prefix("builtin:") {
-        let all = crate::stories::all();
+        let all = crate::builtin_scripts::all();
         let Some((_, text)) = all.iter().find(|(n, _)| *n == name) else {
             let names: Vec<&str> = all.iter().map(|(n, _)| *n).collect();
             return Err(ScriptError::Invalid(format!("no built-in script '{name}'; there are: {}", names.join(", "))));
@@ -114,7 +114,7 @@ pub fn read_script(path: &Path) -> Result<String, ScriptError> {
             e.offset
         ))
     })?;
-    if crate::script::split(&text).is_empty() {
+    if crate::sentences::split(&text).is_empty() {
         return Err(ScriptError::Empty { path: path.to_path_buf() });
     }
     Ok(text)
@@ -154,7 +154,7 @@ fn write_scene(scene: &Scene, query: &Ssg, cat: &Catalogue, job: &SceneJob) -> R
 /// Composes `text` (read from `source`, named in messages) and writes every output into the job's
 /// folder.
 pub fn run_scene(text: &str, source: &Path, job: &SceneJob) -> Result<SceneReport, ScriptError> {
-    if crate::script::split(text).is_empty() {
+    if crate::sentences::split(text).is_empty() {
         return Err(ScriptError::Empty { path: source.to_path_buf() });
     }
     let (cat, notes) = script_catalogue(text, job)?;
@@ -272,7 +272,7 @@ pub fn story_session(text: &str, job: &RunJob) -> Result<(StorySession, Vec<Diag
 /// the animated glTF, a BVH per character, the preview GIF from the script's camera, the
 /// top-down routes and the cost curves (Fig. 12).
 pub fn run_story(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, ScriptError> {
-    if crate::script::split(text).is_empty() {
+    if crate::sentences::split(text).is_empty() {
         return Err(ScriptError::Empty { path: source.to_path_buf() });
     }
     let (mut session, notes) = story_session(text, job)?;
@@ -291,7 +291,7 @@ pub fn run_story_in(
     use crate::animate::camera_track;
     use crate::optimize::plot_costs;
     let start = std::time::Instant::now();
-    if crate::script::split(text).is_empty() {
+    if crate::sentences::split(text).is_empty() {
         return Err(ScriptError::Empty { path: source.to_path_buf() });
     }
     let name = source.display().to_string();

@@ -292,7 +292,7 @@ mod tests {
         assert_eq!(count(&three, "organized desk"), 1);
         assert_eq!(count(&three, "camera front"), 1);
         assert_eq!(count(&three, "Eve types on the laptop."), 3);
-        assert_eq!(crate::script::split(&three).len() - crate::script::split(&one).len(), 6);
-        assert_eq!(crate::script::split(&one).len(), crate::script::split(DEMO).len());
+        assert_eq!(crate::sentences::split(&three).len() - crate::sentences::split(&one).len(), 6);
+        assert_eq!(crate::sentences::split(&one).len(), crate::sentences::split(DEMO).len());
     }
 }
