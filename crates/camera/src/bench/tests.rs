@@ -1,4 +1,5 @@
 use super::*;
+use crate::infer::Cam;
 
 #[test]
 fn report_writes_the_committed_csv_layout_json_and_charts() {
