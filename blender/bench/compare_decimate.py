@@ -9,8 +9,9 @@ quaternion curves, and Decimate in ERROR mode at the margin whose total keyframe
 the Euler run's (bisection on the margin), and Decimate at the largest margin that stays within
 the bound. (EMPTY.blend, any saved file, keeps the splash screen out of the screenshots.) Every figure is measured the same way: world head and
 tail of every bone after `frame_set`, every frame, against the original action; cm. Writes
-OUT_DIR/decimate.md (the table) and OUT_DIR/decimate.json, and Graph Editor screenshots of one bone
-before and after (OUT_DIR/graph_*.png)."""
+OUT_DIR/decimate.md (the table) and OUT_DIR/decimate.json (rows of other takes already there are
+kept, so one process per take works: Blender 3.4 once crashed on the third take of a long run), and
+Graph Editor screenshots of one bone before and after (OUT_DIR/graph_*.png)."""
 
 import builtins
 import json
@@ -86,6 +87,8 @@ def decimate(ob, action, margin):
         bpy.ops.graph.reveal()
         bpy.ops.graph.select_all(action="SELECT")
         bpy.ops.graph.decimate(mode="ERROR", remove_error_margin=margin)
+    # No Graph Editor left open on actions the bench then removes (Blender 3.4 crashed once here).
+    area.type = "VIEW_3D"
     return work
 
 
@@ -132,6 +135,7 @@ def screenshot(ob, action, bone, path):
         bpy.ops.object.mode_set(mode="OBJECT")
     for fc in action.fcurves:
         fc.hide = False
+    area.type = "VIEW_3D"
 
 
 def run():
@@ -214,7 +218,12 @@ def run():
         rows.append(row)
         print(f"compare: {take.stem} done in {time.perf_counter() - t0:.1f} s: {json.dumps(row)}")
         sys.stdout.flush()
-    (OUT / "decimate.json").write_text(json.dumps(rows, indent=1))
+    # Rows of earlier runs (one take per process is the robust way on Blender 3.4) are kept.
+    path = OUT / "decimate.json"
+    done = {r["take"] for r in rows}
+    old = json.loads(path.read_text()) if path.exists() else []
+    rows = sorted([r for r in old if r["take"] not in done] + rows, key=lambda r: r["take"])
+    path.write_text(json.dumps(rows, indent=1))
     lines = [
         f"Bound {BOUND_CM:g} cm; errors measured in Blender {bpy.app.version_string} on every frame (world head and tail "
         "of every bone against the original action, cm). Keyframes: on the rotation and root location curves; "
