@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use inbetween_core::cancel::Cancel;
 use rand::Rng;
 
-use super::texture::Transitions;
+use super::texture::{stretch_head, Transitions};
 use super::types::{Candidate, CdState, CrState, MotionDistance, MotionInfo, Omega, SdpfParams, StepKind, Transition};
 use crate::metric::Graph;
 use crate::motion::angle_between;
@@ -233,10 +233,39 @@ impl<'a> Ctx<'a> {
                 .take_while(|&j| !visited[j] && self.motion.shot_of(j) == self.motion.shot_of(k))
                 .count()
         };
-        let closest = |min_run: usize| {
-            candidates.iter().copied().filter(|&(k, _)| run(k) >= min_run).min_by(|a, b| a.1.total_cmp(&b.1))
+        let closest = |min_run: usize, heads: bool| {
+            candidates
+                .iter()
+                .copied()
+                .filter(|&(k, _)| run(k) >= min_run && (!heads || stretch_head(k, visited, self.motion)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
         };
-        closest(MIN_LOOP).or_else(|| closest(1)).or_else(|| closest(0))
+        closest(MIN_LOOP, false).or_else(|| closest(1, false)).or_else(|| closest(0, false))
+    }
+
+    /// The cut of the walk with matched transitions (issue 41): to the frame of another shot closest
+    /// in content among those followed by at least `min_run` unvisited frames of their shot, the
+    /// first frame of a stretch not yet shown ([`stretch_head`]) first, so that the stretch plays
+    /// whole. The walk asks with `min_run` = [`MIN_LOOP`] first: a cut into a hole of a frame or
+    /// two that a draw of Eq. 20 skipped flashes the other shot and cuts straight back; with 0 only
+    /// when nothing else is left (see [`Transitions::jump_in_shot`]).
+    pub fn cut_into_stretch(&self, from: usize, visited: &[bool], min_run: usize) -> Option<(usize, f32)> {
+        let shot = self.motion.shot_of(from);
+        let n = self.graph.n;
+        let run = |k: usize| {
+            (k + 1..n.min(k + 1 + min_run))
+                .take_while(|&j| !visited[j] && self.motion.shot_of(j) == self.motion.shot_of(k))
+                .count()
+        };
+        let candidates: Vec<(usize, f32, bool)> = (0..n)
+            .filter(|&k| !visited[k] && self.motion.shot_of(k) != shot && !self.forbids(from, k) && run(k) >= min_run)
+            .map(|k| (k, self.edge(from, k), stretch_head(k, visited, self.motion)))
+            .filter(|(_, e, _)| !e.is_nan())
+            .collect();
+        let closest = |heads: bool| {
+            candidates.iter().filter(|c| c.2 || !heads).min_by(|a, b| a.1.total_cmp(&b.1)).map(|&(k, e, _)| (k, e))
+        };
+        closest(true).or_else(|| closest(false))
     }
 
     /// S2 was empty and no cut is left: the position in `path` to loop back to, the one whose

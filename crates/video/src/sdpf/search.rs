@@ -199,10 +199,12 @@ fn walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<SdpfPath, 
 /// 1. the shortest way within the shot to a frame not yet shown, by next source frames and matched
 ///    transitions ([`Transitions::route`](super::texture::Transitions::route)), followed step by
 ///    step unless a later draw finds a new frame first;
-/// 2. else, with frames of the shot still unshown, a jump cut inside the shot to the one that best
-///    follows ([`Transitions::jump_in_shot`](super::texture::Transitions::jump_in_shot)), marked as a cut;
-/// 3. else a cut to the shot that best matches, if one still has frames not yet shown;
-/// 4. else round the longest loop ([`Transitions::loop_step`](super::texture::Transitions::loop_step)).
+/// 2. else, with a stretch of at least [`MIN_LOOP`] + 1 frames of the shot still unshown, a jump cut
+///    inside the shot ([`Transitions::jump_in_shot`](super::texture::Transitions::jump_in_shot)),
+///    marked as a cut, to the first frame of such a stretch where it can;
+/// 3. else a cut to the shot that best matches, into such a stretch ([`Ctx::cut_into_stretch`]);
+/// 4. else on round the longest loop ([`Transitions::loop_step`](super::texture::Transitions::loop_step));
+/// 5. else (no transition at all) a jump cut or a cut to any frame not yet shown.
 fn texture_walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<SdpfPath, VideoError> {
     let n = ctx.graph.n;
     let Some(tex) = &ctx.texture else { return Err(VideoError::Invalid("SDPF: no transitions".into())) };
@@ -237,15 +239,21 @@ fn texture_walk(ctx: &Ctx, start: usize, seed: u64, attempt: usize) -> Result<Sd
                     None => no_route_at = Some(shown),
                 }
             }
+            let look = |a: usize, b: usize| ctx.look(a, b);
+            let jump_cut = |run: usize| {
+                tex.jump_in_shot(current, &visited, ctx.motion, ctx.p.reverse_window, run, look)
+                    .map(|(k, cost)| (k, StepKind::JumpCut { cost }))
+            };
+            let cut =
+                |run: usize| ctx.cut_into_stretch(current, &visited, run).map(|(k, edge)| (k, StepKind::Cut { edge }));
             let way = plan
                 .pop()
-                .or_else(|| {
-                    let look = |a: usize, b: usize| ctx.look(a, b);
-                    tex.jump_in_shot(current, &visited, ctx.motion, ctx.p.reverse_window, MIN_LOOP, look)
-                        .map(|(k, cost)| (k, StepKind::JumpCut { cost }))
-                })
-                .or_else(|| ctx.cut(current, &visited).map(|(k, edge)| (k, StepKind::Cut { edge })));
-            if let Some((k, kind)) = way.or_else(|| tex.loop_step(current, ctx.motion)) {
+                .or_else(|| jump_cut(MIN_LOOP))
+                .or_else(|| cut(MIN_LOOP))
+                .or_else(|| tex.loop_step(current, ctx.motion))
+                .or_else(|| jump_cut(0))
+                .or_else(|| cut(0));
+            if let Some((k, kind)) = way {
                 t.chosen = Some(k);
                 t.kind = kind;
             }

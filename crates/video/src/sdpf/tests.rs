@@ -627,4 +627,16 @@ fn a_cut_enters_the_other_shot_where_the_walk_can_go_on() {
     visited[5] = true;
     visited[8] = true;
     assert_eq!(ctx.cut(2, &visited).map(|c| c.0), Some(9));
+    // The walk with matched transitions cuts only into a stretch followed by MIN_LOOP unvisited
+    // frames, entered at its first frame, and into a smaller one only when nothing else is left.
+    let mut visited = vec![false; 10];
+    visited[2] = true;
+    visited[5] = true;
+    assert_eq!(ctx.cut_into_stretch(2, &visited, super::distill::MIN_LOOP), None, "6..9 is 4 frames");
+    visited[5] = false;
+    assert_eq!(ctx.cut_into_stretch(2, &visited, super::distill::MIN_LOOP).map(|c| c.0), Some(5));
+    visited[7] = true;
+    assert_eq!(ctx.cut_into_stretch(2, &visited, super::distill::MIN_LOOP), None);
+    // 9 is closer (0.5) but inside the stretch 8..9; of the heads 5 and 8, 5 is closer.
+    assert_eq!(ctx.cut_into_stretch(2, &visited, 0).map(|c| c.0), Some(5));
 }
