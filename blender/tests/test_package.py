@@ -59,3 +59,40 @@ def test_operators_panels_and_menus_are_registered():
     for menu in ui.MENUS:
         assert ui.menu_entry in getattr(bpy.types, menu)._dyn_ui_initialize()
     assert bpy.context.scene.inbetween.max_error_cm == 1.0
+
+
+INSTALL = """
+import bpy, sys
+r = bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+assert r == {"FINISHED"}, r
+assert "bl_ext.user_default.inbetween_blender" in bpy.context.preferences.addons.keys()
+import inbetween
+assert "/extensions/" in inbetween.__file__, inbetween.__file__
+bpy.ops.object.armature_add()
+try:
+    bpy.ops.inbetween.reduce_keys()
+except RuntimeError as e:
+    assert "no action to reduce" in str(e), e
+    print("installed and enabled; reduce_keys reports:", e)
+else:
+    raise AssertionError("reduce_keys on an armature without an action did not report an error")
+"""
+
+
+def test_the_extension_zip_installs_and_enables_in_blender_4_2_and_later(tmp_path):
+    import subprocess
+    import sys
+
+    path = os.environ.get("INBETWEEN_ADDON_ZIP")
+    if not path:
+        pytest.skip("skipped: no INBETWEEN_ADDON_ZIP (set by crates/py/tests/blender.rs)")
+    if bpy.app.version < (4, 2, 0):
+        pytest.skip(f"skipped: Blender {bpy.app.version_string} has no extensions (4.2+; the bpy module run covers it)")
+    if "site-packages" not in pathlib.Path(bpy.__file__).parts:
+        pytest.skip("skipped: installs in a second process of the bpy module (PyPI's bpy), not a Blender binary")
+    # A fresh process with its own home: the install writes into the user's extensions folder.
+    env = dict(os.environ, HOME=str(tmp_path))
+    env.pop("BLENDER_USER_SCRIPTS", None)
+    out = subprocess.run([sys.executable, "-c", INSTALL, path], env=env, capture_output=True, text=True, timeout=300)
+    print(out.stdout[-2000:], out.stderr[-2000:])
+    assert out.returncode == 0, out.stderr[-2000:]
