@@ -5,6 +5,7 @@
 use crate::clip::{Clip, FaceClip};
 use crate::errors::{invalid, JobError};
 use crate::face::{self, EditRequest, SpanArg};
+use crate::video::{self, ResequenceRequest};
 use crate::{ibk, mocap};
 use inbetween_core::cancel::Cancel;
 use inbetween_io::Progress;
@@ -16,6 +17,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_bench_rust, m)?)?;
     m.add_function(wrap_pyfunction!(_bench_sample_rust, m)?)?;
     m.add_function(wrap_pyfunction!(_bench_face_rust, m)?)?;
+    m.add_function(wrap_pyfunction!(_bench_video_rust, m)?)?;
     Ok(())
 }
 
@@ -114,6 +116,45 @@ fn _bench_face_rust(
             .map(|_| {
                 let t = Instant::now();
                 face::edit(input, &request, &Cancel::new(), &Progress::hidden())
+                    .map(|_| t.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect::<Result<Vec<f64>, JobError>>()
+    })
+    .map_err(JobError::into_py)
+}
+
+/// Milliseconds of each of `repeats` runs of `video.resequence`'s work ([`video::resequence`]:
+/// the clip read and analysed, the metric from its cache once trained, the walk measured and
+/// explained) on `path` from `start`, `length` frames, called from Rust.
+#[pyfunction]
+#[pyo3(signature = (path, repeats, start=0, length=None, seed=1, metric="rsfnet".to_string(), cache_dir=None))]
+#[allow(clippy::too_many_arguments)]
+fn _bench_video_rust(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    repeats: usize,
+    start: usize,
+    length: Option<usize>,
+    seed: u64,
+    metric: String,
+    cache_dir: Option<std::path::PathBuf>,
+) -> PyResult<Vec<f64>> {
+    let request = ResequenceRequest {
+        path,
+        start,
+        length,
+        seed: Some(seed),
+        count: 1,
+        transitions: true,
+        metric,
+        cache_dir,
+        ..ResequenceRequest::default()
+    };
+    py.detach(|| {
+        (0..repeats)
+            .map(|_| {
+                let t = Instant::now();
+                video::resequence(&request, &Cancel::new(), &Progress::hidden())
                     .map(|_| t.elapsed().as_secs_f64() * 1e3)
             })
             .collect::<Result<Vec<f64>, JobError>>()

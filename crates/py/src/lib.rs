@@ -19,6 +19,7 @@ mod ibk;
 mod mocap;
 mod runner;
 mod script;
+mod video;
 
 pub use errors::{InbetweenError, ShapeError};
 
@@ -37,5 +38,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     ibk::register(m)?;
     mocap::register(m)?;
     script::register(m)?;
+    video::register(m)?;
     Ok(())
 }

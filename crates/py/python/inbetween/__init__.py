@@ -38,7 +38,7 @@ def read(path: PathLike, unit: Optional[str] = None) -> Union[Clip, FaceClip]:
     return _native.read_clip(path, unit)
 
 
-from . import camera, face, ibk, mocap, script  # noqa: E402  (they import the names above)
+from . import camera, face, ibk, mocap, script, video  # noqa: E402  (they import the names above)
 
 __all__ = [
     "Clip",
@@ -51,5 +51,6 @@ __all__ = [
     "camera",
     "face",
     "script",
+    "video",
     "__version__",
 ]

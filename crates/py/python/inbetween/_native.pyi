@@ -175,6 +175,27 @@ def face_edit(
     progress: _Progress = None,
 ) -> List[Tuple[FaceClip, Dict[str, Any]]]: ...
 def face_synth(seconds: float = 10.0, seed: int = 1) -> Tuple[FaceClip, List[Tuple[float, float, str]]]: ...
+def video_resequence(
+    path: _Path,
+    start: int = 0,
+    length: Optional[int] = None,
+    seed: Optional[int] = None,
+    loop_close: bool = False,
+    count: int = 1,
+    out: Optional[_Path] = None,
+    sheet: Optional[_Path] = None,
+    blend: int = 0,
+    explain: bool = False,
+    stop_early: bool = False,
+    transitions: bool = True,
+    allow_reverse: bool = False,
+    allow_cuts: bool = False,
+    metric: str = "rsfnet",
+    steps: Optional[int] = None,
+    cache_dir: Optional[_Path] = None,
+    max_frames: Optional[int] = None,
+    progress: _Progress = None,
+) -> Tuple[str, str, List[npt.NDArray[np.int64]]]: ...
 def script_run(
     text: str,
     out_dir: Optional[str] = None,
@@ -205,3 +226,12 @@ def _bench_face_rust(
     keys_json: Optional[str] = None,
 ) -> List[float]: ...
 def _panic_in_job() -> None: ...
+def _bench_video_rust(
+    path: _Path,
+    repeats: int,
+    start: int = 0,
+    length: Optional[int] = None,
+    seed: int = 1,
+    metric: str = "rsfnet",
+    cache_dir: Optional[_Path] = None,
+) -> List[float]: ...

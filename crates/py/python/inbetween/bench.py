@@ -1,6 +1,6 @@
 """`python -m inbetween.bench`: each job called from Python and the same work called from Rust (the
-functions the extension runs, timed inside it), on the same CMU take in one run, and the
-`.ibk` runtime sampler's time per pose from Python and from Rust.
+functions the extension runs, timed inside it), on the same inputs in one run (a CMU take, a Live
+Link capture), and the `.ibk` runtime sampler's time per pose from Python and from Rust.
 
     python -m inbetween.bench [--data DIR] [--repeats N] [--out FILE.md]
 
@@ -10,18 +10,20 @@ The Python overhead is `python / rust - 1`; the goal is under 5 % on every job o
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import pathlib
 import platform
 import statistics
 import sys
+import tempfile
 import time
 from typing import Callable, List, Tuple
 
 import numpy as np
 
 import inbetween
-from inbetween import _native, ibk, mocap
+from inbetween import _native, face, ibk, mocap, video
 
 
 def _median_ms(f: Callable[[], object], repeats: int) -> float:
@@ -61,14 +63,36 @@ def run(data: pathlib.Path, repeats: int) -> Tuple[List[Tuple[str, float, float]
         ("ibk.compress max_error_cm=1", lambda: ibk.compress(clip, 1.0, **quiet), dict(max_error_cm=1.0)),
     ]
     kinds = ["read", "select", "select", "reconstruct", "compress"]
+    timed = [(name, py_call, lambda kw=kw, kind=kind: _native._bench_rust(kind, clip, 1, **kw)[0])
+             for (name, py_call, kw), kind in zip(jobs, kinds)]
+    capture = data / "face" / "neurosync" / "livelink" / "Happy" / "Happy.csv"
+    if capture.exists():
+        take = inbetween.read(capture)
+        spans = [(4.0, 6.5)]
+        keys = [{"time_s": 5.0, "shapes": {"JawOpen": 0.8}}]
+        label = f"Happy.csv ({take.num_frames} frames at {take.fps:.0f} fps), 4-6.5 s"
+        timed += [
+            (f"face.edit unguided, 3 variants; {label}", lambda: face.edit(take, spans, variants=3, **quiet),
+             lambda: _native._bench_face_rust(take, spans, 1, variants=3)[0]),
+            (f"face.edit one key (network); {label}", lambda: face.edit(take, spans, keys=keys, **quiet),
+             lambda: _native._bench_face_rust(take, spans, 1, keys_json=json.dumps(keys))[0]),
+        ]
+    mp4 = data / "video" / "carphone_pristine.mp4"
+    if mp4.exists():
+        cache = tempfile.mkdtemp(prefix="inbetween-bench-video-")  # the first (warming) call trains RSFNet here
+        timed.append(
+            ("video.resequence carphone_pristine.mp4 (120 frames), 120 from frame 0, metric cached",
+             lambda: video.resequence(mp4, length=120, cache_dir=cache, **quiet),
+             lambda: _native._bench_video_rust(mp4, 1, length=120, cache_dir=cache)[0]),
+        )
     rows = []
-    for (name, py_call, kw), kind in zip(jobs, kinds):
+    for name, py_call, rust_call in timed:
         py_call()  # warm: caches, the committed policy, page faults
         # Interleaved, so that the machine's drift falls on both sides alike.
         py_ms, rust_ms = [], []
         for _ in range(repeats):
             py_ms.append(_median_ms(py_call, 1))
-            rust_ms.extend(_native._bench_rust(kind, clip, 1, **kw))
+            rust_ms.append(rust_call())
         rows.append((name, statistics.median(py_ms), statistics.median(rust_ms)))
     # The runtime sampler: every frame time and the half-frame between, played forwards.
     data_v4 = ibk.compress(clip, 1.0, progress=False)
@@ -88,7 +112,8 @@ def run(data: pathlib.Path, repeats: int) -> Tuple[List[Tuple[str, float, float]
 def table(rows, sample) -> str:
     out = [
         f"inbetween {inbetween.__version__}, Python {platform.python_version()}, numpy {np.__version__}, "
-        f"{os.cpu_count()} CPUs; CMU 131_01 (994 frames at 120 fps); medians",
+        f"{os.cpu_count()} CPUs; CMU 131_01 (994 frames at 120 fps), Live Link Happy.csv, carphone_pristine.mp4; "
+        "medians",
         "",
         "| job | from Python (ms) | from Rust (ms) | Python overhead |",
         "| --- | ---: | ---: | ---: |",
