@@ -37,6 +37,7 @@ pub const OPTION_FLAGS: &[(&str, &str)] = &[
     ("shared_motions", "--shared-motions"),
     ("data", "--data"),
     ("roles", "--roles"),
+    ("frame", "--frame"),
 ];
 
 /// Library text with each `` `field` `` of [`OPTION_FLAGS`] written as its flag (other text,

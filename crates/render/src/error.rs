@@ -17,4 +17,29 @@ pub enum RenderError {
     Encode(String),
     #[error("plot '{title}': {message}")]
     Plot { title: String, message: String },
+    /// A request that cannot be drawn (an output that is neither `.gif` nor `.png`, a frame asked of a GIF).
+    #[error("{0}")]
+    Request(String),
+    /// A motion file that could not be read.
+    #[error("loading {}", path.display())]
+    Load {
+        path: PathBuf,
+        #[source]
+        source: inbetween_io::IoError,
+    },
+    /// Writing an animation failed.
+    #[error("writing {}", path.display())]
+    Writing {
+        path: PathBuf,
+        #[source]
+        source: Box<RenderError>,
+    },
+    /// Drawing one frame failed.
+    #[error("rendering frame {frame} of {}", file.display())]
+    Frame {
+        frame: usize,
+        file: PathBuf,
+        #[source]
+        source: Box<RenderError>,
+    },
 }

@@ -13,6 +13,7 @@ pub mod face;
 mod fill;
 mod gif_out;
 pub mod plot;
+pub mod preview;
 pub mod stick;
 
 pub use canvas::{Camera3, Canvas};
