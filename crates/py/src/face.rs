@@ -295,9 +295,12 @@ fn face_edit<'py>(
     };
     let input = &clip.clip;
     let edited = run_job(py, progress.as_ref(), |cancel, bar| edit(input, &request, cancel, bar))?;
-    let first = edited.variants.first().map(|v| &v.outcome);
+    let spread: Vec<Option<f64>> = match edited.variants.first() {
+        Some(f) => edited.variants.iter().map(|v| Some(v.outcome.mean_abs_difference(&f.outcome))).collect(),
+        None => Vec::new(),
+    };
     let mut out = Vec::with_capacity(edited.variants.len());
-    for (k, v) in edited.variants.iter().enumerate() {
+    for (k, v) in edited.variants.into_iter().enumerate() {
         let o = &v.outcome;
         let d = PyDict::new(py);
         d.set_item("variant", k + 1)?;
@@ -309,7 +312,7 @@ fn face_edit<'py>(
         d.set_item("segments", o.mask.segments().iter().map(|s| (s.start, s.end)).collect::<Vec<_>>())?;
         d.set_item("key_frames", o.keys.iter().map(|(f, _)| *f).collect::<Vec<_>>())?;
         d.set_item("masked_mse", o.masked_mse())?;
-        d.set_item("difference_from_first", first.filter(|_| k > 0).map(|f| o.mean_abs_difference(f)))?;
+        d.set_item("difference_from_first", spread[k].filter(|_| k > 0))?;
         let (rows, shapes) = o.changed(input);
         d.set_item("changed_rows", (rows.start, rows.end))?;
         let names = inbetween_face::data::ARKIT_NAMES;
@@ -322,7 +325,8 @@ fn face_edit<'py>(
         d.set_item("after", PyArray1::from_vec(py, flat(&o.after)).reshape([n, NUM_ARKIT])?)?;
         let mask: Vec<bool> = (0..n).flat_map(|f| o.mask.frame(f).to_vec()).collect();
         d.set_item("mask", PyArray1::from_vec(py, mask).reshape([n, NUM_ARKIT])?)?;
-        let edited_clip = FaceClip { clip: o.clip.clone(), source: clip.source.clone(), live_link: clip.live_link };
+        // The edited clip is moved, not copied.
+        let edited_clip = FaceClip { clip: v.outcome.clip, source: clip.source.clone(), live_link: clip.live_link };
         out.push((edited_clip, d));
     }
     Ok(out)
