@@ -76,3 +76,27 @@ def test_bad_requests_are_refused_with_their_reason(mp4, tmp_path):
         video.resequence(garbage, metric="pixels", progress=False)
     with pytest.raises(InbetweenError, match="missing.mp4"):
         video.resequence(tmp_path / "missing.mp4", metric="pixels", progress=False)
+
+
+def test_ctrl_c_stops_the_analysis_within_a_second(mp4, tmp_path):
+    import _thread
+    import threading
+    import time
+
+    sent = {}
+
+    def interrupt():
+        time.sleep(1.0)
+        sent["at"] = time.perf_counter()
+        _thread.interrupt_main()
+
+    threading.Thread(target=interrupt, daemon=True).start()
+    returned = False
+    with pytest.raises(KeyboardInterrupt):
+        # RSFNet trained for 5000 steps in a fresh cache: minutes, unless cancelled.
+        video.resequence(mp4, max_frames=40, steps=5000, cache_dir=tmp_path, progress=False)
+        returned = True
+        time.sleep(3.0)
+    stopped = time.perf_counter()
+    assert not returned, "the analysis ended before Ctrl-C: nothing was cancelled (make it longer)"
+    assert stopped - sent["at"] < 1.0, f"stopped {stopped - sent['at']:.2f} s after Ctrl-C"
