@@ -47,9 +47,15 @@ def test_resequence_a_real_mp4_explained_and_written(mp4, quick, tmp_path):
     assert "M_D" in again.text and str(mp4.name) in again.text
 
 
-def test_loop_closes_on_the_start_or_says_it_did_not(mp4, quick):
-    made = video.resequence(mp4, start=10, length=30, seed=1, loop=True, explain=True, **quick, progress=False)
+def test_loop_closes_on_the_start_or_says_it_did_not_written_as_mp4(mp4, quick, tmp_path):
+    out = tmp_path / "loop.mp4"
+    made = video.resequence(mp4, start=10, length=30, seed=1, loop=True, explain=True, out=out, **quick,
+                            progress=False)
     s = made[0]
+    # The MP4 holds the order's frames: read back, it has as many frames as the order.
+    assert s.file == str(out) and out.read_bytes()[4:8] == b"ftyp"
+    back = video.resequence(out, length=1, metric="pixels", progress=False)
+    assert (back.frames, back.width, back.height) == (len(s.order), 176, 144)
     assert made.report["loop_close"] is True
     if s.closes_loop:
         assert s.closing is not None and s.closing.from_frame == s.order[-1] and s.closing.to_frame == 10
