@@ -1,15 +1,15 @@
 //! `inbetween video …`: new frame orders from one clip (RSFNet metric + SDPF path finding).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use inbetween_core::cancel::Cancel;
-use inbetween_io::{OutputSet, Progress};
-use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, Decoder, ProceduralKind, ReadOptions};
-use inbetween_video::pipeline::{analyse, reorder, resequence, MetricChoice, ResequenceConfig, VideoLimits};
-use inbetween_video::preview::{write_contact_sheet, SheetOptions};
-use inbetween_video::sdpf::{backward_steps, direction_words, explain, overlap_delta_o, stability_md, SdpfParams};
+use inbetween_io::Progress;
+use inbetween_video::frames::{procedural_clip, write_clip, Decoder, ProceduralKind, ReadOptions};
+use inbetween_video::job::{AnalyseJob, ResequenceJob, ResequenceSource, VideoInput};
+use inbetween_video::pipeline::{MetricChoice, ResequenceConfig, VideoLimits};
+use inbetween_video::sdpf::SdpfParams;
 use inbetween_video::VideoError;
 
 #[derive(Subcommand)]
@@ -115,6 +115,11 @@ pub struct ResequenceArgs {
     /// Print each transition's candidates, what removed them and the softmax choice.
     #[arg(long)]
     pub explain: bool,
+    /// Cross-fade the written clip over N frames at each jump inside a shot whose difference is
+    /// above the shot's own step between frames (Schödl et al. 2000); 0: none. M_D is then measured
+    /// on the written frames.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub blend: usize,
     /// Contact sheet PNG (default: next to the output, <out>.sheet.png).
     #[arg(long)]
     pub sheet: Option<PathBuf>,
@@ -211,6 +216,13 @@ fn limit_flag(field: &str) -> &'static str {
 fn with_flag(e: VideoError) -> anyhow::Error {
     match &e {
         VideoError::Limit { field, .. } => anyhow::anyhow!("{e}; raise it with {}", limit_flag(field)),
+        VideoError::StartOutside { start, frames } => {
+            anyhow::anyhow!("--start {start} is outside the clip (frames 0..{})", frames.saturating_sub(1))
+        }
+        VideoError::TooManyFrames { path, limit } => anyhow::anyhow!(
+            "{}: more than {limit} frames, the limit; raise it with --limit-frames, or read only the first frames with --max-frames",
+            path.display()
+        ),
         _ => e.into(),
     }
 }
@@ -248,55 +260,7 @@ fn run_probe(a: ProbeArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `new.mp4` → `new-2.mp4` for the second of several outputs.
-fn numbered(path: &Path, i: usize, count: usize) -> PathBuf {
-    if count <= 1 {
-        return path.to_path_buf();
-    }
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
-    path.with_file_name(format!("{stem}-{}{ext}", i + 1))
-}
-
-fn sheet_path(out: &Path) -> PathBuf {
-    out.with_extension("sheet.png")
-}
-
-fn read_input(a: &ResequenceArgs, limits: &VideoLimits) -> anyhow::Result<Clip> {
-    let decoder = match a.decoder {
-        DecoderArg::Auto => Decoder::Auto,
-        DecoderArg::Openh264 => Decoder::OpenH264,
-        DecoderArg::Ffmpeg => Decoder::Ffmpeg,
-    };
-    // One frame past the limit is enough to know the clip is too long: decoding stops there.
-    let past_limit = limits.max_frames.saturating_add(1);
-    let max_frames = Some(a.max_frames.map_or(past_limit, |m| m.min(past_limit)));
-    let (clip, report) = read_clip(&a.input, &ReadOptions { decoder, max_frames })?;
-    if clip.len() > limits.max_frames {
-        anyhow::bail!(
-            "{}: more than {} frames, the limit; raise it with --limit-frames, or read only the first frames with --max-frames",
-            a.input.display(),
-            limits.max_frames
-        );
-    }
-    println!(
-        "{}: {} frames {}x{} at {:.3} fps, decoded by {}",
-        a.input.display(),
-        clip.len(),
-        clip.width(),
-        clip.height(),
-        clip.fps,
-        report.decoder
-    );
-    for n in &report.notes {
-        println!("  {n}");
-    }
-    Ok(clip)
-}
-
 fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
-    let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    anyhow::ensure!(ext == "mp4" || ext == "gif", "{}: the output must end in .mp4 or .gif", a.out.display());
     if a.length == Some(0) {
         anyhow::bail!(
             "--length 0 asks for no frame: give at least 1 (the start frame), or leave it out for the source's length"
@@ -311,35 +275,26 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         max_length: a.limit_length,
         max_count: a.limit_count,
     };
-    // What the request alone decides, before decoding anything.
-    limits.check_request(a.length, 0, a.count).map_err(with_flag)?;
-    Cancel::with_optional_limit_s(a.time_limit).map_err(|e| anyhow::anyhow!("--time-limit: {e}"))?;
-    let clip = read_input(&a, &limits)?;
-    anyhow::ensure!(
-        a.start < clip.len(),
-        "--start {} is outside the clip (frames 0..{})",
-        a.start,
-        clip.len().saturating_sub(1)
-    );
-    let mut cfg = ResequenceConfig {
+    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(|e| anyhow::anyhow!("--time-limit: {e}"))?;
+    let decoder = match a.decoder {
+        DecoderArg::Auto => Decoder::Auto,
+        DecoderArg::Openh264 => Decoder::OpenH264,
+        DecoderArg::Ffmpeg => Decoder::Ffmpeg,
+    };
+    let mut config = ResequenceConfig {
         metric: match a.metric {
             MetricArg::Rsfnet => MetricChoice::RsfNet,
             MetricArg::Pixels => MetricChoice::Pixels,
         },
-        limits: limits.clone(),
-        cancel: Cancel::with_optional_limit_s(a.time_limit).map_err(|e| anyhow::anyhow!("--time-limit: {e}"))?,
+        limits,
         ..ResequenceConfig::default()
     };
     if let Some(s) = a.steps {
-        cfg.train.steps = s;
+        config.train.steps = s;
     }
     if let Some(d) = &a.cache_dir {
-        cfg.cache_dir = d.clone();
+        config.cache_dir = d.clone();
     }
-    let progress = Progress::new(cfg.train.steps as u64, "RSFNet");
-    let analysis = analyse(&clip, &cfg, &progress).map_err(with_flag)?;
-    progress.finish();
-    println!("{}", analysis.metric_note);
     let params = SdpfParams {
         use_cd: !a.no_cd,
         use_ct: !a.no_ct,
@@ -353,74 +308,26 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         transitions: !a.no_transitions,
         ..SdpfParams::default()
     };
-    let params = if a.paper_choice { params.paper_choice() } else { params };
-    let (paths, walk_s) = resequence(&analysis, a.start, &params, a.count, &limits).map_err(with_flag)?;
-    if a.explain {
-        print!(
-            "{}",
-            crate::errors::with_flags(&direction_words(
-                &analysis.info,
-                &analysis.direction,
-                params.allow_reverse,
-                params.use_cr
-            ))
-        );
-    }
-    let source: Vec<usize> = (0..clip.len()).collect();
-    let md_source = stability_md(&clip.frames, &source);
-    // Every clip and sheet of the run, or none: staged, then moved into place together.
-    let mut set = OutputSet::new();
-    for (i, path) in paths.iter().enumerate() {
-        let out = numbered(&a.out, i, a.count);
-        let staged = set.file(&out).with_context(|| format!("staging {}", out.display()))?;
-        write_clip(&staged, &reorder(&clip, &path.frames)).with_context(|| format!("writing {}", out.display()))?;
-        let sheet = a.sheet.as_ref().map(|s| numbered(s, i, a.count)).unwrap_or_else(|| sheet_path(&out));
-        let staged_sheet = set.file(&sheet).with_context(|| format!("staging {}", sheet.display()))?;
-        let title = format!(
-            "{} from frame {} (seed {}): {} frames (red BACK: backward step, blue CUT, purple LOOP)",
-            a.input.display(),
-            a.start,
-            path.seed,
-            path.frames.len()
-        );
-        let cuts = [path.cut_positions(), path.jump_cut_positions()].concat();
-        let loops = [path.loop_positions(), path.transition_positions()].concat();
-        let opts = SheetOptions { title, cuts: cuts.clone(), loops: loops.clone(), ..SheetOptions::default() };
-        write_contact_sheet(&staged_sheet, &clip.frames, &path.frames, &opts)?;
-        println!(
-            "{}: {} frames ({:?}{}), {} backward steps, {} cuts, {} jumps back or ahead (loop backs, matched transitions), M_D {:.4} (source {:.4}), Δo {:.3}; contact sheet {}",
-            out.display(),
-            path.frames.len(),
-            path.stop,
-            if a.loop_close {
-                if path.closes_loop {
-                    ", loop closes"
-                } else {
-                    ", no loop found"
-                }
-            } else {
-                ""
-            },
-            backward_steps(&path.frames, 3),
-            cuts.len(),
-            loops.len(),
-            stability_md(&clip.frames, &path.frames),
-            md_source,
-            overlap_delta_o(&path.frames, clip.len()),
-            sheet.display()
-        );
-        if a.explain {
-            print!("{}", crate::errors::with_flags(&explain(path)));
-        }
-    }
-    set.commit().with_context(|| format!("moving the outputs into place beside {}", a.out.display()))?;
-    if paths.len() < a.count {
-        println!("only {} distinct sequences exist from frame {} under these constraints", paths.len(), a.start);
-    }
-    for (stage, s) in &analysis.stages {
-        println!("  {stage}: {s:.2} s");
-    }
-    println!("  SDPF walks: {walk_s:.2} s");
+    let steps = config.train.steps as u64;
+    let job = ResequenceJob {
+        source: ResequenceSource::Analyse(Box::new(AnalyseJob {
+            input: VideoInput::File(a.input.clone()),
+            read: ReadOptions { decoder, max_frames: a.max_frames },
+            config,
+        })),
+        start: a.start,
+        params: if a.paper_choice { params.paper_choice() } else { params },
+        count: a.count,
+        out: Some(a.out.clone()),
+        sheet: a.sheet.clone(),
+        blend: a.blend,
+        explain: a.explain,
+    };
+    job.validate().map_err(with_flag)?;
+    let progress = Progress::new(steps, "RSFNet");
+    let report = job.run(&cancel, &progress).map_err(with_flag)?;
+    progress.finish();
+    print!("{}", crate::errors::with_flags(&report.to_string()));
     Ok(())
 }
 

@@ -17,8 +17,10 @@ use axum::{Json, Router};
 use image::{imageops, RgbImage};
 use inbetween_io::Progress;
 use inbetween_video::frames::{procedural_clip, read_clip, write_clip, Clip, ProceduralKind, ReadOptions};
-use inbetween_video::pipeline::{analyse, reorder, resequence, Analysis, ResequenceConfig};
-use inbetween_video::sdpf::{explain_step, frame_rms, stability_md, SdpfParams, StepKind};
+use inbetween_video::job::{AnalyseJob, AnalyseReport, ResequenceJob};
+use inbetween_video::pipeline::reorder;
+use inbetween_video::sdpf::SdpfParams;
+use inbetween_video::VideoError;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -30,32 +32,18 @@ use crate::upload::UploadQuery;
 
 crate::state::panel_state!(AppState, video, VideoState);
 
-/// The open clip and its analysis.
+/// The open clip and its analysis (the engine's [`AnalyseJob`] report: it keeps the clip, the
+/// analysis and its caches of motion distances and of M_D's per-transition differences).
 struct Opened {
     name: String,
-    clip: Clip,
-    analysis: Analysis,
-    source_md: f64,
-    /// `D` of Eq. 21 per transition already measured (most steps of every order are the next
-    /// source frame, so later orders reuse nearly all of them).
-    rms: Mutex<std::collections::HashMap<(usize, usize), f64>>,
+    analysed: Arc<AnalyseReport>,
 }
 
-impl Opened {
-    /// M_D (Eq. 21) of `order`, the same value as `stability_md`, each transition's RMS cached.
-    fn md(&self, order: &[usize]) -> f64 {
-        if order.len() < 2 {
-            return 0.0;
-        }
-        let mut rms = self.rms.lock().unwrap_or_else(|p| p.into_inner());
-        let mut sum = 0.0;
-        for w in order.windows(2) {
-            let d = *rms.entry((w[0], w[1])).or_insert_with(|| {
-                frame_rms(&self.clip.frames[w[0]], &self.clip.frames[w[1]], w[0], w[1]).unwrap_or(f64::NAN)
-            });
-            sum += d;
-        }
-        sum / (order.len() - 1) as f64
+/// An engine error as the page shows it: a start frame past the clip is the request's fault.
+fn engine(e: VideoError) -> StudioError {
+    match e {
+        VideoError::StartOutside { .. } => StudioError::BadRequest(e.to_string()),
+        _ => StudioError::Engine(e.to_string()),
     }
 }
 
@@ -184,36 +172,30 @@ fn opened(st: &AppState, job: &Job, name: String, clip: Clip) -> Result<Value> {
     }
     job.progress("analysing: optical flow, RSFNet (trained on the clip, or from its cache), graph, cuts", 0.15);
     // The job's token: a cancel stops the flow, the metric's training and the graph between stages.
-    let cfg = ResequenceConfig { cancel: job.token().clone(), ..ResequenceConfig::default() };
-    cfg.limits.check_clip(&clip).map_err(|e| StudioError::Engine(e.to_string()))?;
-    let analysis = analyse(&clip, &cfg, &Progress::hidden()).map_err(|e| StudioError::Engine(e.to_string()))?;
+    let analysed = Arc::new(AnalyseJob::for_clip(clip).run(job.token(), &Progress::hidden()).map_err(engine)?);
     if job.is_cancelled() {
         return Err(StudioError::Engine("cancelled".into()));
     }
     // One walk from the first frame fills the analysis's PMSM cache (most pairs any later order
     // needs), so a Generate after opening asks the network for few new pairs.
     job.progress("warming the motion-distance cache (one walk from frame 0)", 0.75);
-    let limits = ResequenceConfig::default().limits;
-    resequence(&analysis, 0, &SdpfParams::default(), 1, &limits).map_err(|e| StudioError::Engine(e.to_string()))?;
+    ResequenceJob::on(analysed.clone()).run(job.token(), &Progress::hidden()).map_err(engine)?;
     if job.is_cancelled() {
         return Err(StudioError::Engine("cancelled".into()));
     }
     job.progress("frame sprite for the page", 0.9);
-    let (jpeg, tw, th) = sprite(&clip)?;
+    let clip = &analysed.clip;
+    let (jpeg, tw, th) = sprite(clip)?;
     let v = st.video.next_version();
     let sprite_url = st.put_file("video/frames.jpg", "image/jpeg", jpeg, v);
-    let source: Vec<usize> = (0..clip.len()).collect();
-    let source_md = stability_md(&clip.frames, &source);
-    let shots = analysis.info.shot.clone();
-    let boundaries: Vec<usize> = (1..shots.len()).filter(|&i| shots[i] != shots[i - 1]).collect();
     let msg = format!(
         "opened {name}: {} frames {}x{} at {:.3} fps, {} shot(s); {}",
         clip.len(),
         clip.width(),
         clip.height(),
         clip.fps,
-        boundaries.len() + 1,
-        analysis.metric_note
+        analysed.shots,
+        analysed.metric
     );
     let out = json!({
         "ok": true,
@@ -223,15 +205,14 @@ fn opened(st: &AppState, job: &Job, name: String, clip: Clip) -> Result<Value> {
         "fps": clip.fps,
         "width": clip.width(),
         "height": clip.height(),
-        "shots": shots,
-        "cuts": boundaries,
-        "directed": analysis.direction.iter().map(|d| d.0).collect::<Vec<_>>(),
-        "stages": analysis.stages.iter().map(|(s, t)| json!({"stage": s, "s": t})).collect::<Vec<_>>(),
-        "source_md": source_md,
+        "shots": analysed.shot,
+        "cuts": analysed.shot_starts,
+        "directed": analysed.directed,
+        "stages": analysed.stages.iter().map(|s| json!({"stage": s.stage, "s": s.seconds})).collect::<Vec<_>>(),
+        "source_md": analysed.source_md,
         "sprite": {"url": sprite_url, "width": tw, "height": th, "columns": SPRITE_COLUMNS.min(clip.len() as u32)},
     });
-    *st.video.open.lock().unwrap_or_else(|p| p.into_inner()) =
-        Some(Arc::new(Opened { name, clip, analysis, source_md, rms: Mutex::default() }));
+    *st.video.open.lock().unwrap_or_else(|p| p.into_inner()) = Some(Arc::new(Opened { name, analysed }));
     Ok(out)
 }
 
@@ -255,76 +236,42 @@ pub async fn generate(State(st): State<Arc<AppState>>, Json(req): Json<GenerateR
     let state = st.clone();
     let id = st.jobs.spawn("video-generate", move |job| {
         let o = open.ok_or_else(|| StudioError::BadRequest("open a clip first".into()))?;
-        let n = o.clip.len();
-        if req.start >= n {
-            return Err(StudioError::BadRequest(format!(
-                "start frame {} is outside the clip (frames 0..{})",
-                req.start,
-                n - 1
-            )));
-        }
         job.progress("SDPF walk", 0.1);
         let params =
             SdpfParams { length: req.length, loop_close: req.loop_close, seed: req.seed, ..SdpfParams::default() };
-        let limits = ResequenceConfig::default().limits;
-        let (paths, walk_s) =
-            resequence(&o.analysis, req.start, &params, 1, &limits).map_err(|e| StudioError::Engine(e.to_string()))?;
-        let path = paths.into_iter().next().ok_or_else(|| StudioError::Engine("no path from this start".into()))?;
-        let order = path.frames.clone();
-        // Each step that is not the next source frame, with the engine's words for it. Steps inside a
-        // repeating loop (after a loop back the path's frames repeat without new transitions) point
-        // to the step they repeat.
-        let mut jumps = Vec::new();
-        let mut first_at: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
-        for p in 1..order.len() {
-            let (from, to) = (order[p - 1], order[p]);
-            if to == from + 1 {
-                continue;
-            }
-            let (kind, text) = match path.transitions.get(p - 1).filter(|t| t.from == from && t.chosen == Some(to)) {
-                Some(t) => {
-                    let kind = match t.kind {
-                        StepKind::Distilled if to < from => "back",
-                        StepKind::Distilled => "jump",
-                        StepKind::Cut { .. } => "cut",
-                        StepKind::LoopBack { .. } => "loop",
-                        StepKind::Replay => "replay",
-                        StepKind::JumpCut { .. } => "cut",
-                        StepKind::Transition { .. } => "transition",
-                    };
-                    (kind, explain_step(t))
-                }
-                None => {
-                    let q = first_at.get(&(from, to)).copied().unwrap_or(p);
-                    ("repeat", format!("frame {from} → {to}: the loop repeats the step at position {q}"))
-                }
-            };
-            first_at.entry((from, to)).or_insert(p);
-            jumps.push(json!({"position": p, "from": from, "to": to, "kind": kind, "text": text}));
-        }
-        let closing = path.closing.as_ref().map(|t| json!({"from": t.from, "to": t.chosen, "text": explain_step(t)}));
-        let md = o.md(&order);
+        let run = ResequenceJob { start: req.start, params, ..ResequenceJob::on(o.analysed.clone()) };
+        run.validate().map_err(engine)?;
+        let report = run.run(job.token(), &Progress::hidden()).map_err(engine)?;
+        let seq =
+            report.sequences.into_iter().next().ok_or_else(|| StudioError::Engine("no path from this start".into()))?;
+        let jumps: Vec<Value> = seq
+            .jumps
+            .iter()
+            .map(|j| json!({"position": j.position, "from": j.from, "to": j.to, "kind": j.kind.word(), "text": j.text}))
+            .collect();
+        let closing = seq.closing.as_ref().map(|t| json!({"from": t.from, "to": t.to, "text": t.text}));
         let v = state.video.next_version();
-        let (mp4, gif) = export(&state, &o, &order, v);
+        let (mp4, gif) = export(&state, &o, &seq.order, v);
         let msg = format!(
-            "SDPF from frame {}: {} frames ({:?}), {} jumps, M_D {md:.4} (source {:.4}), walk {:.0} ms",
+            "SDPF from frame {}: {} frames ({:?}), {} jumps, M_D {:.4} (source {:.4}), walk {:.0} ms",
             req.start,
-            order.len(),
-            path.stop,
+            seq.order.len(),
+            seq.stop,
             jumps.len(),
-            o.source_md,
-            walk_s * 1e3
+            seq.md,
+            o.analysed.source_md,
+            report.walk_s * 1e3
         );
         Ok(json!({
             "ok": true,
             "message": msg,
-            "order": order,
+            "order": seq.order,
             "jumps": jumps,
-            "md": md,
-            "source_md": o.source_md,
-            "closes_loop": path.closes_loop,
+            "md": seq.md,
+            "source_md": o.analysed.source_md,
+            "closes_loop": seq.closes_loop,
             "closing": closing,
-            "walk_ms": walk_s * 1e3,
+            "walk_ms": report.walk_s * 1e3,
             "files": {"mp4": mp4, "gif": gif},
         }))
     });
@@ -343,7 +290,7 @@ fn export(st: &AppState, o: &Arc<Opened>, order: &[usize], v: u64) -> (String, S
             move || {
                 let Ok(dir) = tempfile::tempdir() else { return Vec::new() };
                 let path = dir.path().join(format!("new.{ext}"));
-                match write_clip(&path, &reorder(&o.clip, &order)) {
+                match write_clip(&path, &reorder(&o.analysed.clip, &order)) {
                     Ok(()) => std::fs::read(&path).unwrap_or_default(),
                     Err(_) => Vec::new(),
                 }
