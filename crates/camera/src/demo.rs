@@ -2,7 +2,7 @@
 //! built-in procedural scene, keyframes, the committed weights, one track per behaviour style.
 
 use crate::dataset::{film_sequence, Behaviour, Scene, BEHAVIOURS};
-use crate::infer::{example_keys, GenerateJob};
+use crate::infer::{example_keys, GenerateJob, Keys};
 use crate::toric::Lens;
 use crate::weights::committed;
 use crate::CameraError;
@@ -34,6 +34,19 @@ pub fn write_example_scene(dir: &Path, seed: u64, frames: usize) -> Result<Vec<S
         files.push(name);
     }
     Ok(files)
+}
+
+/// The demo's example at `k`× its length (`camera scale`): a 300·k-frame procedural scene at 30 fps
+/// with a key every 150 frames and on the last one (3 keys at 1×).
+pub fn scaled_example(k: usize) -> (Scene, Keys) {
+    let frames = 300 * k;
+    let scene = Scene::procedural(3, frames, 30.0);
+    let mut at: Vec<usize> = (0..frames).step_by(150).collect();
+    if at.last() != Some(&(frames - 1)) {
+        at.push(frames - 1);
+    }
+    let keys = example_keys(&scene, &at);
+    (scene, keys)
 }
 
 /// The demo: a 300-frame scene with keys at frames 0, 150 and 299, a track per behaviour style

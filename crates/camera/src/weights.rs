@@ -89,6 +89,25 @@ impl CameraWeights {
         self.behaviour_style(b)
     }
 
+    /// The styles one generation runs, each with the behaviour it is the code of (None for a
+    /// reference clip): every behaviour's when `all` (the paper's UI flow), else the style of the
+    /// `reference` clip over `scene`, else the behaviour `named` (default: relative).
+    pub fn requested_styles(
+        &self,
+        all: bool,
+        reference: Option<&Path>,
+        named: Option<&str>,
+        scene: &Scene,
+    ) -> Result<Vec<(Style, Option<Behaviour>)>, CameraError> {
+        if all {
+            return crate::dataset::BEHAVIOURS.iter().map(|b| Ok((self.behaviour_style(*b)?, Some(*b)))).collect();
+        }
+        Ok(vec![match reference {
+            Some(r) => (self.reference_style(r, scene)?, None),
+            None => (self.named_style(named.unwrap_or(Behaviour::Relative.name()))?, None),
+        }])
+    }
+
     /// [`CameraWeights::style`], or an error naming the behaviour the card holds no code for.
     pub fn behaviour_style(&self, b: Behaviour) -> Result<Style, CameraError> {
         self.style(b)

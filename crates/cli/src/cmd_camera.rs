@@ -3,8 +3,8 @@
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_camera::bench;
-use inbetween_camera::dataset::{Behaviour, Scene, BEHAVIOURS};
-use inbetween_camera::infer::{GenerateJob, GenerateLimits, GenerateOptions, Keys, Style};
+use inbetween_camera::dataset::Scene;
+use inbetween_camera::infer::{GenerateJob, GenerateLimits, GenerateOptions, Keys};
 use inbetween_camera::train::TrainConfig;
 use inbetween_camera::weights::{self, CameraWeights};
 use inbetween_camera::TrainJob;
@@ -209,16 +209,8 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
         cancel: Some(&cancel),
         ..GenerateOptions::default()
     };
-    let runs: Vec<(Style, PathBuf)> = if a.all_styles {
-        BEHAVIOURS
-            .iter()
-            .map(|b| Ok((w.behaviour_style(*b)?, with_suffix(&a.out, b.name()))))
-            .collect::<Result<_, inbetween_camera::CameraError>>()?
-    } else if let Some(r) = &a.reference {
-        vec![(w.reference_style(r, &scene)?, a.out.clone())]
-    } else {
-        vec![(w.named_style(a.style.as_deref().unwrap_or(Behaviour::Relative.name()))?, a.out.clone())]
-    };
+    let styles = w.requested_styles(a.all_styles, a.reference.as_deref(), a.style.as_deref(), &scene)?;
+    let runs = styles.into_iter().map(|(s, b)| (s, b.map_or_else(|| a.out.clone(), |b| with_suffix(&a.out, b.name()))));
     // Every track, glTF and preview of the run appear together at the end, or none.
     let mut set = OutputSet::new();
     let mut lines = Vec::new();
@@ -317,21 +309,14 @@ fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
         "camera",
         "camera generate (orbit style) at multiples of the demo's example",
         |k, exe, work| {
-            // The demo's example, k times: a 300·k-frame scene with a key every 150 frames (3 at 1×).
-            let frames = 300 * k;
-            let scene = Scene::procedural(3, frames, 30.0);
-            let mut at: Vec<usize> = (0..frames).step_by(150).collect();
-            if at.last() != Some(&(frames - 1)) {
-                at.push(frames - 1);
-            }
-            let keys = inbetween_camera::infer::example_keys(&scene, &at);
+            let (scene, keys) = inbetween_camera::demo::scaled_example(k);
             let (scene_path, keys_path) = (work.join(format!("scene-{k}.json")), work.join(format!("keys-{k}.json")));
             scene.save(&scene_path)?;
             inbetween_camera::write_json(&keys_path, &keys)?;
             let mut command = std::process::Command::new(exe);
             command.args(["camera", "generate", "--style", "orbit", "--scene"]).arg(&scene_path);
             command.arg("--keys").arg(&keys_path).arg("-o").arg(work.join(format!("cam-{k}.json")));
-            let input = format!("{frames} frames at 30 fps, {} keys", at.len());
+            let input = format!("{} frames at 30 fps, {} keys", scene.num_frames(), keys.keys.len());
             Ok(crate::scale::Measured { input, command })
         },
     )
