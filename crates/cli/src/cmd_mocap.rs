@@ -15,6 +15,7 @@ use inbetween_mocap::dqn::{TrainJob, TrainOptions, DEFAULT_POLICY_PATH};
 use inbetween_mocap::protocol::TrainingData;
 use inbetween_mocap::representation::{skip_first_frame, JointFilter};
 use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
+use inbetween_mocap::stream::RecvOptions;
 use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -138,7 +139,7 @@ pub struct RecvArgs {
     pub unit: Option<LengthUnit>,
 
     /// Seconds to wait for a (re)connection.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = RecvOptions::default().accept_timeout.as_secs_f64())]
     pub timeout_s: f64,
 }
 
@@ -480,10 +481,7 @@ fn stream_send(a: SendArgs) -> anyhow::Result<()> {
 
 fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
     let listener = std::net::TcpListener::bind(&a.addr).with_context(|| format!("listening on {}", a.addr))?;
-    let opts = inbetween_mocap::stream::RecvOptions {
-        max_sessions: 8,
-        accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s),
-    };
+    let opts = RecvOptions { accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s), ..Default::default() };
     let got = inbetween_mocap::stream::recv(&listener, &opts)?;
     for w in &got.warnings {
         eprintln!("warning: {w}");
@@ -512,10 +510,9 @@ fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    use inbetween_core::procedural::{gait, GaitParams};
-    // The demo's procedural walk (60 frames at 1×), k times as long, written as BVH.
+    // The demo's procedural walk, k times as long, written as BVH.
     crate::scale::run(&a, "mocap", "mocap compress (≤ 1 cm) at multiples of the demo's walk", |k, exe, work| {
-        let walk = gait(&GaitParams { frames: 60 * k, ..GaitParams::walk() });
+        let walk = inbetween_mocap::demo::scaled_walk(k);
         let input = work.join(format!("walk-{k}.bvh"));
         inbetween_io::write_bvh(&input, &walk)?;
         let mut command = std::process::Command::new(exe);

@@ -15,11 +15,16 @@ use inbetween_render::StickOptions;
 use std::path::Path;
 use std::time::Instant;
 
+/// The demo's procedural walk at `k`× its length (60·k frames at 30 fps; `mocap scale` runs it).
+pub fn scaled_walk(k: usize) -> Motion {
+    gait(&GaitParams { frames: 60 * k, ..GaitParams::walk() })
+}
+
 /// Runs the demo, writes `mocap_walk.ibk`, `mocap_walk_reconstructed.bvh` and `mocap_overlay.gif`
 /// into `out` (which must exist) and returns the lines to print. Counts 4 steps on `progress`.
 pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>> {
     let t = Instant::now();
-    let walk = gait(&GaitParams { frames: 60, ..GaitParams::walk() });
+    let walk = scaled_walk(1);
     let paper = JointFilter::paper().apply(&walk);
     let rep = SphericalMotion::from_motion(&paper)?;
     let table = SegmentTable::full(&rep);

@@ -332,6 +332,13 @@ pub struct RecvOptions {
     pub accept_timeout: Duration,
 }
 
+impl Default for RecvOptions {
+    /// 8 sessions, 30 s for each (re)connection (`mocap stream recv`'s defaults).
+    fn default() -> Self {
+        RecvOptions { max_sessions: 8, accept_timeout: Duration::from_secs(30) }
+    }
+}
+
 /// What a receiver rebuilt.
 #[derive(Clone, Debug)]
 pub struct Received {
