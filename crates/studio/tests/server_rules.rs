@@ -170,11 +170,11 @@ fn mocap_jobs_on_the_builtin_walk() {
     let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
     assert_eq!(event, "failed", "{r}");
     assert!(r["error"].as_str().unwrap().contains("K must be at least 5"), "{r}");
-    // The error bound: every frame under it.
+    // The error bound: every joint of every frame of the rebuilt clip under it.
     let body = json!({"method": "bound", "bound_cm": 2.0}).to_string();
     let (event, r) = run_job(s.addr(), "/api/mocap/keys", &[("Content-Type", "application/json")], body.as_bytes());
     assert_eq!(event, "result", "{r}");
-    assert!(r["spherical_max_cm"].as_f64().unwrap() <= 2.0 + 1e-9, "{r}");
+    assert!(r["max_cm"].as_f64().unwrap() <= 2.0 + 1e-9, "{r}");
     let body = json!({"bound_cm": 1.0}).to_string();
     let (event, r) = run_job(s.addr(), "/api/mocap/compress", &[("Content-Type", "application/json")], body.as_bytes());
     assert_eq!(event, "result", "{r}");
