@@ -9,11 +9,11 @@ use inbetween_core::cancel::Cancel;
 use inbetween_face::bench::{self, FaceBenchConfig};
 use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
-use inbetween_face::edit::{ConstraintKind, RetrievalOptions};
+use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::plan::{
-    captures_dir, keeps_live_link, retrieval_library, span_seconds, viseme_runs, MethodChoice, SPEECH_GROUPS,
+    captures_dir, keeps_live_link, span_seconds, viseme_runs, EditResources, MethodChoice, SPEECH_GROUPS,
 };
-use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide, Inpainter, Method};
+use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide};
 use inbetween_face::preview::{write_outcome_gif, write_outcome_png};
 use inbetween_face::train::{TrainData, TrainJob};
 use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, PhonemeSpan};
@@ -270,36 +270,12 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         Some(g) => format!("note: --groups {g}: the visemes guide these groups (default: {speech}; the rest unguided)"),
         None => format!("note: the visemes guide {speech}; eyes and brows are filled unguided (--groups overrides)"),
     });
-    let chosen = a.method.choice().resolve(guide.kind(), a.weights.is_some());
-    let net = match chosen {
-        MethodChoice::Network => Some(match &a.weights {
-            Some(w) => weights::load(w).with_context(|| format!("loading face weights {}", w.display()))?,
-            None => weights::committed(guide.kind())
-                .with_context(|| format!("loading the committed {} network", guide.kind().name()))?,
-        }),
-        _ => None,
-    };
-    if !a.library.is_empty() && !matches!(chosen, MethodChoice::Retrieval) {
+    let mut res = EditResources::load_network(a.method.choice(), guide.kind(), a.weights.as_deref())?;
+    if !a.library.is_empty() && !matches!(res.chosen, MethodChoice::Retrieval) {
         bail!("--library is read only by --method retrieval (with --keys or --visemes, auto picks the network)");
     }
-    // Retrieval draws from the library; so do the groups the guidance leaves unguided.
-    let unguided_rest = channels.is_none() && guide.kind() == ConstraintKind::Visemes;
-    let library = match chosen {
-        MethodChoice::Retrieval => Some(retrieval_library(&a.library, limits.max_rows)?),
-        _ if unguided_rest => Some(retrieval_library(&[], limits.max_rows)?),
-        _ => None,
-    };
-    let method = match (&chosen, &net) {
-        (MethodChoice::Linear, _) => Method::Linear,
-        (MethodChoice::Cubic, _) => Method::Cubic,
-        (MethodChoice::Retrieval, _) => {
-            let options = RetrievalOptions::for_variants(guide.kind(), a.variants as usize);
-            Method::Retrieval(library.as_ref().expect("built above"), options)
-        }
-        (MethodChoice::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
-        (MethodChoice::Network, None) => unreachable!("a network was loaded above"),
-        (MethodChoice::Auto, _) => unreachable!("auto was resolved above"),
-    };
+    res.load_library(&a.library, channels.is_some(), limits.max_rows)?;
+    let method = res.method(a.variants as usize)?;
     let guide_file = [&a.keys, &a.guide, &a.visemes].into_iter().flatten().next().map(|p| p.display().to_string());
     let mut job = EditJob {
         clip: &clip,
@@ -311,12 +287,12 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         limits,
         cancel: cancel.clone(),
         guide_file,
-        library: library.as_ref(),
+        library: res.library.as_ref(),
     };
     let live_link = keeps_live_link(&a.input, &a.out);
     // Every variant's clip, PNG and GIF appear together or not at all.
     let mut set = OutputSet::new();
-    let mut first: Option<Vec<inbetween_face::edit::Frame>> = None;
+    let mut first: Option<inbetween_face::infer::EditOutcome> = None;
     let mut spreads = Vec::new();
     for k in 1..=a.variants {
         job.seed = a.seed + u64::from(k - 1);
@@ -333,8 +309,8 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
             named(&a.out).display(),
         );
         match &first {
-            None => first = Some(out.after.clone()),
-            Some(f) => spreads.push(mean_abs_difference(f, &out.after, &out.mask.segments())),
+            None => first = Some(out),
+            Some(f) => spreads.push(out.mean_abs_difference(f)),
         }
     }
     set.commit().context("moving the edit's outputs into place")?;
@@ -360,24 +336,6 @@ fn variant_path(p: &Path, k: u32) -> PathBuf {
         None => format!("{stem}-{k}"),
     };
     p.with_file_name(name)
-}
-
-/// Mean absolute difference of two edits over the frames of `segs`, every channel.
-fn mean_abs_difference(
-    a: &[inbetween_face::edit::Frame],
-    b: &[inbetween_face::edit::Frame],
-    segs: &[inbetween_face::edit::Segment],
-) -> f64 {
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for s in segs {
-        for f in s.start..s.end.min(a.len()).min(b.len()) {
-            for (x, y) in a[f].iter().zip(&b[f]) {
-                sum += (x - y).abs() as f64;
-                n += 1;
-            }
-        }
-    }
-    sum / n.max(1) as f64
 }
 
 /// One edit: runs the job, stages its clip, PNG and (with --gif) GIF under `named` paths.
@@ -476,18 +434,15 @@ fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: ScaleArgs) -> anyhow::Result<()> {
-    use inbetween_face::demo::OCCLUSION_S;
     crate::scale::run(&a, "face", "face edit (unguided network) at multiples of the demo's example", |k, exe, work| {
-        // The demo's example, k times: a 10·k s procedural clip, a gap of 3·k s from 3.5 s.
-        let seconds = 10.0 * k as f64;
-        let (start, end) = (OCCLUSION_S.0, OCCLUSION_S.0 + (OCCLUSION_S.1 - OCCLUSION_S.0) * k as f64);
-        let p = procedural::generate(&procedural::ProceduralConfig { duration_s: seconds, ..Default::default() }, 1);
+        let ex = inbetween_face::demo::scaled_example(k);
+        let (clip, (start, end)) = (&ex.clip, ex.span_s);
         let input = work.join(format!("clip-{k}.csv"));
-        write_clip(&input, &p.clip, false)?;
+        write_clip(&input, clip, false)?;
         let mut command = std::process::Command::new(exe);
         command.args(["face".as_ref(), "edit".as_ref(), input.as_os_str(), "--mask".as_ref()]);
         command.arg(format!("{start}s..{end}s")).arg("-o").arg(work.join(format!("edit-{k}.csv")));
-        let input = format!("{seconds} s clip ({} rows), {:.1} s gap", p.clip.num_frames(), end - start);
+        let input = format!("{} s clip ({} rows), {:.1} s gap", ex.seconds, clip.num_frames(), end - start);
         Ok(crate::scale::Measured { input, command })
     })
 }

@@ -33,6 +33,24 @@ impl std::fmt::Display for FaceDemo {
 /// Occlusion of the demo clip, seconds.
 pub const OCCLUSION_S: (f64, f64) = (3.5, 6.5);
 
+/// The demo's example at `k`× its length (`face scale`).
+pub struct ScaledExample {
+    /// A procedural clip (seed 1), `seconds` long.
+    pub clip: crate::data::BlendshapeClip,
+    /// The clip's length asked of the generator: 10·k s.
+    pub seconds: f64,
+    /// The occlusion: from [`OCCLUSION_S`]'s start, `k` times as long (seconds).
+    pub span_s: (f64, f64),
+}
+
+/// [`ScaledExample`] at `k`×.
+pub fn scaled_example(k: usize) -> ScaledExample {
+    let seconds = 10.0 * k as f64;
+    let clip = generate(&ProceduralConfig { duration_s: seconds, ..ProceduralConfig::default() }, 1).clip;
+    let span_s = (OCCLUSION_S.0, OCCLUSION_S.0 + (OCCLUSION_S.1 - OCCLUSION_S.0) * k as f64);
+    ScaledExample { clip, seconds, span_s }
+}
+
 fn mse(truth: &[Frame], out: &[Frame], seg: Segment) -> f64 {
     let mut s = 0.0;
     for f in seg.start..seg.end {

@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use crate::data::{read_clip_limited, BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT};
 use crate::edit::groups::Group;
 use crate::edit::mask::{parse_span_spec, SpanSpec};
-use crate::edit::ConstraintKind;
-use crate::edit::MotionLibrary;
-use crate::infer::{DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
+use crate::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
+use crate::infer::{Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
 use crate::visemes::{phoneme_viseme, PhonemeSpan, Viseme};
+use crate::weights::Network;
 
 /// How an edit is asked to fill, before [`MethodChoice::resolve`] applies the `auto` rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +85,88 @@ pub fn retrieval_library(files: &[PathBuf], max_rows: usize) -> Result<MotionLib
         lib.push(clip.arkit_frames());
     }
     Ok(lib)
+}
+
+/// A step of setting up an edit that failed, said the way the front ends say it ("loading face
+/// weights w.bpk"), with the engine's error as its cause.
+#[derive(Debug, thiserror::Error)]
+#[error("{what}")]
+pub struct SetupError {
+    /// What was being done.
+    pub what: String,
+    /// Why it failed.
+    #[source]
+    pub source: FaceError,
+}
+
+/// What an edit's method needs loaded: the network (for [`MethodChoice::Network`]) and the retrieval
+/// library (for [`MethodChoice::Retrieval`], and for the groups viseme guidance leaves unguided).
+/// `face edit`'s setup, in the engine so every front end builds the same [`Method`].
+pub struct EditResources {
+    /// The method, `auto` resolved ([`MethodChoice::resolve`]).
+    pub chosen: MethodChoice,
+    /// The guidance the edit follows.
+    pub kind: ConstraintKind,
+    /// The loaded network, when the method is the network.
+    pub network: Option<Network>,
+    /// The retrieval library, when the method or the unguided groups draw from it.
+    pub library: Option<MotionLibrary>,
+}
+
+impl EditResources {
+    /// Resolves `choice` for guidance `kind` and loads the network it needs: `weights` when given,
+    /// else the committed network for `kind`. The library is loaded by [`EditResources::load_library`].
+    pub fn load_network(
+        choice: MethodChoice,
+        kind: ConstraintKind,
+        weights: Option<&Path>,
+    ) -> Result<EditResources, SetupError> {
+        let chosen = choice.resolve(kind, weights.is_some());
+        let network = match (chosen, weights) {
+            (MethodChoice::Network, Some(w)) => Some(
+                crate::weights::load(w)
+                    .map_err(|source| SetupError { what: format!("loading face weights {}", w.display()), source })?,
+            ),
+            (MethodChoice::Network, None) => Some(crate::weights::committed(kind).map_err(|source| SetupError {
+                what: format!("loading the committed {} network", kind.name()),
+                source,
+            })?),
+            _ => None,
+        };
+        Ok(EditResources { chosen, kind, network, library: None })
+    }
+
+    /// Loads the retrieval library ([`retrieval_library`] of `files`, each at most `max_rows` rows)
+    /// when the method is retrieval, or the default one when the guidance is visemes and
+    /// `groups_given` is false (the groups the visemes leave unguided are drawn from it).
+    pub fn load_library(&mut self, files: &[PathBuf], groups_given: bool, max_rows: usize) -> Result<(), FaceError> {
+        let unguided_rest = !groups_given && self.kind == ConstraintKind::Visemes;
+        self.library = match self.chosen {
+            MethodChoice::Retrieval => Some(retrieval_library(files, max_rows)?),
+            _ if unguided_rest => Some(retrieval_library(&[], max_rows)?),
+            _ => None,
+        };
+        Ok(())
+    }
+
+    /// The job's [`Method`]; retrieval draws `variants` distinct fills
+    /// ([`RetrievalOptions::for_variants`]). An error when the network or the library the method
+    /// needs was not loaded.
+    pub fn method(&self, variants: usize) -> Result<Method<'_>, FaceError> {
+        let missing = |what: &str| FaceError::Invalid(format!("method {}: no {what} loaded", self.chosen.name()));
+        Ok(match self.chosen {
+            MethodChoice::Linear => Method::Linear,
+            MethodChoice::Cubic => Method::Cubic,
+            MethodChoice::Retrieval => Method::Retrieval(
+                self.library.as_ref().ok_or_else(|| missing("library"))?,
+                RetrievalOptions::for_variants(self.kind, variants),
+            ),
+            MethodChoice::Network => {
+                Method::Network(self.network.as_ref().ok_or_else(|| missing("network"))? as &dyn Inpainter)
+            }
+            MethodChoice::Auto => return Err(missing("resolved method")),
+        })
+    }
 }
 
 /// Whether an edit of `input` written to `out` keeps the Live Link Face layout: a Live Link CSV in,
@@ -185,6 +267,30 @@ mod tests {
         assert_eq!(MethodChoice::parse("linear").unwrap(), MethodChoice::Linear);
         let e = MethodChoice::parse("bezier").unwrap_err().to_string();
         assert!(e.contains("'bezier'") && e.contains("auto, network, retrieval, linear, cubic"), "{e}");
+    }
+
+    #[test]
+    fn resources_hold_what_the_method_needs_and_failures_say_what_was_loading() {
+        let r = EditResources::load_network(MethodChoice::Auto, ConstraintKind::Keyframes, None).unwrap();
+        assert_eq!(r.chosen, MethodChoice::Network);
+        assert!(r.network.is_some() && matches!(r.method(1), Ok(Method::Network(_))));
+        let mut r = EditResources::load_network(MethodChoice::Auto, ConstraintKind::None, None).unwrap();
+        assert_eq!(r.chosen, MethodChoice::Retrieval);
+        assert!(r.network.is_none());
+        let e = r.method(1).err().unwrap().to_string();
+        assert!(e.contains("method retrieval: no library loaded"), "{e}");
+        r.load_library(&[], false, 100_000).unwrap();
+        assert!(matches!(r.method(2), Ok(Method::Retrieval(..))));
+        // Visemes leave the groups they do not guide to the library, unless the edit names groups.
+        let mut v = EditResources::load_network(MethodChoice::Linear, ConstraintKind::Visemes, None).unwrap();
+        v.load_library(&[], false, 100_000).unwrap();
+        assert!(v.library.is_some() && matches!(v.method(1), Ok(Method::Linear)));
+        v.load_library(&[], true, 100_000).unwrap();
+        assert!(v.library.is_none());
+        let missing = Path::new("/nonexistent/w.bpk");
+        let e = EditResources::load_network(MethodChoice::Auto, ConstraintKind::None, Some(missing)).err().unwrap();
+        assert_eq!(e.to_string(), "loading face weights /nonexistent/w.bpk");
+        assert!(std::error::Error::source(&e).unwrap().to_string().contains("/nonexistent/w.bpk"), "{e:?}");
     }
 
     #[test]
