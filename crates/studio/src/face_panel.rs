@@ -521,33 +521,12 @@ fn fill(
     .run()
     .map_err(face_err)?;
     // The masked error against what was there, at the model rate.
-    let (mut sq, mut count) = (0.0f64, 0usize);
-    for f in 0..out.mask.frames() {
-        for c in 0..NUM_ARKIT {
-            if out.mask.erased(f, c) {
-                sq += f64::from(out.after[f][c] - out.before[f][c]).powi(2);
-                count += 1;
-            }
-        }
-    }
+    let mse = out.masked_mse();
     // Rows the edit changed, and the changed columns there.
-    let (old, new) = (clip.values(), out.clip.values());
-    let stride = clip.num_channels();
-    let changed_rows: Vec<usize> = (0..clip.num_frames())
-        .filter(|f| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride])
-        .collect();
-    let rows = match (changed_rows.first(), changed_rows.last()) {
-        (Some(a), Some(b)) => (*a, b + 1),
-        _ => (0, 0),
-    };
-    let mut changed = [false; NUM_ARKIT];
-    for f in rows.0..rows.1 {
-        for (c, ch) in changed.iter_mut().enumerate() {
-            *ch |= old[f * stride + c] != new[f * stride + c];
-        }
-    }
+    let (rows, changed) = out.changed(clip);
+    let rows = (rows.start, rows.end);
     let model_frames = out.mask.segments().iter().map(|s| s.len()).sum::<usize>();
-    Ok(Fill { clip: out.clip, mse: sq / count.max(1) as f64, model_frames, rows, changed })
+    Ok(Fill { clip: out.clip, mse, model_frames, rows, changed })
 }
 
 #[derive(Deserialize)]

@@ -53,8 +53,10 @@ pub struct ScriptState {
 
 /// `GET /api/script/stories`: the built-in texts by name.
 pub async fn stories() -> Json<Value> {
-    let list: Vec<Value> =
-        inbetween_script::builtin_scripts::all().into_iter().map(|(name, text)| json!({"name": name, "text": text})).collect();
+    let list: Vec<Value> = inbetween_script::builtin_scripts::all()
+        .into_iter()
+        .map(|(name, text)| json!({"name": name, "text": text}))
+        .collect();
     Json(json!({"stories": list, "default": "demo"}))
 }
 
