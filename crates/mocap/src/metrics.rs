@@ -92,14 +92,22 @@ pub trait SegmentModel: Sync {
             let right = mid + d;
             let left = mid.checked_sub(d).filter(|_| d > 0);
             for f in [Some(right), left].into_iter().flatten().filter(|&f| f > a && f < b) {
-                let c = self.frame_cost(a, b, f, scratch);
-                if c.cm_max > max_cm {
-                    return None;
-                }
-                acc = acc.combine(c);
+                acc = acc.combine(self.frame_cost_within(a, b, f, max_cm, scratch)?);
             }
         }
         Some(acc)
+    }
+
+    /// Frame `f`'s cost, or `None` when it breaks the bound (`max_cm`, or a model's own bound).
+    fn frame_cost_within(
+        &self,
+        a: usize,
+        b: usize,
+        f: usize,
+        max_cm: f64,
+        scratch: &mut Scratch,
+    ) -> Option<SegmentCost> {
+        Some(self.frame_cost(a, b, f, scratch)).filter(|c| c.cm_max <= max_cm)
     }
 
     /// Error of a whole keyframe set, as the sum of its segments.

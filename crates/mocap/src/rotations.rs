@@ -222,23 +222,10 @@ impl SegmentModel for CurveModel<'_> {
         self.motion.frame_cost_along(self.curve, a, b, f, s).0
     }
 
-    /// Rejects a segment at its first frame over `max_cm` or over the angle bound.
-    fn segment_cost_within(&self, a: usize, b: usize, max_cm: f64, s: &mut Scratch) -> Option<SegmentCost> {
-        let max_angle = self.max_angle_rad.unwrap_or(f64::INFINITY);
-        let mid = (a + b) / 2;
-        let mut acc = SegmentCost::default();
-        for d in 0..b - a {
-            let right = mid + d;
-            let left = mid.checked_sub(d).filter(|_| d > 0);
-            for f in [Some(right), left].into_iter().flatten().filter(|&f| f > a && f < b) {
-                let (c, angle) = self.motion.frame_cost_along(self.curve, a, b, f, s);
-                if c.cm_max > max_cm || angle > max_angle {
-                    return None;
-                }
-                acc = acc.combine(c);
-            }
-        }
-        Some(acc)
+    /// Rejects a frame over `max_cm` or over the angle bound.
+    fn frame_cost_within(&self, a: usize, b: usize, f: usize, max_cm: f64, s: &mut Scratch) -> Option<SegmentCost> {
+        let (c, angle) = self.motion.frame_cost_along(self.curve, a, b, f, s);
+        (c.cm_max <= max_cm && angle <= self.max_angle_rad.unwrap_or(f64::INFINITY)).then_some(c)
     }
 }
 

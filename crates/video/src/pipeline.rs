@@ -405,13 +405,14 @@ pub fn reorder(clip: &Clip, order: &[usize]) -> Clip {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::frames::{procedural_clip, ProceduralKind};
     use crate::sdpf::{overlap_delta_o, stability_md};
     use crate::VideoError;
 
-    fn quick_config(dir: &std::path::Path) -> ResequenceConfig {
+    /// A small, quick analysis for tests (here and the jobs'), its metric cached in `dir`.
+    pub(crate) fn quick_config(dir: &std::path::Path) -> ResequenceConfig {
         ResequenceConfig {
             flow_side: 48,
             rsf: RsfConfig::tiny(),

@@ -5,20 +5,10 @@ use inbetween_io::Progress;
 
 use super::*;
 use crate::frames::{procedural_clip, read_clip, write_clip, ProceduralKind, ReadOptions};
-use crate::metric::{RsfConfig, TrainOptions};
-use crate::pipeline::ResequenceConfig;
 use crate::sdpf::{stability_md, SdpfParams};
 use crate::VideoError;
 
-fn quick(dir: &std::path::Path) -> ResequenceConfig {
-    ResequenceConfig {
-        flow_side: 48,
-        rsf: RsfConfig::tiny(),
-        train: TrainOptions { steps: 20, ..TrainOptions::default() },
-        cache_dir: dir.to_path_buf(),
-        ..ResequenceConfig::default()
-    }
-}
+use crate::pipeline::tests::quick_config as quick;
 
 #[test]
 fn resequence_job_reads_analyses_walks_measures_explains_and_writes() {
