@@ -7,18 +7,8 @@ use super::protocol::{VideoBenchConfig, CONFIGS, PAPER_GT_MD, PAPER_TABLE3};
 use super::{ClipResult, Run};
 use crate::sdpf::{per_100_frames, Cycle};
 
-/// The `p`-th quantile (p in [0, 1]) by linear interpolation between order statistics; NaN for no
-/// value.
-pub(super) fn quantile(values: &[f64], p: f64) -> f64 {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let pos = p.clamp(0.0, 1.0) * (v.len() - 1) as f64;
-    let (i, f) = (pos.floor() as usize, pos.fract());
-    v[i] + (v[(i + 1).min(v.len() - 1)] - v[i]) * f
-}
+/// The `p`-th quantile by linear interpolation between order statistics (core's one).
+pub(super) use inbetween_core::stats::quantile;
 
 pub(super) fn mean(values: &[f64]) -> f64 {
     if values.is_empty() {
