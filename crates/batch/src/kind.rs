@@ -255,34 +255,23 @@ fn mocap_keys(
     }))
 }
 
+/// The video engine's `AnalyseJob` on one clip (its frame limit, decoding and analysis), the
+/// metric cached beside the outputs.
 fn video_analyse(input: &Input, out: &Path, outputs: &[String], cancel: &Cancel) -> Result<serde_json::Value, String> {
-    use inbetween_video::frames::{read_clip, ReadOptions};
-    use inbetween_video::pipeline::{analyse, ResequenceConfig};
-    let cfg =
-        ResequenceConfig { cache_dir: out.join(&outputs[1]), cancel: cancel.clone(), ..ResequenceConfig::default() };
-    let past_limit = cfg.limits.max_frames.saturating_add(1);
-    let (clip, decoded) =
-        read_clip(&input.path, &ReadOptions { max_frames: Some(past_limit), ..ReadOptions::default() })
-            .map_err(|e| err(input, e))?;
-    if clip.len() > cfg.limits.max_frames {
-        return Err(format!(
-            "{}: more than {} frames, the analysis's limit",
-            input.path.display(),
-            cfg.limits.max_frames
-        ));
-    }
-    let analysis = analyse(&clip, &cfg, &Progress::hidden()).map_err(|e| err(input, e))?;
-    let shots = analysis.info.shot.iter().copied().max().map_or(1, |m| m + 1);
+    use inbetween_video::job::AnalyseJob;
+    let mut job = AnalyseJob::for_file(&input.path);
+    job.config.cache_dir = out.join(&outputs[1]);
+    let r = job.run(cancel, &Progress::hidden()).map_err(|e| err(input, e))?;
     let report = serde_json::json!({
-        "frames": clip.len(),
-        "width": clip.width(),
-        "height": clip.height(),
-        "fps": clip.fps,
-        "decoder": decoded.decoder.to_string(),
-        "shots": shots,
-        "directed": analysis.direction.iter().map(|d| d.0).collect::<Vec<_>>(),
-        "metric": analysis.metric_note,
-        "stages_s": analysis.stages.iter().map(|(s, t)| serde_json::json!({"stage": s, "seconds": t})).collect::<Vec<_>>(),
+        "frames": r.frames,
+        "width": r.width,
+        "height": r.height,
+        "fps": r.fps,
+        "decoder": r.decoder.as_deref().unwrap_or_default(),
+        "shots": r.shots,
+        "directed": r.directed,
+        "metric": r.metric,
+        "stages_s": r.stages,
     });
     let text = serde_json::to_vec_pretty(&report).map_err(|e| e.to_string())?;
     write(out, &outputs[0], &text)?;
