@@ -152,13 +152,13 @@ mod tests {
         let feats = scene.character_features(0, 1, true);
         let keys = example_keys(&scene, &[0, 59]);
         let style = [0.1f32, 0.0, -0.2, 0.3];
-        let mut live = CausalCamera::new(&fast, &style, &keys.keys[0].camera, None, 30.0);
-        live.set_key(59, &keys.keys[1].camera, &feats[59]);
+        let mut live = CausalCamera::new(&fast, &style, &keys.keys[0].camera.toric().unwrap(), None, 30.0);
+        live.set_key(59, &keys.keys[1].camera.toric().unwrap(), &feats[59]);
         let out: Vec<Toric> = (1..60).map(|f| live.push(&feats[f])).collect();
         // The same steps by hand.
-        let mut state = fast.map_state(&style, &[encode_camera(&keys.keys[0].camera); MAP_FRAMES]);
-        let mut prev = encode_camera(&keys.keys[0].camera);
-        let key = key_vector(&encode_camera(&keys.keys[1].camera), &encode_character(&feats[59]));
+        let mut state = fast.map_state(&style, &[encode_camera(&keys.keys[0].camera.toric().unwrap()); MAP_FRAMES]);
+        let mut prev = encode_camera(&keys.keys[0].camera.toric().unwrap());
+        let key = key_vector(&encode_camera(&keys.keys[1].camera.toric().unwrap()), &encode_character(&feats[59]));
         for f in (5..60).step_by(5) {
             let input = crate::infer::StepIn {
                 style: &style,
@@ -172,7 +172,8 @@ mod tests {
             assert!((0..6).all(|j| (got[j] - prev[j]).abs() < 1e-6), "frame {f}");
         }
         // In between, the last step's motion is extrapolated.
-        let (f0, f5, f7) = (encode_camera(&keys.keys[0].camera), encode_camera(&out[4]), encode_camera(&out[6]));
+        let (f0, f5, f7) =
+            (encode_camera(&keys.keys[0].camera.toric().unwrap()), encode_camera(&out[4]), encode_camera(&out[6]));
         assert!(
             (0..6).all(|j| (f7[j] - (f5[j] + (f5[j] - f0[j]) * 0.4)).abs() < 1e-6),
             "frame 7 extrapolates frames 0 → 5"
@@ -186,11 +187,11 @@ mod tests {
         let feats = scene.character_features(0, 1, true);
         let keys = example_keys(&scene, &[0, 30, 59]);
         let style = [0.1f32, 0.0, -0.2, 0.3];
-        let mut live = CausalCamera::new(&fast, &style, &keys.keys[0].camera, None, 30.0);
-        live.set_key(30, &keys.keys[1].camera, &feats[30]);
+        let mut live = CausalCamera::new(&fast, &style, &keys.keys[0].camera.toric().unwrap(), None, 30.0);
+        live.set_key(30, &keys.keys[1].camera.toric().unwrap(), &feats[30]);
         let out: Vec<Toric> = (1..=30).map(|f| live.push(&feats[f])).collect();
         let steps: [Cam; MAP_FRAMES] = std::array::from_fn(|i| encode_camera(&out[10 + 5 * i - 1]));
-        live.set_key(59, &keys.keys[2].camera, &feats[59]);
+        live.set_key(59, &keys.keys[2].camera.toric().unwrap(), &feats[59]);
         let expected = fast.map_state(&style, &steps);
         let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
         assert!(
@@ -214,11 +215,11 @@ mod tests {
         assert_eq!(track.key_residuals.iter().map(|r| r.frame).collect::<Vec<_>>(), [0, 45, 89]);
         // The same track by hand: announce key 1 at once, key 2 after key 1 has passed.
         let feats = scene.character_features(0, 1, true);
-        let mut live = CausalCamera::new(&fast, &style.code, &keys.keys[0].camera, None, 30.0);
-        live.set_key(45, &keys.keys[1].camera, &feats[45]);
+        let mut live = CausalCamera::new(&fast, &style.code, &keys.keys[0].camera.toric().unwrap(), None, 30.0);
+        live.set_key(45, &keys.keys[1].camera.toric().unwrap(), &feats[45]);
         for f in 1..90 {
             if f == 46 {
-                live.set_key(89, &keys.keys[2].camera, &feats[89]);
+                live.set_key(89, &keys.keys[2].camera.toric().unwrap(), &feats[89]);
             }
             let t = live.push(&feats[f]);
             assert_eq!(track.frames[f].toric, t.clamped(&job.options.lens, 0.02), "frame {f}");

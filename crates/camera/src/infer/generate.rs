@@ -339,7 +339,7 @@ mod tests {
         assert!(track.max_corrected_residual < 1e-9, "{}", track.max_corrected_residual);
         for k in &keys.keys {
             let got = track.frames[k.frame].toric.to_array();
-            let want = k.camera.to_array();
+            let want = k.camera.toric().unwrap().to_array();
             assert!((0..6).all(|i| (got[i] - want[i]).abs() < 1e-9), "key at {}", k.frame);
         }
         // Same inputs, same track.
@@ -367,13 +367,41 @@ mod tests {
             (a + b) * 0.5 + DVec3::new(0.0, 1.0, 0.0) + (b - a).cross(DVec3::Y).normalize() * 4.0,
             (a + b) * 0.5,
         );
-        keys.keys[2].camera = crate::toric::from_pose(&pose, a, b, &lens).unwrap();
+        keys.keys[2].camera = crate::toric::from_pose(&pose, a, b, &lens).unwrap().into();
         keys.keys[2].targets = Some(["B".into(), "A".into()]);
         let track = GenerateJob::new(&fast, &scene, &keys, &style).run().unwrap();
         assert_eq!(track.frames[30].targets, [0, 1]);
         assert_eq!(track.frames[90].targets, [1, 0]);
         let end = &track.frames[119];
         assert!((end.pose.position - pose.position).length() < 1e-6, "the transition key is met in world space too");
+    }
+
+    /// A key given as a camera pose is met where that pose sees the two targets: same screen
+    /// positions, same place and orientation.
+    #[test]
+    fn a_pose_key_is_met_at_its_screen_positions() {
+        let (fast, style) = (small(), zero_style());
+        let scene = Scene::procedural(2, 120, 30.0);
+        let lens = Lens::default();
+        let f = 60;
+        let (a, b) = (scene.characters[0].frame(f).target(), scene.characters[1].frame(f).target());
+        let (mid, side) = ((a + b) * 0.5, (b - a).cross(DVec3::Y).normalize());
+        // Set by hand: 5 m to the pair's side, 1.5 m up, aimed a little off their midpoint.
+        let pose = CameraPose::look_at(mid + side * 5.0 + DVec3::Y * 1.5, mid + DVec3::new(0.2, -0.1, 0.0));
+        let mut keys = example_keys(&scene, &[0, f, 119]);
+        keys.keys[1].camera =
+            crate::infer::KeyPose { position: pose.position, rotation: pose.rotation, fov_deg: Some(45.0) }.into();
+        let track = GenerateJob::new(&fast, &scene, &keys, &style).run().unwrap();
+        let got = &track.frames[f].pose;
+        for (name, t) in [("A", a), ("B", b)] {
+            let (want, have) = (pose.project(&lens, t).unwrap(), got.project(&lens, t).unwrap());
+            assert!((want - have).length() < 1e-9, "{name} on screen at {have}, the pose key puts it at {want}");
+        }
+        assert!((got.position - pose.position).length() < 1e-6, "{} vs {}", got.position, pose.position);
+        assert!(got.rotation.dot(pose.rotation).abs() > 1.0 - 1e-9);
+        // Frames around the key move smoothly into it (no jump from the pose's conversion).
+        let step = |i: usize| (track.frames[i + 1].pose.position - track.frames[i].pose.position).length();
+        assert!(step(f - 1) < 0.5 && step(f) < 0.5, "steps {} and {} m at the key", step(f - 1), step(f));
     }
 
     #[test]
@@ -406,7 +434,7 @@ mod tests {
         let a = GenerateJob::new(&fast, &scene, &keys, &style).run().unwrap();
         let b = GenerateJob::new(&fast, &scene, &fast_start, &style).run().unwrap();
         assert_ne!(a.frames[10].toric, b.frames[10].toric, "H sees the velocity");
-        assert_eq!(b.frames[0].toric, keys.keys[0].camera, "the key itself stays put");
+        assert_eq!(Some(b.frames[0].toric), keys.keys[0].camera.toric(), "the key itself stays put");
     }
 
     #[test]
@@ -436,7 +464,7 @@ mod tests {
                 [scene.characters[truth.a_index].name.clone(), scene.characters[1 - truth.a_index].name.clone()];
             let key = |f: usize| crate::infer::Keyframe {
                 frame: f,
-                camera: truth.camera[f],
+                camera: truth.camera[f].into(),
                 targets: Some(names.clone()),
                 velocity: None,
             };

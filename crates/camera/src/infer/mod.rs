@@ -28,7 +28,7 @@ use crate::toric::Toric;
 
 pub use causal::CausalCamera;
 pub use generate::{generate_causal, GenerateJob, GenerateLimits, GenerateOptions};
-pub use keys::{example_keys, Keyframe, Keys, ResolvedKey};
+pub use keys::{example_keys, KeyCamera, KeyPose, Keyframe, Keys, ResolvedKey};
 pub use networks::{FastModel, Scratch, StepIn};
 pub use reference_gltf::reference_from_gltf;
 pub use rollout::Rollout;
