@@ -2,14 +2,17 @@
 //! cut) resequenced from one of its frames, written as a GIF with its contact sheet.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
+use inbetween_core::cancel::Cancel;
 use inbetween_io::Progress;
 
 use crate::frames::{procedural_clip, write_clip, ProceduralKind};
+use crate::job::{AnalyseJob, ResequenceJob};
 use crate::metric::TrainOptions;
-use crate::pipeline::{analyse, reorder, resequence, ResequenceConfig};
+use crate::pipeline::{reorder, ResequenceConfig};
 use crate::preview::{write_contact_sheet, SheetOptions};
-use crate::sdpf::{overlap_delta_o, stability_md, SdpfParams};
+use crate::sdpf::SdpfParams;
 use crate::VideoError;
 
 /// What the demo wrote and measured.
@@ -53,27 +56,34 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<VideoDemo, Vide
         cache_dir: dir.join("video-cache"),
         ..ResequenceConfig::default()
     };
-    let analysis = analyse(&clip, &cfg, progress)?;
-    let (paths, _) = resequence(&analysis, START, &SdpfParams { seed, ..SdpfParams::default() }, 1, &cfg.limits)?;
-    let order = paths[0].frames.clone();
+    let cancel = Cancel::default();
+    let analysed = AnalyseJob { config: cfg, ..AnalyseJob::for_clip(clip) }.run(&cancel, progress)?;
+    let job = ResequenceJob {
+        start: START,
+        params: SdpfParams { seed, ..SdpfParams::default() },
+        ..ResequenceJob::on(Arc::new(analysed))
+    };
+    let report = job.run(&cancel, progress)?;
+    let clip = &report.analysis.clip;
+    let sequence = &report.sequences[0];
+    let order = sequence.order.clone();
     std::fs::create_dir_all(dir).map_err(|e| VideoError::io(dir, e))?;
     let source_gif = dir.join("video-demo-source.gif");
-    write_clip(&source_gif, &clip)?;
+    write_clip(&source_gif, clip)?;
     let gif = dir.join("video-demo.gif");
-    write_clip(&gif, &reorder(&clip, &order))?;
+    write_clip(&gif, &reorder(clip, &order))?;
     let sheet = dir.join("video-demo.sheet.png");
     let title = format!("procedural clip resequenced from frame {START} (seed {seed}): {} frames", order.len());
     let opts = SheetOptions {
         title,
         columns: 8,
         thumb_width: 120,
-        cuts: paths[0].cut_positions(),
-        loops: paths[0].loop_positions(),
+        cuts: sequence.path.cut_positions(),
+        loops: sequence.path.loop_positions(),
         ..SheetOptions::default()
     };
     write_contact_sheet(&sheet, &clip.frames, &order, &opts)?;
-    let source: Vec<usize> = (0..clip.len()).collect();
-    let md = (stability_md(&clip.frames, &order), stability_md(&clip.frames, &source));
-    let delta_o = overlap_delta_o(&order, clip.len());
+    let md = (sequence.md, report.analysis.source_md);
+    let delta_o = sequence.delta_o;
     Ok(VideoDemo { files: vec![source_gif, gif, sheet], order, md, delta_o })
 }

@@ -24,6 +24,9 @@ pub struct SheetOptions {
     pub cuts: Vec<usize>,
     /// Positions entered by a loop back: framed in purple, labelled "LOOP".
     pub loops: Vec<usize>,
+    /// Positions entered by a matched transition (Schödl et al. 2000; forward or back in the
+    /// source): framed in teal, labelled "MATCH".
+    pub transitions: Vec<usize>,
     /// Mark backward steps (to one of this many previous source frames, see
     /// [`is_backward_step`](crate::sdpf::is_backward_step)) in red, labelled "BACK"; 0: none.
     pub backward_window: usize,
@@ -37,6 +40,7 @@ impl Default for SheetOptions {
             title: String::new(),
             cuts: Vec::new(),
             loops: Vec::new(),
+            transitions: Vec::new(),
             backward_window: 3,
         }
     }
@@ -52,6 +56,8 @@ const JUMP: [u8; 3] = [214, 96, 40];
 const CUT: [u8; 3] = [40, 90, 210];
 /// A loop back to an earlier frame of the path.
 const LOOP: [u8; 3] = [150, 60, 170];
+/// A matched transition.
+const MATCH: [u8; 3] = [20, 150, 150];
 /// A step back to one of the previous source frames: motion played backwards.
 const BACKWARD: [u8; 3] = [220, 20, 30];
 const LABEL_SIZE: f32 = 13.0;
@@ -65,7 +71,7 @@ pub fn is_jump(order: &[usize], i: usize) -> bool {
 /// The contact sheet of `order` (source frame indices into `frames`): row-major thumbnails, each
 /// labelled `position: source`, framed in green where the order follows the source, orange where
 /// it jumps, and, with a word in the label, red for a backward step ("BACK"), blue for a cut
-/// ("CUT") and purple for a loop back ("LOOP").
+/// ("CUT"), purple for a loop back ("LOOP") and teal for a matched transition ("MATCH").
 pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) -> Result<RgbImage, VideoError> {
     if let Some(&bad) = order.iter().find(|&&f| f >= frames.len()) {
         return Err(VideoError::Invalid(format!("the order names frame {bad} of a {}-frame clip", frames.len())));
@@ -96,6 +102,8 @@ pub fn contact_sheet(frames: &[RgbImage], order: &[usize], opts: &SheetOptions) 
             (CUT, " CUT")
         } else if opts.loops.contains(&i) {
             (LOOP, " LOOP")
+        } else if opts.transitions.contains(&i) {
+            (MATCH, " MATCH")
         } else if backward {
             (BACKWARD, " BACK")
         } else if is_jump(order, i) {

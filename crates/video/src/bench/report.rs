@@ -15,7 +15,15 @@ pub(super) fn sheet_png(
     loops: Vec<usize>,
     title: String,
 ) -> Result<Vec<u8>, VideoError> {
-    let opts = SheetOptions { columns: 16, thumb_width: 72, title, cuts, loops, backward_window: BACKWARD_WINDOW };
+    let opts = SheetOptions {
+        columns: 16,
+        thumb_width: 72,
+        title,
+        cuts,
+        loops,
+        transitions: Vec::new(),
+        backward_window: BACKWARD_WINDOW,
+    };
     let img = contact_sheet(&clip.frames, order, &opts)?;
     let mut bytes = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)

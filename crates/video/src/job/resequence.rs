@@ -181,13 +181,19 @@ impl ResequenceJob {
             let sheet = self.sheet.as_ref().map(|p| numbered(p, i, count)).unwrap_or_else(|| sheet_path(&file));
             let staged_sheet = set.file(&sheet).map_err(|e| VideoError::io(&sheet, e))?;
             let title = format!(
-                "{} from frame {} (seed {}): {} frames (red BACK: backward step, blue CUT, purple LOOP)",
+                "{} from frame {} (seed {}): {} frames (red BACK: backward step, blue CUT, purple LOOP, teal MATCH: matched transition)",
                 a.source,
                 self.start,
                 s.seed,
                 s.order.len()
             );
-            let opts = SheetOptions { title, cuts: s.cuts.clone(), loops: s.loops.clone(), ..SheetOptions::default() };
+            let opts = SheetOptions {
+                title,
+                cuts: s.cuts.clone(),
+                loops: s.path.loop_positions(),
+                transitions: s.path.transition_positions(),
+                ..SheetOptions::default()
+            };
             write_contact_sheet(&staged_sheet, &a.clip.frames, &s.order, &opts)?;
             s.file = Some(file);
             s.sheet = Some(sheet);
