@@ -1,12 +1,14 @@
 //! camera `generate`: the camera engine's `GenerateJob` over two characters (mocap clips) or a
-//! scene JSON, through keyframes, in a behaviour's style (direct, relative, side, orbit) from the
-//! committed weights, as the CLI's `camera generate` runs it. The track comes back as arrays.
+//! scene JSON, through keyframes (Toric coordinates or world camera poses), in a behaviour's style
+//! (direct, relative, side, orbit) from the committed weights, as the CLI's `camera generate` runs
+//! it, through a lens of the caller's field of view. The track comes back as arrays.
 
 use crate::clip::Clip;
 use crate::errors::{ctx, invalid, JobError};
 use crate::runner::run_job;
 use inbetween_camera::dataset::{Behaviour, Scene};
-use inbetween_camera::infer::{GenerateJob, GenerateOptions, Keys};
+use inbetween_camera::infer::{GenerateJob, GenerateOptions, KeyCamera, Keys};
+use inbetween_camera::toric::Lens;
 use inbetween_camera::weights;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -18,10 +20,13 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// Runs a `GenerateJob`. `keys_json` is the keyframes file's JSON. Writes the track JSON, glTF and
-/// preview GIF where paths are given. Returns a dict of arrays and the report.
+/// Runs a `GenerateJob`. `keys_json` is the keyframes file's JSON. The lens: `fov_deg` (vertical)
+/// and `aspect`, by default the first pose key's `fov_deg` (else the engine's 45°) and 16:9. Writes
+/// the track JSON, glTF and preview GIF where paths are given. `names`: the two characters' names
+/// (default: the clips' sources), which keys' `targets` and `main` use. Returns a dict of arrays and
+/// the report.
 #[pyfunction]
-#[pyo3(signature = (keys_json, characters=None, scene=None, style="relative", exact_keys=true, causal=false, json=None, gltf=None, gif=None, progress=None))]
+#[pyo3(signature = (keys_json, characters=None, scene=None, style="relative", exact_keys=true, causal=false, json=None, gltf=None, gif=None, progress=None, fov_deg=None, aspect=None, names=None))]
 #[allow(clippy::too_many_arguments)]
 fn camera_generate<'py>(
     py: Python<'py>,
@@ -35,31 +40,58 @@ fn camera_generate<'py>(
     gltf: Option<PathBuf>,
     gif: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
+    fov_deg: Option<f64>,
+    aspect: Option<f64>,
+    names: Option<(String, String)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let keys: Keys = serde_json::from_str(keys_json).map_err(|e| invalid(format!("keys: {e}")))?;
+    let poses: Vec<usize> =
+        keys.keys.iter().filter(|k| matches!(k.camera, KeyCamera::Pose(_))).map(|k| k.frame).collect();
+    let pose_fov = keys.keys.iter().find_map(|k| match &k.camera {
+        KeyCamera::Pose(p) => p.fov_deg,
+        KeyCamera::Toric(_) => None,
+    });
+    let default = Lens::default();
+    let lens = Lens {
+        fovy: fov_deg.or(pose_fov).map_or(default.fovy, f64::to_radians),
+        aspect: aspect.unwrap_or(default.aspect),
+    };
+    lens.validate().map_err(|e| invalid(format!("fov_deg / aspect: {e}")))?;
     let behaviour = Behaviour::parse(style)
         .ok_or_else(|| invalid(format!("unknown style `{style}` (direct, relative, side, orbit)")))?;
     let takes = match (&characters, &scene) {
-        (Some((a, b)), None) => Some([(a.source.clone(), a.motion.clone()), (b.source.clone(), b.motion.clone())]),
+        (Some((a, b)), None) => {
+            let (na, nb) = names.unwrap_or_else(|| (a.source.clone(), b.source.clone()));
+            Some([(na, a.motion.clone()), (nb, b.motion.clone())])
+        }
         (None, Some(_)) => None,
         _ => return Err(invalid("give either characters=(clip_a, clip_b) or scene=PATH (a scene JSON)")),
     };
-    let (track, scene) = run_job(py, progress.as_ref(), |cancel, bar| {
+    let (track, scene, notes) = run_job(py, progress.as_ref(), |cancel, bar| {
         bar.phase(2, "generating the camera");
         let w = weights::committed().map_err(ctx("loading the committed camera weights"))?;
-        let scene = match (&takes, &scene) {
+        let (scene, notes) = match (&takes, &scene) {
             (Some(t), _) => {
                 let refs: Vec<(&str, &inbetween_core::Motion)> = t.iter().map(|(n, m)| (n.as_str(), m)).collect();
-                inbetween_camera::dataset::scene_from_motions(&refs).map_err(JobError::Failed)?.0
+                inbetween_camera::dataset::scene_from_motions(&refs).map_err(JobError::Failed)?
             }
-            (None, Some(p)) => Scene::load(p).map_err(ctx(""))?,
+            (None, Some(p)) => (Scene::load(p).map_err(ctx(""))?, Default::default()),
             (None, None) => unreachable!("checked above"),
         };
+        // Pose keys are in the takes' world: a character moved aside is no longer where they frame it.
+        if let (Some((c, by)), Some(f)) = (notes.moved, poses.first()) {
+            return Err(JobError::Failed(format!(
+                "keys: the key at frame {f} is a camera pose in the takes' world, but the two takes stand at one \
+                 spot and `{}` was moved {:.2} m aside to frame both; place the characters apart",
+                scene.characters[c].name,
+                by.length()
+            )));
+        }
         let style = w.style(behaviour).ok_or_else(|| {
             JobError::Failed(format!("the weights card has no style code for `{}`", behaviour.name()))
         })?;
         bar.inc(1);
-        let options = GenerateOptions { exact_keys, causal, cancel: Some(cancel), ..GenerateOptions::default() };
+        let options = GenerateOptions { exact_keys, causal, lens, cancel: Some(cancel), ..GenerateOptions::default() };
         let origin = Path::new("keys");
         let job = GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin };
         let track = job.run().map_err(ctx(""))?;
@@ -73,7 +105,7 @@ fn camera_generate<'py>(
         if let Some(p) = &gif {
             inbetween_camera::preview::write_preview(p, &track, &scene, 3).map_err(ctx(""))?;
         }
-        Ok((track, scene))
+        Ok((track, scene, notes))
     })?;
     let n = track.frames.len();
     let flat = |f: &dyn Fn(&inbetween_camera::infer::CameraFrame) -> Vec<f64>| -> Vec<f64> {
@@ -85,6 +117,11 @@ fn camera_generate<'py>(
     d.set_item("rotations", PyArray1::from_vec(py, flat(&|f| f.pose.rotation.to_array().to_vec())).reshape([n, 4])?)?;
     d.set_item("toric", PyArray1::from_vec(py, flat(&|f| f.toric.to_array().to_vec())).reshape([n, 6])?)?;
     d.set_item("targets", track.frames.iter().map(|f| f.targets).collect::<Vec<_>>())?;
+    let target_at = |f: &inbetween_camera::infer::CameraFrame| -> Vec<f64> {
+        f.targets.iter().flat_map(|&c| scene.characters[c].frame(f.frame).target().to_array()).collect()
+    };
+    d.set_item("targets_m", PyArray1::from_vec(py, flat(&target_at)).reshape([n, 2, 3])?)?;
+    d.set_item("notes", notes.lines)?;
     d.set_item("fov_y_rad", PyArray1::from_vec(py, vec![track.lens.fovy; n]))?;
     d.set_item("aspect", track.lens.aspect)?;
     d.set_item("fps", track.fps)?;

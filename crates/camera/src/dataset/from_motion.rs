@@ -15,6 +15,10 @@ use super::scene::{CharacterTrack, Scene};
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SceneNotes {
     pub lines: Vec<String>,
+    /// The character moved aside and by how much (metres), when the takes stood at one spot: the
+    /// scene's world is then not the takes' own (a camera pose given in the takes' world would
+    /// frame the moved character where it no longer is).
+    pub moved: Option<(usize, DVec3)>,
 }
 
 /// A scene of `takes` (name shown to the user, motion). Errors name the take and what was expected.
@@ -98,6 +102,7 @@ pub fn scene_from_motions_with(
         for v in c.root.iter_mut().chain(c.shoulder_l.iter_mut()).chain(c.shoulder_r.iter_mut()) {
             *v += shift;
         }
+        notes.moved = Some((1, shift));
         notes.lines.push(format!(
             "the two takes stand {mean_gap:.2} m apart on average: {} moved 1.5 m along +X so that both can be framed",
             characters[1].name
@@ -128,6 +133,7 @@ mod tests {
         assert!((f.shoulder_l - f.shoulder_r).length() > 0.1, "two distinct shoulders");
         // Same spot: the second character is moved aside, and the notes say so.
         assert!(notes.lines.iter().any(|l| l.contains("moved 1.5 m")), "{notes:?}");
+        assert_eq!(notes.moved, Some((1, DVec3::new(1.5, 0.0, 0.0))));
         assert!(scene.characters[0].frame(0).target().distance(scene.characters[1].frame(0).target()) > 1.0);
     }
 

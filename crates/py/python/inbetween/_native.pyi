@@ -151,6 +151,9 @@ def camera_generate(
     gltf: Optional[str] = None,
     gif: Optional[str] = None,
     progress: _Progress = None,
+    fov_deg: Optional[float] = None,
+    aspect: Optional[float] = None,
+    names: Optional[Tuple[str, str]] = None,
 ) -> Dict[str, Any]: ...
 def face_edit(
     clip: FaceClip,
