@@ -326,11 +326,9 @@ fn face_edit(
     cancel: &Cancel,
 ) -> Result<serde_json::Value, String> {
     use inbetween_face::data::{is_live_link, read_clip_limited, write_clip};
-    use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
-    use inbetween_face::infer::plan::{span_seconds, MethodChoice};
-    use inbetween_face::infer::{
-        EditJob, EditLimits, Guide, Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
-    };
+    use inbetween_face::edit::ConstraintKind;
+    use inbetween_face::infer::plan::{span_seconds, EditResources, MethodChoice};
+    use inbetween_face::infer::{EditJob, EditLimits, Guide};
     let limits = EditLimits::default();
     let clip = read_clip_limited(&input.path, limits.max_rows).map_err(|e| err(input, e))?;
     let mask = options.mask.as_deref().unwrap_or_default();
@@ -342,31 +340,20 @@ fn face_edit(
     // The unguided edit of `face edit --mask …` (no keys, take or visemes): the engine's auto rule.
     let kind = ConstraintKind::None;
     let method_name = options.method.as_deref().unwrap_or("auto");
-    let choice = MethodChoice::parse(method_name).map_err(|e| e.to_string())?.resolve(kind, false);
-    let net = match choice {
-        MethodChoice::Network => Some(inbetween_face::weights::committed(kind).map_err(|e| with_causes(&e))?),
-        _ => None,
-    };
-    let library = matches!(choice, MethodChoice::Retrieval)
-        .then(|| MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED));
-    let method = match (choice, &net, &library) {
-        (MethodChoice::Linear, _, _) => Method::Linear,
-        (MethodChoice::Cubic, _, _) => Method::Cubic,
-        (MethodChoice::Retrieval, _, Some(lib)) => Method::Retrieval(lib, RetrievalOptions::for_variants(kind, 1)),
-        (MethodChoice::Network, Some(n), _) => Method::Network(n as &dyn Inpainter),
-        (other, _, _) => return Err(format!("face-edit: method {} could not be prepared", other.name())),
-    };
+    let choice = MethodChoice::parse(method_name).map_err(|e| e.to_string())?;
+    let mut resources = EditResources::load_network(choice, kind, None).map_err(|e| with_causes(&e))?;
+    resources.load_library(&[], false, limits.max_rows).map_err(|e| with_causes(&e))?;
     let job = EditJob {
         clip: &clip,
         spans: spans.clone(),
         channels: None,
         guide: Guide::None,
-        method,
+        method: resources.method(1).map_err(|e| with_causes(&e))?,
         seed: options.seed.unwrap_or(1),
         limits,
         cancel: cancel.clone(),
         guide_file: None,
-        library: library.as_ref(),
+        library: resources.library.as_ref(),
     };
     let method_used = job.method.name();
     let outcome = job.run().map_err(|e| err(input, e))?;

@@ -2,30 +2,26 @@
 //! `seed, seed + 1, …` (as `inbetween face edit --variants N --seed S`), and its procedural capture
 //! generator (`inbetween face synth`).
 //!
-//! What the CLI decides before it builds the job is decided here the same way, from the face
-//! engine's own rules (`infer::plan`: the `auto` method, spans in seconds or frames, viseme runs;
-//! `EditJob::channel_split`: which shapes the guidance leaves to an unguided fill).
+//! What the CLI decides before it builds the job is decided by the face engine's own pieces, as
+//! there (`infer::plan`: the `auto` method and what it loads, `EditResources`; the guidance read
+//! from what was given, `GuideSource`; spans in seconds or frames).
 
 use crate::clip::FaceClip;
 use crate::errors::{invalid, JobError};
 use crate::runner::run_job;
 use inbetween_core::cancel::Cancel;
-use inbetween_face::data::{read_clip_limited, BlendshapeClip, MODEL_FPS, NUM_ARKIT};
+use inbetween_face::data::{BlendshapeClip, MODEL_FPS, NUM_ARKIT};
 use inbetween_face::edit::groups::parse_groups;
-use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
+use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::keys::parse_keys_json;
-use inbetween_face::infer::plan::{span_seconds, viseme_runs, MethodChoice, SPEECH_GROUPS};
-use inbetween_face::infer::{
-    read_keys, EditJob, EditLimits, EditOutcome, Guide, Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
-};
-use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, validate_spans, PhonemeSpan};
-use inbetween_face::weights;
+use inbetween_face::infer::plan::{span_seconds, EditResources, GuideSource, MethodChoice, SPEECH_GROUPS};
+use inbetween_face::infer::{EditJob, EditLimits, EditOutcome, Guide};
+use inbetween_face::visemes::PhonemeSpan;
 use inbetween_io::Progress;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-use std::sync::OnceLock;
 use std::time::Instant;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -83,13 +79,6 @@ pub struct Edited {
     pub notes: Vec<String>,
 }
 
-/// The procedural retrieval library `face edit` uses without `--library` (fixed seed, so the same on
-/// every call), made once per process.
-fn default_library() -> &'static MotionLibrary {
-    static LIBRARY: OnceLock<MotionLibrary> = OnceLock::new();
-    LIBRARY.get_or_init(|| MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED))
-}
-
 fn span_of(s: &SpanArg, clip: &BlendshapeClip) -> Result<(f64, f64), JobError> {
     match s {
         SpanArg::Seconds(a, b) => Ok((*a, *b)),
@@ -97,7 +86,8 @@ fn span_of(s: &SpanArg, clip: &BlendshapeClip) -> Result<(f64, f64), JobError> {
     }
 }
 
-/// The guidance of `r` (at most one kind), the file it came from and notes for the report.
+/// The guidance of `r` (at most one kind) as the face engine reads it ([`GuideSource`]), the name
+/// the job's messages give it, and notes for the report.
 fn guidance(
     r: &EditRequest,
     clip: &BlendshapeClip,
@@ -120,37 +110,37 @@ fn guidance(
             given.join(" and ")
         )));
     }
-    let shown = |p: &PathBuf| Some(p.display().to_string());
-    Ok(if let Some(p) = &r.keys_path {
-        (Guide::Keys(read_keys(p)?), shown(p))
+    // What was given in memory is named by its argument in the job's messages.
+    let (source, label) = if let Some(p) = &r.keys_path {
+        (GuideSource::KeysFile(p), None)
     } else if let Some(j) = &r.keys_json {
-        (Guide::Keys(parse_keys_json(j, "keys")?), Some("keys".into()))
+        (GuideSource::Keys(parse_keys_json(j, "keys")?), Some("keys"))
     } else if let Some(g) = &r.guide {
-        (Guide::Noisy(g.clone()), Some("guide".into()))
+        (GuideSource::Take(g.clone()), Some("guide"))
     } else if let Some(p) = &r.guide_path {
-        (Guide::Noisy(read_clip_limited(p, limits.max_rows)?), shown(p))
+        (GuideSource::TakeFile(p), None)
     } else if let Some(p) = &r.visemes_path {
-        (Guide::Visemes(viseme_runs(&read_viseme_source(p, r.tier.as_deref())?)?), shown(p))
+        (GuideSource::VisemesFile(p, r.tier.as_deref()), None)
     } else if let Some(list) = &r.phonemes {
-        let spans: Vec<PhonemeSpan> = list.iter().map(|(a, b, p)| PhonemeSpan::new(*a, *b, p.clone())).collect();
-        validate_spans(&spans)?;
-        (Guide::Visemes(viseme_runs(&spans)?), Some("visemes".into()))
+        let spans = list.iter().map(|(a, b, p)| PhonemeSpan::new(*a, *b, p.clone())).collect();
+        (GuideSource::Phonemes(spans), Some("visemes"))
     } else if let Some(text) = &r.text {
-        let (s, e) = match &r.text_span {
+        let span = match &r.text_span {
             Some(t) => span_of(t, clip)?,
             None => *spans.first().ok_or_else(|| JobError::Failed("text: no span to speak it over".into()))?,
         };
-        let ph = text_to_phonemes(text, s, e)?;
-        if !ph.guessed_words.is_empty() {
-            notes.push(format!(
-                "not in CMUdict, pronounced by our letter-to-sound rules: {}",
-                ph.guessed_words.join(", ")
-            ));
-        }
-        (Guide::Visemes(viseme_runs(&ph.spans)?), None)
+        (GuideSource::Text(text, span), None)
     } else {
-        (Guide::None, None)
-    })
+        (GuideSource::None, None)
+    };
+    let loaded = source.load(limits.max_rows)?;
+    if !loaded.guessed_words.is_empty() {
+        notes.push(format!(
+            "not in CMUdict, pronounced by our letter-to-sound rules: {}",
+            loaded.guessed_words.join(", ")
+        ));
+    }
+    Ok((loaded.guide, loaded.file.or(label.map(String::from))))
 }
 
 /// Runs the edit `r` asks for on `clip`, once per variant, as `face edit` does.
@@ -178,60 +168,28 @@ pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progr
             None => format!("the visemes guide {speech}; eyes and brows are filled unguided (groups= overrides)"),
         });
     }
-    let chosen = MethodChoice::parse(&r.method)?.resolve(kind, r.weights.is_some());
-    if !r.library.is_empty() && chosen != MethodChoice::Retrieval {
+    let mut resources = EditResources::load_network(MethodChoice::parse(&r.method)?, kind, r.weights.as_deref())
+        .map_err(|e| crate::errors::ctx(e.what)(e.source))?;
+    if !r.library.is_empty() && resources.chosen != MethodChoice::Retrieval {
         return Err(JobError::Failed(format!(
             "library is read only by method='retrieval' (method '{}' resolved to {} for {} guidance)",
             r.method,
-            chosen.name(),
+            resources.chosen.name(),
             kind.name()
         )));
     }
-    let net = match chosen {
-        MethodChoice::Network => Some(match &r.weights {
-            Some(w) => weights::load(w).map_err(crate::errors::ctx(format!("loading face weights {}", w.display())))?,
-            None => weights::committed(kind)
-                .map_err(crate::errors::ctx(format!("loading the committed {} network", kind.name())))?,
-        }),
-        _ => None,
-    };
-    let own;
-    let library: &MotionLibrary = if r.library.is_empty() {
-        default_library()
-    } else {
-        let mut lib = MotionLibrary::default();
-        for (i, c) in r.library.iter().enumerate() {
-            let at_model_rate = c.resample(MODEL_FPS).map_err(crate::errors::ctx(format!("library[{i}]")))?;
-            lib.push(at_model_rate.arkit_frames());
-        }
-        own = lib;
-        &own
-    };
-    let method = match (chosen, &net) {
-        (MethodChoice::Linear, _) => Method::Linear,
-        (MethodChoice::Cubic, _) => Method::Cubic,
-        (MethodChoice::Retrieval, _) => Method::Retrieval(library, RetrievalOptions::for_variants(kind, r.variants)),
-        (MethodChoice::Network, Some(n)) => Method::Network(n as &dyn Inpainter),
-        (other, _) => return Err(JobError::Failed(format!("method {} could not be prepared", other.name()))),
-    };
+    resources.load_library_clips(&r.library, channels.is_some(), |i| format!("library[{i}]"))?;
     let mut job = EditJob {
         clip,
         spans: spans.clone(),
         channels,
         guide,
-        method,
+        method: resources.method(r.variants)?,
         seed: r.seed,
         limits,
         cancel: cancel.clone(),
         guide_file,
-        library: None,
-    };
-    // Retrieval draws from the library, and so do the shapes the guidance leaves unguided.
-    let unguided_rest = job.channel_split().1.iter().any(|c| *c);
-    job.library = match chosen {
-        MethodChoice::Retrieval => Some(library),
-        _ if unguided_rest => Some(default_library()),
-        _ => None,
+        library: resources.library.as_ref(),
     };
     job.validate()?;
     bar.phase(r.variants as u64, "editing the face");
@@ -319,12 +277,11 @@ fn face_edit<'py>(
         d.set_item("changed_shapes", (0..NUM_ARKIT).filter(|c| shapes[*c]).map(|c| names[c]).collect::<Vec<_>>())?;
         d.set_item("ms", v.ms)?;
         d.set_item("notes", &edited.notes)?;
+        // One copy each into the new arrays.
         let n = o.before.len();
-        let flat = |fr: &[[f32; NUM_ARKIT]]| fr.iter().flatten().copied().collect::<Vec<f32>>();
-        d.set_item("before", PyArray1::from_vec(py, flat(&o.before)).reshape([n, NUM_ARKIT])?)?;
-        d.set_item("after", PyArray1::from_vec(py, flat(&o.after)).reshape([n, NUM_ARKIT])?)?;
-        let mask: Vec<bool> = (0..n).flat_map(|f| o.mask.frame(f).to_vec()).collect();
-        d.set_item("mask", PyArray1::from_vec(py, mask).reshape([n, NUM_ARKIT])?)?;
+        d.set_item("before", PyArray1::from_slice(py, o.before.as_flattened()).reshape([n, NUM_ARKIT])?)?;
+        d.set_item("after", PyArray1::from_slice(py, o.after.as_flattened()).reshape([n, NUM_ARKIT])?)?;
+        d.set_item("mask", PyArray1::from_slice(py, o.mask.flags()).reshape([n, NUM_ARKIT])?)?;
         // The edited clip is moved, not copied.
         let edited_clip = FaceClip { clip: v.outcome.clip, source: clip.source.clone(), live_link: clip.live_link };
         out.push((edited_clip, d));

@@ -8,7 +8,7 @@
 //! rows the edit changed, so a 2 s span costs a few kilobytes however long the take.
 
 use std::path::Path;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex};
 
 use axum::body::Bytes;
 use axum::extract::{Query, State};
@@ -20,13 +20,10 @@ use inbetween_face::data::{
 };
 use inbetween_face::edit::distances::{distance_bases, distance_matrix, DISTANCE_NAMES};
 use inbetween_face::edit::groups::{parse_groups, Group};
-use inbetween_face::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
-use inbetween_face::infer::plan::{viseme_runs, MethodChoice};
-use inbetween_face::infer::{
-    EditJob, EditLimits, Guide, Inpainter, KeyPose, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED,
-};
-use inbetween_face::visemes::{parse_phoneme_csv, parse_textgrid, text_to_phonemes, Viseme};
-use inbetween_face::weights::{self, Network};
+use inbetween_face::edit::MotionLibrary;
+use inbetween_face::infer::plan::{viseme_runs, EditResources, GuideSource, MethodChoice};
+use inbetween_face::infer::{EditJob, EditLimits, Guide, KeyPose, Method};
+use inbetween_face::visemes::{parse_phoneme_csv, parse_textgrid, Viseme};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -63,33 +60,18 @@ enum GuideFile {
     Visemes(Vec<(f64, f64, Viseme)>),
 }
 
-/// The panel's take, its guide file, and what edits reuse (networks, the retrieval library).
+/// The panel's take and its guide file (the networks and the default retrieval library edits reuse
+/// are the face engine's, loaded once per process: `EditResources`).
 #[derive(Default)]
 pub struct FaceState {
     session: Mutex<Option<Session>>,
     guide: Mutex<Option<(String, Arc<GuideFile>)>>,
     version: std::sync::atomic::AtomicU64,
-    library: OnceLock<MotionLibrary>,
-    nets: Mutex<Vec<(ConstraintKind, Arc<Network>)>>,
 }
 
 impl FaceState {
     fn next_version(&self) -> u64 {
         self.version.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1
-    }
-
-    fn library(&self) -> &MotionLibrary {
-        self.library.get_or_init(|| MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED))
-    }
-
-    fn network(&self, kind: ConstraintKind) -> Result<Arc<Network>> {
-        let mut nets = self.nets.lock().unwrap_or_else(|p| p.into_inner());
-        if let Some((_, n)) = nets.iter().find(|(k, _)| *k == kind) {
-            return Ok(n.clone());
-        }
-        let n = Arc::new(weights::committed(kind).map_err(face_err)?);
-        nets.push((kind, n.clone()));
-        Ok(n)
     }
 }
 
@@ -374,8 +356,8 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
                 Guide::Keys(keys)
             }
             "text" => {
-                let ph = text_to_phonemes(&req.text, req.start_s, req.end_s).map_err(face_err)?;
-                Guide::Visemes(viseme_runs(&ph.spans).map_err(face_err)?)
+                let source = GuideSource::Text(&req.text, (req.start_s, req.end_s));
+                source.load(EditLimits::default().max_rows).map_err(face_err)?.guide
             }
             "noisy" | "visemes" => {
                 let g = state.face.guide.lock().unwrap_or_else(|p| p.into_inner()).clone();
@@ -401,26 +383,19 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
                 )))
             }
         };
-        let kind = guide.kind();
-        let chosen = MethodChoice::parse(&req.method)
-            .map_err(|e| StudioError::BadRequest(e.to_string().replace("invalid clip: ", "")))?
-            .resolve(kind, false);
-        let method_name = chosen.name();
-        let net = if chosen == MethodChoice::Network { Some(state.face.network(kind)?) } else { None };
-        let method = match chosen {
-            MethodChoice::Network => Method::Network(net.as_deref().expect("loaded above") as &dyn Inpainter),
-            MethodChoice::Retrieval => {
-                Method::Retrieval(state.face.library(), RetrievalOptions::for_variants(kind, req.variants as usize))
-            }
-            MethodChoice::Linear => Method::Linear,
-            _ => Method::Cubic,
-        };
+        let choice = MethodChoice::parse(&req.method)
+            .map_err(|e| StudioError::BadRequest(e.to_string().replace("invalid clip: ", "")))?;
+        let mut resources = EditResources::load_network(choice, guide.kind(), None)
+            .map_err(|e| StudioError::Engine(format!("{}: {}", e.what, e.source)))?;
+        resources.load_library(&[], channels.is_some(), EditLimits::default().max_rows).map_err(face_err)?;
+        let method_name = resources.chosen.name();
         let n = req.variants as usize;
+        let method = resources.method(n).map_err(face_err)?;
         let mut fills = Vec::with_capacity(n);
         for k in 0..n {
             job.progress(&format!("filling the span (variant {} of {n})", k + 1), 0.2 + 0.7 * k as f64 / n as f64);
             let seed = req.seed + k as u64;
-            fills.push(fill(&clip, &req, channels, guide.clone(), method, seed, state.face.library(), job)?);
+            fills.push(fill(&clip, &req, channels, guide.clone(), method, seed, resources.library.as_ref(), job)?);
         }
         let first = &fills[0];
         let v = state.face.next_version();
@@ -503,7 +478,7 @@ fn fill(
     guide: Guide,
     method: Method,
     seed: u64,
-    library: &MotionLibrary,
+    library: Option<&MotionLibrary>,
     job: &crate::jobs::Job,
 ) -> Result<Fill> {
     let out = EditJob {
@@ -516,7 +491,7 @@ fn fill(
         limits: EditLimits::default(),
         cancel: job.token().clone(),
         guide_file: None,
-        library: Some(library),
+        library,
     }
     .run()
     .map_err(face_err)?;

@@ -2,14 +2,16 @@
 //! the post-processing of a generated edit: keyframes hit exactly, C1 joins at the mask borders,
 //! weights in [0, 1] (the paper's §6 names exact hits as its limitation).
 //!
-//! Both work per channel on each erased run of that channel, with [`hermite`](super::hermite): the
-//! baseline interpolates the known values around the gap (and the keys inside it); the correction
-//! interpolates the *residual* `known − generated` at the same places and adds it to the generated
-//! curve, so the network's motion survives and only drifts at keys and borders are bent away.
+//! Both work per channel on each erased run of that channel, with a curve through knots
+//! ([`knot_curve`]: a core [`ScalarTrack`], the codebase's one Hermite): the baseline interpolates
+//! the known values around the gap (and the keys inside it); the correction interpolates the
+//! *residual* `known − generated` at the same places and adds it to the generated curve, so the
+//! network's motion survives and only drifts at keys and borders are bent away.
+
+use inbetween_core::curve::{Animatable, Curve, Interpolation, Key, ScalarTrack};
 
 use crate::data::NUM_ARKIT;
 
-use super::hermite::{hermite, linear, Knot};
 use super::mask::{Mask, Segment};
 use super::Frame;
 
@@ -20,6 +22,42 @@ pub enum Interp {
     Linear,
     /// Cubic Hermite matching the values and slopes at the gap's borders.
     Cubic,
+}
+
+/// A knot at frame (or time) `t` with value `v` and, when the curve must match a known derivative
+/// there, `slope` (per unit of `t`). Knots without a slope get a Catmull–Rom slope from their
+/// neighbours (central difference, one-sided at the ends).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Knot {
+    /// Frame or time (may be fractional).
+    pub t: f64,
+    /// Value.
+    pub v: f64,
+    /// Derivative per unit of `t`, if fixed.
+    pub slope: Option<f64>,
+}
+
+/// The curve through `knots` (sorted by `t`, distinct): cubic Hermite (C1, matching the given
+/// slopes) or linear, as a core [`ScalarTrack`], held flat outside the knots (a blendshape should not
+/// drift away from its last known value; sample it with [`Curve::sample_clamped`]). `None` without
+/// knots or with times that do not increase.
+pub fn knot_curve(knots: &[Knot], interp: Interp) -> Option<ScalarTrack> {
+    let last = knots.len().checked_sub(1)?;
+    let keys = (0..knots.len())
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(last));
+            let slope = knots[i].slope.unwrap_or_else(|| match a == b {
+                true => 0.0,
+                false => f64::finite_tangent((knots[a].t, knots[a].v), (knots[b].t, knots[b].v)),
+            });
+            Key { time: knots[i].t, value: knots[i].v, tangent: slope }
+        })
+        .collect();
+    let interpolation = match interp {
+        Interp::Cubic => Interpolation::Hermite,
+        Interp::Linear => Interpolation::Linear,
+    };
+    ScalarTrack::new(keys, interpolation).ok()
 }
 
 /// Erased runs of channel `c`.
@@ -106,11 +144,9 @@ fn apply_residual(base: &[Frame], anim: &[Frame], mask: &Mask, keys: &[(usize, F
             let key_residuals: Vec<(usize, f64)> =
                 ck.iter().map(|(f, v)| (*f, f64::from(*v) - f64::from(base[*f][c]))).collect();
             let knots = run_knots(run, frames, residual, &key_residuals, interp == Interp::Cubic);
+            let curve = knot_curve(&knots, interp);
             for (f, row) in out.iter_mut().enumerate().take(run.end).skip(run.start) {
-                let r = match interp {
-                    Interp::Cubic => hermite(&knots, f as f64),
-                    Interp::Linear => linear(&knots, f as f64),
-                };
+                let r = curve.as_ref().map_or(0.0, |k| k.sample_clamped(f as f64));
                 row[c] = (f64::from(base[f][c]) + r).clamp(0.0, 1.0) as f32;
             }
         }
@@ -121,6 +157,49 @@ fn apply_residual(base: &[Frame], anim: &[Frame], mask: &Mask, keys: &[(usize, F
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn cubic(knots: &[Knot], t: f64) -> f64 {
+        knot_curve(knots, Interp::Cubic).map_or(0.0, |c| c.sample_clamped(t))
+    }
+
+    fn linear(knots: &[Knot], t: f64) -> f64 {
+        knot_curve(knots, Interp::Linear).map_or(0.0, |c| c.sample_clamped(t))
+    }
+
+    fn k(t: f64, v: f64, slope: Option<f64>) -> Knot {
+        Knot { t, v, slope }
+    }
+
+    #[test]
+    fn passes_through_knots_and_matches_given_slopes() {
+        let knots = [k(0.0, 1.0, Some(0.5)), k(4.0, 2.0, None), k(10.0, 0.0, Some(-1.0))];
+        for kn in &knots {
+            assert!((cubic(&knots, kn.t) - kn.v).abs() < 1e-12);
+        }
+        let eps = 1e-6;
+        let d0 = (cubic(&knots, eps) - cubic(&knots, 0.0)) / eps;
+        assert!((d0 - 0.5).abs() < 1e-4, "{d0}");
+        let d1 = (cubic(&knots, 10.0) - cubic(&knots, 10.0 - eps)) / eps;
+        assert!((d1 + 1.0).abs() < 1e-4, "{d1}");
+        // C1 at the interior knot: left and right derivatives agree.
+        let l = (cubic(&knots, 4.0) - cubic(&knots, 4.0 - eps)) / eps;
+        let r = (cubic(&knots, 4.0 + eps) - cubic(&knots, 4.0)) / eps;
+        assert!((l - r).abs() < 1e-4, "{l} {r}");
+    }
+
+    #[test]
+    fn reproduces_a_cubic_given_its_end_slopes() {
+        let f = |t: f64| 0.01 * t * t * t - 0.1 * t * t + 0.3 * t + 1.0;
+        let df = |t: f64| 0.03 * t * t - 0.2 * t + 0.3;
+        let knots = [k(0.0, f(0.0), Some(df(0.0))), k(7.0, f(7.0), Some(df(7.0)))];
+        for i in 0..=70 {
+            let t = i as f64 / 10.0;
+            assert!((cubic(&knots, t) - f(t)).abs() < 1e-9);
+        }
+        assert_eq!(linear(&knots, 3.5), (f(0.0) + f(7.0)) / 2.0);
+        assert_eq!(cubic(&knots, -1.0), f(0.0));
+        assert_eq!(cubic(&[], 1.0), 0.0);
+    }
 
     fn wave(n: usize, phase: f32) -> Vec<Frame> {
         (0..n).map(|f| [0.5 + 0.3 * ((f as f32) * 0.15 + phase).sin(); NUM_ARKIT]).collect()

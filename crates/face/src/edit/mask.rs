@@ -83,6 +83,11 @@ impl Mask {
         self.erased[f * NUM_ARKIT + c]
     }
 
+    /// Every flag, frame-major (`frames × 52`, in [`crate::data::ARKIT_NAMES`] order).
+    pub fn flags(&self) -> &[bool] {
+        &self.erased
+    }
+
     /// The 52 flags of frame `f`.
     pub fn frame(&self, f: usize) -> &[bool] {
         &self.erased[f * NUM_ARKIT..(f + 1) * NUM_ARKIT]

@@ -5,7 +5,6 @@ pub mod constraints;
 pub mod distances;
 pub mod fill;
 pub mod groups;
-pub mod hermite;
 pub mod mask;
 pub mod retrieve;
 pub mod seam;

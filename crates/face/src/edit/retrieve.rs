@@ -34,21 +34,25 @@ use inbetween_core::interp::smoothstep;
 
 use crate::data::NUM_ARKIT;
 
+use std::sync::Arc;
+
 use super::constraints::{Constraint, ConstraintKind};
 use super::groups::Group;
 use super::mask::{Mask, Segment};
 use super::Frame;
 
-/// Motion to fill gaps from: clips at the model rate (25 fps).
+/// Motion to fill gaps from: clips at the model rate (25 fps). A clone shares the frames (the
+/// default library is made once per process and handed to every edit,
+/// [`crate::infer::setup::default_library`]).
 #[derive(Clone, Debug, Default)]
 pub struct MotionLibrary {
-    clips: Vec<Vec<Frame>>,
+    clips: Arc<Vec<Vec<Frame>>>,
 }
 
 impl MotionLibrary {
     /// A library of clips (each at the model rate).
     pub fn new(clips: Vec<Vec<Frame>>) -> Self {
-        MotionLibrary { clips }
+        MotionLibrary { clips: Arc::new(clips) }
     }
 
     /// `seconds` of procedural faces (blinks, speech, expressions, gaze) in 20 s clips, drawn with `seed`.
@@ -56,12 +60,12 @@ impl MotionLibrary {
         let n = (seconds / 20.0).ceil().max(1.0) as usize;
         let clips =
             crate::procedural::generate_corpus(n, 20.0, seed).into_iter().map(|p| p.clip.arkit_frames()).collect();
-        MotionLibrary { clips }
+        MotionLibrary::new(clips)
     }
 
-    /// Add a clip.
+    /// Add a clip (to this library only: a clone that shared the frames keeps its own).
     pub fn push(&mut self, clip: Vec<Frame>) {
-        self.clips.push(clip);
+        Arc::make_mut(&mut self.clips).push(clip);
     }
 
     /// Frames in all clips.

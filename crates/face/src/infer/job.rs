@@ -13,7 +13,7 @@
 use std::collections::BTreeMap;
 
 use crate::data::{BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT, NUM_HEAD_EYE};
-use crate::edit::hermite::{hermite, Knot};
+use crate::edit::fill::{knot_curve, Knot};
 use crate::edit::seam::{is_eye_channel, join_borders, limit_eye_holds, limit_hold, JOIN_FADE_S};
 use crate::edit::{
     correct, interpolate, retrieve, Constraint, ConstraintKind, Frame, Interp, Mask, MotionLibrary, RetrievalOptions,
@@ -23,8 +23,9 @@ use crate::model::input;
 use crate::visemes::Viseme;
 
 use super::keys::KeyPose;
-use super::plan::guided_channels;
+use crate::edit::groups::guided_channels;
 use inbetween_core::cancel::Cancel;
+use inbetween_core::curve::Curve;
 use inbetween_io::LimitExceeded;
 
 /// The limits of an edit, checked by [`EditJob::validate`] before any work: the cost of an edit
@@ -112,7 +113,7 @@ pub struct EditJob<'a> {
     pub spans: Vec<(f64, f64)>,
     /// ARKit shapes to regenerate (others stay exactly as they are), the guidance acting on all of
     /// them; `None` (the default of `face edit` and the studio): every shape, the guidance acting on
-    /// the shapes it means something for ([`super::plan::guided_channels`]: the speech groups for
+    /// the shapes it means something for ([`crate::edit::groups::guided_channels`]: the speech groups for
     /// visemes) and the others filled as an unguided edit is, by retrieval from `library` and the
     /// clip itself.
     pub channels: Option<[bool; NUM_ARKIT]>,
@@ -153,7 +154,8 @@ impl EditOutcome {
     /// model rate (blendshape weight², how much the fill departs from the input it replaced).
     pub fn masked_mse(&self) -> f64 {
         let (mut sq, mut count) = (0.0f64, 0usize);
-        for f in 0..self.mask.frames() {
+        // Frames with an erased entry only (the same entries in the same order as every frame).
+        for f in self.mask.segments().into_iter().flat_map(|s| s.start..s.end) {
             for c in 0..NUM_ARKIT {
                 if self.mask.erased(f, c) {
                     sq += f64::from(self.after[f][c] - self.before[f][c]).powi(2);
@@ -164,12 +166,17 @@ impl EditOutcome {
         sq / count.max(1) as f64
     }
 
-    /// The rows of `input` (the clip the job edited) that the edit changed, `first..last + 1`
-    /// (`0..0` when none), and the ARKit shapes changed there.
+    /// The rows of `input` (the clip the job edited) that the edit changed (any value not bit for bit
+    /// the input's), `first..last + 1` (`0..0` when none), and the ARKit shapes changed there.
     pub fn changed(&self, input: &BlendshapeClip) -> (std::ops::Range<usize>, [bool; NUM_ARKIT]) {
         let (old, new) = (input.values(), self.clip.values());
         let stride = input.num_channels();
-        let differs = |f: &usize| old[f * stride..(f + 1) * stride] != new[f * stride..(f + 1) * stride];
+        // Bits compared without an early exit inside a row, so the scan of the unchanged rows
+        // vectorises (a face edit's report reads this for every variant).
+        let differs = |f: &usize| {
+            let row = f * stride..(f + 1) * stride;
+            old[row.clone()].iter().zip(&new[row]).fold(0u32, |acc, (a, b)| acc | (a.to_bits() ^ b.to_bits())) != 0
+        };
         let first = (0..input.num_frames()).find(differs);
         let last = (0..input.num_frames()).rev().find(differs);
         let rows = match (first, last) {
@@ -179,7 +186,7 @@ impl EditOutcome {
         let mut shapes = [false; NUM_ARKIT];
         for f in rows.clone() {
             for (c, ch) in shapes.iter_mut().enumerate() {
-                *ch |= old[f * stride + c] != new[f * stride + c];
+                *ch |= old[f * stride + c].to_bits() != new[f * stride + c].to_bits();
             }
         }
         (rows, shapes)
@@ -591,11 +598,9 @@ fn fill_head_eye(values: &mut [f32], stride: usize, times: &[f64], inside: &[boo
                 let slope = (end + 1 < n).then(|| (v(end + 1) - v(end)) / (times[end + 1] - times[end]));
                 knots.push(Knot { t: times[end], v: v(end), slope });
             }
-            if knots.is_empty() {
-                continue;
-            }
+            let Some(curve) = knot_curve(&knots, Interp::Cubic) else { continue };
             for i in start..end {
-                values[i * stride + c] = hermite(&knots, times[i]) as f32;
+                values[i * stride + c] = curve.sample_clamped(times[i]) as f32;
             }
         }
     }

@@ -1,17 +1,21 @@
 //! The policy of an edit that the front ends used to carry each on their own (issues 40 and 43): the
-//! `auto` method rule, viseme runs from phoneme timings, spans given in seconds or frames, the
-//! groups each guidance acts on, and where the shared captures are. `face edit`, the studio's face
-//! panel and the tests build their [`super::EditJob`] with these, so the rules live in one place.
+//! `auto` method rule, what the method loads ([`EditResources`]), the guidance read from what the
+//! user gave ([`GuideSource`]), viseme runs from phoneme timings, spans given in seconds or frames,
+//! the groups each guidance acts on, and where the shared captures are. `face edit`, the studio's
+//! face panel, the Python package, the batch runner and the tests build their [`super::EditJob`] with
+//! these, so the rules live in one place.
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
 
-use crate::data::{read_clip_limited, BlendshapeClip, FaceError, MODEL_FPS, NUM_ARKIT};
-use crate::edit::groups::Group;
+use crate::data::{read_clip_limited, BlendshapeClip, FaceError, MODEL_FPS};
 use crate::edit::mask::{parse_span_spec, SpanSpec};
 use crate::edit::{ConstraintKind, MotionLibrary, RetrievalOptions};
-use crate::infer::{Inpainter, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
-use crate::visemes::{phoneme_viseme, PhonemeSpan, Viseme};
+use crate::infer::{read_keys, Guide, Inpainter, KeyPose, Method, DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED};
+use crate::visemes::{phoneme_viseme, read_viseme_source, text_to_phonemes, validate_spans, PhonemeSpan, Viseme};
 use crate::weights::Network;
+
+pub use crate::edit::groups::{guided_channels, SPEECH_GROUPS};
 
 /// How an edit is asked to fill, before [`MethodChoice::resolve`] applies the `auto` rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,19 +74,44 @@ impl MethodChoice {
     }
 }
 
+/// The procedural retrieval library ([`DEFAULT_LIBRARY_S`] seconds, seed [`DEFAULT_LIBRARY_SEED`]):
+/// made once per process; every call hands out a clone sharing its frames.
+pub fn default_library() -> MotionLibrary {
+    static LIBRARY: OnceLock<MotionLibrary> = OnceLock::new();
+    LIBRARY.get_or_init(|| MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED)).clone()
+}
+
+/// The committed network for guidance `kind` ([`crate::weights::committed`]), loaded once per
+/// process and shared by every edit after (the studio's, Python's and the batch runner's many edits).
+pub fn committed_network(kind: ConstraintKind) -> Result<Arc<Network>, FaceError> {
+    static NETWORKS: Mutex<Vec<(ConstraintKind, Arc<Network>)>> = Mutex::new(Vec::new());
+    let mut nets = NETWORKS.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some((_, n)) = nets.iter().find(|(k, _)| *k == kind) {
+        return Ok(n.clone());
+    }
+    let n = Arc::new(crate::weights::committed(kind)?);
+    nets.push((kind, n.clone()));
+    Ok(n)
+}
+
 /// The library retrieval draws from: the clips in `files` at the model rate (each at most `max_rows`
-/// rows), or the procedural library ([`DEFAULT_LIBRARY_S`] seconds, seed [`DEFAULT_LIBRARY_SEED`])
-/// when none is given.
+/// rows), or the procedural library ([`default_library`]) when none is given.
 pub fn retrieval_library(files: &[PathBuf], max_rows: usize) -> Result<MotionLibrary, FaceError> {
     if files.is_empty() {
-        return Ok(MotionLibrary::procedural(DEFAULT_LIBRARY_S, DEFAULT_LIBRARY_SEED));
+        return Ok(default_library());
     }
+    let clips = files.iter().map(|f| read_clip_limited(f, max_rows)).collect::<Result<Vec<_>, _>>()?;
+    library_of_clips(&clips, |i| files[i].display().to_string())
+}
+
+/// A retrieval library of `clips` (at any frame rate, resampled to the model rate); a clip that
+/// cannot be resampled is an error naming it by `name(index)`.
+pub fn library_of_clips(clips: &[BlendshapeClip], name: impl Fn(usize) -> String) -> Result<MotionLibrary, FaceError> {
     let mut lib = MotionLibrary::default();
-    for f in files {
-        let clip = read_clip_limited(f, max_rows)?
-            .resample(MODEL_FPS)
-            .map_err(|e| FaceError::File { file: f.display().to_string(), message: e.to_string() })?;
-        lib.push(clip.arkit_frames());
+    for (i, c) in clips.iter().enumerate() {
+        let at_model_rate =
+            c.resample(MODEL_FPS).map_err(|e| FaceError::File { file: name(i), message: e.to_string() })?;
+        lib.push(at_model_rate.arkit_frames());
     }
     Ok(lib)
 }
@@ -101,14 +130,17 @@ pub struct SetupError {
 
 /// What an edit's method needs loaded: the network (for [`MethodChoice::Network`]) and the retrieval
 /// library (for [`MethodChoice::Retrieval`], and for the groups viseme guidance leaves unguided).
-/// `face edit`'s setup, in the engine so every front end builds the same [`Method`].
+/// The one setup of every front end (`face edit`, the studio's face panel, `inbetween.face.edit`,
+/// the batch runner's `face-edit`), so all build the same [`Method`] and [`super::EditJob::library`]. The
+/// committed networks and the default library are loaded once per process ([`committed_network`],
+/// [`default_library`]).
 pub struct EditResources {
     /// The method, `auto` resolved ([`MethodChoice::resolve`]).
     pub chosen: MethodChoice,
     /// The guidance the edit follows.
     pub kind: ConstraintKind,
     /// The loaded network, when the method is the network.
-    pub network: Option<Network>,
+    pub network: Option<Arc<Network>>,
     /// The retrieval library, when the method or the unguided groups draw from it.
     pub library: Option<MotionLibrary>,
 }
@@ -123,11 +155,11 @@ impl EditResources {
     ) -> Result<EditResources, SetupError> {
         let chosen = choice.resolve(kind, weights.is_some());
         let network = match (chosen, weights) {
-            (MethodChoice::Network, Some(w)) => Some(
+            (MethodChoice::Network, Some(w)) => Some(Arc::new(
                 crate::weights::load(w)
                     .map_err(|source| SetupError { what: format!("loading face weights {}", w.display()), source })?,
-            ),
-            (MethodChoice::Network, None) => Some(crate::weights::committed(kind).map_err(|source| SetupError {
+            )),
+            (MethodChoice::Network, None) => Some(committed_network(kind).map_err(|source| SetupError {
                 what: format!("loading the committed {} network", kind.name()),
                 source,
             })?),
@@ -140,10 +172,32 @@ impl EditResources {
     /// when the method is retrieval, or the default one when the guidance is visemes and
     /// `groups_given` is false (the groups the visemes leave unguided are drawn from it).
     pub fn load_library(&mut self, files: &[PathBuf], groups_given: bool, max_rows: usize) -> Result<(), FaceError> {
+        self.set_library(groups_given, || retrieval_library(files, max_rows))
+    }
+
+    /// [`EditResources::load_library`] from clips in memory ([`library_of_clips`], named
+    /// `name(index)` in errors; the default library when `clips` is empty).
+    pub fn load_library_clips(
+        &mut self,
+        clips: &[BlendshapeClip],
+        groups_given: bool,
+        name: impl Fn(usize) -> String,
+    ) -> Result<(), FaceError> {
+        self.set_library(groups_given, || match clips {
+            [] => Ok(default_library()),
+            _ => library_of_clips(clips, name),
+        })
+    }
+
+    fn set_library(
+        &mut self,
+        groups_given: bool,
+        chosen_library: impl FnOnce() -> Result<MotionLibrary, FaceError>,
+    ) -> Result<(), FaceError> {
         let unguided_rest = !groups_given && self.kind == ConstraintKind::Visemes;
         self.library = match self.chosen {
-            MethodChoice::Retrieval => Some(retrieval_library(files, max_rows)?),
-            _ if unguided_rest => Some(retrieval_library(&[], max_rows)?),
+            MethodChoice::Retrieval => Some(chosen_library()?),
+            _ if unguided_rest => Some(default_library()),
             _ => None,
         };
         Ok(())
@@ -162,10 +216,68 @@ impl EditResources {
                 RetrievalOptions::for_variants(self.kind, variants),
             ),
             MethodChoice::Network => {
-                Method::Network(self.network.as_ref().ok_or_else(|| missing("network"))? as &dyn Inpainter)
+                Method::Network(self.network.as_deref().ok_or_else(|| missing("network"))? as &dyn Inpainter)
             }
             MethodChoice::Auto => return Err(missing("resolved method")),
         })
+    }
+}
+
+/// Where an edit's guidance comes from, as the front ends receive it. [`GuideSource::load`] turns
+/// it into the job's [`Guide`] the same way for all of them: keys read, a noisy take read (at most
+/// the edit's `max_rows` rows), phoneme timings checked, text pronounced (CMUdict, then the
+/// letter-to-sound rules), phonemes made viseme runs ([`viseme_runs`]).
+pub enum GuideSource<'a> {
+    /// Unguided.
+    None,
+    /// A keys file ([`crate::infer::read_keys`]).
+    KeysFile(&'a Path),
+    /// Keys already parsed.
+    Keys(Vec<KeyPose>),
+    /// A noisy take of the same performance, as a clip file.
+    TakeFile(&'a Path),
+    /// A noisy take in memory.
+    Take(BlendshapeClip),
+    /// A TextGrid (with the tier to read, default the phones tier) or a phoneme CSV / JSON file.
+    VisemesFile(&'a Path, Option<&'a str>),
+    /// Timed phonemes (ARPAbet or MFA labels), checked like a file's ([`validate_spans`]).
+    Phonemes(Vec<PhonemeSpan>),
+    /// English words spoken over `span` (seconds from the clip's first frame).
+    Text(&'a str, (f64, f64)),
+}
+
+/// A loaded guidance: the job's [`Guide`], the file it came from (for [`super::EditJob::guide_file`]) and
+/// the words of a text that CMUdict does not list (pronounced by the letter-to-sound rules; the
+/// front ends say so).
+pub struct LoadedGuide {
+    pub guide: Guide,
+    pub file: Option<String>,
+    pub guessed_words: Vec<String>,
+}
+
+impl GuideSource<'_> {
+    /// The guidance, read and checked (see [`GuideSource`]); `max_rows` bounds a noisy take's rows.
+    pub fn load(self, max_rows: usize) -> Result<LoadedGuide, FaceError> {
+        let shown = |p: &Path| Some(p.display().to_string());
+        let (guide, file, guessed_words) = match self {
+            GuideSource::None => (Guide::None, None, Vec::new()),
+            GuideSource::KeysFile(p) => (Guide::Keys(read_keys(p)?), shown(p), Vec::new()),
+            GuideSource::Keys(keys) => (Guide::Keys(keys), None, Vec::new()),
+            GuideSource::TakeFile(p) => (Guide::Noisy(read_clip_limited(p, max_rows)?), shown(p), Vec::new()),
+            GuideSource::Take(clip) => (Guide::Noisy(clip), None, Vec::new()),
+            GuideSource::VisemesFile(p, tier) => {
+                (Guide::Visemes(viseme_runs(&read_viseme_source(p, tier)?)?), shown(p), Vec::new())
+            }
+            GuideSource::Phonemes(spans) => {
+                validate_spans(&spans)?;
+                (Guide::Visemes(viseme_runs(&spans)?), None, Vec::new())
+            }
+            GuideSource::Text(text, (start_s, end_s)) => {
+                let ph = text_to_phonemes(text, start_s, end_s)?;
+                (Guide::Visemes(viseme_runs(&ph.spans)?), None, ph.guessed_words)
+            }
+        };
+        Ok(LoadedGuide { guide, file, guessed_words })
     }
 }
 
@@ -174,19 +286,6 @@ impl EditResources {
 pub fn keeps_live_link(input: &Path, out: &Path) -> bool {
     let ext = |p: &Path, e: &str| p.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
     ext(input, "csv") && !ext(out, "json") && crate::data::is_live_link(input)
-}
-
-/// The groups speech moves, which viseme guidance (text, TextGrid, phoneme timings) drives when the
-/// edit names no groups: jaw, mouth, cheeks (and nose), tongue.
-pub const SPEECH_GROUPS: [Group; 4] = [Group::Jaw, Group::Mouth, Group::Cheeks, Group::Tongue];
-
-/// The shapes a guidance acts on when the edit names no groups: the speech groups for visemes,
-/// every shape otherwise (keys and a noisy take say something about the whole face).
-pub fn guided_channels(kind: ConstraintKind) -> [bool; NUM_ARKIT] {
-    match kind {
-        ConstraintKind::Visemes => std::array::from_fn(|c| SPEECH_GROUPS.iter().any(|g| g.contains(c))),
-        _ => [true; NUM_ARKIT],
-    }
 }
 
 /// Phoneme spans as viseme runs `(start_s, end_s, viseme)`; a phoneme with no viseme class is an
@@ -252,7 +351,7 @@ pub fn captures_dir(given: Option<&Path>) -> Result<PathBuf, FaceError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::data::arkit_index;
+    use crate::data::{arkit_index, NUM_ARKIT};
 
     #[test]
     fn auto_picks_per_guidance_and_weights_mean_the_network() {
