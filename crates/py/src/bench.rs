@@ -1,6 +1,11 @@
 //! The Rust side of `python -m inbetween.bench`: the same work each Python function does (the same
-//! functions of this crate, minus the Python argument and result conversion, the worker thread
-//! and the GIL), timed in Rust, so the bench can put the two side by side on the same input.
+//! functions of this crate, minus the Python argument and result conversion and the GIL), timed in
+//! Rust, so the bench can put the two side by side on the same input. `pool=True` runs it on a
+//! thread of rayon's pool, where the Python functions run their jobs ([`crate::runner::run_job`]):
+//! the same thread kind, allocator arena and pool as the Python call, so only the Python side's own
+//! work differs; `pool=False` on the calling thread, as the CLI runs a job (the process's main
+//! thread, whose allocator hands memory back after a call and faults it in again on the next:
+//! 1353 page faults per face edit with a key there, none on a pool thread).
 
 use crate::clip::{Clip, FaceClip};
 use crate::errors::{invalid, JobError};
@@ -18,13 +23,52 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_bench_sample_rust, m)?)?;
     m.add_function(wrap_pyfunction!(_bench_face_rust, m)?)?;
     m.add_function(wrap_pyfunction!(_bench_video_rust, m)?)?;
+    m.add_function(wrap_pyfunction!(_rayon_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(_build_profile, m)?)?;
     Ok(())
+}
+
+/// The build profile of this extension: `release`, or `dev` (debug assertions on; the workspace's
+/// dev profile still optimises, opt-level 2 and 3 for dependencies).
+#[pyfunction]
+fn _build_profile() -> &'static str {
+    if cfg!(debug_assertions) {
+        "dev"
+    } else {
+        "release"
+    }
+}
+
+/// The threads of rayon's pool (the engines' parallel work and the Python jobs run there; set by
+/// `RAYON_NUM_THREADS` before the first job).
+#[pyfunction]
+fn _rayon_threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// Milliseconds of each of `repeats` runs of `run`, with the GIL released: on a thread of rayon's
+/// pool when `pool`, else on the calling thread.
+fn timed<E: Send>(
+    py: Python<'_>,
+    repeats: usize,
+    pool: bool,
+    run: impl Fn() -> Result<(), E> + Send + Sync,
+) -> Result<Vec<f64>, E> {
+    let all = || {
+        (0..repeats)
+            .map(|_| {
+                let t = Instant::now();
+                run().map(|_| t.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect::<Result<Vec<f64>, E>>()
+    };
+    py.detach(|| if pool { rayon::scope(|_| all()) } else { all() })
 }
 
 /// Milliseconds of each of `repeats` runs of `what` ("read", "select", "reconstruct",
 /// "compress") on `clip`, called from Rust.
 #[pyfunction]
-#[pyo3(signature = (what, clip, repeats, method=None, k=None, bound_cm=None, keys=None, max_error_cm=None))]
+#[pyo3(signature = (what, clip, repeats, method=None, k=None, bound_cm=None, keys=None, max_error_cm=None, pool=true))]
 #[allow(clippy::too_many_arguments)]
 fn _bench_rust(
     py: Python<'_>,
@@ -36,6 +80,7 @@ fn _bench_rust(
     bound_cm: Option<f64>,
     keys: Option<Vec<usize>>,
     max_error_cm: Option<f64>,
+    pool: bool,
 ) -> PyResult<Vec<f64>> {
     let clip: &Clip = &clip;
     let (cancel, progress) = (Cancel::new(), Progress::hidden());
@@ -58,15 +103,7 @@ fn _bench_rust(
         }
         other => return Err(invalid(format!("unknown bench job {other:?}"))),
     };
-    py.detach(|| {
-        (0..repeats)
-            .map(|_| {
-                let t = Instant::now();
-                run().map(|_| t.elapsed().as_secs_f64() * 1e3)
-            })
-            .collect::<Result<Vec<f64>, JobError>>()
-    })
-    .map_err(JobError::into_py)
+    timed(py, repeats, pool, run).map_err(JobError::into_py)
 }
 
 /// Nanoseconds per pose of `inbetween_ibk::Clip::sample` at each of `times`, in Rust, into
@@ -92,7 +129,8 @@ fn _bench_sample_rust(py: Python<'_>, data: Vec<u8>, times: Vec<f64>) -> PyResul
 /// and run `variants` times from `seed`) on `clip` over `spans` (seconds), unguided or with
 /// `keys_json`, called from Rust.
 #[pyfunction]
-#[pyo3(signature = (clip, spans, repeats, variants=1, seed=1, keys_json=None))]
+#[pyo3(signature = (clip, spans, repeats, variants=1, seed=1, keys_json=None, pool=true))]
+#[allow(clippy::too_many_arguments)]
 fn _bench_face_rust(
     py: Python<'_>,
     clip: PyRef<'_, FaceClip>,
@@ -101,6 +139,7 @@ fn _bench_face_rust(
     variants: usize,
     seed: u64,
     keys_json: Option<String>,
+    pool: bool,
 ) -> PyResult<Vec<f64>> {
     let request = EditRequest {
         spans: spans.into_iter().map(|(a, b)| SpanArg::Seconds(a, b)).collect(),
@@ -111,23 +150,15 @@ fn _bench_face_rust(
         ..EditRequest::default()
     };
     let input = &clip.clip;
-    py.detach(|| {
-        (0..repeats)
-            .map(|_| {
-                let t = Instant::now();
-                face::edit(input, &request, &Cancel::new(), &Progress::hidden())
-                    .map(|_| t.elapsed().as_secs_f64() * 1e3)
-            })
-            .collect::<Result<Vec<f64>, JobError>>()
-    })
-    .map_err(JobError::into_py)
+    timed(py, repeats, pool, || face::edit(input, &request, &Cancel::new(), &Progress::hidden()).map(|_| ()))
+        .map_err(JobError::into_py)
 }
 
 /// Milliseconds of each of `repeats` runs of `video.resequence`'s work ([`video::resequence`]:
 /// the clip read and analysed, the metric from its cache once trained, the walk measured and
 /// explained) on `path` from `start`, `length` frames, called from Rust.
 #[pyfunction]
-#[pyo3(signature = (path, repeats, start=0, length=None, seed=1, metric="rsfnet".to_string(), cache_dir=None))]
+#[pyo3(signature = (path, repeats, start=0, length=None, seed=1, metric="rsfnet".to_string(), cache_dir=None, pool=true))]
 #[allow(clippy::too_many_arguments)]
 fn _bench_video_rust(
     py: Python<'_>,
@@ -138,6 +169,7 @@ fn _bench_video_rust(
     seed: u64,
     metric: String,
     cache_dir: Option<std::path::PathBuf>,
+    pool: bool,
 ) -> PyResult<Vec<f64>> {
     let request = ResequenceRequest {
         path,
@@ -150,14 +182,6 @@ fn _bench_video_rust(
         cache_dir,
         ..ResequenceRequest::default()
     };
-    py.detach(|| {
-        (0..repeats)
-            .map(|_| {
-                let t = Instant::now();
-                video::resequence(&request, &Cancel::new(), &Progress::hidden())
-                    .map(|_| t.elapsed().as_secs_f64() * 1e3)
-            })
-            .collect::<Result<Vec<f64>, JobError>>()
-    })
-    .map_err(JobError::into_py)
+    timed(py, repeats, pool, || video::resequence(&request, &Cancel::new(), &Progress::hidden()).map(|_| ()))
+        .map_err(JobError::into_py)
 }

@@ -218,6 +218,7 @@ def _bench_rust(
     bound_cm: Optional[float] = None,
     keys: Optional[List[int]] = None,
     max_error_cm: Optional[float] = None,
+    pool: bool = True,
 ) -> List[float]: ...
 def _bench_sample_rust(data: bytes, times: List[float]) -> float: ...
 def _bench_face_rust(
@@ -227,6 +228,7 @@ def _bench_face_rust(
     variants: int = 1,
     seed: int = 1,
     keys_json: Optional[str] = None,
+    pool: bool = True,
 ) -> List[float]: ...
 def _panic_in_job() -> None: ...
 def _bench_video_rust(
@@ -237,4 +239,7 @@ def _bench_video_rust(
     seed: int = 1,
     metric: str = "rsfnet",
     cache_dir: Optional[_Path] = None,
+    pool: bool = True,
 ) -> List[float]: ...
+def _rayon_threads() -> int: ...
+def _build_profile() -> str: ...
