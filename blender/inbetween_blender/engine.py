@@ -34,6 +34,9 @@ def require():
 #: The curve Blender evaluates for a pose bone in quaternion mode with FREE handles a third of a
 #: segment out: per-component cubic Hermite, normalised (mocap's `RotationCurve::QuaternionBezier`).
 CURVE = "quaternion_bezier"
+#: The curve Blender evaluates for pose bones in Euler modes (three Bezier F-curves, composed after
+#: the bone's rest rotation), the others as CURVE (mocap's `RotationCurve::EulerBezier`).
+EULER_CURVE = "euler_bezier"
 
 
 def _has(fn, name: str) -> bool:
@@ -43,16 +46,19 @@ def _has(fn, name: str) -> bool:
         return False
 
 
-def select_keys(clip, method: str, bound_cm, k, progress=None, bound_deg=None):
-    """Key frames of `clip` chosen for Blender's curve: `inbetween.mocap.select_keys` with
-    `curve="quaternion_bezier"`, so the engine's bounds (cm, and degrees when given) hold on what
-    Blender plays for quaternion bones."""
+def select_keys(clip, method: str, bound_cm, k, progress=None, bound_deg=None, euler=None):
+    """Key frames of `clip` chosen for Blender's curves: `inbetween.mocap.select_keys` with
+    `curve="quaternion_bezier"`, or with `euler` (a dict of `euler_orders`, `pre_rotations`,
+    `euler_reference`) `curve="euler_bezier"`, so the engine's bounds (cm, and degrees when given)
+    hold on what Blender plays for quaternion and Euler bones."""
     from .jobs import JobError
 
     mocap = require().mocap
     if not _has(mocap.select_keys, "curve"):
         raise JobError("this inbetween package has no Blender curve (select_keys(curve=...)); update it")
-    kwargs = {"method": method, "progress": progress, "curve": CURVE}
+    if euler and not _has(mocap.select_keys, "euler_orders"):
+        raise JobError("this inbetween package has no Euler curve (select_keys(euler_orders=...)); update it")
+    kwargs = {"method": method, "progress": progress, "curve": EULER_CURVE if euler else CURVE, **(euler or {})}
     if bound_cm is not None:
         kwargs["max_error_cm"] = bound_cm
         if bound_deg:
@@ -62,13 +68,18 @@ def select_keys(clip, method: str, bound_cm, k, progress=None, bound_deg=None):
     return mocap.select_keys(clip, **kwargs)
 
 
-def bezier_handles(clip, frames) -> dict:
+def bezier_handles(clip, frames, euler=None) -> dict:
     """Per key and joint the value and both handles of every channel (`inbetween.mocap.
     bezier_handles`): `frames`, `left_frames`, `right_frames` `[K]`; `rotations`,
     `rotations_left`, `rotations_right` `[K, J, 4]` (x, y, z, w); `translations_cm`,
-    `translations_left_cm`, `translations_right_cm` `[K, J, 3]`."""
-    out = require().mocap.bezier_handles(clip, [int(f) for f in frames])
-    return {name: getattr(out, name) for name in _BEZIER_FIELDS}
+    `translations_left_cm`, `translations_right_cm` `[K, J, 3]`; with `euler` (as for
+    `select_keys`) `euler`, `euler_left`, `euler_right` `[K, J, 3]` (x, y, z, radians)."""
+    mocap = require().mocap
+    if euler:
+        out = mocap.bezier_handles(clip, [int(f) for f in frames], curve=EULER_CURVE, **euler)
+    else:
+        out = mocap.bezier_handles(clip, [int(f) for f in frames])
+    return {name: getattr(out, name, None) for name in _BEZIER_FIELDS}
 
 
 _BEZIER_FIELDS = (
@@ -81,4 +92,7 @@ _BEZIER_FIELDS = (
     "translations_cm",
     "translations_left_cm",
     "translations_right_cm",
+    "euler",
+    "euler_left",
+    "euler_right",
 )

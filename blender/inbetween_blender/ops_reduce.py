@@ -18,7 +18,7 @@ METHOD_ITEMS = [
 ]
 
 ROTATION_ITEMS = [
-    ("KEEP", "Keep Mode", "Euler bones keep Euler curves (keys are added where they leave the bound)"),
+    ("KEEP", "Keep Mode", "Euler bones keep Euler curves, keys chosen for them (and added where Blender's curve still leaves the bound)"),
     (
         "QUATERNION",
         "Quaternion",

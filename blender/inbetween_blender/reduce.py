@@ -12,11 +12,13 @@ Blender evaluates for FREE handles a third of a segment out), mapped into the bo
 `rest_rel⁻¹ ⊗ ·` (a fixed unit quaternion on the left is an orthogonal map of the four components,
 so it commutes with component-wise Hermite and with normalising). A bone in an Euler mode keeps
 Euler curves (so the original action still plays with the bone's mode unchanged, and keys outside
-a frame range are untouched): the values at the keys are the original curves' own, the slopes the
-engine's angular velocity through the Euler rate map (Ė = J(E)⁻¹ ω). Euler Hermite is not the
-engine's model, so the bound is then measured in Blender and, where it is exceeded, the selection
-is run again at a tighter bound until it holds (`rounds` in the result). The same check and
-tightening apply to every bone, and to the optional bound in degrees.
+a frame range are untouched), chosen for them: the engine's `euler_bezier` curve plays each such
+joint as `rest_rel ⊗ R(E)`, a cubic Hermite per angle of the bone's own Euler values (its mode's
+order, the original curves' values as the reference so the keys carry them) with slopes the Euler
+rates `Ė = J(E)⁻¹ ω`; the engine gives the values and handles, which are what Blender evaluates.
+The bound is then measured in Blender on every frame; where it is exceeded (float32 storage, an
+angle bound the engine bounds on local rotations only), the worst frame of each such segment
+becomes a key, until it holds (`rounds` in the result; `engine_keys` the engine's own count).
 """
 
 from __future__ import annotations
@@ -134,36 +136,13 @@ class ReduceResult:
         return s
 
 
-def _euler_matrix(order: str, e) -> np.ndarray:
-    from mathutils import Euler
-
-    return np.array(Euler(e, order).to_matrix())
+EULER_MODES = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 
 
-def euler_rates(order: str, e: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Euler angle rates Ė (per second) of a rotation R(E) turning at body-frame angular
-    velocity ω (Rᵀ Ṙ = [ω]×): Ė = J⁻¹ ω, J's columns vee(Rᵀ ∂R/∂E_k) by central differences."""
-    h = 1e-6
-    r = _euler_matrix(order, e)
-    jac = np.zeros((3, 3))
-    for k in range(3):
-        d = np.zeros(3)
-        d[k] = h
-        dr = (_euler_matrix(order, e + d) - _euler_matrix(order, e - d)) / (2 * h)
-        w = r.T @ dr
-        jac[:, k] = [w[2, 1], w[0, 2], w[1, 0]]
-    sol, *_ = np.linalg.lstsq(jac, omega, rcond=1e-9)
-    return sol
-
-
-def _handles(frames: np.ndarray, values: np.ndarray, slopes: np.ndarray):
-    """FREE handles a third of each side's segment out along the slope (per frame): `(K, 2)` each."""
-    gaps = np.diff(frames).astype(np.float64)
-    before = np.concatenate([[gaps[0]], gaps]) / 3.0
-    after = np.concatenate([gaps, [gaps[-1]]]) / 3.0
-    left = np.stack([frames - before, values - slopes * before], axis=1)
-    right = np.stack([frames + after, values + slopes * after], axis=1)
-    return left, right
+def engine_order(mode: str) -> str:
+    """The engine's Euler order (channel order, composed left to right) of a Blender rotation mode:
+    Blender's "XYZ" applies X first, R = Rz·Ry·Rx, which the engine calls "ZYX"."""
+    return mode[::-1]
 
 
 @dataclass
@@ -253,9 +232,17 @@ class ReduceJob:
                     f"{len(switched)} bones switched from Euler to quaternion rotation (the new action keys "
                     "rotation_mode; set the mode back to play the original)"
                 )
+            euler = self._euler_playback(rig, action, np.arange(a, b + 1), basis[inside])
             keys = yield from engine_fractions(
                 call_engine(
-                    engine.select_keys, self.cancel, clip, o.engine_method(), bound, o.keys or None, bound_deg=o.max_error_deg
+                    engine.select_keys,
+                    self.cancel,
+                    clip,
+                    o.engine_method(),
+                    bound,
+                    o.keys or None,
+                    bound_deg=o.max_error_deg,
+                    euler=euler,
                 ),
                 0.25,
                 0.55,
@@ -266,7 +253,7 @@ class ReduceJob:
             history: List[Tuple[int, float, float]] = []
             while True:
                 rounds += 1
-                bz = engine.bezier_handles(clip, frames)
+                bz = engine.bezier_handles(clip, frames, euler)
                 yield from fractions(
                     self._write(ob, new, rig, todo, bz, fps, (a, b), basis[inside]), 0.55, 0.6, "writing keys"
                 )
@@ -425,7 +412,6 @@ class ReduceJob:
         frames = np.asarray(bz["frames"], dtype=np.float64) + a
         lf = np.asarray(bz["left_frames"], dtype=np.float64) + a
         rf = np.asarray(bz["right_frames"], dtype=np.float64) + a
-        k = len(frames)
         rest_q = mat3_to_quat(rig.rest_rel[:, :3, :3])  # (B, 4) wxyz
         wxyz = [3, 0, 1, 2]
         q_val = np.asarray(bz["rotations"], dtype=np.float64)[..., wxyz]  # (K, J, 4)
@@ -433,16 +419,18 @@ class ReduceJob:
         q_right = np.asarray(bz["rotations_right"], dtype=np.float64)[..., wxyz]
         t_val = np.asarray(bz["translations_cm"], dtype=np.float64)
         t_right = np.asarray(bz["translations_right_cm"], dtype=np.float64)
+        e_val, e_left, e_right = (
+            None if bz.get(name) is None else np.asarray(bz[name], dtype=np.float64)
+            for name in ("euler", "euler_left", "euler_right")
+        )
         by_bone: Dict[int, List[_Channel]] = {}
         for c in todo:
             by_bone.setdefault(c.joint, []).append(c)
-        pose = ob.pose.bones
         # Rates per frame from the right handles (each key's one slope; the first and last keys'
         # handles mirror their one segment).
         gap_r = (rf - frames)[:, None]
         for n, (j, cs) in enumerate(by_bone.items()):
             yield n / len(by_bone)
-            pb = pose[rig.bone_index[j]]
             for kind in ("quat", "euler", "loc"):
                 group = [c for c in cs if c.kind == kind]
                 if not group:
@@ -452,22 +440,27 @@ class ReduceJob:
                     values = np.array([_orig_values(orig, group, f, basis[int(f) - a, j], "loc") for f in frames])
                     rate = (t_right[:, j] - t_val[:, j]) / gap_r / rig.cm_per_unit @ inv.T  # per frame
                     left, right = values - rate * (frames - lf)[:, None], values + rate * gap_r
-                else:
+                elif kind == "quat":
                     # The rest frame's inverse on the left: an orthogonal map of the components.
                     r_inv = quat_conj(rest_q[j])[None]
                     q, ql, qr = (quat_mul(r_inv, x[:, j]) for x in (q_val, q_left, q_right))
-                    if kind == "quat":
-                        start = _orig_values(orig, group, a, basis[0, j], "quat")
-                        if np.dot(start, q[0]) < 0:  # the original's sign at the first key
-                            q, ql, qr = -q, -ql, -qr
-                        values, left, right = q, ql, qr
-                    else:
-                        order = pb.rotation_mode
-                        values = np.array([_orig_values(orig, group, f, basis[int(f) - a, j], "euler", order) for f in frames])
-                        dq = (qr - q) / gap_r  # component rate per frame
-                        omega = 2.0 * quat_mul(quat_conj(q), dq)[:, 1:] / np.sum(q * q, axis=1, keepdims=True)
-                        rate = np.array([euler_rates(order, values[i], omega[i]) for i in range(k)])
-                        left, right = values - rate * (frames - lf)[:, None], values + rate * gap_r
+                    start = _orig_values(orig, group, a, basis[0, j], "quat")
+                    if np.dot(start, q[0]) < 0:  # the original's sign at the first key
+                        q, ql, qr = -q, -ql, -qr
+                    values, left, right = q, ql, qr
+                else:
+                    # The engine's Euler curves of this bone: x, y, z as rotation_euler holds them.
+                    values, left, right = e_val[:, j].copy(), e_left[:, j].copy(), e_right[:, j].copy()
+                    # The values are the original curves' own (the engine's reference) to
+                    # rounding: take them exactly, so a range's end keys join the curve outside.
+                    for i in range(3):
+                        fc = orig.get((group[0].data_path, i))
+                        if fc is not None:
+                            own = np.array([fc.evaluate(f) for f in frames])
+                            d = np.where(np.abs(own - values[:, i]) < 1e-4, own - values[:, i], 0.0)
+                            values[:, i] += d
+                            left[:, i] += d
+                            right[:, i] += d
                 for c in group:
                     i = c.index
                     fc = chans.get((c.data_path, i))
@@ -481,6 +474,40 @@ class ReduceJob:
                         np.stack([lf, left[:, i]], axis=1),
                         np.stack([rf, right[:, i]], axis=1),
                     )
+
+    def _euler_playback(self, rig: Rig, action, frames: np.ndarray, basis: np.ndarray):
+        """The engine's Euler playback of the rig (None when no bone plays Euler curves): each bone
+        in an Euler mode its order, its rest rotation relative to its parent as the pre-rotation,
+        and the original action's own angles at `frames` as the reference (the evaluated basis
+        where a curve is missing); quaternion and axis-angle bones and tail joints play quaternion
+        curves."""
+        from mathutils import Matrix
+
+        pose = self.ob.pose.bones
+        orig = anim.channels(self.ob, action)
+        nj = len(rig.names)
+        orders: List[Optional[str]] = [None] * nj
+        pre = np.zeros((nj, 4))
+        pre[:, 3] = 1.0
+        ref = np.zeros((len(frames), nj, 3))
+        rest_q = mat3_to_quat(rig.rest_rel[:, :3, :3])  # (B, 4) wxyz
+        for j in range(rig.num_bones):
+            pb = pose[rig.bone_index[j]]
+            mode = pb.rotation_mode
+            if mode not in EULER_MODES:
+                continue
+            orders[j] = engine_order(mode)
+            pre[j] = rest_q[j][[1, 2, 3, 0]]
+            path = f'pose.bones["{_escape(pb.name)}"].rotation_euler'
+            for i in range(3):
+                fc = orig.get((path, i))
+                if fc is not None:
+                    ref[:, j, i] = [fc.evaluate(float(f)) for f in frames]
+                else:
+                    ref[:, j, i] = [Matrix(m[:3, :3].tolist()).to_euler(mode)[i] for m in basis[:, j]]
+        if not any(orders):
+            return None
+        return {"euler_orders": orders, "pre_rotations": pre, "euler_reference": ref}
 
     def _world_rotations(self, ob, scene, frames):
         """Yields progress; returns each bone's armature-space orientation per frame (T, B, 4)."""
@@ -504,15 +531,11 @@ def _angle_deg(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
     return np.degrees(2 * np.arccos(d))
 
 
-def _orig_values(orig: anim.Channels, group, frame, basis: np.ndarray, kind: str, order: str = "XYZ") -> np.ndarray:
+def _orig_values(orig: anim.Channels, group, frame, basis: np.ndarray, kind: str) -> np.ndarray:
     """The original action's own values of a bone's channel set at `frame` (its curves where it
     has them, the evaluated basis elsewhere)."""
     if kind == "quat":
         v = mat3_to_quat(basis[:3, :3])
-    elif kind == "euler":
-        from mathutils import Matrix
-
-        v = np.array(Matrix(basis[:3, :3].tolist()).to_euler(order))
     else:
         v = basis[:3, 3].copy()
     path = group[0].data_path

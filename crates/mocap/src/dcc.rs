@@ -8,8 +8,12 @@
 //! a translation are its translation Hermite. Handles use each side's own segment length, so keys
 //! with gaps of different lengths on either side keep one slope (aligned, unequal handles: a DCC's
 //! "free" or "aligned" handle type, never "auto", which would move them).
+//!
+//! Euler curves ([`RotationCurve::EulerBezier`](crate::rotations::RotationCurve::EulerBezier)) are
+//! three such curves per joint on its angles, with the angles' rates as slopes: the DCC composes
+//! `pre ⊗ R(E)` from the values it evaluates, which is the engine's Euler curve.
 
-use crate::rotations::{quat_component_rate, KeyPose};
+use crate::rotations::{euler_by_axis, quat_component_rate, EulerKeys, KeyPose};
 use crate::{MocapError, Result};
 
 /// One channel's key: the value and its left and right handles' values.
@@ -34,12 +38,23 @@ pub struct BezierKeys {
     pub rotations: Vec<Vec<BezierKey<4>>>,
     /// `[key][joint]` translations in the clip's length unit.
     pub translations: Vec<Vec<BezierKey<3>>>,
+    /// `[key][joint]` Euler angles `(x, y, z)` by axis (a DCC's X, Y and Z rotation curves), radians,
+    /// continuous along each joint's track; NaN for joints without an Euler order; empty without
+    /// Euler keys.
+    pub euler: Vec<Vec<BezierKey<3>>>,
 }
 
 /// The Bezier keys that play back `keys` (the key poses at `frames`, as
 /// [`crate::SelectReport::key_poses`] gives them) along [`RotationCurve::QuaternionBezier`](crate::rotations::RotationCurve::QuaternionBezier) on a
-/// clip of `frame_time` seconds per frame.
-pub fn bezier_keys(frames: &[usize], keys: &[KeyPose], frame_time: f64) -> Result<BezierKeys> {
+/// clip of `frame_time` seconds per frame; with `euler` (the keys' Euler keys,
+/// [`crate::SelectReport::key_euler`]) also the Euler curves that play
+/// [`RotationCurve::EulerBezier`](crate::rotations::RotationCurve::EulerBezier).
+pub fn bezier_keys(
+    frames: &[usize],
+    keys: &[KeyPose],
+    euler: Option<&EulerKeys>,
+    frame_time: f64,
+) -> Result<BezierKeys> {
     if frames.len() < 2 || frames.len() != keys.len() || frames.windows(2).any(|w| w[0] >= w[1]) {
         return Err(MocapError::Invalid(format!(
             "{} key frames for {} key poses: expected at least 2 increasing frames, one per pose",
@@ -49,6 +64,15 @@ pub fn bezier_keys(frames: &[usize], keys: &[KeyPose], frame_time: f64) -> Resul
     }
     if !(frame_time.is_finite() && frame_time > 0.0) {
         return Err(MocapError::Invalid(format!("frame time {frame_time} s: expected a positive number of seconds")));
+    }
+    if let Some(e) = euler {
+        if e.keys.len() != keys.len() {
+            return Err(MocapError::Invalid(format!(
+                "{} Euler keys for {} key poses: expected one per key",
+                e.keys.len(),
+                keys.len()
+            )));
+        }
     }
     let last = frames.len() - 1;
     // Each side's segment, frames: the first and last keys mirror their one segment.
@@ -92,12 +116,36 @@ pub fn bezier_keys(frames: &[usize], keys: &[KeyPose], frame_time: f64) -> Resul
         rotations.push(rot);
         translations.push(trans);
     }
+    let euler = match euler {
+        None => Vec::new(),
+        Some(e) => e
+            .keys
+            .iter()
+            .enumerate()
+            .map(|(k, row)| {
+                row.iter()
+                    .zip(&e.orders)
+                    .map(|(key, order)| match order {
+                        Some(o) => {
+                            let (value, rate) =
+                                (euler_by_axis(*o, key.angles).to_array(), euler_by_axis(*o, key.rates).to_array());
+                            let mut b = BezierKey { value, left: [0.0; 3], right: [0.0; 3] };
+                            handle(&value, &rate, k, (&mut b.left, &mut b.right));
+                            b
+                        }
+                        None => BezierKey { value: [f64::NAN; 3], left: [f64::NAN; 3], right: [f64::NAN; 3] },
+                    })
+                    .collect()
+            })
+            .collect(),
+    };
     Ok(BezierKeys {
         frames: frames.to_vec(),
         left_frames: (0..=last).map(|k| frames[k] as f64 - before[k] / 3.0).collect(),
         right_frames: (0..=last).map(|k| frames[k] as f64 + after[k] / 3.0).collect(),
         rotations,
         translations,
+        euler,
     })
 }
 
@@ -147,13 +195,14 @@ mod tests {
         // The bound holds on the rebuilt clip along the DCC curve.
         assert!(report.reconstruction.error.max_cm <= 1.0 + 1e-9, "{}", report.reconstruction.error.max_cm);
         let frames = report.keys().frames().to_vec();
-        let bz = bezier_keys(&frames, &report.key_poses, clip.motion.frame_time).unwrap();
+        let bz = bezier_keys(&frames, &report.key_poses, None, clip.motion.frame_time).unwrap();
         let poses = reconstruct_poses(
             &clip.motion.skeleton,
             clip.motion.frame_time,
             &frames,
             &report.key_poses,
             RotationCurve::QuaternionBezier,
+            None,
         )
         .unwrap();
         let mut worst = 0.0f64;
@@ -182,7 +231,7 @@ mod tests {
 
     #[test]
     fn mismatched_keys_are_refused() {
-        let err = bezier_keys(&[0, 5], &[], 0.01).unwrap_err().to_string();
+        let err = bezier_keys(&[0, 5], &[], None, 0.01).unwrap_err().to_string();
         assert!(err.contains("2 key frames for 0 key poses"), "{err}");
     }
 }

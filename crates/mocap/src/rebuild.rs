@@ -4,7 +4,7 @@
 
 use crate::metrics::PositionError;
 use crate::prepared::PreparedClip;
-use crate::rotations::{reconstruct_poses, RotationCurve};
+use crate::rotations::{reconstruct_poses, EulerPlayback, RotationCurve, RotationMotion};
 use crate::{MocapError, Result};
 use inbetween_core::cancel::Cancel;
 use inbetween_core::{forward, KeyframeSet, Motion, Pose};
@@ -18,8 +18,11 @@ pub struct ReconstructJob {
     /// Key frames; the clip's first and last frames are added when missing.
     pub keys: Vec<usize>,
     /// How rotations are interpolated between keys (the engine's Hermite, or what a DCC's
-    /// quaternion Bezier curves play back).
+    /// quaternion or Euler Bezier curves play back).
     pub curve: RotationCurve,
+    /// How Euler curves play each joint ([`RotationCurve::EulerBezier`]; by default the skeleton's
+    /// BVH channels).
+    pub euler: Option<EulerPlayback>,
 }
 
 /// The rebuilt clip and how far it is from its source.
@@ -42,19 +45,24 @@ impl ReconstructJob {
 
     /// Checks the keys against a clip of `n` frames.
     pub fn validate(&self, n: usize) -> Result<()> {
+        crate::rotations::check_playback(self.curve, self.euler.as_ref())?;
         self.key_set(n).map(|_| ())
     }
 
     /// Rebuilds `clip` from its poses at the job's keys.
     pub fn run(&self, clip: &PreparedClip, cancel: &Cancel, progress: &Progress) -> Result<ReconstructReport> {
+        self.validate(clip.num_frames())?;
         let keys = self.key_set(clip.num_frames())?;
-        rebuild(clip, keys, self.curve, cancel, progress)
+        let played = clip.rotations.played(self.curve, self.euler.as_ref())?;
+        rebuild(clip, &played, keys, self.curve, cancel, progress)
     }
 }
 
-/// [`ReconstructJob::run`] for a key set already made for `clip`.
+/// [`ReconstructJob::run`] for a key set already made for `clip`, its key poses from `rotations`
+/// (the clip's, with Euler keys for [`RotationCurve::EulerBezier`]).
 pub(crate) fn rebuild(
     clip: &PreparedClip,
+    rotations: &RotationMotion,
     keys: KeyframeSet,
     curve: RotationCurve,
     cancel: &Cancel,
@@ -69,9 +77,10 @@ pub(crate) fn rebuild(
     }
     progress.phase(2, "reconstructing");
     let frames = keys.frames();
-    let key_poses: Vec<_> = frames.iter().map(|&f| clip.rotations.frames[f].clone()).collect();
+    let key_poses: Vec<_> = frames.iter().map(|&f| rotations.frames[f].clone()).collect();
+    let euler = rotations.key_euler(&keys);
     let skeleton = &clip.motion.skeleton;
-    let poses = reconstruct_poses(skeleton, clip.motion.frame_time, frames, &key_poses, curve)?;
+    let poses = reconstruct_poses(skeleton, clip.motion.frame_time, frames, &key_poses, curve, euler.as_ref())?;
     cancel.check()?;
     progress.inc(1);
     use rayon::prelude::*;

@@ -413,6 +413,7 @@ impl Rebuild {
                         h,
                         (f - a) as f64 / (frame - a) as f64,
                         RotationCurve::Hermite,
+                        None,
                         &mut p.rotations,
                         &mut p.translations,
                     );

@@ -1,6 +1,6 @@
 //! The error-bounded search's bound holds on what is played back (skipped when the corpus is
 //! absent): on every CMU take at 1 cm, the clip rebuilt along the engine's Hermite curve and along
-//! a DCC's quaternion Bezier curves stays within 1 cm on every joint of every frame, and the keys
+//! a DCC's quaternion and Euler Bezier curves stays within 1 cm on every joint of every frame, and the keys
 //! this costs beside the spherical model's plan (which bounds the model, not the rebuild) are
 //! printed.
 
@@ -34,7 +34,7 @@ fn a_bound_in_cm_holds_on_the_rebuilt_clip_along_either_curve_on_every_take() {
                 planned.len(),
                 planned_rebuilt.error.max_cm
             );
-            for curve in [RotationCurve::Hermite, RotationCurve::QuaternionBezier] {
+            for curve in [RotationCurve::Hermite, RotationCurve::QuaternionBezier, RotationCurve::EulerBezier] {
                 let job =
                     SelectJob { method: Selector::ErrorBounded, bound_cm: Some(1.0), curve, ..SelectJob::default() };
                 let r = job.run(&prepared, &Cancel::new(), &Progress::hidden()).unwrap();

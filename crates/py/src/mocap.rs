@@ -1,17 +1,20 @@
 //! mocap keyframes: `select_keys` (mocap `SelectJob`), `reconstruct` (`ReconstructJob`) and
 //! `bezier_handles` (`dcc::bezier_keys`), on a clip prepared once per call (`PreparedClip`). Key poses come back as arrays: rotations and their
 //! body-frame angular velocities (the Hermite tangents), root-relative translations and velocities
-//! in cm; reports as JSON text (`json.loads` on the Python side) and as the job's own words.
+//! in cm, and for Euler curves the angles and their rates; reports as JSON text (`json.loads` on
+//! the Python side) and as the job's own words. Euler playback (`curve="euler_bezier"`) takes each
+//! joint's order, pre-rotation and the DCC's own angles as flat lists (`EulerPlayback`).
 
 use crate::clip::Clip;
 use crate::errors::{ctx, engine, invalid, JobError};
 use crate::runner::run_job;
 use inbetween_core::cancel::Cancel;
+use inbetween_core::rotation::EulerOrder;
 use inbetween_core::KeyframeSet;
 use inbetween_core::Motion;
 use inbetween_io::Progress;
 use inbetween_mocap::dcc::{bezier_keys, BezierKey};
-use inbetween_mocap::rotations::KeyPose;
+use inbetween_mocap::rotations::{euler_by_axis, EulerKeys, EulerPlayback, KeyPose};
 use inbetween_mocap::{
     PreparedClip, ReconstructJob, ReconstructReport, RotationCurve, RotationMotion, SelectJob, SelectReport, Selector,
 };
@@ -42,8 +45,14 @@ pub fn select(
     Ok((report, prepared))
 }
 
-/// `[K, J, 4]` / `[K, J, 3]` arrays of the key poses (lengths × `cm`).
-fn key_pose_arrays<'py>(py: Python<'py>, poses: &[KeyPose], cm: f64) -> PyResult<Bound<'py, PyDict>> {
+/// `[K, J, 4]` / `[K, J, 3]` arrays of the key poses (lengths × `cm`), and with `euler` the Euler
+/// angles and rates `(x, y, z)` by axis (NaN for joints without an order).
+fn key_pose_arrays<'py>(
+    py: Python<'py>,
+    poses: &[KeyPose],
+    euler: Option<&EulerKeys>,
+    cm: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let k = poses.len();
     let j = poses.first().map_or(0, |p| p.rotations.len());
     let quat: Vec<f32> =
@@ -59,7 +68,69 @@ fn key_pose_arrays<'py>(py: Python<'py>, poses: &[KeyPose], cm: f64) -> PyResult
     )?;
     d.set_item("translations_cm", PyArray1::from_vec(py, vec3(&|p| &p.translations, cm)).reshape([k, j, 3])?)?;
     d.set_item("velocities_cm_s", PyArray1::from_vec(py, vec3(&|p| &p.velocities, cm)).reshape([k, j, 3])?)?;
+    if let Some(e) = euler {
+        let by_axis = |pick: fn(&inbetween_mocap::rotations::EulerKey) -> glam::DVec3| -> Vec<f32> {
+            e.keys
+                .iter()
+                .flat_map(|row| {
+                    row.iter().zip(&e.orders).flat_map(move |(key, o)| match o {
+                        Some(o) => euler_by_axis(*o, pick(key)).to_array().map(|v| v as f32),
+                        None => [f32::NAN; 3],
+                    })
+                })
+                .collect()
+        };
+        d.set_item("euler_angles", PyArray1::from_vec(py, by_axis(|k| k.angles)).reshape([k, j, 3])?)?;
+        d.set_item("euler_rates", PyArray1::from_vec(py, by_axis(|k| k.rates)).reshape([k, j, 3])?)?;
+    }
     Ok(d)
+}
+
+/// The Euler playback of `clip` from Python's arguments (`None` when none is given: the job then
+/// plays the skeleton's own channels): per joint an order name (the engine's channel order, `ZYX`
+/// = Rz·Ry·Rx) or `None`, pre-rotations `[J × 4]` (x, y, z, w), the DCC's angles `[T × J × 3]`
+/// radians by axis, all flat.
+fn playback(
+    clip: &Clip,
+    orders: Option<Vec<Option<String>>>,
+    pre: Option<Vec<f64>>,
+    reference: Option<Vec<f64>>,
+) -> PyResult<Option<EulerPlayback>> {
+    if orders.is_none() && pre.is_none() && reference.is_none() {
+        return Ok(None);
+    }
+    let sk = &clip.motion.skeleton;
+    let nj = sk.len();
+    let mut p = EulerPlayback::of_skeleton(sk);
+    if let Some(orders) = orders {
+        if orders.len() != nj {
+            return Err(invalid(format!("{} Euler orders: expected one per joint, {nj}", orders.len())));
+        }
+        p.orders = orders
+            .iter()
+            .enumerate()
+            .map(|(j, o)| match o {
+                None => Ok(None),
+                Some(name) => EulerOrder::parse(name).map(Some).ok_or_else(|| {
+                    invalid(format!("Euler order '{name}' of joint {j} ({}): expected XYZ, ZYX, …", sk.joint(j).name))
+                }),
+            })
+            .collect::<PyResult<_>>()?;
+    }
+    if let Some(pre) = pre {
+        if pre.len() != nj * 4 {
+            return Err(invalid(format!("{} pre-rotation values: expected [{nj}, 4] (x, y, z, w)", pre.len())));
+        }
+        p.pre = pre.chunks(4).map(|c| glam::DQuat::from_xyzw(c[0], c[1], c[2], c[3])).collect();
+    }
+    if let Some(r) = reference {
+        let n = clip.motion.num_frames();
+        if r.len() != n * nj * 3 {
+            return Err(invalid(format!("{} reference Euler values: expected [{n}, {nj}, 3]", r.len())));
+        }
+        p.reference = Some(r.chunks(3).map(|c| glam::DVec3::new(c[0], c[1], c[2])).collect());
+    }
+    Ok(Some(p))
 }
 
 fn curve(name: Option<&str>) -> PyResult<RotationCurve> {
@@ -67,10 +138,11 @@ fn curve(name: Option<&str>) -> PyResult<RotationCurve> {
 }
 
 /// Runs a `SelectJob`: `method` (uniform, greedy, sidql, optimal, error_bounded) with `k` keys or
-/// `bound_cm` / `bound_deg`, rotations along `curve` (hermite, quaternion_bezier). Returns (key
-/// frames, key pose arrays, report JSON, report text, rebuilt clip).
+/// `bound_cm` / `bound_deg`, rotations along `curve` (hermite, quaternion_bezier, euler_bezier with
+/// its playback: see [`playback`]). Returns (key frames, key pose arrays, report JSON, report text,
+/// rebuilt clip).
 #[pyfunction]
-#[pyo3(signature = (clip, method, k=None, bound_cm=None, max_gap_s=None, progress=None, bound_deg=None, curve=None))]
+#[pyo3(signature = (clip, method, k=None, bound_cm=None, max_gap_s=None, progress=None, bound_deg=None, curve=None, euler_orders=None, pre_rotations=None, euler_reference=None))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn mocap_select<'py>(
     py: Python<'py>,
@@ -82,6 +154,9 @@ fn mocap_select<'py>(
     progress: Option<Bound<'py, PyAny>>,
     bound_deg: Option<f64>,
     curve: Option<&str>,
+    euler_orders: Option<Vec<Option<String>>>,
+    pre_rotations: Option<Vec<f64>>,
+    euler_reference: Option<Vec<f64>>,
 ) -> PyResult<(Vec<usize>, Bound<'py, PyDict>, String, String, Clip)> {
     let method = Selector::parse(method).map_err(|e| engine("", &e))?;
     let defaults = SelectJob::default();
@@ -92,29 +167,35 @@ fn mocap_select<'py>(
         bound_deg,
         max_gap_s: max_gap_s.unwrap_or(defaults.max_gap_s),
         curve: self::curve(curve)?,
+        euler: playback(&clip, euler_orders, pre_rotations, euler_reference)?,
     };
     job.validate(clip.motion.num_frames()).map_err(|e| engine(&clip.source, &e))?;
     let clip_ref: &Clip = &clip;
     let (report, prepared) = run_job(py, progress.as_ref(), |cancel, bar| select(clip_ref, &job, cancel, bar))?;
     let json = serde_json::to_string(&report).map_err(|e| invalid(e.to_string()))?;
     let rebuilt = report.reconstruction.motion(&prepared).map_err(|e| engine("", &e))?;
-    let poses = key_pose_arrays(py, &report.key_poses, clip.unit.cm_per_unit())?;
+    let poses = key_pose_arrays(py, &report.key_poses, report.key_euler.as_ref(), clip.unit.cm_per_unit())?;
     let out = Clip::new(rebuilt, clip.unit.clone(), clip.source.clone());
     Ok((report.keys().frames().to_vec(), poses, json, report.to_string(), out))
 }
 
-/// Runs a `ReconstructJob`: the clip rebuilt from its poses at `keys`. Returns (rebuilt clip,
-/// report JSON, report text).
+/// Runs a `ReconstructJob`: the clip rebuilt from its poses at `keys` (Euler playback as for
+/// `mocap_select`). Returns (rebuilt clip, report JSON, report text).
 #[pyfunction]
-#[pyo3(signature = (clip, keys, progress=None, curve=None))]
+#[pyo3(signature = (clip, keys, progress=None, curve=None, euler_orders=None, pre_rotations=None, euler_reference=None))]
+#[allow(clippy::too_many_arguments)]
 fn mocap_reconstruct<'py>(
     py: Python<'py>,
     clip: PyRef<'py, Clip>,
     keys: Vec<usize>,
     progress: Option<Bound<'py, PyAny>>,
     curve: Option<&str>,
+    euler_orders: Option<Vec<Option<String>>>,
+    pre_rotations: Option<Vec<f64>>,
+    euler_reference: Option<Vec<f64>>,
 ) -> PyResult<(Clip, String, String)> {
-    let job = ReconstructJob { keys, curve: self::curve(curve)? };
+    let euler = playback(&clip, euler_orders, pre_rotations, euler_reference)?;
+    let job = ReconstructJob { keys, curve: self::curve(curve)?, euler };
     job.validate(clip.motion.num_frames()).map_err(|e| engine(&clip.source, &e))?;
     let clip_ref: &Clip = &clip;
     let (report, motion) = run_job(py, progress.as_ref(), |cancel, bar| reconstruct(clip_ref, &job, cancel, bar))?;
@@ -137,14 +218,27 @@ pub fn reconstruct(
 }
 
 /// The Bezier keys (`dcc::bezier_keys`) of `clip` at `keys` (first and last frames added when
-/// missing): a dict of float64 arrays, frames for the handles' times, cm for translations.
+/// missing): a dict of float64 arrays, frames for the handles' times, cm for translations; with
+/// `curve="euler_bezier"` (playback as for `mocap_select`) also the Euler curves, radians by axis.
 #[pyfunction]
-fn mocap_bezier<'py>(py: Python<'py>, clip: PyRef<'py, Clip>, keys: Vec<usize>) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (clip, keys, curve=None, euler_orders=None, pre_rotations=None, euler_reference=None))]
+fn mocap_bezier<'py>(
+    py: Python<'py>,
+    clip: PyRef<'py, Clip>,
+    keys: Vec<usize>,
+    curve: Option<&str>,
+    euler_orders: Option<Vec<Option<String>>>,
+    pre_rotations: Option<Vec<f64>>,
+    euler_reference: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
     let n = clip.motion.num_frames();
     let set = KeyframeSet::new(keys, n).map_err(|e| engine(&clip.source, &e))?;
     let cm = clip.unit.cm_per_unit();
+    let euler = playback(&clip, euler_orders, pre_rotations, euler_reference)?;
     let motion = RotationMotion::from_motion_in(&clip.motion, cm).map_err(|e| engine(&clip.source, &e))?;
-    let bz = bezier_keys(set.frames(), &motion.key_poses(&set), clip.motion.frame_time)
+    let motion = motion.played(self::curve(curve)?, euler.as_ref()).map_err(|e| engine(&clip.source, &e))?;
+    let key_euler = motion.key_euler(&set);
+    let bz = bezier_keys(set.frames(), &motion.key_poses(&set), key_euler.as_ref(), clip.motion.frame_time)
         .map_err(|e| engine(&clip.source, &e))?;
     let (k, j) = (bz.frames.len(), clip.motion.skeleton.len());
     let d = PyDict::new(py);
@@ -167,6 +261,15 @@ fn mocap_bezier<'py>(py: Python<'py>, clip: PyRef<'py, Clip>, keys: Vec<usize>) 
         ("translations_right_cm", |b| b.right),
     ] {
         d.set_item(name, PyArray1::from_vec(py, part(&bz.translations, pick, cm)).reshape([k, j, 3])?)?;
+    }
+    if !bz.euler.is_empty() {
+        for (name, pick) in [
+            ("euler", (|b| b.value) as fn(&BezierKey<3>) -> [f64; 3]),
+            ("euler_left", |b| b.left),
+            ("euler_right", |b| b.right),
+        ] {
+            d.set_item(name, PyArray1::from_vec(py, part(&bz.euler, pick, 1.0)).reshape([k, j, 3])?)?;
+        }
     }
     Ok(d)
 }

@@ -87,6 +87,84 @@ def test_quaternion_bezier_keys_and_handles_play_back_within_the_bound(take):
         mocap.select_keys(clip, max_error_deg=float("nan"))
 
 
+def _axis(axis, angle):
+    """Rotation matrices about one axis, (…, 3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    m = np.zeros(np.shape(angle) + (3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)]["XYZ".index(axis)]
+    k = "XYZ".index(axis)
+    m[..., k, k] = 1.0
+    m[..., i, i] = m[..., j, j] = c
+    m[..., i, j], m[..., j, i] = -s, s
+    return m
+
+
+def _quat_matrix(q):
+    """(…, 4) (x, y, z, w) unit quaternions to (…, 3, 3)."""
+    x, y, z, w = np.moveaxis(q, -1, 0)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
+
+
+def test_euler_bezier_keys_and_handles_play_back_within_the_bound(take):
+    clip = take.crop(0, 240)
+    j = len(clip.joints)
+    rng = np.random.default_rng(45)
+    orders = [("XYZ", "ZXY", "YZX", None)[i % 4] for i in range(j)]
+    pre = rng.normal(size=(j, 4))
+    pre /= np.linalg.norm(pre, axis=1, keepdims=True)
+    euler = dict(euler_orders=orders, pre_rotations=pre)
+    keys = mocap.select_keys(clip, max_error_cm=1.0, curve="euler_bezier", **euler)
+    n = len(keys)
+    assert keys.euler_angles.shape == keys.euler_rates.shape == (n, j, 3)
+    assert np.isnan(keys.euler_angles[:, 3]).all() and not np.isnan(keys.euler_angles[:, 0]).any()
+    rec = mocap.reconstruct(clip, keys, **euler)
+    assert rec.report["curve"] == "euler_bezier"
+    err = np.linalg.norm(rec.clip.positions_cm() - clip.positions_cm(), axis=-1)
+    assert err.max() <= 1.0 + 1e-3, err.max()
+    h = mocap.bezier_handles(clip, keys, curve="euler_bezier", **euler)
+    assert h.euler.shape == h.euler_left.shape == h.euler_right.shape == (n, j, 3)
+    assert np.allclose(h.euler[:, 0], keys.euler_angles[:, 0], atol=1e-5)
+    # Every Euler joint's three curves evaluated as a DCC does, composed axis by axis after its
+    # pre-rotation, against the engine's rebuilt rotations.
+    want = _quat_matrix(rec.clip.rotations)
+    worst = 0.0
+    for s in range(n - 1):
+        a, b = h.frames[s], h.frames[s + 1]
+        x = [a, h.right_frames[s], h.left_frames[s + 1], b]
+        for f in range(a, b + 1, 3):
+            e = np.stack(
+                [_bezier(x, [h.euler[s, :, c], h.euler_right[s, :, c], h.euler_left[s + 1, :, c], h.euler[s + 1, :, c]], f) for c in range(3)],
+                axis=-1,
+            )
+            for jj, order in enumerate(orders):
+                if order is None:
+                    continue
+                m = _quat_matrix(pre[jj])
+                for axis in order:
+                    m = m @ _axis(axis, e[jj, "XYZ".index(axis)])
+                worst = max(worst, float(np.abs(m - want[f, jj]).max()))
+    assert worst < 1e-4, worst
+    # The DCC's own angles (here two turns up) are the keys' values.
+    ref = np.zeros((clip.num_frames, j, 3))
+    ref[keys.frames] = keys.euler_angles + 4 * np.pi
+    ref[np.isnan(ref)] = 0.0
+    h2 = mocap.bezier_handles(clip, keys, curve="euler_bezier", euler_reference=ref, **euler)
+    assert np.allclose(h2.euler[:, :3], h.euler[:, :3] + 4 * np.pi, atol=1e-4)
+    with pytest.raises(InbetweenError, match="need curve 'euler_bezier'"):
+        mocap.select_keys(clip, max_error_cm=1.0, curve="quaternion_bezier", euler_orders=orders)
+    with pytest.raises(InbetweenError, match="expected one per joint"):
+        mocap.select_keys(clip, max_error_cm=1.0, curve="euler_bezier", euler_orders=["XYZ"])
+    with pytest.raises(InbetweenError, match="Euler order 'ABC'"):
+        mocap.select_keys(clip, max_error_cm=1.0, curve="euler_bezier", euler_orders=["ABC"] * j)
+
+
 @pytest.mark.parametrize("method", ["greedy", "uniform", "sidql"])
 def test_every_selector(take, method):
     keys = mocap.select_keys(take.crop(0, 120), k=8, method=method)

@@ -8,7 +8,7 @@
 use crate::metrics::{ErrorMeasure, ReconstructionError, SegmentModel, SegmentTable};
 use crate::prepared::PreparedClip;
 use crate::rebuild::{rebuild, ReconstructReport};
-use crate::rotations::{KeyPose, RotationCurve};
+use crate::rotations::{EulerKeys, EulerPlayback, KeyPose, RotationCurve, RotationMotion};
 use crate::{MocapError, Result};
 use inbetween_core::cancel::Cancel;
 use inbetween_core::KeyframeSet;
@@ -98,8 +98,11 @@ pub struct SelectJob {
     /// Longest gap between two keys of an error-bounded search, seconds.
     pub max_gap_s: f64,
     /// How the reconstruction (and the error-bounded search's bound) evaluates rotations between
-    /// keys: the engine's Hermite, or a DCC's quaternion Bezier curves.
+    /// keys: the engine's Hermite, or a DCC's quaternion or Euler Bezier curves.
     pub curve: RotationCurve,
+    /// How Euler curves play each joint ([`RotationCurve::EulerBezier`]: orders, pre-rotations, the
+    /// DCC's own angles); by default the skeleton's BVH channels.
+    pub euler: Option<EulerPlayback>,
 }
 
 impl Default for SelectJob {
@@ -111,6 +114,7 @@ impl Default for SelectJob {
             bound_deg: None,
             max_gap_s: DEFAULT_MAX_GAP_S,
             curve: RotationCurve::Hermite,
+            euler: None,
         }
     }
 }
@@ -128,6 +132,9 @@ pub struct SelectReport {
     /// (rad/s) and translations with their velocities (file units/s), the tangents of the Hermite
     /// segments between keys.
     pub key_poses: Vec<KeyPose>,
+    /// The keys' Euler angles and rates ([`RotationCurve::EulerBezier`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub key_euler: Option<EulerKeys>,
     /// The error the selectors minimise, on the spherical model (Eq. 17–18, 24).
     pub planned: ReconstructionError,
     /// The rebuilt clip (rotation reconstruction) and its measured position error.
@@ -159,6 +166,7 @@ impl SelectJob {
                 return Err(MocapError::Invalid(format!("a clip of {n} frames has no segments")));
             }
         }
+        crate::rotations::check_playback(self.curve, self.euler.as_ref())?;
         if !(self.max_gap_s.is_finite() && self.max_gap_s > 0.0) {
             return Err(MocapError::Invalid(format!(
                 "max_gap_s {} s: expected a positive number of seconds",
@@ -173,26 +181,39 @@ impl SelectJob {
     pub fn run(&self, clip: &PreparedClip, cancel: &Cancel, progress: &Progress) -> Result<SelectReport> {
         self.validate(clip.num_frames())?;
         let t = Instant::now();
-        let keys = self.keys(clip, cancel, progress)?;
+        let rotations = clip.rotations.played(self.curve, self.euler.as_ref())?;
+        let keys = self.keys(clip, &rotations, cancel, progress)?;
         let select_ms = t.elapsed().as_secs_f64() * 1000.0;
         cancel.check()?;
         // The planned error beside the reconstruction (rayon's pool).
-        let (planned, reconstruction) =
-            rayon::join(|| clip.rep.error(&keys), || rebuild(clip, keys.clone(), self.curve, cancel, progress));
+        let (planned, reconstruction) = rayon::join(
+            || clip.rep.error(&keys),
+            || rebuild(clip, &rotations, keys.clone(), self.curve, cancel, progress),
+        );
         let reconstruction = reconstruction?;
-        let key_poses = clip.rotations.key_poses(&keys);
+        let key_poses = rotations.key_poses(&keys);
+        let key_euler = rotations.key_euler(&keys);
         Ok(SelectReport {
             method: self.method,
             bound_cm: self.bound_cm,
             bound_deg: self.bound_deg,
             select_ms,
             key_poses,
+            key_euler,
             planned,
             reconstruction,
         })
     }
 
-    fn keys(&self, clip: &PreparedClip, cancel: &Cancel, progress: &Progress) -> Result<KeyframeSet> {
+    /// The keys; an error-bounded search measures along the job's curve on `rotations` (the clip's,
+    /// with its Euler keys for [`RotationCurve::EulerBezier`]).
+    fn keys(
+        &self,
+        clip: &PreparedClip,
+        rotations: &RotationMotion,
+        cancel: &Cancel,
+        progress: &Progress,
+    ) -> Result<KeyframeSet> {
         let n = clip.num_frames();
         let k = self.k.unwrap_or(2);
         progress.phase(1000, "choosing keys");
@@ -222,7 +243,7 @@ impl SelectJob {
                 // Infeasible segments are stored at an infinite cm: a finite stand-in when only degrees bound.
                 let b = self.bound_cm.unwrap_or(f64::MAX);
                 let max_gap = max_gap_frames(self.max_gap_s, clip.motion.frame_time).min(n - 1);
-                let model = clip.rotations.along(self.curve, self.bound_deg.map(f64::to_radians));
+                let model = rotations.along(self.curve, self.bound_deg.map(f64::to_radians));
                 let table = SegmentTable::bounded(&model, max_gap, b);
                 cancel.check()?;
                 super::error_bounded(&table, b, ErrorMeasure::Angle)?

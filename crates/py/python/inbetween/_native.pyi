@@ -135,11 +135,27 @@ def mocap_select(
     progress: _Progress = None,
     bound_deg: Optional[float] = None,
     curve: Optional[str] = None,
+    euler_orders: Optional[List[Optional[str]]] = None,
+    pre_rotations: Optional[List[float]] = None,
+    euler_reference: Optional[List[float]] = None,
 ) -> Tuple[List[int], Dict[str, npt.NDArray[np.float32]], str, str, Clip]: ...
 def mocap_reconstruct(
-    clip: Clip, keys: List[int], progress: _Progress = None, curve: Optional[str] = None
+    clip: Clip,
+    keys: List[int],
+    progress: _Progress = None,
+    curve: Optional[str] = None,
+    euler_orders: Optional[List[Optional[str]]] = None,
+    pre_rotations: Optional[List[float]] = None,
+    euler_reference: Optional[List[float]] = None,
 ) -> Tuple[Clip, str, str]: ...
-def mocap_bezier(clip: Clip, keys: List[int]) -> Dict[str, Any]: ...
+def mocap_bezier(
+    clip: Clip,
+    keys: List[int],
+    curve: Optional[str] = None,
+    euler_orders: Optional[List[Optional[str]]] = None,
+    pre_rotations: Optional[List[float]] = None,
+    euler_reference: Optional[List[float]] = None,
+) -> Dict[str, Any]: ...
 def camera_generate(
     keys_json: str,
     characters: Optional[Tuple[Clip, Clip]] = None,

@@ -18,8 +18,10 @@ __all__ = ["Keys", "Reconstruction", "BezierHandles", "select_keys", "reconstruc
 METHODS = ("optimal", "error_bounded", "greedy", "sidql", "uniform")
 #: How rotations are evaluated between keys: "hermite" (the engine's own, on the rotation
 #: manifold) or "quaternion_bezier" (a cubic per quaternion component, normalised: what a DCC plays
-#: back from Bezier F-curves with the handles of `bezier_handles`, e.g. Blender's quaternion mode).
-CURVES = ("hermite", "quaternion_bezier")
+#: back from Bezier F-curves with the handles of `bezier_handles`, e.g. Blender's quaternion mode)
+#: or "euler_bezier" (a cubic per Euler angle, `pre ⊗ R(E)`: what a DCC plays from Euler F-curves,
+#: e.g. Blender's Euler modes, BVH and Maya channels; see `select_keys` for the playback).
+CURVES = ("hermite", "quaternion_bezier", "euler_bezier")
 
 
 @dataclass(frozen=True)
@@ -55,6 +57,10 @@ class Keys:
     #: The job's report (planned spherical-model error, timings) as a dict, and in words.
     report: Dict[str, Any] = field(repr=False)
     text: str = field(repr=False)
+    #: With curve "euler_bezier": the Euler angles at the keys (x, y, z by axis, radians, NaN for
+    #: joints played from quaternions) and their rates (rad/s), float32 `[K, J, 3]`; else None.
+    euler_angles: Optional[np.ndarray] = None
+    euler_rates: Optional[np.ndarray] = None
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -72,6 +78,30 @@ def _reconstruction(clip: Clip, report: Dict[str, Any], text: str) -> Reconstruc
     )
 
 
+def _euler(
+    clip: Clip,
+    curve: str,
+    euler_orders: Optional[Sequence[Optional[str]]],
+    pre_rotations: Any,
+    euler_reference: Any,
+) -> Dict[str, Any]:
+    """The Euler playback arguments of the native calls, checked and flattened."""
+    given = euler_orders is not None or pre_rotations is not None or euler_reference is not None
+    if given and curve != "euler_bezier":
+        raise InbetweenError(f"euler_orders, pre_rotations and euler_reference need curve 'euler_bezier', not {curve!r}")
+    out: Dict[str, Any] = {}
+    if euler_orders is not None:
+        out["euler_orders"] = [None if o is None else str(o) for o in euler_orders]
+    for name, value, width in (("pre_rotations", pre_rotations, 4), ("euler_reference", euler_reference, 3)):
+        if value is None:
+            continue
+        arr = np.asarray(value, dtype=np.float64)
+        if arr.ndim < 2 or arr.shape[-1] != width:
+            raise InbetweenError(f"{name}: expected float [..., {width}], got shape {list(arr.shape)}")
+        out[name] = arr.ravel().tolist()
+    return out
+
+
 def select_keys(
     clip: Clip,
     max_error_cm: Optional[float] = None,
@@ -82,6 +112,9 @@ def select_keys(
     curve: str = "hermite",
     max_gap_s: Optional[float] = None,
     progress: Optional[Callback] = None,
+    euler_orders: Optional[Sequence[Optional[str]]] = None,
+    pre_rotations: Any = None,
+    euler_reference: Any = None,
 ) -> Keys:
     """Keyframes of `clip` by the mocap engine's `SelectJob`.
 
@@ -90,7 +123,16 @@ def select_keys(
     along `curve`; method "error_bounded") or `k` keys (method "optimal" unless `method` names
     "greedy", "sidql" or "uniform"). The clip is rebuilt from the keys (rotations along `curve`,
     cubic Hermite translations) and the error measured on it. For keys a DCC will play back with
-    Bezier curves, pass `curve="quaternion_bezier"` and hand the keys to `bezier_handles`."""
+    Bezier curves, pass `curve="quaternion_bezier"` (quaternion F-curves) or `curve="euler_bezier"`
+    (Euler F-curves) and hand the keys to `bezier_handles` with the same arguments.
+
+    Euler playback: a joint's local rotation is `pre ⊗ R(E)`. `euler_orders` gives each joint's
+    order in the engine's convention (the BVH channel order, composed left to right: "ZYX" is
+    Rz·Ry·Rx, which Blender calls "XYZ"; None: that joint plays quaternion curves), by default the
+    clip's own channels; `pre_rotations` `[J, 4]` (x, y, z, w) a constant rotation on the left
+    (Blender: the bone's rest rotation relative to its parent), by default none; `euler_reference`
+    `[T, J, 3]` the DCC's own angles (x, y, z by axis, radians), so the keys carry the curves'
+    own values (by default the angles are made continuous along each track)."""
     bounded = max_error_cm is not None or max_error_deg is not None
     if method is None:
         method = "error_bounded" if bounded else "optimal"
@@ -103,9 +145,10 @@ def select_keys(
             raise InbetweenError(f"method {method!r} takes max_error_cm and/or max_error_deg (bounds), not k")
     elif k is None or bounded:
         raise InbetweenError(f"method {method!r} takes k (the number of keys, ends included), not max_error_cm")
+    euler = _euler(clip, curve, euler_orders, pre_rotations, euler_reference)
     with progress_callback(progress, "choosing keys") as cb:
         frames, poses, report_json, text, rebuilt = _native.mocap_select(
-            clip, method, k, max_error_cm, max_gap_s, cb, max_error_deg, curve
+            clip, method, k, max_error_cm, max_gap_s, cb, max_error_deg, curve, **euler
         )
     report = json.loads(report_json)
     rec = report["reconstruction"]
@@ -119,6 +162,8 @@ def select_keys(
         reconstruction=_reconstruction(rebuilt, rec, str(rebuilt)),
         report=report,
         text=text,
+        euler_angles=poses.get("euler_angles"),
+        euler_rates=poses.get("euler_rates"),
     )
 
 
@@ -136,17 +181,22 @@ def reconstruct(
     *,
     curve: Optional[str] = None,
     progress: Optional[Callback] = None,
+    euler_orders: Optional[Sequence[Optional[str]]] = None,
+    pre_rotations: Any = None,
+    euler_reference: Any = None,
 ) -> Reconstruction:
     """`clip` rebuilt from its poses at `keys` (a `Keys`, or frame indices; the first and last
     frames are added when missing) by the mocap engine's `ReconstructJob`, rotations along `curve`
-    (by default the one `keys` were chosen with, else "hermite")."""
+    (by default the one `keys` were chosen with, else "hermite"; Euler playback as in
+    `select_keys`)."""
     if curve is None:
         curve = keys.report["reconstruction"]["curve"] if isinstance(keys, Keys) else "hermite"
     if curve not in CURVES:
         raise InbetweenError(f"curve {curve!r}: expected one of {', '.join(CURVES)}")
+    euler = _euler(clip, curve, euler_orders, pre_rotations, euler_reference)
     frames = _frames(keys)
     with progress_callback(progress, "reconstructing") as cb:
-        rebuilt, report_json, text = _native.mocap_reconstruct(clip, frames, cb, curve)
+        rebuilt, report_json, text = _native.mocap_reconstruct(clip, frames, cb, curve, **euler)
     return _reconstruction(rebuilt, json.loads(report_json), text)
 
 
@@ -171,11 +221,30 @@ class BezierHandles:
     translations_cm: np.ndarray
     translations_left_cm: np.ndarray
     translations_right_cm: np.ndarray
+    #: With curve "euler_bezier": Euler angles (x, y, z by axis: the DCC's X, Y and Z rotation
+    #: curves), radians, continuous along each joint (NaN for joints played from quaternions),
+    #: float64 `[K, J, 3]`, and handles; else None.
+    euler: Optional[np.ndarray] = None
+    euler_left: Optional[np.ndarray] = None
+    euler_right: Optional[np.ndarray] = None
 
 
-def bezier_handles(clip: Clip, keys: "Keys | Sequence[int] | np.ndarray") -> BezierHandles:
+def bezier_handles(
+    clip: Clip,
+    keys: "Keys | Sequence[int] | np.ndarray",
+    *,
+    curve: str = "quaternion_bezier",
+    euler_orders: Optional[Sequence[Optional[str]]] = None,
+    pre_rotations: Any = None,
+    euler_reference: Any = None,
+) -> BezierHandles:
     """The Bezier keys (values and handles) that make a DCC's own curve evaluation reproduce the
     engine's "quaternion_bezier" in-betweens of `clip` at `keys` (choose the keys with
-    `select_keys(..., curve="quaternion_bezier")` for the bound to hold on the DCC's playback)."""
-    d = _native.mocap_bezier(clip, _frames(keys))
+    `select_keys(..., curve="quaternion_bezier")` for the bound to hold on the DCC's playback).
+    With `curve="euler_bezier"` and the Euler playback `select_keys` was given, also the Euler
+    curves that play its "euler_bezier" in-betweens."""
+    if curve not in ("quaternion_bezier", "euler_bezier"):
+        raise InbetweenError(f"curve {curve!r}: expected quaternion_bezier or euler_bezier")
+    euler = _euler(clip, curve, euler_orders, pre_rotations, euler_reference)
+    d = _native.mocap_bezier(clip, _frames(keys), curve, **euler)
     return BezierHandles(frames=np.asarray(d.pop("frames"), dtype=np.int64), **d)
