@@ -21,9 +21,9 @@ engine.add_vendor_path()
 
 import bpy  # noqa: E402
 
-from . import ops_face, ops_reduce, ops_scene, ui  # noqa: E402
+from . import ops_camera, ops_face, ops_reduce, ops_scene, ui  # noqa: E402
 
-_MODULES = [ops_reduce, ops_scene, ops_face]
+_MODULES = [ops_reduce, ops_scene, ops_face, ops_camera]
 
 
 def _classes():

@@ -74,6 +74,7 @@ class INBETWEEN_PT_scene(bpy.types.Panel):
     def draw(self, context):
         col = self.layout.column()
         col.operator("inbetween.text_to_scene", icon="TEXT")
+        col.operator("inbetween.camera_from_armatures", icon="CAMERA_DATA")
         col.operator("inbetween.face_inpaint", icon="SHAPEKEY_DATA")
         row = col.row(align=True)
         row.operator("inbetween.import_live_link", text="Import Live Link", icon="IMPORT")

@@ -1,6 +1,7 @@
 """What needs a window (run by crates/py/tests/blender.rs under xvfb-run, Blender started with
 `--enable-event-simulate`): reduce_keys as a modal operator (progress, the main loop kept running),
-undo of its result, and Esc cancelling a run with nothing changed. Driven by a timer, since the
+undo of its result, and Esc cancelling a run with nothing changed; then the same for
+camera_from_armatures (ui_camera.py). Driven by a timer, since the
 main loop has to run for a modal operator; prints `ui session: ok` at the end, exits 1 on failure."""
 
 import builtins
@@ -12,6 +13,8 @@ import traceback
 
 import addon_utils
 import bpy
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # camera_scene, ui_camera
 
 DATA = pathlib.Path(os.environ.get("INBETWEEN_DATA") or pathlib.Path(__file__).resolve().parents[3] / "shared" / "data")
 TAKE = DATA / "mocap" / "cmu" / "cgspeed" / "131_01.bvh"
@@ -114,9 +117,16 @@ def step():
         if actions() != state["before"] or ob.animation_data.action.name != "131_01":
             fail(f"Esc left actions {actions()} and {ob.animation_data.action.name!r} assigned")
         say("Esc cancelled the run; nothing changed")
-        say("ok")
-        bpy.ops.wm.quit_blender()
-        return None
+        state["phase"] = "camera"
+        return 0.1
+    if phase.startswith("camera"):
+        import ui_camera
+
+        interval = ui_camera.step(state, now, say, fail, override, TAKE.with_name("131_02.bvh"))
+        if interval is None:
+            say("ok")
+            bpy.ops.wm.quit_blender()
+        return interval
     fail(f"unknown phase {phase}")
 
 

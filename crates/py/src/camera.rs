@@ -62,7 +62,7 @@ fn camera_generate<'py>(
     let takes = match (&characters, &scene) {
         (Some((a, b)), None) => {
             let (na, nb) = names.unwrap_or_else(|| (a.source.clone(), b.source.clone()));
-            Some([(na, a.motion.clone()), (nb, b.motion.clone())])
+            Some([(na, a.motion.clone(), a.unit.unit), (nb, b.motion.clone(), b.unit.unit)])
         }
         (None, Some(_)) => None,
         _ => return Err(invalid("give either characters=(clip_a, clip_b) or scene=PATH (a scene JSON)")),
@@ -72,8 +72,11 @@ fn camera_generate<'py>(
         let w = weights::committed().map_err(ctx("loading the committed camera weights"))?;
         let (scene, notes) = match (&takes, &scene) {
             (Some(t), _) => {
-                let refs: Vec<(&str, &inbetween_core::Motion)> = t.iter().map(|(n, m)| (n.as_str(), m)).collect();
-                inbetween_camera::dataset::scene_from_motions(&refs).map_err(JobError::Failed)?
+                // Each clip's own length unit (read from a file, given, or cm for arrays).
+                let refs: Vec<(&str, &inbetween_core::Motion)> = t.iter().map(|(n, m, _)| (n.as_str(), m)).collect();
+                let units: Vec<_> = t.iter().map(|(_, _, u)| Some(*u)).collect();
+                inbetween_camera::dataset::scene_from_motions_in_units(&refs, &units, &Default::default())
+                    .map_err(JobError::Failed)?
             }
             (None, Some(p)) => (Scene::load(p).map_err(ctx(""))?, Default::default()),
             (None, None) => unreachable!("checked above"),

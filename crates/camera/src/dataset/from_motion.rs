@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 use inbetween_core::roles::{find_motion_roles, Role, RoleOverrides, Side};
-use inbetween_core::units::UnitChoice;
+use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{positions_clip, Motion};
 
 use super::scene::{CharacterTrack, Scene};
@@ -45,6 +45,17 @@ pub fn scene_from_motions_with(
     takes: &[(&str, &Motion)],
     overrides: &RoleOverrides,
 ) -> Result<(Scene, SceneNotes), String> {
+    scene_from_motions_in_units(takes, &[], overrides)
+}
+
+/// [`scene_from_motions_with`] with the takes' length units where the caller knows them (`units[i]`
+/// for take `i`, e.g. a clip made from arrays in cm; missing or `None`: inferred from the skeleton,
+/// as for a file). A clip's rest pose need not be a standing one, so inferring is a guess there.
+pub fn scene_from_motions_in_units(
+    takes: &[(&str, &Motion)],
+    units: &[Option<LengthUnit>],
+    overrides: &RoleOverrides,
+) -> Result<(Scene, SceneNotes), String> {
     if takes.len() < 2 {
         return Err(format!("a camera scene needs two characters, got {}", takes.len()));
     }
@@ -57,7 +68,7 @@ pub fn scene_from_motions_with(
     }
     let mut notes = SceneNotes::default();
     let mut characters = Vec::new();
-    for (name, motion) in takes {
+    for (i, (name, motion)) in takes.iter().enumerate() {
         let roles = find_motion_roles(motion, overrides).map_err(|e| format!("{name}: {e}"))?;
         let (hips, l, r) = (
             roles.joint(Role::Hips),
@@ -65,7 +76,7 @@ pub fn scene_from_motions_with(
             roles.joint(Role::UpperArm(Side::Right)),
         );
         let how = roles.how(Role::UpperArm(Side::Left)).map(|h| h.to_string()).unwrap_or_default();
-        let unit = UnitChoice::resolve(None, &motion.skeleton);
+        let unit = UnitChoice::resolve(units.get(i).copied().flatten(), &motion.skeleton);
         let m = unit.cm_per_unit() / 100.0;
         let pos = positions_clip(motion);
         let at = |f: usize, j: usize| pos[f][j] * m;
@@ -135,6 +146,22 @@ mod tests {
         assert!(notes.lines.iter().any(|l| l.contains("moved 1.5 m")), "{notes:?}");
         assert_eq!(notes.moved, Some((1, DVec3::new(1.5, 0.0, 0.0))));
         assert!(scene.characters[0].frame(0).target().distance(scene.characters[1].frame(0).target()) > 1.0);
+    }
+
+    #[test]
+    fn a_unit_the_caller_knows_is_used_instead_of_inferring_one() {
+        let a = gait(&GaitParams { frames: 30, ..GaitParams::walk() });
+        let b = gait(&GaitParams { frames: 30, ..GaitParams::walk() });
+        let takes = [("a.bvh", &a), ("b.bvh", &b)];
+        let (inferred, _) = scene_from_motions(&takes).unwrap();
+        let (given, notes) =
+            scene_from_motions_in_units(&takes, &[Some(LengthUnit::Inch), None], &RoleOverrides::default()).unwrap();
+        assert!(notes.lines[0].contains("given"), "{notes:?}");
+        let (fa, ga) = (inferred.characters[0].frame(10), given.characters[0].frame(10));
+        let k = LengthUnit::Inch.cm_per_unit() / LengthUnit::infer(&a.skeleton).cm_per_unit();
+        assert!((ga.shoulder_l - fa.shoulder_l * k).length() < 1e-9, "{:?} vs {:?}", ga.shoulder_l, fa.shoulder_l);
+        // B keeps its inferred unit (heights: the same-spot rule may move it along X only).
+        assert_eq!(inferred.characters[1].frame(10).shoulder_l.y, given.characters[1].frame(10).shoulder_l.y);
     }
 
     #[test]

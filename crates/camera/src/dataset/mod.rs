@@ -6,7 +6,9 @@ pub mod from_motion;
 pub mod scene;
 
 pub use behaviours::{film, Behaviour, BehaviourParams, BEHAVIOURS};
-pub use from_motion::{scene_from_files, scene_from_motions, scene_from_motions_with, SceneNotes};
+pub use from_motion::{
+    scene_from_files, scene_from_motions, scene_from_motions_in_units, scene_from_motions_with, SceneNotes,
+};
 pub use scene::Scene;
 
 use crate::features::{encode_camera, encode_character, CharacterFeatures, CAM_DIM, CHAR_ENC};
