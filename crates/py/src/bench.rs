@@ -25,7 +25,16 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_bench_video_rust, m)?)?;
     m.add_function(wrap_pyfunction!(_rayon_threads, m)?)?;
     m.add_function(wrap_pyfunction!(_build_profile, m)?)?;
+    m.add_function(wrap_pyfunction!(_empty_job, m)?)?;
     Ok(())
+}
+
+/// A job that does nothing, run as every long Python call runs its job ([`crate::runner::run_job`]:
+/// the hop to a thread of rayon's pool and back, with the GIL released and taken again): what that
+/// costs a call, timed from Python.
+#[pyfunction]
+fn _empty_job(py: Python<'_>) -> PyResult<()> {
+    crate::runner::run_job(py, None, |_, _| Ok::<(), JobError>(()))
 }
 
 /// The build profile of this extension: `release`, or `dev` (debug assertions on; the workspace's

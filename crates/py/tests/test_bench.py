@@ -22,6 +22,7 @@ def test_rounds_are_interleaved_and_the_table_has_the_overhead():
     assert all(t > 0 for t in row.python + row.rust_pool + row.rust_calling)
     med, lo, hi, mins = row.overhead()
     assert all(math.isfinite(x) for x in (med, lo, hi, mins)) and lo <= med <= hi
-    text = bench.table([row], (900.0, 400.0, 1000), (1.0, 1.2))
-    assert "| face.edit linear | 3 |" in text and "+500 ns per call" in text
+    text = bench.table([row], (900.0, 400.0, 1000, 80.0, 40.0), (1.0, 1.2))
+    assert "| face.edit linear | 3 |" in text and "+500 ns per call" in text and "| 80 / 40 µs |" in text
+    _native._empty_job()
     assert _native._rayon_threads() >= 1 and _native._build_profile() in ("dev", "release")

@@ -103,7 +103,7 @@ def measure(
     return row
 
 
-def run(data: pathlib.Path, min_rounds: int, budget_s: float) -> Tuple[List[Row], Tuple[float, float, int]]:
+def run(data: pathlib.Path, min_rounds: int, budget_s: float) -> Tuple[List[Row], Tuple[float, float, int, float, float]]:
     path = data / "mocap" / "cmu" / "cgspeed" / "131_01.bvh"
     if not path.exists():
         raise SystemExit(f"no data at {path} (give --data or INBETWEEN_DATA)")
@@ -164,7 +164,9 @@ def run(data: pathlib.Path, min_rounds: int, budget_s: float) -> Tuple[List[Row]
             reader.sample(s, rot, tr)
         best_py = min(best_py, (time.perf_counter() - t) * 1e9 / len(times))
         best_rust = min(best_rust, _native._bench_sample_rust(data_v4, times))
-    return rows, (best_py, best_rust, len(data_v4))
+    # The hop every long call makes: an empty job to a thread of rayon's pool and back.
+    hops = [_ms(_native._empty_job) * 1e3 for _ in range(2000)]
+    return rows, (best_py, best_rust, len(data_v4), statistics.median(hops), min(hops))
 
 
 def table(rows: List[Row], sample, load: Tuple[float, float]) -> str:
@@ -187,10 +189,14 @@ def table(rows: List[Row], sample, load: Tuple[float, float]) -> str:
             f"| {100 * med:+.1f} % [{100 * lo:+.1f}, {100 * hi:+.1f}] | {100 * mins:+.1f} % "
             f"| {statistics.median(r.rust_calling):.2f} |"
         )
-    py_ns, rust_ns, size = sample
+    py_ns, rust_ns, size, hop_us, hop_min_us = sample
     out.append(
         f"| Reader.sample, one pose (.ibk v4 at 1 cm, {size} bytes; best of rounds) | | {py_ns:.0f} ns | {rust_ns:.0f} ns "
         f"| +{py_ns - rust_ns:.0f} ns per call | | |"
+    )
+    out.append(
+        f"| an empty job: the hop to a pool thread and back every long call makes (µs; 2000 calls) | 2000 "
+        f"| {hop_us:.0f} / {hop_min_us:.0f} µs | | | | |"
     )
     return "\n".join(out)
 
