@@ -4,7 +4,9 @@
 //! rotations (quaternions x, y, z, w) and translations into the caller's buffers with no
 //! allocation. The C ABI (`inbetween_ibk_open`, `_sample`, `_close`; header
 //! `include/inbetween_ibk.h`) is [`capi`]. The offline encoder is in the mocap engine
-//! (`inbetween_mocap::codec::v4`), which uses this crate to measure what a runtime decodes.
+//! (`inbetween_mocap::codec::v4`), which uses this crate to measure what a runtime decodes and
+//! to read files back: this crate is the one decoder of the layout ([`read_head`] also reads the
+//! head version 3 shares: header fields, skeleton, tracks).
 //!
 //! Layout (little-endian), version 4:
 //! ```text
@@ -137,6 +139,11 @@ pub struct Joint {
     pub parent: Option<usize>,
     /// Rest translation (the file's length unit).
     pub offset: [f64; 3],
+    /// Channel codes in file order: 0 to 2 X, Y, Z position, 3 to 5 X, Y, Z rotation (the
+    /// order of the rotation codes is the joint's Euler order).
+    pub channels: Vec<u8>,
+    /// End-site offset (the file's length unit), for a leaf that has one.
+    pub end_site: Option<[f64; 3]>,
     /// Rotation track (three Euler channels) and translation track (any position channel).
     pub has_rotation: bool,
     pub has_translation: bool,
@@ -229,10 +236,20 @@ impl Bits<'_> {
 }
 
 /// Skeleton lengths are micro-units when the format byte says decimal.
-const DECIMAL_SCALE: f64 = 1e6;
+pub const DECIMAL_SCALE: f64 = 1e6;
 
-/// Reads the deflated skeleton block (as version 3 writes it).
-fn read_skeleton(r: &mut Reader) -> Result<Vec<Joint>> {
+/// Reads the deflated skeleton block (as versions 3 and 4 write it) that starts at byte `at` of
+/// `body`: the joints and the byte after the block. Byte positions in errors are `body`'s.
+pub fn read_skeleton(body: &[u8], at: usize) -> Result<(Vec<Joint>, usize)> {
+    if at > body.len() {
+        return format_err(format!("truncated: the skeleton at byte {at} starts past the end ({} bytes)", body.len()));
+    }
+    let mut r = Reader { b: body, pos: at, base: 0 };
+    let joints = read_skeleton_block(&mut r)?;
+    Ok((joints, r.pos))
+}
+
+fn read_skeleton_block(r: &mut Reader) -> Result<Vec<Joint>> {
     let at = r.base + r.pos;
     let raw_len = r.u32("skeleton length")?;
     let packed_len = r.u32("deflated skeleton length")?;
@@ -287,9 +304,7 @@ fn read_skeleton(r: &mut Reader) -> Result<Vec<Joint>> {
             rot += 1;
             axes[(c - 3) as usize] = true;
         }
-        if s.u8("end site flag")? == 1 {
-            vec3(&mut s, "end site")?;
-        }
+        let end_site = if s.u8("end site flag")? == 1 { Some(vec3(&mut s, "end site")?) } else { None };
         let parent = match parent {
             p if p < 0 => None,
             p if (p as usize) < i => Some(p as usize),
@@ -299,6 +314,8 @@ fn read_skeleton(r: &mut Reader) -> Result<Vec<Joint>> {
             name,
             parent,
             offset,
+            channels: codes.to_vec(),
+            end_site,
             has_rotation: rot == 3 && axes.iter().all(|&a| a),
             has_translation: codes.iter().any(|&c| c < 3),
         });
@@ -307,6 +324,90 @@ fn read_skeleton(r: &mut Reader) -> Result<Vec<Joint>> {
         return format_err(format!("skeleton at byte {at}: {} bytes left after its {nj} joints", raw.len() - s.pos));
     }
     Ok(joints)
+}
+
+/// Joint poses a file may describe per byte of file (a clip of constant tracks costs almost no
+/// bytes per frame; this keeps a hostile header from sizing a huge allocation).
+pub const POSES_PER_BYTE: u64 = 1024;
+
+/// What versions 3 and 4 share before their segments, read and checked once for both (the
+/// runtime's [`Clip::open`] and the mocap engine's version 3 reader): the header fields, the
+/// skeleton and the tracks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Head {
+    pub frame_time: f64,
+    pub num_frames: usize,
+    pub segment_len: usize,
+    pub cm_per_unit: f64,
+    pub bound_cm: f64,
+    pub joints: Vec<Joint>,
+    /// Per track: joint, whether a rotation, and its value when constant (file order: rotations,
+    /// then translations, in joint order).
+    pub tracks: Vec<(usize, bool, Option<[f32; 3]>)>,
+    /// The byte of `body` after the tracks, where the version's own blocks start.
+    pub end: usize,
+}
+
+/// Reads [`Head`] from `body` (a version 3 or 4 file less its checksum, whose envelope the caller
+/// checked) of a file of `file_len` bytes.
+pub fn read_head(body: &[u8], file_len: usize) -> Result<Head> {
+    if body.len() < 8 {
+        return format_err(format!("truncated file: {} bytes is shorter than the magic and version", body.len()));
+    }
+    let mut r = Reader { b: body, pos: 8, base: 0 };
+    let frame_time = r.f64("frame time")?;
+    let num_frames = r.u32("frame count")? as usize;
+    let segment_len = r.u16("segment length")? as usize;
+    let cm_per_unit = r.f64("cm per unit")?;
+    let bound_cm = r.f64("error bound")?;
+    let valid = frame_time.is_finite()
+        && frame_time > 0.0
+        && num_frames > 0
+        && (1..=MAX_SEGMENT_LEN).contains(&segment_len)
+        && cm_per_unit.is_finite()
+        && cm_per_unit > 0.0
+        && bound_cm.is_finite()
+        && bound_cm >= 0.0;
+    if !valid {
+        return format_err(format!(
+            "invalid header: frame time {frame_time} s, {num_frames} frames, segments of {segment_len} frames (1 to {MAX_SEGMENT_LEN}), {cm_per_unit} cm per unit, bound {bound_cm} cm"
+        ));
+    }
+    let joints = read_skeleton_block(&mut r)?;
+    let nj = joints.len();
+    let limit = MAX_FRAME_JOINTS.min(POSES_PER_BYTE * file_len as u64);
+    if num_frames as u64 * nj as u64 > limit {
+        return format_err(format!(
+            "invalid header: {num_frames} frames of {nj} joints exceed the {limit} joint poses a file of {file_len} bytes may hold"
+        ));
+    }
+    // Tracks: rotations, then translations, in joint order.
+    let order: Vec<(usize, bool)> = (0..nj)
+        .filter(|&j| joints[j].has_rotation)
+        .map(|j| (j, true))
+        .chain((0..nj).filter(|&j| joints[j].has_translation).map(|j| (j, false)))
+        .collect();
+    let mut tracks = Vec::with_capacity(order.len());
+    for (i, &(j, rot)) in order.iter().enumerate() {
+        let at = r.pos;
+        let constant = match r.u8("track kind")? {
+            0 => None,
+            1 => {
+                let v = [r.f32("constant value")?, r.f32("constant value")?, r.f32("constant value")?];
+                if v.iter().any(|x| !x.is_finite()) {
+                    return format_err(format!("track {i} (joint {j}) at byte {at}: constant value is not finite"));
+                }
+                Some(v)
+            }
+            k => {
+                return format_err(format!(
+                    "track {i} (joint {j}) at byte {at}: kind {k}, expected 0 (animated) or 1 (constant)"
+                ))
+            }
+        };
+        tracks.push((j, rot, constant));
+    }
+    Ok(Head { frame_time, num_frames, segment_len, cm_per_unit, bound_cm, joints, tracks, end: r.pos })
 }
 
 /// Where one animated component of one segment lives and how it dequantises.
@@ -322,12 +423,8 @@ struct Comp {
 /// An opened version 4 file: the borrowed bytes and the tables made once at open.
 pub struct Clip<'a> {
     data: &'a [u8],
-    joints: Vec<Joint>,
-    frame_time: f64,
-    num_frames: usize,
-    segment_len: usize,
-    cm_per_unit: f64,
-    bound_cm: f64,
+    /// The header fields, the skeleton and the tracks.
+    head: Head,
     /// Animated components per segment (3 × animated tracks).
     ncomp: usize,
     /// segments × ncomp.
@@ -341,8 +438,6 @@ pub struct Clip<'a> {
     /// Frame values before the animated slots are written: rotation vector 0 or a constant
     /// track's value, translation the rest offset or a constant track's value.
     rest: Vec<f32>,
-    /// Per track: joint and whether it is a rotation, and the constant value when constant.
-    tracks: Vec<(usize, bool, Option<[f32; 3]>)>,
     /// Joints whose rotation has an animated component: the only ones whose quaternion a decoded
     /// frame recomputes.
     animated_rot: Vec<usize>,
@@ -374,67 +469,17 @@ impl<'a> Clip<'a> {
                 "checksum mismatch (stored {stored:08x}, computed {computed:08x}): the file is corrupt or truncated"
             ));
         }
-        let mut r = Reader { b: body, pos: 8, base: 0 };
-        let frame_time = r.f64("frame time")?;
-        let num_frames = r.u32("frame count")? as usize;
-        let segment_len = r.u16("segment length")? as usize;
-        let cm_per_unit = r.f64("cm per unit")?;
-        let bound_cm = r.f64("error bound")?;
-        let valid = frame_time.is_finite()
-            && frame_time > 0.0
-            && num_frames > 0
-            && (1..=MAX_SEGMENT_LEN).contains(&segment_len)
-            && cm_per_unit.is_finite()
-            && cm_per_unit > 0.0
-            && bound_cm.is_finite()
-            && bound_cm >= 0.0;
-        if !valid {
-            return format_err(format!(
-                "invalid header: frame time {frame_time} s, {num_frames} frames, segments of {segment_len} frames (1 to {MAX_SEGMENT_LEN}), {cm_per_unit} cm per unit, bound {bound_cm} cm"
-            ));
-        }
-        let joints = read_skeleton(&mut r)?;
+        let head = read_head(body, bytes.len())?;
+        let Head { num_frames, segment_len, ref joints, ref tracks, end, .. } = head;
         let nj = joints.len();
-        let limit = MAX_FRAME_JOINTS.min(1024 * bytes.len() as u64);
-        if num_frames as u64 * nj as u64 > limit {
-            return format_err(format!(
-                "invalid header: {num_frames} frames of {nj} joints exceed the {limit} joint poses a file of {} bytes may hold",
-                bytes.len()
-            ));
-        }
-        // Tracks: rotations, then translations, in joint order.
-        let order: Vec<(usize, bool)> = (0..nj)
-            .filter(|&j| joints[j].has_rotation)
-            .map(|j| (j, true))
-            .chain((0..nj).filter(|&j| joints[j].has_translation).map(|j| (j, false)))
-            .collect();
-        let mut tracks = Vec::with_capacity(order.len());
-        for (i, &(j, rot)) in order.iter().enumerate() {
-            let at = r.pos;
-            let constant = match r.u8("track kind")? {
-                0 => None,
-                1 => {
-                    let v = [r.f32("constant value")?, r.f32("constant value")?, r.f32("constant value")?];
-                    if v.iter().any(|x| !x.is_finite()) {
-                        return format_err(format!("track {i} (joint {j}) at byte {at}: constant value is not finite"));
-                    }
-                    Some(v)
-                }
-                k => {
-                    return format_err(format!(
-                        "track {i} (joint {j}) at byte {at}: kind {k}, expected 0 (animated) or 1 (constant)"
-                    ))
-                }
-            };
-            tracks.push((j, rot, constant));
-        }
+        let mut r = Reader { b: body, pos: end, base: 0 };
         let mut rest = Vec::with_capacity(6 * nj);
-        for jt in &joints {
+        for jt in joints {
             rest.extend([0.0, 0.0, 0.0]);
             rest.extend(jt.offset.map(|x| x as f32));
         }
         let mut slot = Vec::new();
-        for &(j, rot, c) in &tracks {
+        for &(j, rot, c) in tracks {
             let s = 6 * j + if rot { 0 } else { 3 };
             match c {
                 Some(v) => rest[s..s + 3].copy_from_slice(&v),
@@ -521,65 +566,52 @@ impl<'a> Clip<'a> {
         animated_rot.sort_unstable();
         animated_rot.dedup();
         let rest_rot = (0..joints.len()).map(|j| exp_map([rest[6 * j], rest[6 * j + 1], rest[6 * j + 2]])).collect();
-        Ok(Clip {
-            data,
-            joints,
-            frame_time,
-            num_frames,
-            segment_len,
-            cm_per_unit,
-            bound_cm,
-            ncomp,
-            comps,
-            seg_start,
-            frame_bits,
-            slot,
-            rest,
-            tracks,
-            animated_rot,
-            rest_rot,
-        })
+        Ok(Clip { data, head, ncomp, comps, seg_start, frame_bits, slot, rest, animated_rot, rest_rot })
     }
 
     pub fn joints(&self) -> &[Joint] {
-        &self.joints
+        &self.head.joints
     }
     pub fn num_joints(&self) -> usize {
-        self.joints.len()
+        self.head.joints.len()
     }
     pub fn num_frames(&self) -> usize {
-        self.num_frames
+        self.head.num_frames
     }
     /// Seconds per frame.
     pub fn frame_time(&self) -> f64 {
-        self.frame_time
+        self.head.frame_time
     }
     /// Seconds from the first frame to the last.
     pub fn duration(&self) -> f64 {
-        (self.num_frames - 1) as f64 * self.frame_time
+        (self.head.num_frames - 1) as f64 * self.head.frame_time
     }
     pub fn segment_len(&self) -> usize {
-        self.segment_len
+        self.head.segment_len
     }
     /// Centimetres per length unit of the translations.
     pub fn cm_per_unit(&self) -> f64 {
-        self.cm_per_unit
+        self.head.cm_per_unit
     }
     /// The virtual-vertex error bound (cm) the file was compressed to.
     pub fn bound_cm(&self) -> f64 {
-        self.bound_cm
+        self.head.bound_cm
     }
     /// Per track: joint, whether a rotation, and its value when constant (file order).
     pub fn tracks(&self) -> &[(usize, bool, Option<[f32; 3]>)] {
-        &self.tracks
+        &self.head.tracks
+    }
+    /// The header fields, the skeleton and the tracks, as [`read_head`] read them.
+    pub fn head(&self) -> &Head {
+        &self.head
     }
 
     /// Decodes frame `f` into `vals` (6 per joint: rotation vector, translation), from the rest
     /// values and the animated components.
     #[inline]
     fn decode_frame(&self, f: usize, vals: &mut [f32]) {
-        let seg = f / self.segment_len;
-        let i = f - seg * self.segment_len;
+        let seg = f / self.head.segment_len;
+        let i = f - seg * self.head.segment_len;
         let comps = &self.comps[seg * self.ncomp..(seg + 1) * self.ncomp];
         let bit0 = self.seg_start[seg] * 8 + i * self.frame_bits[seg];
         let data = self.data;
@@ -601,7 +633,7 @@ impl<'a> Clip<'a> {
     pub fn frame_values(&self, f: usize, out: &mut Vec<f32>) {
         out.clear();
         out.extend_from_slice(&self.rest);
-        self.decode_frame(f.min(self.num_frames - 1), out);
+        self.decode_frame(f.min(self.head.num_frames - 1), out);
     }
 
     /// Decodes frame `f` into a slot of `ctx` (values, then quaternions). Joints with a constant
@@ -640,7 +672,7 @@ impl<'a> Clip<'a> {
         rotations: &mut [[f32; 4]],
         translations: &mut [[f32; 3]],
     ) -> Result<()> {
-        let nj = self.joints.len();
+        let nj = self.head.joints.len();
         if rotations.len() != nj || translations.len() != nj {
             return Err(IbkError::Buffer(format!(
                 "pose buffers hold {} rotations and {} translations; the clip has {nj} joints",
@@ -649,9 +681,13 @@ impl<'a> Clip<'a> {
             )));
         }
         ctx.bind(self);
-        let x = if time.is_finite() { (time / self.frame_time).clamp(0.0, (self.num_frames - 1) as f64) } else { 0.0 };
-        let f0 = (x as usize).min(self.num_frames - 1);
-        let f1 = (f0 + 1).min(self.num_frames - 1);
+        let x = if time.is_finite() {
+            (time / self.head.frame_time).clamp(0.0, (self.head.num_frames - 1) as f64)
+        } else {
+            0.0
+        };
+        let f0 = (x as usize).min(self.head.num_frames - 1);
+        let f1 = (f0 + 1).min(self.head.num_frames - 1);
         let u = (x - f0 as f64) as f32;
         // Reuse what the last call decoded: the same frames, or its second frame as our first.
         if ctx.a.frame != f0 {

@@ -22,7 +22,9 @@ fn generated_header() -> String {
     };
     // The Rust constants of the format stay out of C's global namespace.
     config.export.exclude =
-        ["VERSION", "MAX_SEGMENT_LEN", "MAX_WIDTH", "MAX_FRAME_JOINTS", "STEP_BIAS"].map(String::from).to_vec();
+        ["VERSION", "MAX_SEGMENT_LEN", "MAX_WIDTH", "MAX_FRAME_JOINTS", "STEP_BIAS", "DECIMAL_SCALE", "POSES_PER_BYTE"]
+            .map(String::from)
+            .to_vec();
     let mut out = Vec::new();
     cbindgen::Builder::new()
         .with_crate(crate_dir())

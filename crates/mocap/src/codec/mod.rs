@@ -1,7 +1,9 @@
 //! The `.ibk` keyframe codec: compact, versioned, checksummed binaries of a clip from which the whole
 //! clip is rebuilt. What every version shares lives here: the envelope (magic, version, CRC-32), the
 //! skeleton sections, the bounds-checked [`Reader`] and [`read`], which reads any version into an
-//! [`IbkFile`]. The versions: [`v2`] (keyframes rebuilt by the rotation reconstruction,
+//! [`IbkFile`]. Versions 3 and 4 are read through the runtime crate `inbetween_ibk`, the one
+//! decoder of their head (header fields, deflated skeleton, tracks: `read_head`) and of version
+//! 4's segments (`Clip`). The versions: [`v2`] (keyframes rebuilt by the rotation reconstruction,
 //! [`crate::rotations`]; version 1 still read), [`v3`] (every frame, entropy coded) and [`v4`]
 //! (every frame at fixed widths, the runtime layout of `inbetween_ibk`), written by [`v3_encode`].
 
@@ -28,8 +30,9 @@ pub const MAGIC: &[u8; 4] = b"IBK\0";
 /// The oldest version [`decode`] reads.
 pub const OLDEST_VERSION: u16 = 1;
 /// Largest clip a file may describe (frames × joints), so a corrupt or hostile header cannot make
-/// the decoder's caller allocate without bound: 2²⁶ joint poses (~4.5 GB of f64 channels at most).
-pub const MAX_FRAME_JOINTS: u64 = 1 << 26;
+/// the decoder's caller allocate without bound: 2²⁶ joint poses (~4.5 GB of f64 channels at most);
+/// the runtime's limit, one for every version.
+pub use inbetween_ibk::MAX_FRAME_JOINTS;
 
 fn channel_code(c: Channel) -> u8 {
     match c {
@@ -83,8 +86,8 @@ fn write_skeleton_with(out: &mut Vec<u8>, sk: &Skeleton, vec3: impl Fn(&mut Vec<
     }
 }
 
-/// Micro-units per length unit of a compact skeleton's decimal lengths.
-const DECIMAL_SCALE: f64 = 1e6;
+// Micro-units per length unit of a compact skeleton's decimal lengths: the runtime's, which reads them.
+use inbetween_ibk::DECIMAL_SCALE;
 
 /// `x` as a whole number of micro-units when that reads back as exactly `x` (BVH and ASF
 /// lengths are written with a few decimals).
@@ -121,64 +124,44 @@ pub fn write_compact_skeleton(out: &mut Vec<u8>, sk: &Skeleton) {
     out.extend_from_slice(&packed);
 }
 
-/// Longest compact skeleton (before deflating) a file may declare.
-const MAX_SKELETON_BYTES: u32 = 1 << 22;
-
-/// Reads a skeleton written by [`write_compact_skeleton`].
+/// Reads a skeleton written by [`write_compact_skeleton`], through the runtime's reader (the one
+/// decoder of the block for versions 3 and 4).
 pub fn read_compact_skeleton(r: &mut Reader) -> Result<Skeleton> {
-    let at = r.pos();
-    let raw_len = r.u32("skeleton length")?;
-    let packed_len = r.u32("deflated skeleton length")?;
-    // Deflate expands at most ~1032 times.
-    if raw_len == 0 || raw_len > MAX_SKELETON_BYTES || raw_len as u64 > 1032 * packed_len as u64 + 64 {
-        return Err(MocapError::Codec(format!(
-            "skeleton at byte {at}: {raw_len} bytes from {packed_len} deflated bytes, expected 1 to {MAX_SKELETON_BYTES} and at most 1032 per deflated byte"
-        )));
-    }
-    let packed = r.take(packed_len as usize, "deflated skeleton")?;
-    let mut raw = Vec::with_capacity(raw_len as usize);
-    let inflated = std::io::Read::read_to_end(
-        &mut std::io::Read::take(flate2::read::DeflateDecoder::new(packed), raw_len as u64 + 1),
-        &mut raw,
-    );
-    if inflated.is_err() || raw.len() != raw_len as usize {
-        return Err(MocapError::Codec(format!(
-            "skeleton at byte {at}: the deflated bytes do not inflate to the {raw_len} bytes announced"
-        )));
-    }
-    let mut sr = Reader::new(&raw);
-    let decimal = match sr.u8("skeleton length format")? {
-        0 => false,
-        1 => true,
-        f => {
-            return Err(MocapError::Codec(format!(
-                "skeleton at byte {at}: length format {f}, expected 0 (f64) or 1 (decimal)"
-            )))
-        }
-    };
-    let nj = sr.u16("joint count")? as usize;
-    if nj == 0 {
-        return Err(MocapError::Codec("skeleton with no joints".into()));
-    }
-    let sk = read_skeleton_joints_with(&mut sr, nj, |r, what| {
-        let mut v = [0.0; 3];
-        for x in &mut v {
-            *x = if decimal {
-                let u = r.varint(what)?;
-                (((u >> 1) as i64) ^ -((u & 1) as i64)) as f64 / DECIMAL_SCALE
-            } else {
-                r.f64(what)?
-            };
-        }
-        Ok(DVec3::from_array(v))
-    })?;
-    if sr.remaining() != 0 {
-        return Err(MocapError::Codec(format!(
-            "skeleton at byte {at}: {} bytes left after its {nj} joints",
-            sr.remaining()
-        )));
-    }
-    Ok(sk)
+    let (joints, end) = inbetween_ibk::read_skeleton(r.bytes, r.pos).map_err(runtime_error)?;
+    r.pos = end;
+    skeleton_of(&joints)
+}
+
+/// An error of the runtime reader as the codec's.
+pub(crate) fn runtime_error(e: inbetween_ibk::IbkError) -> MocapError {
+    MocapError::Codec(e.to_string())
+}
+
+/// The engine's skeleton of the joints the runtime read (channel codes as [`write_skeleton`]
+/// writes them).
+pub(crate) fn skeleton_of(joints: &[inbetween_ibk::Joint]) -> Result<Skeleton> {
+    let joints = joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let channels = j
+                .channels
+                .iter()
+                .map(|&c| {
+                    channel_from_code(c)
+                        .ok_or_else(|| MocapError::Codec(format!("joint {i} '{}': unknown channel code {c}", j.name)))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Ok(Joint {
+                name: j.name.clone(),
+                parent: j.parent,
+                offset: DVec3::from_array(j.offset),
+                channels,
+                end_site: j.end_site.map(DVec3::from_array),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Skeleton::new(joints).map_err(|e| MocapError::Codec(format!("skeleton: {e}")))
 }
 
 pub(crate) fn write_varint(out: &mut Vec<u8>, mut v: u64) {
@@ -264,22 +247,13 @@ impl<'a> Reader<'a> {
 
 /// Reads `nj` joints written by [`write_skeleton`] (after its joint count).
 pub fn read_skeleton_joints(r: &mut Reader, nj: usize) -> Result<Skeleton> {
-    read_skeleton_joints_with(r, nj, |r, what| r.vec3_f64(what))
-}
-
-/// [`read_skeleton_joints`] with lengths read by `vec3`.
-fn read_skeleton_joints_with(
-    r: &mut Reader,
-    nj: usize,
-    vec3: impl Fn(&mut Reader, &str) -> Result<DVec3>,
-) -> Result<Skeleton> {
     let mut joints = Vec::with_capacity(nj);
     for i in 0..nj {
         let len = r.u16("joint name length")? as usize;
         let name = String::from_utf8(r.take(len, "joint name")?.to_vec())
             .map_err(|_| MocapError::Codec(format!("joint {i}: name is not UTF-8")))?;
         let parent = r.i16("joint parent")?;
-        let offset = vec3(r, "joint offset")?;
+        let offset = r.vec3_f64("joint offset")?;
         let nch = r.u8("channel count")? as usize;
         let channels = (0..nch)
             .map(|_| {
@@ -288,7 +262,7 @@ fn read_skeleton_joints_with(
                     .ok_or_else(|| MocapError::Codec(format!("joint {i} '{name}': unknown channel code {c}")))
             })
             .collect::<Result<Vec<_>>>()?;
-        let end_site = if r.u8("end site flag")? == 1 { Some(vec3(r, "end site")?) } else { None };
+        let end_site = if r.u8("end site flag")? == 1 { Some(r.vec3_f64("end site")?) } else { None };
         let parent = if parent < 0 { None } else { Some(parent as usize) };
         joints.push(Joint { name, parent, offset, channels, end_site });
     }

@@ -31,7 +31,7 @@
 //! channels their skeleton offset.
 
 use super::bits::{unzigzag, zigzag, BitReader, BitWriter};
-use super::{read_compact_skeleton, write_compact_skeleton, Reader, MAGIC, MAX_FRAME_JOINTS};
+use super::{runtime_error, skeleton_of, write_compact_skeleton, Reader, MAGIC};
 use crate::{MocapError, Result};
 use glam::{DQuat, DVec3};
 use inbetween_core::rotation::rotvec_to_quat;
@@ -42,16 +42,14 @@ pub const VERSION: u16 = 3;
 /// Frames per segment written by default: on the CMU takes at 0.05 cm, 32 gave 21.10:1 against
 /// 20.27:1 with 16 (ACL's segments hold 16 samples); a pose still decodes from one segment.
 pub const DEFAULT_SEGMENT_LEN: usize = 32;
-/// Longest segment a file may declare (bounds the work of decoding one pose).
-pub const MAX_SEGMENT_LEN: usize = 256;
+/// Longest segment a file may declare (bounds the work of decoding one pose); the runtime's, as
+/// versions 3 and 4 share their head.
+pub use inbetween_ibk::MAX_SEGMENT_LEN;
 /// Step code bias: step = 2^((code − STEP_BIAS) / 4).
-pub const STEP_BIAS: i32 = 192;
+pub use inbetween_ibk::STEP_BIAS;
 /// Largest |quantised value| the encoder produces: second-order residuals then stay within
 /// [`super::bits::MAX_RICE_VALUE`].
 pub const MAX_Q: i64 = 1 << 38;
-/// Decoded poses a file may describe per byte of file (a clip of constant tracks costs almost no
-/// bytes per frame; this keeps a hostile header from sizing a huge allocation).
-const POSES_PER_BYTE: u64 = 1024;
 
 /// Step size of a step code.
 pub fn step(code: u8) -> f64 {
@@ -101,6 +99,55 @@ pub struct Header {
     pub tracks: Vec<Track>,
     /// Per track: `Some` value for a constant track, `None` for an animated one.
     pub constants: Vec<Option<[f32; 3]>>,
+}
+
+impl Header {
+    /// The header of the head the runtime read ([`inbetween_ibk::read_head`]: the fields,
+    /// skeleton and tracks versions 3 and 4 share), with the engine's skeleton.
+    pub fn from_head(head: &inbetween_ibk::Head) -> Result<Header> {
+        let skeleton = skeleton_of(&head.joints)?;
+        let tracks = tracks(&skeleton);
+        let same = tracks.len() == head.tracks.len()
+            && tracks.iter().zip(&head.tracks).all(|(a, b)| a.joint == b.0 && (a.kind == TrackKind::Rotation) == b.1);
+        if !same {
+            return Err(MocapError::Codec("the skeleton's channels do not give the tracks the runtime reads".into()));
+        }
+        Ok(Header {
+            skeleton,
+            frame_time: head.frame_time,
+            num_frames: head.num_frames,
+            segment_len: head.segment_len,
+            cm_per_unit: head.cm_per_unit,
+            bound_cm: head.bound_cm,
+            tracks,
+            constants: head.tracks.iter().map(|t| t.2).collect(),
+        })
+    }
+
+    /// Appends what versions 3 and 4 write before their segments: magic, `version`, the header
+    /// fields, the compact skeleton and the tracks (kind, and the value of a constant one).
+    pub(crate) fn write_head(&self, out: &mut Vec<u8>, version: u16) {
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&version.to_le_bytes());
+        out.extend_from_slice(&0u16.to_le_bytes());
+        out.extend_from_slice(&self.frame_time.to_le_bytes());
+        out.extend_from_slice(&(self.num_frames as u32).to_le_bytes());
+        out.extend_from_slice(&(self.segment_len as u16).to_le_bytes());
+        out.extend_from_slice(&self.cm_per_unit.to_le_bytes());
+        out.extend_from_slice(&self.bound_cm.to_le_bytes());
+        write_compact_skeleton(out, &self.skeleton);
+        for c in &self.constants {
+            match c {
+                None => out.push(0),
+                Some(v) => {
+                    out.push(1);
+                    for x in v {
+                        out.extend_from_slice(&x.to_le_bytes());
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Everything a version 3 file holds, quantised: what [`encode`] writes and [`decode`] reads back.
@@ -242,26 +289,7 @@ fn encode_segment(qz: &Quantised, seg: usize) -> Vec<u8> {
 /// Writes a version 3 file.
 pub fn encode(qz: &Quantised) -> Vec<u8> {
     let mut out = Vec::new();
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&0u16.to_le_bytes());
-    out.extend_from_slice(&qz.header.frame_time.to_le_bytes());
-    out.extend_from_slice(&(qz.header.num_frames as u32).to_le_bytes());
-    out.extend_from_slice(&(qz.header.segment_len as u16).to_le_bytes());
-    out.extend_from_slice(&qz.header.cm_per_unit.to_le_bytes());
-    out.extend_from_slice(&qz.header.bound_cm.to_le_bytes());
-    write_compact_skeleton(&mut out, &qz.header.skeleton);
-    for c in &qz.header.constants {
-        match c {
-            None => out.push(0),
-            Some(v) => {
-                out.push(1);
-                for x in v {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-            }
-        }
-    }
+    qz.header.write_head(&mut out, VERSION);
     let segments: Vec<Vec<u8>> = (0..qz.num_segments()).map(|s| encode_segment(qz, s)).collect();
     let mut offset = 0u32;
     for s in &segments {
@@ -327,64 +355,11 @@ impl<'a> File<'a> {
     /// Parses a version 3 file (magic, version, checksum and every header field checked).
     pub fn open(bytes: &'a [u8]) -> Result<File<'a>> {
         let body = super::check_envelope(bytes, VERSION, VERSION)?.1;
+        let head = inbetween_ibk::read_head(body, bytes.len()).map_err(runtime_error)?;
+        let header = Header::from_head(&head)?;
+        let (num_frames, segment_len) = (header.num_frames, header.segment_len);
         let mut r = Reader::new(body);
-        r.skip(8, "magic and version")?;
-        let frame_time = r.f64("frame time")?;
-        let num_frames = r.u32("frame count")? as usize;
-        let segment_len = r.u16("segment length")? as usize;
-        let cm_per_unit = r.f64("cm per unit")?;
-        let bound_cm = r.f64("error bound")?;
-        let valid = frame_time.is_finite()
-            && frame_time > 0.0
-            && num_frames > 0
-            && (1..=MAX_SEGMENT_LEN).contains(&segment_len)
-            && cm_per_unit.is_finite()
-            && cm_per_unit > 0.0
-            && bound_cm.is_finite()
-            && bound_cm >= 0.0;
-        if !valid {
-            return Err(MocapError::Codec(format!(
-                "invalid header: frame time {frame_time}, {num_frames} frames, segments of {segment_len} frames (1 to {MAX_SEGMENT_LEN}), {cm_per_unit} cm per unit, bound {bound_cm} cm"
-            )));
-        }
-        let skeleton = read_compact_skeleton(&mut r)?;
-        let poses = num_frames as u64 * skeleton.len() as u64;
-        let limit = MAX_FRAME_JOINTS.min(POSES_PER_BYTE * bytes.len() as u64);
-        if poses > limit {
-            return Err(MocapError::Codec(format!(
-                "invalid header: {num_frames} frames of {} joints exceed the {limit} joint poses a file of {} bytes may hold",
-                skeleton.len(),
-                bytes.len()
-            )));
-        }
-        let tracks = tracks(&skeleton);
-        let mut constants = Vec::with_capacity(tracks.len());
-        for (i, t) in tracks.iter().enumerate() {
-            let at = r.pos();
-            constants.push(match r.u8("track kind")? {
-                0 => None,
-                1 => {
-                    let v = [
-                        r.f32("constant track value")?,
-                        r.f32("constant track value")?,
-                        r.f32("constant track value")?,
-                    ];
-                    if v.iter().any(|x| !x.is_finite()) {
-                        return Err(MocapError::Codec(format!(
-                            "track {i} (joint {}): constant value is not finite",
-                            t.joint
-                        )));
-                    }
-                    Some(v.map(|x| x as f32))
-                }
-                k => {
-                    return Err(MocapError::Codec(format!(
-                        "track {i} (joint {}) at byte {at}: kind {k}, expected 0 (animated) or 1 (constant)",
-                        t.joint
-                    )))
-                }
-            });
-        }
+        r.skip(head.end, "the head")?;
         let segments = num_frames.div_ceil(segment_len);
         if segments * 4 + 4 > r.remaining() {
             return Err(MocapError::Codec(format!(
@@ -415,9 +390,8 @@ impl<'a> File<'a> {
         }
         let data_at = r.pos();
         let data = &body[data_at..];
-        let animated = (0..tracks.len()).filter(|&t| constants[t].is_none()).collect();
+        let animated = (0..header.tracks.len()).filter(|&t| header.constants[t].is_none()).collect();
         let crc = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().expect("the envelope holds a checksum"));
-        let header = Header { skeleton, frame_time, num_frames, segment_len, cm_per_unit, bound_cm, tracks, constants };
         Ok(File { header, animated, offsets, data, data_at, crc })
     }
 

@@ -15,9 +15,9 @@
 //! Compared with version 3 a file is larger (fixed widths instead of Rice codes of prediction
 //! residuals); version 3 stays the format for storage, version 4 for playing back.
 
+use super::runtime_error;
 use super::v3::{Header, Quantised, TrackKind};
-use super::{read_compact_skeleton, write_compact_skeleton, Reader};
-use crate::{MocapError, Result};
+use crate::Result;
 use glam::{DQuat, DVec3};
 use inbetween_core::{Motion, Pose};
 pub use inbetween_ibk::{exp_map, step, Clip, Context, MAX_WIDTH, VERSION};
@@ -108,26 +108,7 @@ pub fn encode(qz: &Quantised) -> Vec<u8> {
     let animated: Vec<usize> = (0..nt).filter(|&t| h.constants[t].is_none()).collect();
     let segments = qz.num_segments();
     let mut out = Vec::new();
-    out.extend_from_slice(super::MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&0u16.to_le_bytes());
-    out.extend_from_slice(&h.frame_time.to_le_bytes());
-    out.extend_from_slice(&(h.num_frames as u32).to_le_bytes());
-    out.extend_from_slice(&(h.segment_len as u16).to_le_bytes());
-    out.extend_from_slice(&h.cm_per_unit.to_le_bytes());
-    out.extend_from_slice(&h.bound_cm.to_le_bytes());
-    write_compact_skeleton(&mut out, &h.skeleton);
-    for c in &h.constants {
-        match c {
-            None => out.push(0),
-            Some(v) => {
-                out.push(1);
-                for x in v {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-            }
-        }
-    }
+    h.write_head(&mut out, VERSION);
     let mut headers = Bits::new();
     let mut data = Vec::new();
     let mut prev: Vec<(i64, u8)> = vec![(0, 0); 3 * animated.len()];
@@ -232,30 +213,11 @@ pub fn frame_pose(clip: &Clip, f: usize, vals: &mut Vec<f32>, out: &mut Pose) {
     }
 }
 
-/// Decodes a whole version 4 file (the runtime's checks, then mocap's skeleton).
+/// Decodes a whole version 4 file: the runtime opens it (every check, the one reader of the
+/// layout) and decodes every frame; the engine's skeleton is made from the joints it read.
 pub fn decode(bytes: &[u8]) -> Result<Decoded> {
-    let clip = Clip::open(bytes).map_err(|e| MocapError::Codec(e.to_string()))?;
-    // The skeleton as the mocap engine reads it (names, channels, end sites), after the fixed
-    // header of 38 bytes.
-    let mut r = Reader::new(&bytes[38..bytes.len() - 4]);
-    let skeleton = read_compact_skeleton(&mut r)?;
-    let tracks = super::v3::tracks(&skeleton);
-    let same = tracks.len() == clip.tracks().len()
-        && tracks.iter().zip(clip.tracks()).all(|(a, b)| a.joint == b.0 && (a.kind == TrackKind::Rotation) == b.1);
-    if !same {
-        return Err(MocapError::Codec("the skeleton's channels do not give the tracks the runtime reads".into()));
-    }
-    let constants = clip.tracks().iter().map(|t| t.2).collect();
-    let header = Header {
-        skeleton,
-        frame_time: clip.frame_time(),
-        num_frames: clip.num_frames(),
-        segment_len: clip.segment_len(),
-        cm_per_unit: clip.cm_per_unit(),
-        bound_cm: clip.bound_cm(),
-        tracks,
-        constants,
-    };
+    let clip = Clip::open(bytes).map_err(runtime_error)?;
+    let header = Header::from_head(clip.head())?;
     let mut vals = Vec::new();
     let poses = (0..clip.num_frames())
         .map(|f| {
