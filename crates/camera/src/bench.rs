@@ -31,13 +31,37 @@ use crate::dataset::Behaviour;
 use crate::infer::FastModel;
 use crate::model::STYLE_STEPS;
 use crate::toric::Lens;
+use crate::CameraError;
+use inbetween_io::report::{BenchOptions, Report};
 use inbetween_io::Progress;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+/// The camera bench's own options (beside [`BenchOptions`]).
+#[derive(Clone, Debug, Default)]
+pub struct CameraBench {
+    /// Weights to bench (None: the committed weights).
+    pub weights: Option<std::path::PathBuf>,
+}
+
+/// `inbetween camera bench`: the weights, then [`measure`] with [`BenchConfig::quick`] or
+/// [`BenchConfig::full`] (`seed` replacing the configuration's), then the report with its charts.
+pub fn run(opts: &BenchOptions<CameraBench>) -> Result<Report, CameraError> {
+    let loaded = match &opts.engine.weights {
+        Some(path) => crate::weights::load(path).map_err(|e| (format!("camera weights {}", path.display()), e)),
+        None => crate::weights::committed().map_err(|e| ("the committed camera weights".to_string(), e)),
+    };
+    let model = loaded.map_err(|(what, e)| CameraError::Request(format!("loading {what}: {e}")))?.model;
+    let cfg = if opts.quick { BenchConfig::quick() } else { BenchConfig::full() };
+    let cfg = BenchConfig { seed: opts.seed.unwrap_or(cfg.seed), ..cfg };
+    let results = measure(&model, &cfg, &opts.progress);
+    opts.progress.phase(1, "charts");
+    results.report()
+}
+
 /// Runs the whole benchmark, advancing `progress` through its phases (style codes, Table 1,
 /// Table 2, §6.3, speed); the caller finishes the bar.
-pub fn run(model: &FastModel, cfg: &BenchConfig, progress: &Progress) -> BenchReport {
+pub fn measure(model: &FastModel, cfg: &BenchConfig, progress: &Progress) -> BenchReport {
     let lens = Lens::default();
     let seqs = eval_sequences(cfg.seed, cfg.scenes);
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);

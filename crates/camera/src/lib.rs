@@ -16,6 +16,7 @@ pub mod dataset;
 pub mod demo;
 mod error;
 pub mod features;
+pub mod generate_files;
 pub mod gltf;
 pub mod infer;
 pub mod model;

@@ -4,11 +4,13 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_camera::bench;
 use inbetween_camera::dataset::Scene;
-use inbetween_camera::infer::{GenerateJob, GenerateLimits, GenerateOptions, Keys};
+use inbetween_camera::generate_files::{write_tracks, TrackFiles};
+use inbetween_camera::infer::{GenerateLimits, GenerateOptions, Keys};
 use inbetween_camera::train::TrainConfig;
 use inbetween_camera::weights::{self, CameraWeights};
 use inbetween_camera::TrainJob;
 use inbetween_core::cancel::Cancel;
+use inbetween_io::report::BenchOptions;
 use inbetween_io::{LimitExceeded, OutputSet};
 use std::path::{Path, PathBuf};
 
@@ -179,12 +181,6 @@ fn load_weights(path: Option<&Path>) -> anyhow::Result<CameraWeights> {
     }
 }
 
-fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
-    path.with_file_name(format!("{stem}-{suffix}{ext}"))
-}
-
 fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
     let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
     let limits = GenerateLimits { max_frames: a.max_frames, max_keys: a.max_keys };
@@ -210,39 +206,8 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
         ..GenerateOptions::default()
     };
     let styles = w.requested_styles(a.all_styles, a.reference.as_deref(), a.style.as_deref(), &scene)?;
-    let runs = styles.into_iter().map(|(s, b)| (s, b.map_or_else(|| a.out.clone(), |b| with_suffix(&a.out, b.name()))));
-    // Every track, glTF and preview of the run appear together at the end, or none.
-    let mut set = OutputSet::new();
-    let mut lines = Vec::new();
-    for (style, out) in runs {
-        let name = style.name.clone();
-        let track =
-            GenerateJob { model: &w.model, scene: &scene, keys: &keys, style: &style, options, origin: &a.keys }
-                .run()?;
-        let staged = |set: &mut OutputSet, p: &Path| set.file(p).with_context(|| format!("preparing {}", p.display()));
-        inbetween_camera::write_json(&staged(&mut set, &out)?, &track)?;
-        let gltf = match &a.gltf {
-            Some(g) if a.all_styles => with_suffix(g, &name),
-            Some(g) => g.clone(),
-            None => out.with_extension("gltf"),
-        };
-        inbetween_camera::gltf::write_gltf(&staged(&mut set, &gltf)?, &track, &scene)?;
-        if let Some(g) = &a.gif {
-            let g = if a.all_styles { with_suffix(g, &name) } else { g.clone() };
-            inbetween_camera::preview::write_preview(&staged(&mut set, &g)?, &track, &scene, 3)?;
-            lines.push(format!("  preview {}", g.display()));
-        }
-        cancel.check()?;
-        let worst = track.worst_key_miss();
-        lines.push(format!(
-            "{name}: {} frames -> {} (network keyframe miss max {worst:.4}, after correction {:.1e})",
-            track.frames.len(),
-            out.display(),
-            track.max_corrected_residual
-        ));
-    }
-    set.commit().context("moving the camera tracks into place")?;
-    for line in lines {
+    let files = TrackFiles { out: a.out, gltf: a.gltf, gif: a.gif, per_style: a.all_styles };
+    for line in write_tracks(&w.model, &scene, &keys, &a.keys, styles, options, &files)? {
         println!("{line}");
     }
     Ok(())
@@ -263,18 +228,9 @@ fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
 }
 
 fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
-    let model = load_weights(a.weights.as_deref())?.model;
-    let cfg = if a.quick { bench::BenchConfig::quick() } else { bench::BenchConfig::full() };
-    let t0 = std::time::Instant::now();
-    let progress = inbetween_io::Progress::new(1, "camera bench");
-    let results = bench::run(&model, &cfg, &progress);
-    progress.phase(1, "charts");
-    let report = results.report();
-    progress.finish();
-    let report = report?;
-    print!("{}", report.to_text());
-    let files = report.write(&a.out).with_context(|| format!("writing the camera bench to {}", a.out.display()))?;
-    println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t0.elapsed().as_secs_f64());
+    let engine = bench::CameraBench { weights: a.weights };
+    let opts = BenchOptions { out: Some(a.out), quick: a.quick, ..BenchOptions::new(engine) };
+    crate::bench::run("camera bench", opts, bench::run)?.print_summary();
     Ok(())
 }
 

@@ -6,18 +6,20 @@ use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
 
 use inbetween_core::cancel::Cancel;
-use inbetween_face::bench::{self, FaceBenchConfig};
+use inbetween_face::bench;
 use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::plan::{
-    captures_dir, keeps_live_link, span_seconds, viseme_runs, EditResources, MethodChoice, SPEECH_GROUPS,
+    keeps_live_link, span_seconds, viseme_runs, EditResources, MethodChoice, SPEECH_GROUPS,
 };
 use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide};
 use inbetween_face::preview::{write_outcome_gif, write_outcome_png};
+use inbetween_face::procedural;
 use inbetween_face::train::{TrainData, TrainJob};
 use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, PhonemeSpan};
-use inbetween_face::{procedural, weights};
+use inbetween_io::fsutil::with_stem_suffix;
+use inbetween_io::report::BenchOptions;
 use inbetween_io::{OutputSet, Progress};
 
 use crate::errors;
@@ -296,7 +298,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let mut spreads = Vec::new();
     for k in 1..=a.variants {
         job.seed = a.seed + u64::from(k - 1);
-        let named = |p: &Path| if a.variants == 1 { p.to_path_buf() } else { variant_path(p, k) };
+        let named = |p: &Path| if a.variants == 1 { p.to_path_buf() } else { with_stem_suffix(p, &k.to_string()) };
         let (out, ms) = edit_once(&a, &job, &mut set, live_link, &named)?;
         println!(
             "edited {} span(s) of {} ({} frames at {:.3} fps) with {} (seed {}) in {ms:.1} ms -> {}",
@@ -326,16 +328,6 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
-}
-
-/// `out.csv` → `out-<k>.csv`.
-fn variant_path(p: &Path, k: u32) -> PathBuf {
-    let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let name = match p.extension() {
-        Some(e) => format!("{stem}-{k}.{}", e.to_string_lossy()),
-        None => format!("{stem}-{k}"),
-    };
-    p.with_file_name(name)
 }
 
 /// One edit: runs the job, stages its clip, PNG and (with --gif) GIF under `named` paths.
@@ -397,21 +389,9 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
 }
 
 fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
-    let captures = captures_dir(a.captures.as_deref())?;
-    let cfg = if a.quick { FaceBenchConfig::quick(captures) } else { FaceBenchConfig::full(captures) };
-    let mut sets = vec![match &a.weights {
-        Some(dir) => weights::set_from_dir(dir, "procedural")?,
-        None => weights::committed_set()?,
-    }];
-    if let Some(dir) = &a.real_weights {
-        sets.push(weights::set_from_dir(dir, "real")?);
-    }
-    let t = std::time::Instant::now();
-    let progress = Progress::new(1, "face bench");
-    let report = bench::run(&cfg, &sets, &progress)?;
-    print!("{}", report.to_text());
-    let files = report.write(&a.out).with_context(|| format!("writing the face bench to {}", a.out.display()))?;
-    println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t.elapsed().as_secs_f64());
+    let engine = bench::FaceBench { weights: a.weights, real_weights: a.real_weights };
+    let opts = BenchOptions { out: Some(a.out), data: a.captures, quick: a.quick, ..BenchOptions::new(engine) };
+    crate::bench::run("face bench", opts, bench::run)?.print_summary();
     Ok(())
 }
 

@@ -7,6 +7,7 @@ use inbetween_core::cancel::Cancel;
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::Motion;
 use inbetween_io::fsutil::write_atomic;
+use inbetween_io::report::BenchOptions;
 use inbetween_io::Progress;
 use inbetween_mocap::bench::{self, Protocol};
 use inbetween_mocap::codec::job::Version;
@@ -386,60 +387,58 @@ impl BenchArgs {
             (None, episodes) => bench::PolicyChoice::train(episodes),
         };
         bench::BenchConfig {
-            data: self.data.clone(),
             unit: self.unit,
-            protocol: Protocol { stride: self.stride, seed: self.seed, ..Protocol::paper() },
+            protocol: Protocol { stride: self.stride, ..Protocol::paper() },
             policy,
             codec_bounds_cm: self.codec_bounds.clone(),
-            output_dir: self.output.clone(),
-            csv: self.csv.clone(),
-            plot: self.plot.clone(),
+            chart: self.plot.is_some(),
             kfold: (self.folds > 0).then(|| bench::run::KFoldConfig { folds: self.folds, ..Default::default() }),
             ..bench::BenchConfig::default()
+        }
+    }
+
+    /// The codec table on ACL's protocol (`bench::acl`), written beside the bench report.
+    fn acl(&self) -> bench::acl::AclConfig {
+        bench::acl::AclConfig {
+            unit: self.unit,
+            bounds_cm: self.acl_bounds.clone(),
+            segment_len: self.acl_segment,
+            race_bounds: self.race_bounds.clone(),
+            ..Default::default()
+        }
+    }
+
+    fn options<E>(&self, engine: E) -> BenchOptions<E> {
+        BenchOptions {
+            out: self.output.clone(),
+            data: self.data.clone(),
+            seed: Some(self.seed),
+            ..BenchOptions::new(engine)
         }
     }
 }
 
 fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
     if !a.codec_only {
-        let progress = inbetween_io::Progress::new(0, "mocap bench");
-        let out = bench::run(&a.config(), &progress);
-        progress.finish();
-        let out = out?;
-        print!("{}", crate::errors::with_flags(&out.report.to_text()));
-        for p in &out.written {
-            println!("wrote {}", p.display());
+        let mut done = crate::bench::run("mocap bench", a.options(a.config()), bench::run)?;
+        if let Some(p) = &a.csv {
+            let rows = done.report.find_table("mocap_bench").map(|t| t.to_csv()).unwrap_or_default();
+            write_atomic(p, rows.as_bytes()).with_context(|| format!("writing {}", p.display()))?;
+            done.files.push(p.clone());
         }
+        if let Some(p) = &a.plot {
+            let png = done.report.file_bytes("table3.png").unwrap_or_default();
+            write_atomic(p, png).with_context(|| format!("writing {}", p.display()))?;
+            done.files.push(p.clone());
+        }
+        done.print_files();
     }
-    acl_bench(&a)
-}
-
-/// The codec table on ACL's protocol (`bench::acl`), written beside the bench report.
-fn acl_bench(a: &BenchArgs) -> anyhow::Result<()> {
-    let cfg = bench::acl::AclConfig {
-        data: a.data.clone(),
-        unit: a.unit,
-        bounds_cm: a.acl_bounds.clone(),
-        segment_len: a.acl_segment,
-        seed: a.seed,
-        race_bounds: a.race_bounds.clone(),
-        ..Default::default()
-    };
-    let progress = inbetween_io::Progress::new(0, "codec (ACL protocol)");
-    let out = bench::acl::run(&cfg, a.output.as_deref(), &progress);
-    progress.finish();
-    let (_, report, written) = out?;
-    print!("{}", crate::errors::with_flags(&report.to_text()));
-    for p in &written {
-        println!("wrote {}", p.display());
-    }
+    crate::bench::run("codec (ACL protocol)", a.options(a.acl()), bench::acl::run)?.print_files();
     Ok(())
 }
 
 fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
-    let Some(base) = TrainOptions::preset(&a.preset) else {
-        bail!("unknown preset '{}'; expected default, paper or quick", a.preset)
-    };
+    let base = TrainOptions::preset_with(&a.preset, a.pretrain_steps, a.episodes, a.lr, a.gamma)?;
     let job = TrainJob {
         data: match (a.procedural, a.all_takes) {
             (true, _) => TrainingData::Procedural,
@@ -449,15 +448,7 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
         data_dir: a.data,
         unit: a.unit,
         stride: a.stride,
-        options: TrainOptions {
-            pretrain_steps: a.pretrain_steps.unwrap_or(base.pretrain_steps),
-            episodes: a.episodes.unwrap_or(base.episodes),
-            lr: a.lr.unwrap_or(base.lr),
-            gamma: a.gamma.unwrap_or(base.gamma),
-            seed: a.seed,
-            time_limit_s: a.time_limit_min.map(|m| m * 60.0),
-            ..base
-        },
+        options: TrainOptions { seed: a.seed, time_limit_s: a.time_limit_min.map(|m| m * 60.0), ..base },
         output: a.output,
     };
     println!("{}", job.run(&Cancel::new(), &Progress::hidden())?);

@@ -202,7 +202,7 @@ fn run_job(a: &RunArgs) -> RunJob {
     }
 }
 
-fn print_run(source: &Path, r: &inbetween_script::jobs::RunReport, shown: &dyn Fn(&Path) -> PathBuf) {
+fn print_run(source: &Path, r: &inbetween_script::jobs::RunReport) {
     for d in &r.scene.diagnostics {
         eprintln!("warning: {}: {d}", source.display());
     }
@@ -213,64 +213,39 @@ fn print_run(source: &Path, r: &inbetween_script::jobs::RunReport, shown: &dyn F
         println!("{line}");
     }
     for f in &r.files {
-        println!("  wrote {}", shown(f).display());
+        println!("  wrote {}", f.display());
     }
 }
 
-/// A path as the user will find it: one written under `staging` is shown under `out`, where the
-/// output set moved it.
-fn moved(staging: &Path, out: &Path, p: &Path) -> PathBuf {
-    p.strip_prefix(staging).map_or_else(|_| p.to_path_buf(), |rest| out.join(rest))
-}
-
-/// `script run`: the story's outputs are written into a staging folder and moved into `--out`
-/// only when the run finishes, so a failed, cancelled or timed-out run leaves no partial set.
-/// `--skinned` outputs are a second set, written after (a missing asset folder leaves the story's
-/// outputs in place and writes none of the skinned ones).
+/// `script run`: the story's outputs appear in `--out` whole or not at all; `--skinned` outputs are
+/// a second set, written after (a missing asset folder leaves the story's outputs in place).
 fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let (text, source) = load_script(&a.scene.script)?;
-    let cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
+    let mut job = run_job(&a);
+    job.cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
         .map_err(anyhow::Error::msg)
         .context("--time-limit")?;
-    let mut set = inbetween_io::OutputSet::new();
-    let staging = set.dir(&a.scene.out).with_context(|| format!("preparing {}", a.scene.out.display()))?;
-    let mut job = run_job(&a);
-    job.scene.out_dir = staging.clone();
-    job.cancel = cancel;
     job.progress = Progress::new(6, "script run");
-    let report = inbetween_script::jobs::run_story(&text, &source, &job)
+    let report = inbetween_script::jobs::run_story_whole(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
-    set.commit().with_context(|| format!("moving the outputs into {}", a.scene.out.display()))?;
-    print_run(&source, &report, &|p: &Path| moved(&staging, &a.scene.out, p));
+    print_run(&source, &report);
     if a.skinned {
-        let mut set = inbetween_io::OutputSet::new();
-        let staging = set.dir(&a.scene.out).with_context(|| format!("preparing {}", a.scene.out.display()))?;
-        let s = skinned(&a, &report, &staging)?;
-        set.commit().with_context(|| format!("moving the skinned outputs into {}", a.scene.out.display()))?;
-        print_skinned(&s, &|p: &Path| moved(&staging, &a.scene.out, p));
+        print_skinned(&a, &report)?;
     }
     Ok(())
 }
 
-/// `--skinned`: the skinned Kenney outputs into `dir`, beside the story's.
-fn skinned(
-    a: &RunArgs,
-    r: &inbetween_script::jobs::RunReport,
-    dir: &Path,
-) -> anyhow::Result<inbetween_script::output::skinned::SkinnedStory> {
-    let models = a.scene.models.as_deref();
-    let cat = inbetween_script::jobs::catalogue(models)?;
-    inbetween_script::output::skinned::write_skinned_story(dir, &r.animation, &cat, models)
-        .context("writing the skinned characters")
-}
-
-fn print_skinned(s: &inbetween_script::output::skinned::SkinnedStory, shown: &dyn Fn(&Path) -> PathBuf) {
+/// `--skinned`: the skinned Kenney outputs beside the story's.
+fn print_skinned(a: &RunArgs, r: &inbetween_script::jobs::RunReport) -> anyhow::Result<()> {
+    let s = inbetween_script::jobs::write_skinned_whole(&a.scene.out, r, a.scene.models.as_deref())
+        .context("writing the skinned characters")?;
     for n in &s.notes {
         println!("  {n}");
     }
     for f in &s.files {
-        println!("  wrote {}", shown(f).display());
+        println!("  wrote {}", f.display());
     }
+    Ok(())
 }
 
 fn watch(a: WatchArgs) -> anyhow::Result<()> {
@@ -278,12 +253,9 @@ fn watch(a: WatchArgs) -> anyhow::Result<()> {
     println!("watching {} (Ctrl-C to stop)", path.display());
     inbetween_script::jobs::watch(&path, &run_job(&a.run), a.max_runs, |outcome| match outcome {
         Ok(r) => {
-            print_run(&path, &r, &|p: &Path| p.to_path_buf());
-            if a.run.skinned {
-                match skinned(&a.run, &r, &a.run.scene.out) {
-                    Ok(s) => print_skinned(&s, &|p: &Path| p.to_path_buf()),
-                    Err(e) => eprintln!("error: {}: {e:#}", path.display()),
-                }
+            print_run(&path, &r);
+            if let Err(e) = a.run.skinned.then(|| print_skinned(&a.run, &r)).transpose() {
+                eprintln!("error: {}: {e:#}", path.display());
             }
         }
         Err(e) => eprintln!("error: {}: {e}", path.display()),
@@ -339,19 +311,13 @@ fn list_stories(a: StoriesArgs) -> anyhow::Result<()> {
 }
 
 fn bench(a: BenchArgs) -> anyhow::Result<()> {
-    use inbetween_script::bench::{run, BenchConfig};
-    let cfg = if a.quick { BenchConfig::quick(a.seed) } else { BenchConfig { seed: a.seed, ..BenchConfig::default() } };
-    let progress = Progress::new(1, "script bench");
-    let files =
-        run(&a.out, &cfg, &progress).with_context(|| format!("writing the script bench to {}", a.out.display()))?;
-    progress.finish();
-    let txt = files.iter().find(|f| f.extension().is_some_and(|e| e == "txt"));
-    if let Some(txt) = txt {
-        print!("{}", std::fs::read_to_string(txt).with_context(|| format!("reading {}", txt.display()))?);
-    }
-    for f in &files {
-        println!("wrote {}", f.display());
-    }
+    let opts = inbetween_io::report::BenchOptions {
+        out: Some(a.out),
+        quick: a.quick,
+        seed: Some(a.seed),
+        ..inbetween_io::report::BenchOptions::new(())
+    };
+    crate::bench::run("script bench", opts, inbetween_script::bench::run)?.print_files();
     Ok(())
 }
 

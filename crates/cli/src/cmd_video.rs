@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use inbetween_core::cancel::Cancel;
+use inbetween_io::report::BenchOptions;
 use inbetween_io::Progress;
 use inbetween_video::frames::{procedural_clip, write_clip, Decoder, ProceduralKind, ReadOptions};
 use inbetween_video::job::{AnalyseJob, ResequenceJob, ResequenceSource, VideoInput};
@@ -98,7 +99,7 @@ pub struct ResequenceArgs {
     #[arg(long, default_value_t = VideoLimits::default().max_frames)]
     pub limit_frames: usize,
     /// Refuse frames larger than this, WIDTHxHEIGHT (compared as a pixel count).
-    #[arg(long, default_value = "3840x2160", value_parser = parse_resolution)]
+    #[arg(long, default_value = "3840x2160", value_parser = VideoLimits::parse_pixels)]
     pub limit_resolution: u64,
     /// Refuse target lengths above this many frames.
     #[arg(long, default_value_t = VideoLimits::default().max_length)]
@@ -188,18 +189,6 @@ pub fn run(c: VideoCommand) -> anyhow::Result<()> {
         VideoCommand::Bench(a) => run_bench(a),
         VideoCommand::Scale(a) => run_scale(a),
     }
-}
-
-/// `1280x720` → 921 600 pixels.
-fn parse_resolution(s: &str) -> Result<u64, String> {
-    let (w, h) =
-        s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT such as 3840x2160, got {s:?}"))?;
-    let w: u64 = w.trim().parse().map_err(|_| format!("width {w:?} is not a whole number (in {s:?})"))?;
-    let h: u64 = h.trim().parse().map_err(|_| format!("height {h:?} is not a whole number (in {s:?})"))?;
-    if w == 0 || h == 0 {
-        return Err(format!("a resolution limit of {s} allows no frame"));
-    }
-    Ok(w * h)
 }
 
 /// The command-line flag that raises each limit of [`VideoLimits`].
@@ -332,46 +321,14 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
 }
 
 fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
-    use inbetween_video::bench::{run, VideoBenchConfig};
-    // A fresh cache, so the stage times include training the metric.
-    let cache = tempfile_dir()?;
-    let cfg = if a.quick {
-        VideoBenchConfig::quick(cache.clone())
-    } else {
-        let dir = a
-            .clips
-            .clone()
-            .or_else(|| Some(inbetween_io::shared_data_dir().unwrap_or_else(|missing| missing).join("video")));
-        match &dir {
-            Some(d) if d.exists() => println!("real clips from {}", d.display()),
-            _ => println!(
-                "skipped real clips: no data at {}",
-                dir.as_ref().map(|d| d.display().to_string()).unwrap_or_else(|| "../shared/data/video".into())
-            ),
-        }
-        VideoBenchConfig::full(dir.as_deref().filter(|d| d.exists()), cache.clone())
-    };
-    let cfg = match a.starts {
-        Some(0) => anyhow::bail!("--starts 0 runs nothing: give at least 1"),
-        Some(k) => VideoBenchConfig { starts: k, ..cfg },
-        None => cfg,
-    };
-    let t = std::time::Instant::now();
-    let progress = Progress::new(1, "video bench");
-    let report = run(&cfg, &progress)?;
-    progress.finish();
-    print!("{}", report.to_text());
-    let files = report.write(&a.out).with_context(|| format!("writing the video bench to {}", a.out.display()))?;
-    let _ = std::fs::remove_dir_all(&cache);
-    println!("wrote {} files to {} ({:.1} s)", files.len(), a.out.display(), t.elapsed().as_secs_f64());
+    use inbetween_video::bench::{real_clips, run, VideoBench};
+    if !a.quick {
+        println!("{}", real_clips(a.clips.as_deref()).1);
+    }
+    let engine = VideoBench { starts: a.starts };
+    let opts = BenchOptions { out: Some(a.out), data: a.clips, quick: a.quick, ..BenchOptions::new(engine) };
+    crate::bench::run("video bench", opts, run)?.print_summary();
     Ok(())
-}
-
-/// A new empty folder under the system temp dir.
-fn tempfile_dir() -> anyhow::Result<PathBuf> {
-    let dir = std::env::temp_dir().join(format!("inbetween-video-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    Ok(dir)
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {

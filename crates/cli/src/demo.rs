@@ -3,7 +3,6 @@
 
 use anyhow::Context;
 use clap::Args;
-use inbetween_core::procedural::{gait, GaitParams};
 use inbetween_io::Progress;
 use std::path::PathBuf;
 
@@ -21,28 +20,8 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     // One step for the walk, four for the mocap demo, one each for the camera, face, video and script demos.
     let steps = Progress::new(9, "demo");
-    let mut params = GaitParams::walk().jittered(a.seed, 0.15);
-    params.frames = 150;
-    params.turn_rate = 0.35;
-    let walk = gait(&params);
-    let bvh = a.out.join("walk.bvh");
-    inbetween_io::bvh::write_bvh(&bvh, &walk).with_context(|| format!("writing {}", bvh.display()))?;
-    let gif = a.out.join("walk.gif");
-    let opts = inbetween_render::stick::StickOptions {
-        title: Some(format!("procedural walk (seed {})", a.seed)),
-        ..Default::default()
-    };
-    inbetween_render::stick::render_motion_gif(&gif, &[&walk], &opts)
-        .with_context(|| format!("writing {}", gif.display()))?;
+    let mut lines = vec![inbetween_mocap::demo::opening_walk(&a.out, a.seed)?];
     steps.inc(1);
-    let mut lines = vec![format!(
-        "walk: {} frames at {:.0} fps, {} joints -> {} and {}",
-        walk.num_frames(),
-        walk.fps(),
-        walk.skeleton.len(),
-        bvh.display(),
-        gif.display()
-    )];
     lines.extend(inbetween_mocap::demo::run(&a.out, &steps)?);
     lines.extend(inbetween_camera::demo::run(&a.out, &steps)?);
     lines.push(inbetween_face::demo::run(&a.out, a.seed, &Progress::hidden())?.to_string());

@@ -38,6 +38,7 @@ pub const OPTION_FLAGS: &[(&str, &str)] = &[
     ("data", "--data"),
     ("roles", "--roles"),
     ("frame", "--frame"),
+    ("starts", "--starts"),
 ];
 
 /// Library text with each `` `field` `` of [`OPTION_FLAGS`] written as its flag (other text,

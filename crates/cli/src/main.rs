@@ -1,5 +1,6 @@
 //! `inbetween`: the command-line front end of every engine.
 
+mod bench;
 mod cmd_batch;
 mod cmd_camera;
 mod cmd_face;

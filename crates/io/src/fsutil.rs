@@ -1,7 +1,15 @@
 //! Writes that never leave a half-written file: write a temporary file beside the target, then rename.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// `path` with `-<suffix>` after its stem: `out.json` → `out-orbit.json`, `out` → `out-2`. For the
+/// several outputs one command writes under one given name (a style each, a variant each).
+pub fn with_stem_suffix(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    path.with_file_name(format!("{stem}-{suffix}{ext}"))
+}
 
 /// Writes `bytes` to `path` atomically (temp file in the same folder, fsync, rename); creates the
 /// folder when missing. Readers see the old file or the new one, never a partial one.
@@ -36,6 +44,13 @@ pub fn write_atomic_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_suffix_goes_after_the_stem() {
+        assert_eq!(with_stem_suffix(Path::new("a/out.json"), "orbit"), Path::new("a/out-orbit.json"));
+        assert_eq!(with_stem_suffix(Path::new("out.tar.gz"), "2"), Path::new("out.tar-2.gz"));
+        assert_eq!(with_stem_suffix(Path::new("out"), "2"), Path::new("out-2"));
+    }
 
     #[test]
     fn failed_write_leaves_no_file() {

@@ -1,7 +1,8 @@
 //! The bench/report harness every engine's `bench` uses: [`Table`] (aligned text, CSV and Markdown
 //! from one set of rows, with the paper's figures as a column beside ours), [`Report`] (a titled
-//! list of tables and text plus extra files, written atomically into one folder) and
-//! [`seconds_per_call`] for timings.
+//! list of tables and text plus extra files, written atomically into one folder),
+//! [`BenchOptions`] (what every engine's bench takes: `run(&BenchOptions<E>) -> Result<Report, _>`,
+//! `E` the engine's own options) and [`seconds_per_call`] for timings.
 //!
 //! ```
 //! use inbetween_io::report::{num, Report, Table};
@@ -18,7 +19,40 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::{write_atomic, IoError};
+use crate::{write_atomic, IoError, Progress};
+
+/// What every engine's bench takes: `bench::run(&BenchOptions<E>) -> Result<Report, _>`, with the
+/// options all benches share here and the engine's own in `engine`. A bench writes nothing itself:
+/// it returns its [`Report`], and the caller writes it into `out` ([`BenchOptions::write`]).
+#[derive(Clone, Debug)]
+pub struct BenchOptions<E = ()> {
+    /// Folder the report will be written to (None: printed only). Benches add files that cost time
+    /// to render (charts) only when it is set.
+    pub out: Option<PathBuf>,
+    /// Data folder (None: the bench's default, the shared corpus under [`crate::shared_data_dir`]).
+    pub data: Option<PathBuf>,
+    /// A reduced run (seconds to a minute) that checks the bench works; its numbers are not the
+    /// bench's.
+    pub quick: bool,
+    /// Seed of every random choice (None: the bench's own, which may differ between quick and full).
+    pub seed: Option<u64>,
+    /// Advanced through the bench's phases; the caller finishes it.
+    pub progress: Progress,
+    /// The engine's own options.
+    pub engine: E,
+}
+
+impl<E> BenchOptions<E> {
+    /// A full run on the default data, printed only, with the bench's own seed and no bar.
+    pub fn new(engine: E) -> BenchOptions<E> {
+        BenchOptions { out: None, data: None, quick: false, seed: None, progress: Progress::hidden(), engine }
+    }
+
+    /// Writes `report` into [`BenchOptions::out`] ([`Report::write`]); nothing when it is None.
+    pub fn write(&self, report: &Report) -> Result<Vec<PathBuf>, IoError> {
+        self.out.as_deref().map_or(Ok(Vec::new()), |dir| report.write(dir))
+    }
+}
 
 /// A number as a table cell with `decimals` digits; NaN (not measured) becomes "—".
 pub fn num(x: f64, decimals: usize) -> String {
@@ -199,6 +233,16 @@ impl Report {
         self
     }
 
+    /// The bytes of an added file ([`Report::file`]), by name.
+    pub fn file_bytes(&self, file: &str) -> Option<&[u8]> {
+        self.files.iter().find(|(name, _)| name == file).map(|(_, bytes)| bytes.as_slice())
+    }
+
+    /// A table by its name.
+    pub fn find_table(&self, name: &str) -> Option<&Table> {
+        self.tables().find(|t| t.name == name)
+    }
+
     pub fn tables(&self) -> impl Iterator<Item = &Table> {
         self.sections.iter().filter_map(|s| match s {
             Section::Table(t) => Some(t),
@@ -329,6 +373,21 @@ mod tests {
         assert_eq!(json["x"], 1.5);
         // No temporary files left behind.
         assert_eq!(std::fs::read_dir(dir.path().join("sub")).unwrap().count(), 5);
+        assert_eq!(r.file_bytes("plot.png"), Some(&[1u8, 2, 3][..]));
+        assert_eq!(r.file_bytes("none.png"), None);
+        assert_eq!(r.find_table("t1").map(|t| t.rows.len()), Some(3));
+    }
+
+    #[test]
+    fn bench_options_write_only_where_asked() {
+        let mut r = Report::new("report", "bench");
+        r.text("x");
+        let mut opts = BenchOptions::new(());
+        assert!(opts.write(&r).unwrap().is_empty());
+        let dir = tempfile::tempdir().unwrap();
+        opts.out = Some(dir.path().join("out"));
+        assert_eq!(opts.write(&r).unwrap().len(), 2);
+        assert!(dir.path().join("out/report.txt").is_file());
     }
 
     #[test]

@@ -11,6 +11,7 @@
 //! ```
 
 use std::io::Read;
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -103,6 +104,45 @@ pub fn scale_table(name: &str, title: &str, rows: &[ScaleRow]) -> crate::report:
     t
 }
 
+/// One scale's run as a front end prepares it: the input in words with units, and the command to
+/// measure.
+pub struct Measured {
+    pub input: String,
+    pub command: Command,
+}
+
+/// A scaling bench: for each of `scales`, `prepare(k, scratch)` writes the input at `k`× into a
+/// scratch folder (removed afterwards) and gives the command, which is run and measured as its own
+/// process ([`run_measured`]) and told to `each` as its row. Returns the report "`engine` scaling"
+/// (file stem `report`) holding the table `<engine>_scale` titled `title`. A run that fails (a limit
+/// refusing the input, say) is a row whose result is its first error line; a failure to prepare or
+/// start one stops the bench.
+pub fn run_scales<E: From<crate::IoError>>(
+    engine: &str,
+    title: &str,
+    scales: &[usize],
+    mut prepare: impl FnMut(usize, &Path) -> Result<Measured, E>,
+    mut each: impl FnMut(&ScaleRow),
+) -> Result<crate::report::Report, E> {
+    let io = |path: &Path, source| crate::IoError::Io { path: path.to_path_buf(), source };
+    let scratch = std::env::temp_dir().join(format!("inbetween-scale-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).map_err(|e| io(&scratch, e))?;
+    let mut rows = Vec::new();
+    let result = scales.iter().try_for_each(|&k| -> Result<(), E> {
+        let mut m = prepare(k, &scratch)?;
+        let program = Path::new(m.command.get_program()).to_path_buf();
+        let run = run_measured(&mut m.command).map_err(|e| io(&program, e))?;
+        rows.push(ScaleRow { scale: k, input: m.input, run });
+        each(rows.last().expect("just pushed"));
+        Ok(())
+    });
+    let _ = std::fs::remove_dir_all(&scratch);
+    result?;
+    let mut report = crate::report::Report::new("report", &format!("{engine} scaling"));
+    report.table(scale_table(&format!("{engine}_scale"), title, &rows));
+    Ok(report)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +168,30 @@ mod tests {
         assert!(own_peak_mib().unwrap() > 0.0);
         let failed = run_measured(Command::new("sh").args(["-c", "echo oops >&2; exit 3"])).unwrap();
         assert!(!failed.success && failed.stderr.contains("oops"));
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_scaling_bench_has_one_row_per_scale_and_a_failed_run_says_why() {
+        let mut seen = Vec::new();
+        let report = run_scales::<crate::IoError>(
+            "sh",
+            "sh at multiples",
+            &[1, 3],
+            |k, scratch| {
+                assert!(scratch.is_dir());
+                let mut command = Command::new("sh");
+                command.args(["-c", if k == 1 { "true" } else { "echo refused >&2; exit 2" }]);
+                Ok(Measured { input: format!("{k} lines"), command })
+            },
+            |row| seen.push(row.scale),
+        )
+        .unwrap();
+        assert_eq!(seen, [1, 3]);
+        assert_eq!(report.title, "sh scaling");
+        let table = report.find_table("sh_scale").unwrap();
+        assert_eq!(table.rows.len(), 2);
+        assert_eq!((table.rows[0][5].as_str(), table.rows[1][5].as_str()), ("ok", "refused"));
+        assert_eq!(table.rows[1][1], "3 lines");
     }
 }

@@ -20,7 +20,7 @@ pub mod run;
 pub use crate::corpus::Clip;
 pub use crate::protocol::{clip_windows, procedural_clips, split_clips, training_windows, Protocol, Window};
 pub use report::BenchResults;
-pub use run::{run, BenchConfig, BenchOutput, PolicyChoice};
+pub use run::{run, BenchConfig, PolicyChoice};
 
 use crate::metrics::{ErrorMeasure, SegmentModel};
 use crate::representation::SphericalMotion;

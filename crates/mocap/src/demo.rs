@@ -20,6 +20,28 @@ pub fn scaled_walk(k: usize) -> Motion {
     gait(&GaitParams { frames: 60 * k, ..GaitParams::walk() })
 }
 
+/// The demo's opening walk: a procedural walk jittered by `seed` (150 frames, turning), written
+/// as `walk.bvh` with its preview `walk.gif` into `out` (which must exist); returns the line to print.
+pub fn opening_walk(out: &Path, seed: u64) -> Result<String> {
+    let walk = gait(&GaitParams { frames: 150, turn_rate: 0.35, ..GaitParams::walk().jittered(seed, 0.15) });
+    let bvh = out.join("walk.bvh");
+    inbetween_io::bvh::write_bvh(&bvh, &walk)?;
+    let gif = out.join("walk.gif");
+    let opts = StickOptions { title: Some(format!("procedural walk (seed {seed})")), ..Default::default() };
+    inbetween_render::stick::render_motion_gif(&gif, &[&walk], &opts).map_err(|e| MocapError::Io {
+        path: gif.display().to_string(),
+        source: std::io::Error::other(e.to_string()),
+    })?;
+    Ok(format!(
+        "walk: {} frames at {:.0} fps, {} joints -> {} and {}",
+        walk.num_frames(),
+        walk.fps(),
+        walk.skeleton.len(),
+        bvh.display(),
+        gif.display()
+    ))
+}
+
 /// Runs the demo, writes `mocap_walk.ibk`, `mocap_walk_reconstructed.bvh` and `mocap_overlay.gif`
 /// into `out` (which must exist) and returns the lines to print. Counts 4 steps on `progress`.
 pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>> {
@@ -120,6 +142,17 @@ fn codec_line(m: &Motion, c: &codec::Compressed) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_opening_walk_is_seeded_and_written_with_its_preview() {
+        let dir = tempfile::tempdir().unwrap();
+        let line = opening_walk(dir.path(), 1).unwrap();
+        assert!(line.starts_with("walk: 150 frames at 30 fps, 31 joints -> "), "{line}");
+        let first = std::fs::read(dir.path().join("walk.bvh")).unwrap();
+        assert!(std::fs::metadata(dir.path().join("walk.gif")).unwrap().len() > 1000);
+        opening_walk(dir.path(), 2).unwrap();
+        assert_ne!(std::fs::read(dir.path().join("walk.bvh")).unwrap(), first, "the seed changes the walk");
+    }
 
     #[test]
     fn the_demo_writes_its_files_and_reports_every_selector() {

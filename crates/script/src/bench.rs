@@ -9,10 +9,10 @@
 //!   their places.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-use inbetween_io::report::{num, seconds_per_call, Report, Table};
+use inbetween_io::report::{num, seconds_per_call, BenchOptions, Report, Table};
 use inbetween_io::Progress;
 
 use crate::builtin_scripts;
@@ -49,8 +49,17 @@ impl BenchConfig {
     }
 }
 
-/// Runs the bench and writes its report (text, Markdown, CSVs, box plot) into `dir`.
-pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<PathBuf>, ScriptError> {
+/// `inbetween script bench`: [`BenchConfig::quick`] or the default one, with `seed` (None: 1), then
+/// [`measure`].
+pub fn run(opts: &BenchOptions) -> Result<Report, ScriptError> {
+    let seed = opts.seed.unwrap_or(BenchConfig::default().seed);
+    let cfg = if opts.quick { BenchConfig::quick(seed) } else { BenchConfig { seed, ..BenchConfig::default() } };
+    measure(&cfg, &opts.progress)
+}
+
+/// Runs the bench: its report (tables, the box plot `fig8.png`, the cost curves `fig12_costs.png`
+/// and the top views `fidelity/<story>.png`).
+pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<Report, ScriptError> {
     let cat = builtin();
     let db = SceneDatabase::builtin(&cat, DEFAULT_VARIATIONS, cfg.seed);
     let compose_cfg = ComposeConfig { seed: cfg.seed, ..ComposeConfig::default() };
@@ -115,8 +124,7 @@ pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<Pat
     ));
     report.table(speed);
     report.table(layout);
-    std::fs::create_dir_all(dir).map_err(|e| ScriptError::io(dir, e))?;
-    let (fidelity, failures, views) = fidelity_tables(&cat, &db, cfg.seed, dir)?;
+    let (fidelity, failures, views) = fidelity_tables(&cat, &db, cfg.seed)?;
     report.table(fidelity);
     report.table(failures);
     progress.inc(1);
@@ -181,29 +189,40 @@ pub fn run(dir: &Path, cfg: &BenchConfig, progress: &Progress) -> Result<Vec<Pat
     report.table(inc);
     progress.inc(1);
 
-    std::fs::create_dir_all(dir).map_err(|e| ScriptError::io(dir, e))?;
     let (stories, curves, invariants) = story_table(&cat, &db, &compose_cfg, cfg)?;
     report.table(stories);
     report.table(invariants);
-    let costs_png = dir.join("fig12_costs.png");
-    crate::optimize::plot_costs(&costs_png, &curves)?;
+    let costs = chart("fig12_costs.png", |p| {
+        crate::optimize::plot_costs(p, &curves).map_err(|e| inbetween_render::RenderError::InvalidInput(e.to_string()))
+    })?;
     progress.inc(1);
 
-    let plot = dir.join("fig8.png");
-    inbetween_render::plot::box_plot(
-        &plot,
-        "SSG matching score (Fig. 8 analogue)",
-        "matching score",
-        &groups,
-        &[("relation-first (Algorithm 1)".into(), ours), ("object-first (LDS)".into(), lds)],
-    )
-    .map_err(|e| ScriptError::Invalid(format!("{}: {e}", plot.display())))?;
-    let mut files = report.write(dir).map_err(|e| ScriptError::Invalid(e.to_string()))?;
-    files.push(plot);
-    files.push(costs_png);
-    files.extend(views);
+    report.file(
+        "fig8.png",
+        chart("fig8.png", |p| {
+            inbetween_render::plot::box_plot(
+                p,
+                "SSG matching score (Fig. 8 analogue)",
+                "matching score",
+                &groups,
+                &[("relation-first (Algorithm 1)".into(), ours), ("object-first (LDS)".into(), lds)],
+            )
+        })?,
+    );
+    report.file("fig12_costs.png", costs);
+    for (file, bytes) in views {
+        report.file(&file, bytes);
+    }
     progress.inc(1);
-    Ok(files)
+    Ok(report)
+}
+
+/// A chart's PNG bytes, drawn into a scratch file ([`inbetween_render::rendered_bytes`]).
+fn chart(
+    name: &str,
+    draw: impl FnOnce(&Path) -> Result<(), inbetween_render::RenderError>,
+) -> Result<Vec<u8>, ScriptError> {
+    inbetween_render::rendered_bytes(name, draw).map_err(|e| ScriptError::Invalid(format!("{name}: {e}")))
 }
 
 /// Part 2 (issue 13) per text: characters animated and the joint optimisation of §4.3 run with the
@@ -317,6 +336,9 @@ fn story_table(
     Ok((t, demo_curves.unwrap_or_default(), inv))
 }
 
+/// A PNG for the report: its name inside the report folder and its bytes.
+type Png = (String, Vec<u8>);
+
 /// Random stories the invariant table checks besides the built-in texts.
 const RANDOM_STORIES: u64 = 40;
 
@@ -326,8 +348,7 @@ fn fidelity_tables(
     cat: &crate::catalogue::Catalogue,
     db: &SceneDatabase,
     seed: u64,
-    dir: &Path,
-) -> Result<(Table, Table, Vec<PathBuf>), ScriptError> {
+) -> Result<(Table, Table, Vec<Png>), ScriptError> {
     use crate::fidelity::{corpus, realise, run, scores};
     let lib = crate::motion::MotionLibrary::procedural(seed);
     let stories = corpus();
@@ -367,15 +388,14 @@ fn fidelity_tables(
             f.row([r.name.to_string(), r.phrase.to_string(), format!("{:?}", c.check), c.measured.clone()]);
         }
     }
-    // A top view of one story per new relation or place (issue 39).
+    // A top view of one story per new relation or place (issue 39), as `fidelity/<name>.png`.
     let mut views = Vec::new();
-    let folder = dir.join("fidelity");
-    std::fs::create_dir_all(&folder).map_err(|e| ScriptError::io(&folder, e))?;
     for s in stories.iter().filter(|s| TOP_VIEWS.contains(&s.name)) {
         let (_, anim) = realise(s.text, cat, db, &lib, seed);
-        let path = folder.join(format!("{}.png", s.name));
-        crate::output::write_png(&path, &crate::output::preview::top_down(&anim.scene, cat))?;
-        views.push(path);
+        let file = format!("fidelity/{}.png", s.name);
+        let png = inbetween_render::png_bytes(&crate::output::preview::top_down(&anim.scene, cat))
+            .map_err(|e| ScriptError::Invalid(format!("{file}: {e}")))?;
+        views.push((file, png));
     }
     Ok((t, f, views))
 }

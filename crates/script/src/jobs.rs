@@ -279,6 +279,46 @@ pub fn run_story(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, S
     run_story_in(&mut session, notes, text, source, job)
 }
 
+/// [`run_story`] with its outputs whole or not at all: written into a staging folder that is moved
+/// into `job.scene.out_dir` (merged into it when it exists) only when the run finishes, so a failed,
+/// cancelled or timed-out run leaves no partial set. The report's paths are where the files end up.
+pub fn run_story_whole(text: &str, source: &Path, job: &RunJob) -> Result<RunReport, ScriptError> {
+    let out = &job.scene.out_dir;
+    let mut set = inbetween_io::OutputSet::new();
+    let staging = set.dir(out).map_err(|e| ScriptError::io(out, e))?;
+    let staged = RunJob { scene: SceneJob { out_dir: staging.clone(), ..job.scene.clone() }, ..job.clone() };
+    let mut report = run_story(text, source, &staged)?;
+    set.commit().map_err(|e| ScriptError::io(out, e))?;
+    for p in report.files.iter_mut().chain(report.scene.files.iter_mut()) {
+        *p = moved(&staging, out, p);
+    }
+    Ok(report)
+}
+
+/// The skinned outputs of a finished story ([`output::skinned::write_skinned_story`], the
+/// characters from `models` or the shared data) into `out` beside the story's, whole or not at all
+/// (a missing asset folder writes none of them); the paths are where the files end up.
+pub fn write_skinned_whole(
+    out: &Path,
+    report: &RunReport,
+    models: Option<&Path>,
+) -> Result<output::skinned::SkinnedStory, ScriptError> {
+    let cat = catalogue(models)?;
+    let mut set = inbetween_io::OutputSet::new();
+    let staging = set.dir(out).map_err(|e| ScriptError::io(out, e))?;
+    let mut story = output::skinned::write_skinned_story(&staging, &report.animation, &cat, models)?;
+    set.commit().map_err(|e| ScriptError::io(out, e))?;
+    for p in story.files.iter_mut() {
+        *p = moved(&staging, out, p);
+    }
+    Ok(story)
+}
+
+/// A path written under `staging`, shown under `out` where the output set moved it.
+fn moved(staging: &Path, out: &Path, p: &Path) -> PathBuf {
+    p.strip_prefix(staging).map_or_else(|_| p.to_path_buf(), |rest| out.join(rest))
+}
+
 /// [`run_story`] in a session: only the first version of a story is solved in full; a later one
 /// re-solves only the characters and objects its edit touches.
 pub fn run_story_in(
@@ -420,5 +460,32 @@ pub fn watch(
             }
         }
         std::thread::sleep(std::time::Duration::from_millis(250));
+    }
+}
+
+#[cfg(test)]
+mod whole_tests {
+    use super::*;
+
+    #[test]
+    fn a_whole_run_lands_in_its_folder_and_a_failed_one_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let job = RunJob {
+            scene: SceneJob { out_dir: out.clone(), ..SceneJob::default() },
+            optimize: false,
+            gif_width: 120,
+            ..RunJob::default()
+        };
+        let e = run_story_whole("", Path::new("empty.txt"), &job).unwrap_err();
+        assert!(matches!(e, ScriptError::Empty { .. }), "{e}");
+        assert!(!out.exists(), "a failed run writes nothing");
+        let r =
+            run_story_whole("A chair is near a desk$.\nEve walks to the desk.\n", Path::new("s.txt"), &job).unwrap();
+        assert!(!r.files.is_empty());
+        for f in r.files.iter().chain(&r.scene.files) {
+            assert!(f.starts_with(&out) && f.is_file(), "{}", f.display());
+        }
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no staging folder left");
     }
 }

@@ -77,6 +77,19 @@ impl Default for VideoLimits {
 }
 
 impl VideoLimits {
+    /// A frame-size limit written `WIDTHxHEIGHT` (`3840x2160`, `x` or `X`), as the pixel count
+    /// [`VideoLimits::max_pixels`] holds; an error says what was expected.
+    pub fn parse_pixels(s: &str) -> Result<u64, String> {
+        let (w, h) =
+            s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT such as 3840x2160, got {s:?}"))?;
+        let w: u64 = w.trim().parse().map_err(|_| format!("width {w:?} is not a whole number (in {s:?})"))?;
+        let h: u64 = h.trim().parse().map_err(|_| format!("height {h:?} is not a whole number (in {s:?})"))?;
+        if w == 0 || h == 0 {
+            return Err(format!("a resolution limit of {s} allows no frame"));
+        }
+        Ok(w * h)
+    }
+
     /// The clip's frame count and frame size.
     pub fn check_clip(&self, clip: &Clip) -> Result<(), VideoError> {
         let subject = clip.source.clone();
@@ -420,6 +433,15 @@ pub(crate) mod tests {
             cache_dir: dir.to_path_buf(),
             ..ResequenceConfig::default()
         }
+    }
+
+    #[test]
+    fn a_resolution_limit_reads_as_pixels_and_says_what_is_wrong() {
+        assert_eq!(VideoLimits::parse_pixels("1280x720"), Ok(921_600));
+        assert_eq!(VideoLimits::parse_pixels(" 2 X 3 "), Ok(6));
+        assert!(VideoLimits::parse_pixels("1280").unwrap_err().contains("expected WIDTHxHEIGHT"));
+        assert!(VideoLimits::parse_pixels("ax720").unwrap_err().contains("width \"a\""));
+        assert!(VideoLimits::parse_pixels("0x720").unwrap_err().contains("allows no frame"));
     }
 
     #[test]

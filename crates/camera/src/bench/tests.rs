@@ -4,7 +4,7 @@ use crate::infer::Cam;
 #[test]
 fn report_writes_the_committed_csv_layout_json_and_charts() {
     let progress = Progress::hidden();
-    let r = run(&tiny_model(), &tiny_config(), &progress);
+    let r = measure(&tiny_model(), &tiny_config(), &progress);
     assert_eq!(progress.position(), 1, "the last phase (speed) is done");
     let dir = tempfile::tempdir().unwrap();
     let files = r.write(dir.path()).unwrap();
@@ -126,7 +126,7 @@ fn a_generator_that_predicts_no_correction_scores_exactly_as_toric_interpolation
     let mut model = tiny_model();
     model.dec2.w.iter_mut().for_each(|w| *w = 0.0);
     model.dec2.b.iter_mut().for_each(|b| *b = 0.0);
-    let r = run(&model, &tiny_config(), &Progress::hidden());
+    let r = measure(&model, &tiny_config(), &Progress::hidden());
     for row in &r.table1 {
         for (name, v) in
             [("zero", row.zero), ("gaussian", row.gaussian), ("warm", row.warm_start), ("mapped", row.mapped)]
@@ -144,8 +144,16 @@ fn a_generator_that_predicts_no_correction_scores_exactly_as_toric_interpolation
     }
     assert!(r.style_spread < 1e-6, "style spread {}", r.style_spread);
     // The same tiny model with its (random) decoder departs from the line and styles differ.
-    let r = run(&tiny_model(), &tiny_config(), &Progress::hidden());
+    let r = measure(&tiny_model(), &tiny_config(), &Progress::hidden());
     let departs = r.table1.iter().map(|row| (row.mapped - row.lerp).abs()).fold(0.0, f64::max);
     assert!(departs > 1e-4 && r.style_spread > 1e-5, "departure {departs}, style spread {}", r.style_spread);
     assert!(r.speed.single_frames_per_s > 0.0 && r.speed.batched_frames_per_s > 0.0);
+}
+
+#[test]
+fn the_bench_entry_names_weights_it_cannot_load() {
+    let opts =
+        BenchOptions { quick: true, ..BenchOptions::new(CameraBench { weights: Some("no/such/camera.bpk".into()) }) };
+    let e = run(&opts).unwrap_err().to_string();
+    assert!(e.starts_with("loading camera weights no/such/camera.bpk: ") && e.contains("no/such/camera"), "{e}");
 }

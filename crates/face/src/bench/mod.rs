@@ -24,8 +24,9 @@ pub use protocol::{libraries, test_clips, viseme_runs, FaceBenchConfig, Library,
 use tables::*;
 
 use inbetween_core::seed::derive;
-use inbetween_io::report::Report;
+use inbetween_io::report::{BenchOptions, Report};
 use inbetween_io::Progress;
+use std::path::PathBuf;
 
 use crate::data::split::{TEST_FILES, TRAIN_FILES};
 use crate::data::FaceError;
@@ -33,8 +34,34 @@ use crate::edit::ConstraintKind;
 use crate::procedural;
 use crate::weights::NetworkSet;
 
+/// The face bench's own options (beside [`BenchOptions`], whose `data` is the captures folder).
+#[derive(Clone, Debug, Default)]
+pub struct FaceBench {
+    /// A folder of weights trained on procedural clips to bench instead of the committed ones.
+    pub weights: Option<PathBuf>,
+    /// A folder of weights trained on the real captures, compared too.
+    pub real_weights: Option<PathBuf>,
+}
+
+/// `inbetween face bench`: the captures ([`crate::infer::plan::captures_dir`] of `data`),
+/// [`FaceBenchConfig::quick`] or [`FaceBenchConfig::full`] (`seed` replacing the configuration's),
+/// the weight sets, then [`evaluate`].
+pub fn run(opts: &BenchOptions<FaceBench>) -> Result<Report, FaceError> {
+    let captures = crate::infer::plan::captures_dir(opts.data.as_deref())?;
+    let cfg = if opts.quick { FaceBenchConfig::quick(captures) } else { FaceBenchConfig::full(captures) };
+    let cfg = FaceBenchConfig { seed: opts.seed.unwrap_or(cfg.seed), ..cfg };
+    let mut sets = vec![match &opts.engine.weights {
+        Some(dir) => crate::weights::set_from_dir(dir, "procedural")?,
+        None => crate::weights::committed_set()?,
+    }];
+    if let Some(dir) = &opts.engine.real_weights {
+        sets.push(crate::weights::set_from_dir(dir, "real")?);
+    }
+    evaluate(&cfg, &sets, &opts.progress)
+}
+
 /// Run the whole evaluation.
-pub fn run(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> Result<Report, FaceError> {
+pub fn evaluate(cfg: &FaceBenchConfig, sets: &[NetworkSet], progress: &Progress) -> Result<Report, FaceError> {
     let mut report = Report::new("face-bench", "Face engine benchmark (facial animation editing, Berson et al.)");
     let tests = test_clips(&cfg.captures, cfg.one_test_file)?;
     let libs = libraries(cfg)?;
@@ -103,9 +130,9 @@ mod tests {
     #[test]
     fn quick_bench_on_real_captures_fills_every_table_with_finite_errors() {
         inbetween_io::data::with_shared_data("face bench", |data| {
-            let cfg = FaceBenchConfig::quick(data.join("face/neurosync"));
-            let sets = vec![crate::weights::committed_set().expect("committed weights")];
-            let report = run(&cfg, &sets, &Progress::hidden()).expect("bench runs");
+            let data = Some(data.join("face/neurosync"));
+            let report = run(&BenchOptions { data, quick: true, ..BenchOptions::new(FaceBench::default()) })
+                .expect("bench runs");
             let names: Vec<&str> = report.tables().map(|t| t.name.as_str()).collect();
             for n in [
                 "heldout_by_gap",

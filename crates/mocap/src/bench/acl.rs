@@ -11,7 +11,7 @@ pub use crate::corpus::{takes, Take};
 use crate::{MocapError, Result};
 use inbetween_core::units::LengthUnit;
 use inbetween_core::Motion;
-use inbetween_io::report::{num, seconds_per_call, Report, Table};
+use inbetween_io::report::{num, seconds_per_call, BenchOptions, Report, Table};
 use inbetween_io::Progress;
 use rand::{Rng, SeedableRng};
 use std::io::{Read, Write};
@@ -476,23 +476,25 @@ impl AclResults {
     }
 }
 
-/// Measures and writes the report (`acl_codec.txt/.md`, `acl_codec.csv`, `acl_baselines.csv`)
-/// and the chart (`acl_rate_error.png`) into `output_dir` when given.
-pub fn run(
-    cfg: &AclConfig,
-    output_dir: Option<&std::path::Path>,
-    progress: &Progress,
-) -> Result<(AclResults, Report, Vec<PathBuf>)> {
-    let results = measure(cfg, progress)?;
-    let report = results.report();
-    let mut written = Vec::new();
-    if let Some(d) = output_dir {
-        written = report.write(d)?;
-        let png = d.join("acl_rate_error.png");
-        results.plot(&png)?;
-        written.push(png);
+/// `inbetween mocap bench`'s codec table on ACL's protocol: [`measure`] (`data` and `seed` of the
+/// options replacing the configuration's) and the report (`acl_codec.txt/.md`, `acl_codec.csv`,
+/// `acl_baselines.csv`), with the chart `acl_rate_error.png` when it will be written to a folder.
+pub fn run(opts: &BenchOptions<AclConfig>) -> Result<Report> {
+    let cfg = AclConfig {
+        data: opts.data.clone().or_else(|| opts.engine.data.clone()),
+        seed: opts.seed.unwrap_or(opts.engine.seed),
+        ..opts.engine.clone()
+    };
+    let results = measure(&cfg, &opts.progress)?;
+    let mut report = results.report();
+    if opts.out.is_some() {
+        let png = inbetween_render::rendered_bytes("acl_rate_error.png", |p| {
+            results.plot(p).map_err(|e| inbetween_render::RenderError::InvalidInput(e.to_string()))
+        })
+        .map_err(|e| MocapError::Invalid(format!("acl_rate_error.png: {e}")))?;
+        report.file("acl_rate_error.png", png);
     }
-    Ok((results, report, written))
+    Ok(report)
 }
 
 #[cfg(test)]
@@ -513,7 +515,11 @@ mod tests {
         }
         let cfg = AclConfig { data: Some(data), bounds_cm: vec![0.5, 0.05], seek_poses: 50, ..Default::default() };
         let out = dir.path().join("out");
-        let (r, report, written) = run(&cfg, Some(&out), &Progress::hidden()).unwrap();
+        let r = measure(&cfg, &Progress::hidden()).unwrap();
+        let opts = BenchOptions { out: Some(out.clone()), ..BenchOptions::new(cfg.clone()) };
+        let report = run(&opts).unwrap();
+        let written = opts.write(&report).unwrap();
+        assert!(run(&BenchOptions::new(cfg.clone())).unwrap().file_bytes("acl_rate_error.png").is_none());
         assert_eq!(r.rows.len(), 2, "one group (plain folder), two bounds");
         let (fine, coarse) = (&r.rows[0], &r.rows[1]);
         assert_eq!((fine.bound_cm, coarse.bound_cm), (0.05, 0.5));

@@ -2,7 +2,7 @@
 //! get a SIDQL policy (committed, from a file, or trained here on the training split), score every
 //! selector on all windows and on the test split, run the take-level k-fold (a policy trained per
 //! fold, every window scored once by a policy that never saw its take), add the extra
-//! measurements, and write the report.
+//! measurements, and make the report.
 
 use super::measure::{both_reconstructions, codec_ratio, reconstruction_throughput};
 use super::report::BenchResults;
@@ -15,7 +15,7 @@ use crate::dqn::{DqnConfig, Finish, SidqlPolicy, TrainOptions};
 use crate::representation::SphericalMotion;
 use crate::{MocapError, Result};
 use inbetween_core::units::{LengthUnit, UnitChoice};
-use inbetween_io::report::Report;
+use inbetween_io::report::{BenchOptions, Report};
 use inbetween_io::Progress;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -56,12 +56,11 @@ impl Default for KFoldConfig {
     }
 }
 
-/// What `inbetween mocap bench` runs and where it writes.
+/// What `inbetween mocap bench` runs, beside [`BenchOptions`]: its `data` is the folder (every
+/// CMU take under `<dir>/mocap/cmu`, or each .bvh in it; None: the shared corpus), its `seed` the
+/// protocol's, its `quick` skips the k-fold.
 #[derive(Clone, Debug)]
 pub struct BenchConfig {
-    /// Data folder: every CMU take under `<dir>/mocap/cmu`, or each .bvh in it. None: the shared
-    /// corpus (`inbetween_io::data::shared_data_dir`).
-    pub data: Option<PathBuf>,
     /// Length unit of every clip, overriding the corpus's known units and the per-clip inference
     /// ([`crate::corpus::load`]).
     pub unit: Option<LengthUnit>,
@@ -71,12 +70,8 @@ pub struct BenchConfig {
     pub policy: PolicyChoice,
     /// Codec error bounds (cm) measured on the full-rate clips in CMU units.
     pub codec_bounds_cm: Vec<f64>,
-    /// Write the whole report here (report.txt/.md, one CSV per table, table3.png).
-    pub output_dir: Option<PathBuf>,
-    /// Also write every row as CSV here (the columns of `mocap_bench.csv`).
-    pub csv: Option<PathBuf>,
-    /// Also write the bar chart here.
-    pub plot: Option<PathBuf>,
+    /// Put the bar chart (`table3.png`) into the report even when it is not written to a folder.
+    pub chart: bool,
     /// The take-level k-fold of SIDQL (None: skipped).
     pub kfold: Option<KFoldConfig>,
 }
@@ -85,46 +80,21 @@ impl Default for BenchConfig {
     /// The paper's protocol on the shared corpus with the committed policy, codec at 1 and 0.1 cm.
     fn default() -> BenchConfig {
         BenchConfig {
-            data: None,
             unit: None,
             protocol: Protocol::paper(),
             ks: vec![5, 10, 15],
             policy: PolicyChoice::Committed,
             codec_bounds_cm: vec![1.0, 0.1],
-            output_dir: None,
-            csv: None,
-            plot: None,
+            chart: false,
             kfold: Some(KFoldConfig::default()),
         }
     }
 }
 
-/// A finished bench: the report (print `report.to_text()`) and the files written.
-#[derive(Debug)]
-pub struct BenchOutput {
-    pub results: BenchResults,
-    pub report: Report,
-    pub written: Vec<PathBuf>,
-}
-
-/// Runs the whole bench ([`measure`]) and writes what `cfg` asks for.
-pub fn run(cfg: &BenchConfig, progress: &Progress) -> Result<BenchOutput> {
-    let results = measure(cfg, progress)?;
-    let report = results.report(cfg.output_dir.is_some())?;
-    let mut written = Vec::new();
-    if let Some(dir) = &cfg.output_dir {
-        written.extend(report.write(dir)?);
-    }
-    if let Some(p) = &cfg.csv {
-        inbetween_io::write_atomic(p, results.rows_table().to_csv().as_bytes())
-            .map_err(|source| MocapError::Io { path: p.display().to_string(), source })?;
-        written.push(p.clone());
-    }
-    if let Some(p) = &cfg.plot {
-        results.plot(p)?;
-        written.push(p.clone());
-    }
-    Ok(BenchOutput { results, report, written })
+/// Runs the whole bench ([`measure`]); its report holds the chart (`table3.png`) when it will be
+/// written to a folder or `chart` asks.
+pub fn run(opts: &BenchOptions<BenchConfig>) -> Result<Report> {
+    measure(opts)?.report(opts.out.is_some() || opts.engine.chart)
 }
 
 pub use crate::corpus::data_dir;
@@ -231,8 +201,14 @@ pub fn kfold(
 }
 
 /// Every measurement of the bench, no files written.
-pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
-    let dir = data_dir(cfg.data.as_deref())?;
+pub fn measure(opts: &BenchOptions<BenchConfig>) -> Result<BenchResults> {
+    let progress = &opts.progress;
+    let cfg = &BenchConfig {
+        protocol: Protocol { seed: opts.seed.unwrap_or(opts.engine.protocol.seed), ..opts.engine.protocol.clone() },
+        kfold: opts.engine.kfold.clone().filter(|_| !opts.quick),
+        ..opts.engine.clone()
+    };
+    let dir = data_dir(opts.data.as_deref())?;
     progress.phase(1, "corpus");
     progress.set_message(dir.display().to_string());
     let corpus = crate::corpus::load(&dir, cfg.unit)?;
@@ -284,7 +260,7 @@ pub fn measure(cfg: &BenchConfig, progress: &Progress) -> Result<BenchResults> {
         }
     }
     Ok(BenchResults {
-        source: if cfg.data.is_some() { dir.display().to_string() } else { "the shared corpus".into() },
+        source: if opts.data.is_some() { dir.display().to_string() } else { "the shared corpus".into() },
         takes: clips.len(),
         sources: describe_sources(clips),
         unit_notes,
@@ -389,11 +365,8 @@ mod tests {
             inbetween_io::write_bvh(&data.join(format!("walk{i}.bvh")), &inbetween_core::procedural::gait(&p)).unwrap();
         }
         let cfg = BenchConfig {
-            data: Some(data.clone()),
             ks: vec![5, 10],
             codec_bounds_cm: vec![1.0],
-            output_dir: Some(dir.path().join("report")),
-            csv: Some(dir.path().join("rows.csv")),
             kfold: Some(KFoldConfig {
                 folds: 2,
                 stride: 30,
@@ -408,9 +381,8 @@ mod tests {
             }),
             ..BenchConfig::default()
         };
-        let progress = Progress::hidden();
-        let out = run(&cfg, &progress).unwrap();
-        let r = &out.results;
+        let opts = BenchOptions { data: Some(data.clone()), ..BenchOptions::new(cfg) };
+        let r = &measure(&opts).unwrap();
         assert_eq!((r.takes, r.windows, r.test_windows, r.test.len()), (2, 4, 2, 1));
         assert_eq!(r.rows.len(), 2 * 5 * 2, "two splits, five methods, two K");
         assert!(r.policy.starts_with("the committed policy (trained on: every CMU take"), "{}", r.policy);
@@ -419,11 +391,13 @@ mod tests {
         assert_eq!(kf.rows.len(), 8 * 2, "eight selectors, two K");
         assert!(kf.rows.iter().all(|row| row.windows == 4), "every window scored once: {:?}", kf.rows);
         assert_eq!(r.codec.len(), 1);
-        assert_eq!(out.written.len(), 2 + 6 + 1 + 1, "txt, md, six CSVs, the chart, rows.csv");
-        let csv = std::fs::read_to_string(dir.path().join("rows.csv")).unwrap();
-        assert_eq!(csv, std::fs::read_to_string(dir.path().join("report/mocap_bench.csv")).unwrap());
+        // The bench entry: quick skips the k-fold; the chart only for a folder (or when asked).
+        let quick = BenchOptions { quick: true, out: Some(dir.path().join("report")), ..opts.clone() };
+        let report = run(&quick).unwrap();
+        assert_eq!(quick.write(&report).unwrap().len(), 2 + 5 + 1, "txt, md, five CSVs (no k-fold), the chart");
+        assert!(run(&BenchOptions { quick: true, ..opts.clone() }).unwrap().file_bytes("table3.png").is_none());
         let text = std::fs::read_to_string(dir.path().join("report/report.txt")).unwrap();
-        assert_eq!(text, out.report.to_text());
+        assert_eq!(text, report.to_text());
         assert!(text.contains("Table 3: mean angle error") && text.contains("frames/s"), "{text}");
         assert!(
             r.unit_notes.len() == 1 && text.contains(&r.unit_notes[0]),
@@ -435,7 +409,7 @@ mod tests {
         let mut p = inbetween_core::procedural::GaitParams::walk();
         p.frames = 40;
         inbetween_io::write_bvh(&short.join("w.bvh"), &inbetween_core::procedural::gait(&p)).unwrap();
-        let e = run(&BenchConfig { data: Some(short), kfold: None, ..BenchConfig::default() }, &progress)
+        let e = run(&BenchOptions { data: Some(short), quick: true, ..BenchOptions::new(BenchConfig::default()) })
             .unwrap_err()
             .to_string();
         assert!(e.contains("long enough") && e.contains("short"), "{e}");

@@ -115,7 +115,42 @@ impl TrainOptions {
             _ => None,
         }
     }
+
+    /// The preset `name` ([`TrainOptions::preset`]) with the values given in place of its own
+    /// (what `mocap train` runs); an unknown name is an error naming the presets.
+    pub fn preset_with(
+        name: &str,
+        pretrain_steps: Option<usize>,
+        episodes: Option<usize>,
+        lr: Option<f64>,
+        gamma: Option<f64>,
+    ) -> crate::Result<TrainOptions> {
+        let base = TrainOptions::preset(name).ok_or_else(|| {
+            crate::MocapError::Invalid(format!("unknown preset '{name}'; expected default, paper or quick"))
+        })?;
+        Ok(TrainOptions {
+            pretrain_steps: pretrain_steps.unwrap_or(base.pretrain_steps),
+            episodes: episodes.unwrap_or(base.episodes),
+            lr: lr.unwrap_or(base.lr),
+            gamma: gamma.unwrap_or(base.gamma),
+            ..base
+        })
+    }
 }
 
 /// Where `mocap train` and a bench that trains write the policy by default.
 pub const DEFAULT_POLICY_PATH: &str = "out/sidql_cmu.bpk";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_preset_takes_the_values_given_and_an_unknown_one_is_named() {
+        let p = TrainOptions::preset_with("paper", None, Some(5), None, Some(0.9)).unwrap();
+        assert_eq!((p.episodes, p.gamma, p.lr, p.batch), (5, 0.9, 0.01, 256));
+        assert_eq!(TrainOptions::preset_with("quick", None, None, None, None).unwrap(), TrainOptions::quick());
+        let e = TrainOptions::preset_with("fast", None, None, None, None).unwrap_err().to_string();
+        assert!(e.contains("unknown preset 'fast'; expected default, paper or quick"), "{e}");
+    }
+}

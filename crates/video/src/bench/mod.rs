@@ -18,8 +18,9 @@ mod tables;
 
 pub use protocol::{BenchClip, VideoBenchConfig};
 
-use inbetween_io::report::Report;
+use inbetween_io::report::{BenchOptions, Report};
 use inbetween_io::Progress;
+use std::path::{Path, PathBuf};
 
 use crate::job::BACKWARD_WINDOW;
 use crate::pipeline::{analyse, resequence, ResequenceConfig, VideoLimits};
@@ -212,8 +213,44 @@ fn bench_clip(spec: &BenchClip, cfg: &VideoBenchConfig, progress: &Progress) -> 
     })
 }
 
+/// The video bench's own options (beside [`BenchOptions`], whose `data` is the folder of real clips).
+#[derive(Clone, Debug, Default)]
+pub struct VideoBench {
+    /// Start frames per clip (None: the configuration's, 4 or 2 when quick).
+    pub starts: Option<usize>,
+}
+
+/// The real clips a full run reads, `data` or `video` under the shared data folder, when that
+/// folder exists; and the line that says which (or that they are skipped).
+pub fn real_clips(data: Option<&Path>) -> (Option<PathBuf>, String) {
+    let dir = data.map_or_else(|| inbetween_io::shared_data_dir().unwrap_or_else(|m| m).join("video"), PathBuf::from);
+    match dir.exists() {
+        true => (Some(dir.clone()), format!("real clips from {}", dir.display())),
+        false => (None, format!("skipped real clips: no data at {}", dir.display())),
+    }
+}
+
+/// `inbetween video bench`: [`VideoBenchConfig::quick`] (procedural only) or
+/// [`VideoBenchConfig::full`] on the [`real_clips`], with a fresh metric cache (removed afterwards) so
+/// the stage times include training, then [`measure`].
+pub fn run(opts: &BenchOptions<VideoBench>) -> Result<Report, VideoError> {
+    if opts.engine.starts == Some(0) {
+        return Err(VideoError::Invalid("`starts` 0 runs nothing: give at least 1".into()));
+    }
+    let cache = tempfile::Builder::new()
+        .prefix("inbetween-video-bench-")
+        .tempdir()
+        .map_err(|source| VideoError::Io { path: std::env::temp_dir(), source })?;
+    let cfg = match opts.quick {
+        true => VideoBenchConfig::quick(cache.path().to_path_buf()),
+        false => VideoBenchConfig::full(real_clips(opts.data.as_deref()).0.as_deref(), cache.path().to_path_buf()),
+    };
+    let starts = opts.engine.starts.unwrap_or(cfg.starts);
+    measure(&VideoBenchConfig { starts, seed: opts.seed.unwrap_or(cfg.seed), ..cfg }, &opts.progress)
+}
+
 /// Runs the bench and returns its report (tables as text, Markdown and CSV).
-pub fn run(cfg: &VideoBenchConfig, progress: &Progress) -> Result<Report, VideoError> {
+pub fn measure(cfg: &VideoBenchConfig, progress: &Progress) -> Result<Report, VideoError> {
     let results: Vec<ClipResult> = cfg.clips.iter().map(|c| bench_clip(c, cfg, progress)).collect::<Result<_, _>>()?;
     let mut report = Report::new("video-bench", "Video engine benchmark (resequencing with SDPF, Le et al.)");
     report.table(table2(&results, cfg));
@@ -248,7 +285,7 @@ mod tests {
     #[test]
     fn quick_bench_fills_every_table() {
         let dir = tempfile::tempdir().unwrap();
-        let report = run(&VideoBenchConfig::quick(dir.path().to_path_buf()), &Progress::hidden()).unwrap();
+        let report = run(&BenchOptions { quick: true, ..BenchOptions::new(VideoBench::default()) }).unwrap();
         let text = report.to_text();
         for needle in [
             "Table 2 analogue",
@@ -269,5 +306,10 @@ mod tests {
         assert!(text.contains("SSPF (shortest path)") && text.contains("SSPF on pixel distance"));
         let written = report.write(&dir.path().join("out")).unwrap();
         assert!(written.iter().any(|p| p.ends_with("ssim.png")));
+        let none = BenchOptions { quick: true, ..BenchOptions::new(VideoBench { starts: Some(0) }) };
+        assert!(run(&none).unwrap_err().to_string().contains("`starts` 0 runs nothing"));
+        let (clips, line) = real_clips(Some(&dir.path().join("missing")));
+        assert!(clips.is_none() && line.starts_with("skipped real clips: no data at "), "{line}");
+        assert_eq!(real_clips(Some(dir.path())).1, format!("real clips from {}", dir.path().display()));
     }
 }
