@@ -38,6 +38,7 @@ STYLE_ITEMS = [
     ("RELATIVE", "Relative", "Rigid in the frame of the pair: dollies as they approach or part, the framing kept"),
     ("SIDE", "Side", "A profile two-shot on the pair's bisector at a constant distance, no zoom"),
     ("ORBIT", "Orbit", "Swings from one character's shoulder to the other's, whatever they do"),
+    ("REFERENCE", "Reference Camera", "The style of another camera's motion over these two characters (Reference)"),
 ]
 #: Blender (Z up) to the engine (Y up): (x, y, z) → (x, z, −y).
 C = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -89,9 +90,10 @@ def camera_key_frames(cam):
 class CameraJob:
     """Generates the camera (see the module's words)."""
 
-    def __init__(self, context, a, b, cam, styles, active_style):
+    def __init__(self, context, a, b, cam, styles, active_style, reference=None):
         self.scene = context.scene
         self.a, self.b, self.cam = a, b, cam
+        self.reference = reference  #: the camera whose motion gives the "reference" style
         self.styles = list(styles)
         self.active_style = active_style
         self.cancel = threading.Event()
@@ -118,6 +120,14 @@ class CameraJob:
         )
         if delta > 1e-9:
             raise JobError(f"{cam.name}: delta transforms are set; apply or clear them first")
+        ref = self.reference
+        if "reference" in self.styles:
+            if ref is None:
+                raise JobError("style Reference Camera: name the reference camera (a camera object with an action)")
+            if ref == cam:
+                raise JobError(f"the reference camera {ref.name} is the camera being made: name another one")
+            if ref.type != "CAMERA" or ref.animation_data is None or ref.animation_data.action is None:
+                raise JobError(f"reference camera {ref.name}: expected a camera object with an action")
         frames = camera_key_frames(cam)
         if not frames:
             raise JobError(
@@ -168,8 +178,10 @@ class CameraJob:
             keys, fov, aspect = self._keys(frames, first)
             yield 0.5, "generating"
             tracks = {}
+            reference = self._reference_poses(span) if "reference" in self.styles else None
             for i, style in enumerate(self.styles):
                 lo = 0.5 + 0.4 * i / len(self.styles)
+                how = {"reference": reference} if style == "reference" else {"style": style}
                 track = yield from _blender_frames(first, inbetween.InbetweenError, engine_fractions(
                     call_engine(
                         inbetween.camera.generate,
@@ -177,9 +189,9 @@ class CameraJob:
                         keys,
                         characters=tuple(clips),
                         names=(a.name, b.name),
-                        style=style,
                         fov_deg=math.degrees(fov),
                         aspect=aspect,
+                        **how,
                     ),
                     lo,
                     lo + 0.4 / len(self.styles),
@@ -271,6 +283,18 @@ class CameraJob:
                     f"{math.degrees(fov):.2f}° at frame {f}): the engine frames the track through one lens"
                 )
         return keys, fov0, aspect
+
+    def _reference_poses(self, span):
+        """The reference camera's world pose at each frame of `span`, in the engine's frame."""
+        sc, ref = self.scene, self.reference
+        pos, rot = [], []
+        for f in span:
+            sc.frame_set(int(f))
+            m = _matrix(ref.matrix_world)
+            r = C @ (m[:3, :3] / np.linalg.norm(m[:3, :3], axis=0))
+            pos.append(C @ m[:3, 3] * sc.unit_settings.scale_length)
+            rot.append(mat3_to_quat(r)[[1, 2, 3, 0]])
+        return np.array(pos), np.array(rot)
 
     def _write(self, track, first, m_per_unit, style):
         """A new action on the camera: location and rotation keyed on every frame of the track
@@ -364,7 +388,7 @@ def _blender_frames(first, error_type, gen):
     try:
         return (yield from gen)
     except error_type as e:
-        text = re.sub(r"\(frame (\d+)\)", lambda m: f"(frame {int(m.group(1)) + first})", str(e))
+        text = re.sub(r"\bframe (\d+)", lambda m: f"frame {int(m.group(1)) + first}", str(e))
         raise JobError(text) from None
 
 
@@ -451,6 +475,10 @@ class INBETWEEN_OT_camera_from_armatures(JobOperator, bpy.types.Operator):
         name="Character B", description="Armature of character B (default: the other selected one)"
     )
     camera: StringProperty(name="Camera", description="The camera (default: the scene camera)")
+    reference_camera: StringProperty(
+        name="Reference",
+        description="Style Reference Camera: the camera whose motion over these characters gives the style",
+    )
 
     def make_job(self, context):
         a, b = pick_characters(context, self.armature_a, self.armature_b)
@@ -461,15 +489,18 @@ class INBETWEEN_OT_camera_from_armatures(JobOperator, bpy.types.Operator):
         else:
             cam = context.scene.camera
         style = self.style.lower()
-        styles = list(STYLES) if self.shot_list else [style]
-        job = CameraJob(context, a, b, cam, styles, style)
+        styles = [style] + [s for s in STYLES if s != style] if self.shot_list else [style]
+        reference = bpy.data.objects.get(self.reference_camera) if self.reference_camera else None
+        if self.reference_camera and reference is None:
+            raise JobError(f"reference camera {self.reference_camera!r}: no such object")
+        job = CameraJob(context, a, b, cam, styles, style, reference)
         job.check()
         return job
 
     def draw(self, context):
         layout = self.layout
         layout.use_property_split = True
-        for name in ("style", "shot_list", "armature_a", "armature_b", "camera"):
+        for name in ("style", "reference_camera", "shot_list", "armature_a", "armature_b", "camera"):
             layout.prop(self, name)
 
 

@@ -99,6 +99,30 @@ def test_shot_list_makes_one_action_per_style(two):
     assert spread > 0.05, "the styles move the camera differently"
 
 
+def test_a_reference_camera_gives_the_style(two):
+    a, b = two
+    cam = keyed_camera(a, b, frames=(20, 120))
+    original = cam.animation_data.action
+    want = on_screen(cam, (a, b), (20, 120))
+    select(a, b)
+    assert bpy.ops.inbetween.camera_from_armatures(style="ORBIT") == {"FINISHED"}
+    # The orbit result, played by a copy of the camera, is the reference.
+    ref = cam.copy()
+    bpy.context.scene.collection.objects.link(ref)
+    cam.animation_data.action = original
+    r = bpy.ops.inbetween.camera_from_armatures(style="REFERENCE", reference_camera=ref.name)
+    assert r == {"FINISHED"}
+    new = cam.animation_data.action
+    assert new.name == "CamAction.inbetween.reference" and new["inbetween_camera"]["style"] == "reference"
+    err = np.abs(on_screen(cam, (a, b), (20, 120)) - want).max()
+    print(f"\nreference camera: keys on screen within {err:.2e}")
+    assert err < 0.01
+    with pytest.raises(RuntimeError, match="name the reference camera"):
+        bpy.ops.inbetween.camera_from_armatures(style="REFERENCE")
+    with pytest.raises(RuntimeError, match="is the camera being made"):
+        bpy.ops.inbetween.camera_from_armatures(style="REFERENCE", reference_camera=cam.name)
+
+
 def test_bad_inputs_report_and_change_nothing(two):
     a, b = two
     cam = keyed_camera(a, b)

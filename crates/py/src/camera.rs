@@ -6,9 +6,10 @@
 use crate::clip::Clip;
 use crate::errors::{ctx, invalid, JobError};
 use crate::runner::run_job;
+use glam::{DQuat, DVec3};
 use inbetween_camera::dataset::{Behaviour, Scene};
-use inbetween_camera::infer::{GenerateJob, GenerateOptions, KeyCamera, Keys};
-use inbetween_camera::toric::Lens;
+use inbetween_camera::infer::{GenerateJob, GenerateOptions, KeyCamera, Keys, ReferenceClip, Style};
+use inbetween_camera::toric::{CameraPose, Lens};
 use inbetween_camera::weights;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -20,13 +21,17 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
+/// A reference camera's world positions (metres) and rotations (x, y, z, w), one per frame.
+type ReferencePoses = (Vec<[f64; 3]>, Vec<[f64; 4]>);
+
 /// Runs a `GenerateJob`. `keys_json` is the keyframes file's JSON. The lens: `fov_deg` (vertical)
 /// and `aspect`, by default the first pose key's `fov_deg` (else the engine's 45°) and 16:9. Writes
 /// the track JSON, glTF and preview GIF where paths are given. `names`: the two characters' names
-/// (default: the clips' sources), which keys' `targets` and `main` use. Returns a dict of arrays and
-/// the report.
+/// (default: the clips' sources), which keys' `targets` and `main` use. `reference`: a reference
+/// camera's world positions and rotations (x, y, z, w), one per scene frame from frame 0, whose
+/// style (the extractor's code, §4.1) replaces `style`. Returns a dict of arrays and the report.
 #[pyfunction]
-#[pyo3(signature = (keys_json, characters=None, scene=None, style="relative", exact_keys=true, causal=false, json=None, gltf=None, gif=None, progress=None, fov_deg=None, aspect=None, names=None))]
+#[pyo3(signature = (keys_json, characters=None, scene=None, style="relative", exact_keys=true, causal=false, json=None, gltf=None, gif=None, progress=None, fov_deg=None, aspect=None, names=None, reference=None))]
 #[allow(clippy::too_many_arguments)]
 fn camera_generate<'py>(
     py: Python<'py>,
@@ -43,6 +48,7 @@ fn camera_generate<'py>(
     fov_deg: Option<f64>,
     aspect: Option<f64>,
     names: Option<(String, String)>,
+    reference: Option<ReferencePoses>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let keys: Keys = serde_json::from_str(keys_json).map_err(|e| invalid(format!("keys: {e}")))?;
     let poses: Vec<usize> =
@@ -90,9 +96,25 @@ fn camera_generate<'py>(
                 by.length()
             )));
         }
-        let style = w.style(behaviour).ok_or_else(|| {
-            JobError::Failed(format!("the weights card has no style code for `{}`", behaviour.name()))
-        })?;
+        let style = match &reference {
+            // A reference camera's poses over this scene, one per frame from frame 0.
+            Some((positions, rotations)) => {
+                let poses: Vec<CameraPose> = positions
+                    .iter()
+                    .zip(rotations)
+                    .map(|(p, q)| CameraPose {
+                        position: DVec3::from_array(*p),
+                        rotation: DQuat::from_array(*q).normalize(),
+                    })
+                    .collect();
+                let clip = ReferenceClip::from_poses(&scene, &poses, &lens)
+                    .map_err(|e| JobError::Failed(format!("reference: {e}")))?;
+                Style { name: "reference".into(), code: clip.style(&w.model, Path::new("reference")).map_err(ctx(""))? }
+            }
+            None => w.style(behaviour).ok_or_else(|| {
+                JobError::Failed(format!("the weights card has no style code for `{}`", behaviour.name()))
+            })?,
+        };
         bar.inc(1);
         let options = GenerateOptions { exact_keys, causal, lens, cancel: Some(cancel), ..GenerateOptions::default() };
         let origin = Path::new("keys");

@@ -1,9 +1,9 @@
 //! A style reference from a glTF camera animation (issue 24): the camera a user animated (in
 //! Blender, or exported by `camera generate`) over the same two characters. The camera node's
 //! translation and rotation channels are sampled at the scene's frames (LINEAR, quaternions by
-//! slerp, held at the ends), each pose is turned into Toric coordinates against the scene's first
-//! two characters ([`from_pose`]), and the characters' Eq. 1 features come from the scene: a
-//! [`ReferenceClip`] whose style the extractor computes.
+//! slerp, held at the ends), and [`ReferenceClip::from_poses`] turns each pose into Toric
+//! coordinates against the scene's first two characters, with their Eq. 1 features from the scene:
+//! a [`ReferenceClip`] whose style the extractor computes.
 //!
 //! Read: `.gltf` (JSON, buffers as base64 data URIs) and `.glb`; accessors of FLOAT components.
 //! The camera node is the first node with a `camera`; its static parents' transforms are applied.
@@ -14,7 +14,7 @@ use serde_json::Value;
 
 use super::ReferenceClip;
 use crate::dataset::Scene;
-use crate::toric::{from_pose, CameraPose, Lens};
+use crate::toric::{CameraPose, Lens};
 
 fn err(file: &str, m: impl std::fmt::Display) -> String {
     format!("{file}: {m}")
@@ -169,25 +169,21 @@ pub fn reference_from_gltf(bytes: &[u8], file: &str, scene: &Scene, lens: &Lens)
         pt += pr * t;
         pr *= r;
     }
-    let n = scene.num_frames();
-    let (a, b) = (&scene.characters[0], &scene.characters[1]);
-    let mut camera = Vec::with_capacity(n);
-    for f in 0..n {
-        let time = f as f64 / scene.fps;
-        let t = translation.as_ref().map_or(t0, |(ts, v)| {
-            let s = sample(ts, v, time, false);
-            DVec3::new(s[0], s[1], s[2])
-        });
-        let r = rotation.as_ref().map_or(r0, |(ts, v)| {
-            let s = sample(ts, v, time, true);
-            DQuat::from_xyzw(s[0], s[1], s[2], s[3]).normalize()
-        });
-        let pose = CameraPose { position: pt + pr * t, rotation: (pr * r).normalize() };
-        let toric = from_pose(&pose, a.frame(f).target(), b.frame(f).target(), lens)
-            .map_err(|e| err(file, format!("frame {f} ({time:.2} s): the camera cannot frame both characters: {e}")))?;
-        camera.push(toric);
-    }
-    Ok(ReferenceClip { characters: scene.character_features(0, 1, true), camera })
+    let poses: Vec<CameraPose> = (0..scene.num_frames())
+        .map(|f| {
+            let time = f as f64 / scene.fps;
+            let t = translation.as_ref().map_or(t0, |(ts, v)| {
+                let s = sample(ts, v, time, false);
+                DVec3::new(s[0], s[1], s[2])
+            });
+            let r = rotation.as_ref().map_or(r0, |(ts, v)| {
+                let s = sample(ts, v, time, true);
+                DQuat::from_xyzw(s[0], s[1], s[2], s[3]).normalize()
+            });
+            CameraPose { position: pt + pr * t, rotation: (pr * r).normalize() }
+        })
+        .collect();
+    ReferenceClip::from_poses(scene, &poses, lens).map_err(|e| err(file, e))
 }
 
 #[cfg(test)]

@@ -3,10 +3,11 @@
 //! extracted from a user's reference clip.
 
 use super::FastModel;
+use crate::dataset::Scene;
 use crate::dataset::{Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE};
 use crate::features::{encode_camera, encode_character, CharacterFeatures};
 use crate::model::STYLE_STEPS;
-use crate::toric::Toric;
+use crate::toric::{from_pose, CameraPose, Lens, Toric};
 use crate::CameraError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -88,5 +89,66 @@ impl ReferenceClip {
         let chars: Vec<_> = (0..n).step_by(DOWNSAMPLE).map(|i| encode_character(&self.characters[i])).collect();
         let cams: Vec<_> = (0..n).step_by(DOWNSAMPLE).map(|i| encode_camera(&self.camera[i])).collect();
         Ok(model.extract_style(&chars, &cams))
+    }
+
+    /// A reference clip from a camera's world poses over `scene`, one per frame from frame 0 (at
+    /// most the scene's frames): each pose turned into Toric coordinates (Eq. 2) against the
+    /// scene's first two characters ([`from_pose`]), their Eq. 1 features from the scene. The
+    /// error names the first frame whose pose cannot frame both.
+    pub fn from_poses(scene: &Scene, poses: &[CameraPose], lens: &Lens) -> Result<ReferenceClip, String> {
+        if scene.characters.len() < 2 || poses.len() > scene.num_frames() {
+            return Err(format!(
+                "{} camera poses for a scene of {} frames and {} characters: expected at most one pose per frame \
+                 and two characters",
+                poses.len(),
+                scene.num_frames(),
+                scene.characters.len()
+            ));
+        }
+        let (a, b) = (&scene.characters[0], &scene.characters[1]);
+        let camera = poses
+            .iter()
+            .enumerate()
+            .map(|(f, pose)| {
+                from_pose(pose, a.frame(f).target(), b.frame(f).target(), lens).map_err(|e| {
+                    format!("frame {f} ({:.2} s): the camera cannot frame both characters: {e}", f as f64 / scene.fps)
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut characters = scene.character_features(0, 1, true);
+        characters.truncate(camera.len());
+        Ok(ReferenceClip { characters, camera })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::infer::{example_keys, GenerateJob};
+    use glam::DVec3;
+
+    #[test]
+    fn a_reference_from_camera_poses_reads_back_their_toric_track_and_names_a_bad_frame() {
+        let scene = Scene::procedural(3, 120, 30.0);
+        let model = crate::infer::test_model(16, 4);
+        let style = Style { name: "test".into(), code: vec![0.0; 4] };
+        let track = GenerateJob::new(&model, &scene, &example_keys(&scene, &[0, 119]), &style).run().unwrap();
+        let poses: Vec<CameraPose> = track.frames.iter().map(|f| f.pose).collect();
+        let clip = ReferenceClip::from_poses(&scene, &poses, &track.lens).unwrap();
+        assert_eq!((clip.camera.len(), clip.characters.len()), (120, 120));
+        for (got, f) in clip.camera.iter().zip(&track.frames) {
+            let (g, w) = (got.to_array(), f.toric.to_array());
+            assert!((0..6).all(|i| (g[i] - w[i]).abs() < 1e-9), "frame {}: {g:?} vs {w:?}", f.frame);
+        }
+        assert_eq!(clip.style(&model, Path::new("ref")).unwrap().len(), 4);
+        // A pose turned away from both characters at frame 3.
+        let mut away = poses.clone();
+        let p = away[3].position;
+        let (a, b) = (scene.characters[0].frame(3).target(), scene.characters[1].frame(3).target());
+        away[3] = CameraPose::look_at(p, p + (p - (a + b) * 0.5) + DVec3::new(0.0, 0.01, 0.0));
+        let e = ReferenceClip::from_poses(&scene, &away, &track.lens).unwrap_err();
+        assert!(e.starts_with("frame 3 (0.10 s): the camera cannot frame both characters"), "{e}");
+        let e = ReferenceClip::from_poses(&scene, &[poses[0]; 121], &track.lens).unwrap_err();
+        assert!(e.contains("121 camera poses for a scene of 120 frames"), "{e}");
     }
 }

@@ -170,6 +170,7 @@ def camera_generate(
     fov_deg: Optional[float] = None,
     aspect: Optional[float] = None,
     names: Optional[Tuple[str, str]] = None,
+    reference: Optional[Tuple[List[List[float]], List[List[float]]]] = None,
 ) -> Dict[str, Any]: ...
 def face_edit(
     clip: FaceClip,

@@ -73,12 +73,24 @@ def _key(k: Mapping[str, Any]) -> Dict[str, Any]:
     d = dict(k)
     if any(f in d for f in _POSE_FIELDS):
         if "camera" in d:
-            raise InbetweenError(f"key at frame {d.get('frame')}: give either `camera` or a pose (position, rotation), not both")
+            raise InbetweenError(
+                f"key at frame {d.get('frame')}: give either `camera` or a pose (position, rotation), not both"
+            )
         d["camera"] = {f: d.pop(f) for f in _POSE_FIELDS if f in d}
     cam = d.get("camera")
     if isinstance(cam, Mapping):
-        d["camera"] = {n: (np.asarray(v, dtype=np.float64).tolist() if n != "fov_deg" else float(v)) for n, v in cam.items()}
+        d["camera"] = {n: np.asarray(v, dtype=np.float64).tolist() for n, v in cam.items()}
     return d
+
+
+def _reference(ref: Any) -> Optional[Tuple[List[List[float]], List[List[float]]]]:
+    if ref is None:
+        return None
+    pos, rot = (ref.positions_m, ref.rotations) if isinstance(ref, Track) else ref
+    pos, rot = np.asarray(pos, dtype=np.float64), np.asarray(rot, dtype=np.float64)
+    if pos.ndim != 2 or pos.shape[1] != 3 or rot.shape != (len(pos), 4):
+        raise InbetweenError(f"reference: positions {pos.shape} and rotations {rot.shape}; expected [T, 3] and [T, 4]")
+    return pos.tolist(), rot.tolist()
 
 
 def generate(
@@ -97,6 +109,7 @@ def generate(
     fov_deg: Optional[float] = None,
     aspect: Optional[float] = None,
     names: Optional[Tuple[str, str]] = None,
+    reference: "Optional[Track | Tuple[Any, Any]]" = None,
 ) -> Track:
     """A camera track by the camera engine's `GenerateJob` (as `inbetween camera generate`).
 
@@ -110,7 +123,10 @@ def generate(
     two mocap clips (`characters=(a, b)`: roots from the hips, shoulders from the upper arms;
     `names=(name_a, name_b)` names them for keys' `targets` and `main`, default their files) or a
     scene JSON. `json_path`, `gltf`, `gif` also write the track, a glTF camera animation and a
-    top-down preview."""
+    top-down preview. `reference`: a camera to take the style from instead of `style`, as world
+    `(positions [T, 3] metres, rotations [T, 4] (x, y, z, w))` over the same scene, one per frame
+    from frame 0 (at least 50 frames), or a `Track` over it; the extractor's code (§4.1) from its
+    Toric track against the two characters."""
     doc: Dict[str, Any] = {"keys": [_key(k) for k in keys]}
     if main is not None:
         doc["main"] = main
@@ -119,6 +135,7 @@ def generate(
         d = _native.camera_generate(
             json.dumps(doc), characters, fspath(scene), style, exact_keys, causal, fspath(json_path), fspath(gltf),
             fspath(gif), cb, fov_deg, aspect, None if names is None else (str(names[0]), str(names[1])),
+            _reference(reference),
         )
     return Track(
         frames=np.asarray(d["frames"], dtype=np.int64),
