@@ -3,18 +3,19 @@
 //! point) so a viewer shows what the camera follows. Buffers are embedded as a base64 data URI.
 
 use crate::dataset::Scene;
-use crate::infer::CameraTrack;
+use crate::infer::GeneratedTrack;
 use inbetween_io::gltf_buffer::json::{animation::Property, Index, Node};
 use inbetween_io::gltf_buffer::{data_uri, node, perspective, scene, Anim, GltfDoc, Type};
 
 /// The glTF document (JSON) of `track` over `scene`.
-pub fn camera_gltf(track: &CameraTrack, scene_: &Scene) -> serde_json::Value {
+pub fn camera_gltf(track: &GeneratedTrack, scene_: &Scene) -> serde_json::Value {
     // Animation data only: views without a target, bounds on the time input as the spec asks.
     let mut d = GltfDoc::new("inbetween camera");
-    let times: Vec<f32> = track.frames.iter().map(|f| (f.frame as f64 / track.fps) as f32).collect();
+    let camera = track.camera();
+    let times: Vec<f32> = (0..camera.frames.len()).map(|i| camera.seconds(i) as f32).collect();
     let t_acc = d.floats(&times, Type::Scalar, true, None);
-    let pos: Vec<f32> = track.frames.iter().flat_map(|f| f.pose.position.to_array().map(|v| v as f32)).collect();
-    let rot: Vec<f32> = track.frames.iter().flat_map(|f| f.pose.rotation.to_array().map(|v| v as f32)).collect();
+    let pos: Vec<f32> = camera.frames.iter().flat_map(|c| c.pose.position.to_array().map(|v| v as f32)).collect();
+    let rot: Vec<f32> = camera.frames.iter().flat_map(|c| c.pose.rotation.to_array().map(|v| v as f32)).collect();
     let p_acc = d.floats(&pos, Type::Vec3, false, None);
     let r_acc = d.floats(&rot, Type::Vec4, false, None);
     let lens = track.lens;
@@ -40,7 +41,7 @@ pub fn camera_gltf(track: &CameraTrack, scene_: &Scene) -> serde_json::Value {
 }
 
 /// Writes the glTF file atomically.
-pub fn write_gltf(path: &std::path::Path, track: &CameraTrack, scene: &Scene) -> Result<(), crate::CameraError> {
+pub fn write_gltf(path: &std::path::Path, track: &GeneratedTrack, scene: &Scene) -> Result<(), crate::CameraError> {
     let doc = camera_gltf(track, scene);
     inbetween_io::write_atomic(path, doc.to_string().as_bytes())
         .map_err(|source| crate::CameraError::Io { path: path.into(), source })

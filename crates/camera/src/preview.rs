@@ -3,7 +3,7 @@
 //! camera sees (stick torsos and heads projected through the generated pose).
 
 use crate::dataset::Scene;
-use crate::infer::CameraTrack;
+use crate::infer::GeneratedTrack;
 use glam::{DVec2, DVec3};
 use inbetween_render::Canvas;
 
@@ -44,7 +44,7 @@ impl TopDown {
 }
 
 /// What the camera sees at one frame (picture-in-picture).
-fn camera_view(track: &CameraTrack, scene: &Scene, i: usize) -> image::RgbImage {
+fn camera_view(track: &GeneratedTrack, scene: &Scene, i: usize) -> image::RgbImage {
     let f = &track.frames[i];
     let mut c = Canvas::new(PIP_W, PIP_H, [235, 238, 245]);
     let lens = &track.lens;
@@ -83,7 +83,7 @@ fn camera_view(track: &CameraTrack, scene: &Scene, i: usize) -> image::RgbImage 
 }
 
 /// One GIF frame per `stride` frames of the track.
-pub fn render_frames(track: &CameraTrack, scene: &Scene, stride: usize) -> Vec<image::RgbImage> {
+pub fn render_frames(track: &GeneratedTrack, scene: &Scene, stride: usize) -> Vec<image::RgbImage> {
     let pts = track.frames.iter().flat_map(|f| {
         let c = &scene.characters;
         [f.pose.position, c[f.targets[0]].root[f.frame], c[f.targets[1]].root[f.frame]].map(|p| DVec2::new(p.x, p.z))
@@ -131,7 +131,7 @@ pub fn render_frames(track: &CameraTrack, scene: &Scene, stride: usize) -> Vec<i
 /// Writes the preview GIF (every `stride`-th frame, played at the matching rate).
 pub fn write_preview(
     path: &std::path::Path,
-    track: &CameraTrack,
+    track: &GeneratedTrack,
     scene: &Scene,
     stride: usize,
 ) -> Result<(), crate::CameraError> {

@@ -2,10 +2,12 @@
 //! runtime pose clips ([`clip::Clip`]), rotations, forward kinematics, resampling and windowing,
 //! curves with an [`Interval`] domain and their adapters ([`curve`]), keyframe sets, interpolation,
 //! error metrics, joint roles on any humanoid rig ([`roles`]), length units, seeding ([`seed`]),
-//! cooperative cancellation and time limits ([`cancel`]), angle wrapping ([`angle`]), order statistics ([`stats`]) and Toric space
-//! for two-subject camera framing ([`toric`]).
+//! cooperative cancellation and time limits ([`cancel`]), angle wrapping ([`angle`]), order statistics ([`stats`]), Toric space
+//! for two-subject camera framing ([`toric`]) and the camera over a clip's frames that the script and
+//! camera engines place ([`camera`]).
 
 pub mod angle;
+pub mod camera;
 pub mod cancel;
 pub mod clip;
 pub mod curve;

@@ -223,8 +223,7 @@ pub fn check(anim: &Animation, cat: &Catalogue, relations: &[(Relation, usize, u
     // Line of sight from the shot camera to whom it frames.
     let obstacles = obstacles(anim);
     for f in 0..r.frames {
-        let (eye, _, _) = track.pose(f);
-        let eye = DVec3::new(eye[0] as f64, eye[1] as f64, eye[2] as f64);
+        let eye = track.pose(f).eye.as_dvec3();
         if obstacles.iter().any(|o| geom::point_in_box(o, eye)) {
             r.camera_inside += 1;
         } else if !sees(&obstacles, eye, &sight_targets(&bodies, f, track.framed.get(f).copied().unwrap_or(1))) {

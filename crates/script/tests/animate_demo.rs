@@ -122,7 +122,8 @@ fn front_camera_frames_the_characters_from_inside_the_room() {
     assert_eq!((anim.camera[0].start, anim.camera[0].end), (0, anim.frames()));
     let room = &anim.scene.room;
     for f in (0..anim.frames()).step_by(17) {
-        let (eye, target, fov) = camera_pose(&anim, f);
+        let c = camera_pose(&anim, f);
+        let (eye, target, fov) = (c.eye, c.target, c.fovy_deg);
         assert!(
             eye[0] >= 0.0 && eye[0] <= room.width && eye[2] >= 0.0 && eye[2] <= room.depth && eye[1] <= room.height
         );
@@ -152,9 +153,11 @@ fn camera_commands_cut_at_the_next_action() {
         eve.segments.iter().find(|s| s.target.as_deref() == Some("chair")).expect("walk to the chair").start;
     assert_eq!(anim.camera[1].start, sit_start);
     assert_eq!(anim.camera[0].end, sit_start);
-    let (eye, target, _) = camera_pose(&anim, 0);
+    let c = camera_pose(&anim, 0);
+    let (eye, target) = (c.eye, c.target);
     assert!(eye[0] < target[0], "the left camera stands at lower x");
-    let (eye, target, _) = camera_pose(&anim, anim.frames() - 1);
+    let c = camera_pose(&anim, anim.frames() - 1);
+    let (eye, target) = (c.eye, c.target);
     assert!(eye[1] > target[1] + 0.8, "the top camera looks down");
 }
 

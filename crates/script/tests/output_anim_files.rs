@@ -9,6 +9,7 @@ use std::path::Path;
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 use image::AnimationDecoder;
+use inbetween_core::camera::AimedCamera;
 use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
 use inbetween_script::catalogue::builtin::builtin;
@@ -46,9 +47,9 @@ fn walk() -> Clip {
 }
 
 /// A camera in front of the room panning slowly with the frame.
-fn camera(f: usize) -> ([f32; 3], [f32; 3], f32) {
+fn camera(f: usize) -> AimedCamera {
     let x = 1.5 + 0.01 * f as f32;
-    ([x, 2.4, 8.5], [2.5, 0.8, 2.0], 45.0)
+    AimedCamera { eye: Vec3::new(x, 2.4, 8.5), target: Vec3::new(2.5, 0.8, 2.0), fovy_deg: 45.0 }
 }
 
 fn parents_by_node(doc: &Value) -> HashMap<usize, usize> {
@@ -187,10 +188,10 @@ fn check_animation(doc: &Value, bin: &[u8], name: &str, m: &Clip, fps: f64) {
     assert_eq!(pos.len(), 3 * frames);
     assert_eq!(rot.len(), 4 * frames);
     for f in [0, frames / 2, frames - 1] {
-        let (eye, target, _) = camera(f);
-        assert_eq!(&pos[3 * f..3 * f + 3], &eye);
+        let AimedCamera { eye, target, .. } = camera(f);
+        assert_eq!(&pos[3 * f..3 * f + 3], &eye.to_array());
         let q = Quat::from_slice(&rot[4 * f..4 * f + 4]);
-        let dir = (Vec3::from(target) - Vec3::from(eye)).normalize();
+        let dir = (target - eye).normalize();
         assert!((q * Vec3::NEG_Z).dot(dir) > 0.9999, "camera looks at the target");
         assert!((q * Vec3::Y).y > 0.0, "camera upright");
     }
@@ -235,7 +236,11 @@ fn changing_field_of_view_steps_through_animation_pointer() {
     let lookup = |_: &str| None;
     let (doc, _, _) = animated_gltf_document(&scene(), &builtin(), &[("w", &m)], &camera, 30.0, &lookup).unwrap();
     assert!(doc.get("extensionsUsed").is_none(), "constant fov needs no extension");
-    let cut = |f: usize| ([2.5, 1.6, 3.9], [2.5, 1.0, 2.0], if f < 30 { 50.0 } else { 70.0 });
+    let cut = |f: usize| AimedCamera {
+        eye: Vec3::new(2.5, 1.6, 3.9),
+        target: Vec3::new(2.5, 1.0, 2.0),
+        fovy_deg: if f < 30 { 50.0 } else { 70.0 },
+    };
     let (doc, bin, _) = animated_gltf_document(&scene(), &builtin(), &[("w", &m)], &cut, 30.0, &lookup).unwrap();
     assert_eq!(doc["extensionsUsed"], serde_json::json!(["KHR_animation_pointer"]));
     assert!(doc.get("extensionsRequired").is_none());
@@ -255,7 +260,8 @@ fn animated_gltf_rejects_bad_input() {
     let m = walk();
     let lookup = |_: &str| None;
     assert!(animated_gltf_document(&scene(), &builtin(), &[("w", &m)], &camera, 0.0, &lookup).is_err());
-    let bad_fov = |_: usize| ([0.0, 1.0, 5.0], [0.0, 1.0, 0.0], 0.0);
+    let bad_fov =
+        |_: usize| AimedCamera { eye: Vec3::new(0.0, 1.0, 5.0), target: Vec3::new(0.0, 1.0, 0.0), fovy_deg: 0.0 };
     assert!(animated_gltf_document(&scene(), &builtin(), &[("w", &m)], &bad_fov, 30.0, &lookup).is_err());
     // A character without frames cannot be given: a clip has at least one.
     assert!(Clip::from_poses(m.skeleton().clone(), m.frame_time(), &[]).is_err());
@@ -352,7 +358,8 @@ fn preview_frames_respect_size_and_rate_caps() {
     assert!(fps <= 10.0);
     assert_eq!(frames[0].dimensions(), (480, 320));
     // A camera inside the room (floor partly behind it) still draws.
-    let inside = |_: usize| ([2.5, 1.6, 3.8], [2.5, 1.0, 0.0], 60.0);
+    let inside =
+        |_: usize| AimedCamera { eye: Vec3::new(2.5, 1.6, 3.8), target: Vec3::new(2.5, 1.0, 0.0), fovy_deg: 60.0 };
     let (frames, _) = preview_frames(&scene(), &builtin(), &[("walker", &m)], &inside, 30.0, &opts).unwrap();
     assert!(frames[0].pixels().any(|p| p.0 == [236, 233, 226]), "floor visible");
     assert!(preview_frames(&scene(), &builtin(), &[("walker", &m)], &camera, -1.0, &opts).is_err());

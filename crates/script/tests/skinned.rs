@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DQuat, DVec3, Mat4, Quat, Vec3};
+use inbetween_core::camera::AimedCamera;
 use inbetween_core::clip::Clip;
 use inbetween_core::fk::forward;
 use inbetween_core::Pose;
@@ -146,8 +147,8 @@ fn room() -> Scene {
     }
 }
 
-fn camera(_: usize) -> ([f32; 3], [f32; 3], f32) {
-    ([2.0, 1.4, 6.0], [2.0, 0.9, 2.0], 40.0)
+fn camera(_: usize) -> AimedCamera {
+    AimedCamera { eye: Vec3::new(2.0, 1.4, 6.0), target: Vec3::new(2.0, 0.9, 2.0), fovy_deg: 40.0 }
 }
 
 /// Frame 0 the bind pose at (2, y, 2); then the left knee bends to 90°, the right arm drops to the

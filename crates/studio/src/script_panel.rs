@@ -195,8 +195,8 @@ fn run_job(st: &AppState, job: &Job, req: RunRequest) -> Result<Value> {
     let frames = anim.frames();
     let camera: Vec<[f32; 7]> = (0..frames)
         .map(|f| {
-            let (e, t, fov) = cam(f);
-            [e[0], e[1], e[2], t[0], t[1], t[2], fov]
+            let c = cam(f);
+            [c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.fovy_deg]
         })
         .collect();
     let summary = format!(

@@ -9,7 +9,7 @@ use inbetween_core::roles::{find_motion_roles, Role, RoleOverrides, Side};
 use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{positions_clip, Motion};
 
-use super::scene::{CharacterTrack, Scene};
+use super::scene::{CharacterPoints, Scene};
 
 /// What [`scene_from_motions`] did beyond the obvious, for the user to read.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -95,7 +95,7 @@ pub fn scene_from_motions_in_units(
             motion.skeleton.joint(r).name,
             unit
         ));
-        characters.push(CharacterTrack {
+        characters.push(CharacterPoints {
             name: name.to_string(),
             root: (0..frames).map(|f| sample(f, hips)).collect(),
             shoulder_l: (0..frames).map(|f| sample(f, l)).collect(),

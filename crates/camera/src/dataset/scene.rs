@@ -11,16 +11,17 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::Path;
 
-/// One character's animation.
+/// One character as the camera engine sees it: its root and shoulder points at every frame (the
+/// script engine's `CharacterTrack` is a whole animated skeleton; this is what framing needs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CharacterTrack {
+pub struct CharacterPoints {
     pub name: String,
     pub root: Vec<DVec3>,
     pub shoulder_l: Vec<DVec3>,
     pub shoulder_r: Vec<DVec3>,
 }
 
-impl CharacterTrack {
+impl CharacterPoints {
     pub fn frame(&self, f: usize) -> CharacterFrame {
         CharacterFrame { root: self.root[f], shoulder_l: self.shoulder_l[f], shoulder_r: self.shoulder_r[f] }
     }
@@ -34,7 +35,7 @@ pub const TARGETS_APART: f64 = 1e-6;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Scene {
     pub fps: f64,
-    pub characters: Vec<CharacterTrack>,
+    pub characters: Vec<CharacterPoints>,
 }
 
 impl Scene {
@@ -202,9 +203,9 @@ impl Choreographer {
     }
 
     fn run(mut self, frames: usize) -> Scene {
-        let mut tracks: Vec<CharacterTrack> = ["A", "B"]
+        let mut tracks: Vec<CharacterPoints> = ["A", "B"]
             .iter()
-            .map(|n| CharacterTrack { name: n.to_string(), root: vec![], shoulder_l: vec![], shoulder_r: vec![] })
+            .map(|n| CharacterPoints { name: n.to_string(), root: vec![], shoulder_l: vec![], shoulder_r: vec![] })
             .collect();
         let mut f = 0;
         while f < frames {
@@ -327,7 +328,7 @@ mod tests {
     #[test]
     fn coinciding_and_same_named_characters_are_refused() {
         let mut s = Scene::procedural(1, 40, 30.0);
-        s.characters.push(CharacterTrack { name: "C".into(), ..s.characters[0].clone() });
+        s.characters.push(CharacterPoints { name: "C".into(), ..s.characters[0].clone() });
         let e = s.validate().unwrap_err();
         assert!(
             e.contains(&format!("characters `{}` and `C` stand at the same position at frame 0", s.characters[0].name)),

@@ -5,7 +5,7 @@
 //! live camera cannot go back, so it corrects nothing and reports its misses.
 
 use super::keys::ResolvedKeys;
-use super::track::{camera_frame, CameraTrack, KeyResidual};
+use super::track::{camera_frame, GeneratedTrack, KeyResidual};
 use super::{key_vector, toric_distance, velocity_frames, Cam, FastModel, KeyVec, Rollout, Style};
 use crate::dataset::Scene;
 use crate::dataset::DOWNSAMPLE;
@@ -89,7 +89,7 @@ pub(super) fn run_causal(
     scene: &Scene,
     lens: &Lens,
     keys: &ResolvedKeys,
-) -> Result<CameraTrack, CameraError> {
+) -> Result<GeneratedTrack, CameraError> {
     let k = &keys.keys;
     let (first, last) = (keys.first_frame(), keys.last_frame(scene));
     let feats = |f: usize, pair: (usize, usize)| {
@@ -123,7 +123,7 @@ pub(super) fn run_causal(
         frames.push(camera_frame(scene, frame, target.pair, toric, lens)?);
     }
     let max_corrected_residual = residuals.iter().map(|r| r.residual).fold(0.0, f64::max);
-    Ok(CameraTrack {
+    Ok(GeneratedTrack {
         fps: scene.fps,
         style: style.name.clone(),
         style_code: style.code.clone(),

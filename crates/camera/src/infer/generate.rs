@@ -5,7 +5,7 @@
 //! [`GenerateJob::run`].
 
 use super::keys::{ResolvedKey, ResolvedKeys};
-use super::track::{camera_frame, CameraFrame, CameraTrack, KeyResidual};
+use super::track::{camera_frame, CameraFrame, GeneratedTrack, KeyResidual};
 use super::{key_vector, toric_distance, velocity_frames, Chr, FastModel, Keys, Rollout, Style};
 use crate::dataset::{Scene, DOWNSAMPLE};
 use crate::features::{decode_camera, encode_camera, encode_character, CharacterFeatures};
@@ -116,7 +116,7 @@ impl<'a> GenerateJob<'a> {
     }
 
     /// Validates, then generates (offline, or causal when `options.causal`).
-    pub fn run(&self) -> Result<CameraTrack, CameraError> {
+    pub fn run(&self) -> Result<GeneratedTrack, CameraError> {
         let keys = self.validate()?;
         if self.options.causal {
             return super::causal::run_causal(self.model, self.style, self.scene, &self.options.lens, &keys);
@@ -126,7 +126,7 @@ impl<'a> GenerateJob<'a> {
         let (track, max_corrected_residual) = self.fill_and_correct(&keys, &network.samples)?;
         self.options.check_cancel()?;
         let frames = self.posed(&keys, &network.pairs, &track)?;
-        Ok(CameraTrack {
+        Ok(GeneratedTrack {
             fps: self.scene.fps,
             style: self.style.name.clone(),
             style_code: self.style.code.clone(),
@@ -244,7 +244,7 @@ impl<'a> GenerateJob<'a> {
 }
 
 /// [`GenerateJob::run`] in causal mode (kept for callers that hold the pieces).
-pub fn generate_causal(job: &GenerateJob) -> Result<CameraTrack, CameraError> {
+pub fn generate_causal(job: &GenerateJob) -> Result<GeneratedTrack, CameraError> {
     GenerateJob { options: GenerateOptions { causal: true, ..job.options }, ..*job }.run()
 }
 

@@ -7,7 +7,7 @@
 //! | [`rollout`] | [`Rollout`]: one trajectory stepped every 5th frame, restarts through H; shared by generation, the causal mode, the bench and the examples |
 //! | [`keys`] | the keyframes file ([`Keys`]) and its validation against a scene |
 //! | [`style`] | per-behaviour style codes ([`NamedStyle`]) and reference clips ([`ReferenceClip`]) |
-//! | [`track`] | what both modes return: [`CameraTrack`], its frames and key misses |
+//! | [`track`] | what both modes return: [`GeneratedTrack`], its frames and key misses |
 //! | [`generate`] | [`GenerateJob`]: validate, run the network (offline, or the causal mode), Catmull-Rom fill, key correction, world poses |
 //! | [`causal`] | [`CausalCamera`]: one frame at a time, no look-ahead (uses [`track`], not [`generate`]) |
 //!
@@ -33,7 +33,7 @@ pub use networks::{FastModel, Scratch, StepIn};
 pub use reference_gltf::reference_from_gltf;
 pub use rollout::Rollout;
 pub use style::{NamedStyle, ReferenceClip, Style};
-pub use track::{CameraFrame, CameraTrack, KeyResidual};
+pub use track::{CameraFrame, GeneratedTrack, KeyResidual};
 
 /// x^c as the networks see it (Eq. 2 order, f32).
 pub type Cam = [f32; CAM_DIM];

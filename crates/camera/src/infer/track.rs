@@ -1,10 +1,12 @@
 //! What generation returns, offline ([`super::GenerateJob`]) and live ([`super::CausalCamera`])
-//! alike: the camera track, its frames and the misses at keys. Both modes build on this module and
+//! alike: the generated track (its frames with their Toric coordinates and targets, the misses at
+//! keys), whose camera per frame is a core [`CameraTrack`] of [`PosedCamera`]s. Both modes build on this module and
 //! neither imports the other's internals.
 
 use crate::dataset::Scene;
 use crate::toric::{to_pose, CameraPose, Lens, Toric};
 use crate::CameraError;
+use inbetween_core::camera::{CameraTrack, PosedCamera};
 use serde::{Deserialize, Serialize};
 
 /// One generated frame.
@@ -24,9 +26,10 @@ pub struct KeyResidual {
     pub residual: f64,
 }
 
-/// A generated camera track.
+/// A generated camera track: the camera per frame and how the network got there (style, Toric
+/// coordinates, key misses).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CameraTrack {
+pub struct GeneratedTrack {
     pub fps: f64,
     pub style: String,
     pub style_code: Vec<f32>,
@@ -37,9 +40,19 @@ pub struct CameraTrack {
     pub max_corrected_residual: f64,
 }
 
-impl CameraTrack {
+impl GeneratedTrack {
     pub fn toric(&self) -> Vec<Toric> {
         self.frames.iter().map(|f| f.toric).collect()
+    }
+
+    /// The camera of every frame (pose and lens) at the track's rate, from its first frame
+    /// (frames are consecutive).
+    pub fn camera(&self) -> CameraTrack<PosedCamera> {
+        CameraTrack {
+            fps: self.fps,
+            first_frame: self.frames.first().map_or(0, |f| f.frame),
+            frames: self.frames.iter().map(|f| PosedCamera { pose: f.pose, lens: self.lens }).collect(),
+        }
     }
 
     /// The largest network miss at a key (before correction).

@@ -4,7 +4,8 @@
 //! space ([`inbetween_core::toric`]: both heads at fixed screen positions), on the side of the
 //! pair the command names; "top" and "wide" keep the room-relative placement.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
+use inbetween_core::camera::{AimedCamera, CameraTrack};
 use inbetween_core::fk::forward;
 use inbetween_core::toric::{to_pose, Lens, Toric};
 
@@ -71,14 +72,13 @@ pub fn view_at(anim: &Animation, frame: usize) -> &str {
 }
 
 /// The framing a camera command asks for at a frame, ignoring furniture (the outputs use
-/// [`camera_track`], which also keeps the characters in sight): (eye, target, vertical field of
-/// view in degrees). With two or more
+/// [`camera_track`], which also keeps the characters in sight). With two or more
 /// characters, a Toric two-shot when one fits in the room (see the module doc). Otherwise the target is the first
 /// character's chest (the room's centre at chest height without characters); the eye sits 3 m
 /// from it towards the named side of the room (front: +z, the door wall; back: −z; left: −x;
 /// right: +x), 2.2 m above for "top"-like views, 1.3 m away for "close", at the front wall's top
 /// corner side for "wide", clamped into the room.
-pub fn camera_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) {
+pub fn camera_pose(anim: &Animation, frame: usize) -> AimedCamera {
     let head = |c: usize| smoothed_head(&anim.characters[c], frame);
     if let Some(shot) = two_shot(anim, frame, head) {
         return shot;
@@ -90,40 +90,36 @@ pub fn camera_pose(anim: &Animation, frame: usize) -> ([f32; 3], [f32; 3], f32) 
 /// [`camera_pose`]'s framing (each character's forward kinematics run once per frame instead of
 /// once per frame and neighbour), moved where furniture would block the view of whom it frames
 /// (see [`keep_in_sight`]; equal to [`camera_pose`] in a scene without objects).
-/// [`CameraTrack::pose`] answers any frame from it (past its end through [`camera_pose`]).
-pub fn camera_track(anim: &Animation) -> CameraTrack<'_> {
+/// [`ShotCameras::pose`] answers any frame from it (past its end through [`camera_pose`]).
+pub fn camera_track(anim: &Animation) -> ShotCameras<'_> {
     let (poses, framed) = camera_poses(anim);
-    CameraTrack { anim, poses, framed }
+    ShotCameras { anim, track: CameraTrack { fps: anim.fps, first_frame: 0, frames: poses }, framed }
 }
 
-/// The camera of every frame of an animation, computed once.
-pub struct CameraTrack<'a> {
+/// The shot camera of every frame of an animation, computed once, and whom each frame keeps in
+/// sight.
+pub struct ShotCameras<'a> {
     anim: &'a Animation,
-    /// (eye, target, vertical field of view in degrees) per frame.
-    pub poses: Vec<([f32; 3], [f32; 3], f32)>,
+    /// The camera per frame from frame 0, at the animation's rate.
+    pub track: CameraTrack<AimedCamera>,
     /// How many characters (the first ones) each frame's camera keeps in sight: two in a
     /// two-shot, one where furniture stands between the pair (see [`keep_in_sight`]).
     pub framed: Vec<usize>,
 }
 
-impl CameraTrack<'_> {
+impl ShotCameras<'_> {
     /// The camera at `frame`: [`camera_pose`]'s value.
-    pub fn pose(&self, frame: usize) -> ([f32; 3], [f32; 3], f32) {
-        match self.poses.get(frame) {
-            Some(p) => *p,
-            None => camera_pose(self.anim, frame),
-        }
+    pub fn pose(&self, frame: usize) -> AimedCamera {
+        self.track.at(frame).unwrap_or_else(|| camera_pose(self.anim, frame))
     }
 }
 
-type Framing = ([f32; 3], [f32; 3], f32);
-
-fn camera_poses(anim: &Animation) -> (Vec<Framing>, Vec<usize>) {
+fn camera_poses(anim: &Animation) -> (Vec<AimedCamera>, Vec<usize>) {
     let bodies: Vec<Option<Vec<[DVec3; 2]>>> = anim.characters.iter().take(2).map(body_points).collect();
     let heads: Vec<Option<Vec<DVec3>>> =
         bodies.iter().map(|b| b.as_ref().map(|b| b.iter().map(|p| p[0]).collect())).collect();
     let chest = chest_positions(anim);
-    let framing: Vec<Framing> = (0..anim.frames().max(1))
+    let framing: Vec<AimedCamera> = (0..anim.frames().max(1))
         .map(|frame| {
             let head = |c: usize| heads[c].as_deref().map(|h| smoothed(h, frame));
             if let Some(shot) = two_shot(anim, frame, head) {
@@ -277,8 +273,8 @@ fn moved(anim: &Animation, k: usize, eye: [f32; 3], target: [f32; 3]) -> [f32; 3
 fn keep_in_sight(
     anim: &Animation,
     bodies: &[Option<Vec<[DVec3; 2]>>],
-    framing: Vec<Framing>,
-) -> (Vec<Framing>, Vec<usize>) {
+    framing: Vec<AimedCamera>,
+) -> (Vec<AimedCamera>, Vec<usize>) {
     let obstacles = obstacles(anim);
     let counts: Vec<usize> = (0..framing.len()).map(|f| framed_count(anim, f)).collect();
     if obstacles.is_empty() || anim.characters.is_empty() {
@@ -290,7 +286,8 @@ fn keep_in_sight(
     let poses = framing
         .into_iter()
         .enumerate()
-        .map(|(f, (eye, target, fov))| {
+        .map(|(f, cam)| {
+            let (eye, target) = (cam.eye.to_array(), cam.target.to_array());
             let mut n = counts[f];
             let mut targets = sight_targets(bodies, f, n);
             let ok = |k: usize, targets: &[DVec3]| sees(&obstacles, v3(moved(anim, k, eye, target)), targets);
@@ -306,7 +303,7 @@ fn keep_in_sight(
                 current = (0..MOVES.len()).find(|&k| ok(k, &targets)).unwrap_or(0);
             }
             framed.push(n);
-            (moved(anim, current, eye, target), target, fov)
+            AimedCamera { eye: Vec3::from(moved(anim, current, eye, target)), ..cam }
         })
         .collect();
     (poses, framed)
@@ -391,11 +388,7 @@ fn side_score(view: &str, eye: DVec3, mid: DVec3) -> f64 {
 /// characters, a "top"/"wide" view, heads too close, or no framing that puts the camera inside
 /// the room on the named side).
 /// `head(c)`: character `c`'s smoothed head at this frame.
-fn two_shot(
-    anim: &Animation,
-    frame: usize,
-    head: impl Fn(usize) -> Option<DVec3>,
-) -> Option<([f32; 3], [f32; 3], f32)> {
+fn two_shot(anim: &Animation, frame: usize, head: impl Fn(usize) -> Option<DVec3>) -> Option<AimedCamera> {
     let view = view_at(anim, frame);
     if anim.characters.len() < 2 || view == "top" || view == "wide" {
         return None;
@@ -428,12 +421,12 @@ fn two_shot(
     })?;
     // The look-at target: the point of the viewing axis level with the pair (roll is dropped).
     let target = pose.position + pose.forward() * (mid - pose.position).dot(pose.forward()).max(0.5);
-    let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
-    Some((f(pose.position), f(target), TWO_SHOT_FOV as f32))
+    let f = |v: DVec3| Vec3::new(v.x as f32, v.y as f32, v.z as f32);
+    Some(AimedCamera { eye: f(pose.position), target: f(target), fovy_deg: TWO_SHOT_FOV as f32 })
 }
 
 /// The room-relative placement around the first character's `chest` (see [`camera_pose`]).
-fn room_pose(anim: &Animation, frame: usize, chest: Option<DVec3>) -> ([f32; 3], [f32; 3], f32) {
+fn room_pose(anim: &Animation, frame: usize, chest: Option<DVec3>) -> AimedCamera {
     let room = &anim.scene.room;
     let chest = chest.unwrap_or_else(|| DVec3::new(room.width as f64 / 2.0, 1.3, room.depth as f64 / 2.0));
     let t = [chest.x as f32, chest.y as f32, chest.z as f32];
@@ -449,8 +442,8 @@ fn room_pose(anim: &Animation, frame: usize, chest: Option<DVec3>) -> ([f32; 3],
         "wide" => ([if t[0] < w / 2.0 { w } else { 0.0 }, h - 0.1, d], 75.0),
         _ => ([t[0], eye_h, t[2] + 3.0], 50.0),
     };
-    let eye = [eye[0].clamp(0.0, w), eye[1].clamp(0.05, h), eye[2].clamp(0.0, d)];
-    (eye, t, fov)
+    let eye = Vec3::new(eye[0].clamp(0.0, w), eye[1].clamp(0.05, h), eye[2].clamp(0.0, d));
+    AimedCamera { eye, target: Vec3::from(t), fovy_deg: fov }
 }
 
 #[cfg(test)]
@@ -460,7 +453,6 @@ mod tests {
     use crate::motion::rig::{yaw, FPS};
     use crate::scene::{Room, Scene};
     use inbetween_core::clip::Clip;
-    use inbetween_core::toric::CameraPose;
 
     fn standing_at(rig: &Rig, x: f64, z: f64, heading: f64, frames: usize) -> Clip {
         let mut p = rig.standing();
@@ -494,13 +486,11 @@ mod tests {
         forward(&rig.skeleton, &anim.characters[c].clip.pose(f)).positions[rig.head]
     }
 
-    /// Screen positions of both heads for the returned (eye, target), in the two-shot lens.
+    /// Screen positions of both heads for the returned camera, in the two-shot lens.
     fn screen(anim: &Animation, f: usize) -> (DVec2, DVec2, DVec3) {
-        let (eye, target, fov) = camera_pose(anim, f);
-        let (eye, target) = (DVec3::from(eye.map(f64::from)), DVec3::from(target.map(f64::from)));
-        let pose = CameraPose::look_at(eye, target);
-        let lens = Lens { fovy: (fov as f64).to_radians(), aspect: TWO_SHOT_ASPECT };
-        (pose.project(&lens, head(anim, 0, f)).unwrap(), pose.project(&lens, head(anim, 1, f)).unwrap(), eye)
+        let cam = camera_pose(anim, f);
+        let posed = cam.posed(TWO_SHOT_ASPECT);
+        (posed.project(head(anim, 0, f)).unwrap(), posed.project(head(anim, 1, f)).unwrap(), cam.eye.as_dvec3())
     }
 
     #[test]
@@ -520,7 +510,8 @@ mod tests {
                 track.clip = Clip::from_poses(rig.skeleton.clone(), 1.0 / FPS, &poses).unwrap();
             }
             let track = camera_track(&anim);
-            assert_eq!(track.poses.len(), anim.frames());
+            assert_eq!(track.track.frames.len(), anim.frames());
+            assert_eq!((track.track.fps, track.track.first_frame), (anim.fps, 0));
             for f in 0..anim.frames() + 3 {
                 assert_eq!(track.pose(f), camera_pose(&anim, f), "{view}, frame {f}");
             }

@@ -52,7 +52,7 @@ pub(crate) mod routes;
 pub(crate) mod spots;
 
 pub use action::sit::GRIP_ABOVE;
-pub use camera::{camera_pose, camera_shots, camera_track, view_at, CameraTrack};
+pub use camera::{camera_pose, camera_shots, camera_track, view_at, ShotCameras};
 pub(crate) use character::{Actions, CharacterPlan};
 pub(crate) use context::Setup;
 pub use crowd::{min_clearance, Clearance};

@@ -10,6 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
+use inbetween_core::camera::AimedCamera;
 use inbetween_core::clip::Clip;
 use inbetween_io::gltf_buffer::json::animation::{Interpolation, Property};
 use inbetween_io::gltf_buffer::json::mesh::Semantic::{Normals, Positions};
@@ -23,8 +24,8 @@ use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::scene::Scene;
 
-/// Per-frame camera: `frame → (eye, target, vertical field of view in degrees)`, metres, Y up.
-pub type CameraFn<'a> = dyn Fn(usize) -> ([f32; 3], [f32; 3], f32) + 'a;
+/// Per-frame camera: `frame →` eye, target and vertical field of view, metres, Y up.
+pub type CameraFn<'a> = dyn Fn(usize) -> AimedCamera + 'a;
 
 /// Body colours of characters (sRGB), in order; repeats after six.
 pub const CHARACTER_COLORS: [[u8; 3]; 6] =
@@ -283,38 +284,38 @@ pub(crate) fn animated_document(
 
     // The camera.
     let n = animation_frames(&characters, fps);
-    let shots: Vec<([f32; 3], [f32; 3], f32)> = (0..n).map(camera).collect();
-    let yfov = shots[0].2;
-    if let Some(f) = shots.iter().position(|s| !(s.2.is_finite() && s.2 > 0.0 && s.2 < 180.0)) {
+    let shots: Vec<AimedCamera> = (0..n).map(camera).collect();
+    let yfov = shots[0].fovy_deg;
+    if let Some(f) = shots.iter().position(|s| !s.fov_is_valid()) {
         return Err(ScriptError::Invalid(format!(
             "camera field of view {}° at frame {f} must lie in (0, 180)",
-            shots[f].2
+            shots[f].fovy_deg
         )));
     }
-    if let Some(f) = shots.iter().position(|s| !(s.0.iter().chain(&s.1).all(|v| v.is_finite()))) {
+    if let Some(f) = shots.iter().position(|s| !s.is_finite()) {
         return Err(ScriptError::Invalid(format!("camera pose at frame {f} is not finite")));
     }
     let cam = d.push(perspective(Some("story camera".into()), yfov.to_radians(), None, 0.05, Some(200.0)));
-    let q0 = look_rotation(Vec3::from(shots[0].0), Vec3::from(shots[0].1));
+    let q0 = look_rotation(shots[0].eye, shots[0].target);
     let cam_node = d.push(Node {
         camera: Some(cam),
-        translation: Some(shots[0].0),
+        translation: Some(shots[0].eye.to_array()),
         rotation: Some(UnitQuaternion(q0.to_array())),
         ..node("camera")
     });
     roots.push(cam_node);
     let input = time_acc(&mut d, n, 1.0 / fps);
-    let pos: Vec<f32> = shots.iter().flat_map(|s| s.0).collect();
+    let pos: Vec<f32> = shots.iter().flat_map(|s| s.eye.to_array()).collect();
     let out = d.floats(&pos, Type::Vec3, false, None);
     anim.channel(input, out, cam_node, Property::Translation);
-    let rot = continuous_quats(shots.iter().map(|s| look_rotation(Vec3::from(s.0), Vec3::from(s.1))));
+    let rot = continuous_quats(shots.iter().map(|s| look_rotation(s.eye, s.target)));
     let out = d.floats(&rot, Type::Vec4, false, None);
     anim.channel(input, out, cam_node, Property::Rotation);
     let mut fov = None;
-    if shots.iter().any(|s| s.2 != yfov) {
+    if shots.iter().any(|s| s.fovy_deg != yfov) {
         // Core glTF cannot animate a camera's field of view: KHR_animation_pointer (used, not
         // required; viewers without it keep the frame-0 value) steps it at every change.
-        let v: Vec<f32> = shots.iter().map(|s| s.2.to_radians()).collect();
+        let v: Vec<f32> = shots.iter().map(|s| s.fovy_deg.to_radians()).collect();
         let out = d.floats(&v, Type::Scalar, false, None);
         let sampler = anim.sampler(input, out, Interpolation::Step);
         fov = Some((anim.channels.len(), sampler.value(), format!("/cameras/{}/perspective/yfov", cam.value())));

@@ -232,12 +232,12 @@ pub fn preview_frames(
     let (idx, gif_fps) = preview_frame_indices(characters, fps, opts);
     let mut cams = Vec::with_capacity(idx.len());
     for &f in &idx {
-        let (eye, target, fov) = camera(f);
-        let (eye, target) = (DVec3::from(eye.map(f64::from)), DVec3::from(target.map(f64::from)));
-        if !(eye.is_finite() && target.is_finite() && fov.is_finite() && fov > 0.0 && fov < 180.0) {
+        let c = camera(f);
+        if !(c.is_finite() && c.fov_is_valid()) {
             return Err(ScriptError::Invalid(format!("camera pose at frame {f} is not usable")));
         }
-        cams.push(Camera3::new(eye, target, DVec3::Y, fov as f64).with_viewport(w, h));
+        let (eye, target) = (c.eye.as_dvec3(), c.target.as_dvec3());
+        cams.push(Camera3::new(eye, target, DVec3::Y, c.fovy_deg as f64).with_viewport(w, h));
     }
     let figs: Vec<Figure> = characters
         .iter()

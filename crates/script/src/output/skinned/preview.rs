@@ -36,9 +36,9 @@ impl Paint {
 /// to near; characters without a body are left out. A check of the skin, not a renderer.
 pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) -> RgbImage {
     let SkinnedCast { scene, cat, characters, bodies, camera, fps } = *cast;
-    let (eye, target, fov) = camera(frame);
-    let cam = Camera3::new(Vec3::from(eye).as_dvec3(), Vec3::from(target).as_dvec3(), DVec3::Y, fov as f64)
-        .with_viewport(size.0, size.1);
+    let c = camera(frame);
+    let cam =
+        Camera3::new(c.eye.as_dvec3(), c.target.as_dvec3(), DVec3::Y, c.fovy_deg as f64).with_viewport(size.0, size.1);
     let mut cv = Canvas::new(size.0, size.1, [246, 247, 250]);
     draw_room(&mut cv, &cam, scene);
     let light = Vec3::new(0.4, 1.0, 0.6).normalize();
