@@ -11,13 +11,13 @@ use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::plan::{
-    keeps_live_link, span_seconds, viseme_runs, EditResources, MethodChoice, SPEECH_GROUPS,
+    keeps_live_link, span_seconds, EditResources, GuideSource, LoadedGuide, MethodChoice, SPEECH_GROUPS,
 };
-use inbetween_face::infer::{read_keys, EditJob, EditLimits, Guide};
+use inbetween_face::infer::{EditJob, EditLimits};
 use inbetween_face::preview::{write_outcome_gif, write_outcome_png};
 use inbetween_face::procedural;
 use inbetween_face::train::{TrainData, TrainJob};
-use inbetween_face::visemes::{read_viseme_source, text_to_phonemes, PhonemeSpan};
+use inbetween_face::visemes::PhonemeSpan;
 use inbetween_io::fsutil::with_stem_suffix;
 use inbetween_io::report::BenchOptions;
 use inbetween_io::{OutputSet, Progress};
@@ -237,26 +237,21 @@ pub fn run(c: FaceCommand) -> anyhow::Result<()> {
     }
 }
 
-fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow::Result<Guide> {
-    Ok(if let Some(k) = &a.keys {
-        Guide::Keys(read_keys(k)?)
-    } else if let Some(g) = &a.guide {
-        Guide::Noisy(read_clip_limited(g, a.max_rows)?)
-    } else if let Some(v) = &a.visemes {
-        Guide::Visemes(viseme_runs(&read_viseme_source(v, a.tier.as_deref())?)?)
-    } else if let Some(text) = &a.text {
-        let (s, e) = match &a.text_span {
-            Some(t) => span_seconds(t, clip)?,
-            None => spans[0],
-        };
-        let ph = text_to_phonemes(text, s, e)?;
-        if !ph.guessed_words.is_empty() {
-            eprintln!("note: not in CMUdict, pronounced by our letter-to-sound rules: {}", ph.guessed_words.join(", "));
+fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow::Result<LoadedGuide> {
+    let source = match (&a.keys, &a.guide, &a.visemes, &a.text) {
+        (Some(k), ..) => GuideSource::KeysFile(k),
+        (_, Some(g), ..) => GuideSource::TakeFile(g),
+        (_, _, Some(v), _) => GuideSource::VisemesFile(v, a.tier.as_deref()),
+        (_, _, _, Some(text)) => {
+            GuideSource::Text(text, a.text_span.as_ref().map_or(Ok(spans[0]), |t| span_seconds(t, clip))?)
         }
-        Guide::Visemes(viseme_runs(&ph.spans)?)
-    } else {
-        Guide::None
-    })
+        _ => GuideSource::None,
+    };
+    let loaded = source.load(a.max_rows)?;
+    if !loaded.guessed_words.is_empty() {
+        eprintln!("note: not in CMUdict, pronounced by our letter-to-sound rules: {}", loaded.guessed_words.join(", "));
+    }
+    Ok(loaded)
 }
 
 fn run_edit(a: EditArgs) -> anyhow::Result<()> {
@@ -265,7 +260,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let clip = read_clip_limited(&a.input, limits.max_rows)?;
     let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<Result<Vec<_>, _>>()?;
     let channels = a.groups.as_deref().map(parse_groups).transpose().map_err(anyhow::Error::msg)?;
-    let guide = guide_of(&a, &clip, &spans)?;
+    let LoadedGuide { guide, file: guide_file, .. } = guide_of(&a, &clip, &spans)?;
     let speech = SPEECH_GROUPS.map(|g| g.name()).join(", ");
     // Said once the edit is written (an error stays the only line of a failed run).
     let groups_note = (guide.kind() == ConstraintKind::Visemes).then(|| match &a.groups {
@@ -278,7 +273,6 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     }
     res.load_library(&a.library, channels.is_some(), limits.max_rows)?;
     let method = res.method(a.variants as usize)?;
-    let guide_file = [&a.keys, &a.guide, &a.visemes].into_iter().flatten().next().map(|p| p.display().to_string());
     let mut job = EditJob {
         clip: &clip,
         spans: spans.clone(),

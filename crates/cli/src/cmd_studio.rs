@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
+use inbetween_io::report::BenchOptions;
 use inbetween_studio::StudioConfig;
 
 #[derive(Args)]
@@ -51,8 +52,10 @@ pub struct BenchArgs {
 pub fn run(a: StudioArgs) -> anyhow::Result<()> {
     match a.command {
         Some(StudioCommand::Bench(b)) => {
-            let report = inbetween_studio::bench::run(&b.output, b.repeats).context("studio bench")?;
-            println!("{report}");
+            let engine = inbetween_studio::bench::StudioBench { repeats: b.repeats };
+            let opts = BenchOptions { out: Some(b.output), ..BenchOptions::new(engine) };
+            let done = crate::bench::run("studio bench", opts, inbetween_studio::bench::run).context("studio bench")?;
+            println!("{}", done.report.to_text());
             Ok(())
         }
         None => serve(a),

@@ -8,9 +8,7 @@
 //! once its analysis is cached (goal < 1 s). Camera: a key dragged, four styles regenerated and drawn (goal
 //! < 100 ms).
 
-use std::path::Path;
-
-use inbetween_io::report::{num, Report, Table};
+use inbetween_io::report::{num, BenchOptions, Report, Table};
 use serde_json::Value;
 
 use crate::browser::{available, tree_rss_bytes, Browser};
@@ -96,10 +94,18 @@ fn own_rss_bytes() -> Option<u64> {
     s.split_whitespace().nth(1)?.parse::<u64>().ok().map(|pages| pages * 4096)
 }
 
-/// Runs the bench, writes `studio-bench.{txt,md}`, the CSV and the screenshots into `out`, and
-/// returns the text table.
-pub fn run(out: &Path, repeats: usize) -> Result<String> {
-    let repeats = repeats.max(1);
+/// The studio bench's own options (beside [`BenchOptions`], whose `data` is the root the video
+/// panel's clip comes from; None: the shared data when present).
+#[derive(Clone, Debug)]
+pub struct StudioBench {
+    /// Runs of each timed action (the table gives the median).
+    pub repeats: usize,
+}
+
+/// Runs the bench: its report holds the tables (`studio-bench.{txt,md}`, the CSV) and the
+/// screenshots of the panels.
+pub fn run(opts: &BenchOptions<StudioBench>) -> Result<Report> {
+    let repeats = opts.engine.repeats.max(1);
     let (chromium, driver) = available().map_err(|why| {
         StudioError::Browser(format!("{why}: install the Debian packages chromium and chromium-driver"))
     })?;
@@ -107,7 +113,7 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
         return Err(StudioError::Browser(format!("the studio was built without three.js: {why}")));
     }
     // The shared data (when present) gives the video panel its real 132-frame clip.
-    let data = inbetween_io::shared_data_dir().ok();
+    let data = opts.data.clone().or_else(|| inbetween_io::shared_data_dir().ok());
     let studio = Studio::start(StudioConfig { port: 0, root: data.clone(), ..StudioConfig::default() })?;
     let b = Browser::launch(&chromium, &driver, VIEW.0, VIEW.1)?;
     let mut t = Table::new(
@@ -307,6 +313,5 @@ pub fn run(out: &Path, repeats: usize) -> Result<String> {
         .file("face.png", face_png)
         .file("video.png", video_png)
         .file("camera.png", camera_png);
-    report.write(out)?;
-    Ok(report.to_text())
+    Ok(report)
 }
