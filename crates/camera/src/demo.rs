@@ -9,6 +9,9 @@ use crate::CameraError;
 use inbetween_io::Progress;
 use std::path::Path;
 
+/// Frames of `camera scene`'s example (15 s at 30 fps).
+pub const EXAMPLE_SCENE_FRAMES: usize = 450;
+
 /// Writes `scene.json`, `keys.json` (keys at the start, middle and end) and one
 /// `reference-<behaviour>.json` filmed clip per behaviour into `dir`: everything `camera generate`
 /// needs to try each style. Returns the files written.

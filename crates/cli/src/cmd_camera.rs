@@ -110,7 +110,7 @@ pub struct SceneArgs {
     pub out: PathBuf,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    #[arg(long, default_value_t = 450)]
+    #[arg(long, default_value_t = inbetween_camera::demo::EXAMPLE_SCENE_FRAMES)]
     pub frames: usize,
     /// Most frames a scene may hold (the generate job's limit).
     #[arg(long, default_value_t = GenerateLimits::default().max_frames)]

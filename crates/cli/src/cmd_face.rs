@@ -218,7 +218,7 @@ pub struct BenchArgs {
 pub struct SynthArgs {
     #[arg(short, long)]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = procedural::ProceduralConfig::default().duration_s)]
     pub seconds: f64,
     /// Write Live Link Face CSV (else curve CSV/JSON by extension).
     #[arg(long)]

@@ -16,7 +16,7 @@ use inbetween_mocap::dqn::{TrainJob, TrainOptions, DEFAULT_POLICY_PATH};
 use inbetween_mocap::protocol::TrainingData;
 use inbetween_mocap::representation::{skip_first_frame, JointFilter};
 use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
-use inbetween_mocap::stream::RecvOptions;
+use inbetween_mocap::stream::{RecvOptions, SendOptions, DEFAULT_ADDR};
 use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -84,7 +84,7 @@ pub struct TrainArgs {
     /// Stride of the training windows (overlapping windows give more training data).
     #[arg(long, default_value_t = TrainJob::default().stride)]
     pub stride: usize,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = TrainOptions::default().seed)]
     pub seed: u64,
     /// Stop after the epoch during which this many minutes have passed (per stage); run the same
     /// command again to resume (training state is checkpointed in `<output>.ckpt/`).
@@ -103,19 +103,19 @@ pub enum StreamCommand {
 #[derive(Args)]
 pub struct SendArgs {
     pub input: PathBuf,
-    #[arg(long, default_value = "127.0.0.1:7878")]
+    #[arg(long, default_value = DEFAULT_ADDR)]
     pub addr: String,
     #[arg(long, default_value = "1cm")]
     pub max_error: String,
     /// Look-ahead window in frames (bounds the added latency).
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = SendOptions::default().lookahead)]
     pub lookahead: usize,
     /// Send as fast as possible instead of at the clip's frame rate.
     #[arg(long)]
     pub fast: bool,
     #[arg(long)]
     pub skip_first: bool,
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = SendOptions::default().retries)]
     pub retries: usize,
     /// Length unit of the clip: cm, m, mm, in, cmu (CMU mocap units, 5.6444 cm) or cm per unit
     /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (the report says which and why).
@@ -125,7 +125,7 @@ pub struct SendArgs {
 
 #[derive(Args)]
 pub struct RecvArgs {
-    #[arg(long, default_value = "127.0.0.1:7878")]
+    #[arg(long, default_value = DEFAULT_ADDR)]
     pub addr: String,
     #[arg(short, long)]
     pub output: PathBuf,
@@ -265,7 +265,7 @@ pub struct BenchArgs {
     /// Window stride in frames (60 = non-overlapping windows, as in the paper).
     #[arg(long, default_value_t = Protocol::paper().stride)]
     pub stride: usize,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = Protocol::paper().seed)]
     pub seed: u64,
     /// A SIDQL policy written by `mocap train`. Default: the committed policy (trained on every
     /// CMU take of the corpus), unless --train-episodes is given.
@@ -457,7 +457,7 @@ fn train_cmd(a: TrainArgs) -> anyhow::Result<()> {
 
 fn stream_send(a: SendArgs) -> anyhow::Result<()> {
     let m = load(&a.input, a.skip_first)?;
-    let opts = inbetween_mocap::stream::SendOptions {
+    let opts = SendOptions {
         max_cm: codec::parse_length_cm(&a.max_error)?,
         lookahead: a.lookahead,
         realtime: !a.fast,

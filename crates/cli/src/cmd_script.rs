@@ -149,7 +149,7 @@ pub struct StoriesArgs {
 pub struct BenchArgs {
     #[arg(short, long, default_value = "out/script-bench")]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = inbetween_script::bench::BenchConfig::default().seed)]
     pub seed: u64,
     /// Fewer timing repetitions (seconds).
     #[arg(long)]

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use inbetween_io::report::BenchOptions;
+use inbetween_studio::bench::StudioBench;
 use inbetween_studio::StudioConfig;
 
 #[derive(Args)]
@@ -13,7 +14,7 @@ pub struct StudioArgs {
     #[command(subcommand)]
     pub command: Option<StudioCommand>,
     /// TCP port (0 picks a free one).
-    #[arg(long, default_value_t = 7878)]
+    #[arg(long, default_value_t = StudioConfig::default().port)]
     pub port: u16,
     /// Address to listen on. Default 127.0.0.1 (this machine only); another address exposes the
     /// studio to the network.
@@ -45,14 +46,14 @@ pub struct BenchArgs {
     #[arg(short, long, default_value = "crates/studio/bench")]
     pub output: PathBuf,
     /// Repeats of each timed action (the table gives the median).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = StudioBench::default().repeats)]
     pub repeats: usize,
 }
 
 pub fn run(a: StudioArgs) -> anyhow::Result<()> {
     match a.command {
         Some(StudioCommand::Bench(b)) => {
-            let engine = inbetween_studio::bench::StudioBench { repeats: b.repeats };
+            let engine = StudioBench { repeats: b.repeats };
             let opts = BenchOptions { out: Some(b.output), ..BenchOptions::new(engine) };
             let done = crate::bench::run("studio bench", opts, inbetween_studio::bench::run).context("studio bench")?;
             println!("{}", done.report.to_text());

@@ -113,6 +113,9 @@ fn key_payload(skeleton: &Skeleton, frame: usize, key: &KeyPose) -> Vec<u8> {
     p
 }
 
+/// Where `mocap stream` sends to and listens on by default.
+pub const DEFAULT_ADDR: &str = "127.0.0.1:7878";
+
 /// Sender settings.
 #[derive(Clone, Debug)]
 pub struct SendOptions {
@@ -124,6 +127,14 @@ pub struct SendOptions {
     pub retries: usize,
     /// The clip's length unit; `None` infers it from the skeleton.
     pub unit: Option<LengthUnit>,
+}
+
+impl Default for SendOptions {
+    /// Keys within 1 cm, a look-ahead of 15 frames (half a second at 30 fps), paced in real time,
+    /// 10 reconnection attempts, the unit inferred.
+    fn default() -> SendOptions {
+        SendOptions { max_cm: 1.0, lookahead: 15, realtime: true, retries: 10, unit: None }
+    }
 }
 
 /// What a sender did.

@@ -102,6 +102,13 @@ pub struct StudioBench {
     pub repeats: usize,
 }
 
+impl Default for StudioBench {
+    /// 5 runs of each timed action.
+    fn default() -> StudioBench {
+        StudioBench { repeats: 5 }
+    }
+}
+
 /// Runs the bench: its report holds the tables (`studio-bench.{txt,md}`, the CSV) and the
 /// screenshots of the panels.
 pub fn run(opts: &BenchOptions<StudioBench>) -> Result<Report> {
