@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use inbetween_core::cancel::Cancel;
 use inbetween_io::report::BenchOptions;
@@ -332,23 +331,15 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    use inbetween_video::demo::{FRAMES, START};
-    // The demo's clip (48 frames of 192×108 at 1×, from frame 6), k times as long, written by
-    // `video synth` (not timed); a scale over the frame limit is refused and the table says so.
+    use inbetween_video::demo::{scaled_clip, HEIGHT, START, WIDTH};
+    // The demo's clip k times as long (not timed); a scale over the frame limit is refused and the
+    // table says so.
     crate::scale::run(&a, "video", "video resequence at multiples of the demo's procedural clip", |k, exe, work| {
-        let frames = FRAMES * k;
-        let clip = work.join(format!("clip-{k}.gif"));
-        let synth = std::process::Command::new(exe)
-            .args(["video", "synth", "--kind", "mixed", "--width", "192", "--height", "108", "--frames"])
-            .arg(frames.to_string())
-            .arg("-o")
-            .arg(&clip)
-            .output()
-            .context("running video synth")?;
-        anyhow::ensure!(synth.status.success(), "video synth: {}", String::from_utf8_lossy(&synth.stderr));
+        let (clip, path) = (scaled_clip(k), work.join(format!("clip-{k}.gif")));
+        write_clip(&path, &clip)?;
         let mut command = std::process::Command::new(exe);
-        command.args(["video".as_ref(), "resequence".as_ref(), clip.as_os_str(), "--start".as_ref()]);
+        command.args(["video".as_ref(), "resequence".as_ref(), path.as_os_str(), "--start".as_ref()]);
         command.arg(START.to_string()).arg("-o").arg(work.join(format!("new-{k}.gif")));
-        Ok(crate::scale::Measured { input: format!("{frames} frames of 192×108 px"), command })
+        Ok(crate::scale::Measured { input: format!("{} frames of {WIDTH}×{HEIGHT} px", clip.len()), command })
     })
 }

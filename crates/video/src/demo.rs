@@ -30,6 +30,14 @@ pub struct VideoDemo {
 /// Frames of the demo clip and its start frame.
 pub const FRAMES: usize = 48;
 pub const START: usize = 6;
+/// The demo clip's frame size, pixels.
+pub const WIDTH: u32 = 192;
+pub const HEIGHT: u32 = 108;
+
+/// The demo's procedural clip (seed 1) at `k`× its frames: what `video scale` resequences.
+pub fn scaled_clip(k: usize) -> crate::frames::Clip {
+    procedural_clip(ProceduralKind::Mixed, FRAMES * k, WIDTH, HEIGHT, 1)
+}
 
 impl std::fmt::Display for VideoDemo {
     /// The demo's line: the new order's length, M_D beside the source's, Δo and the files.
@@ -49,7 +57,7 @@ impl std::fmt::Display for VideoDemo {
 
 /// Run the demo into `dir` (`video-demo-source.gif`, `video-demo.gif`, `video-demo.sheet.png`).
 pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<VideoDemo, VideoError> {
-    let clip = procedural_clip(ProceduralKind::Mixed, FRAMES, 192, 108, seed);
+    let clip = procedural_clip(ProceduralKind::Mixed, FRAMES, WIDTH, HEIGHT, seed);
     // A short training run keeps the demo quick; `inbetween video resequence` trains longer.
     let cfg = ResequenceConfig {
         train: TrainOptions { steps: 40, seed, ..TrainOptions::default() },
@@ -86,4 +94,15 @@ pub fn run(dir: &Path, seed: u64, progress: &Progress) -> Result<VideoDemo, Vide
     let md = (sequence.md, report.analysis.source_md);
     let delta_o = sequence.delta_o;
     Ok(VideoDemo { files: vec![source_gif, gif, sheet], order, md, delta_o })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_scaled_clip_is_the_demo_clip_k_times_as_long() {
+        let c = scaled_clip(3);
+        assert_eq!((c.len(), c.width(), c.height()), (3 * FRAMES, WIDTH, HEIGHT));
+    }
 }
