@@ -1,26 +1,24 @@
 //! `inbetween face …`: edit blendshape animation by inpainting, train the networks, benchmark.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
 
 use inbetween_core::cancel::Cancel;
 use inbetween_face::bench;
-use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip, MODEL_FPS};
+use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::ConstraintKind;
+use inbetween_face::infer::files::{write_variants, EditFiles};
 use inbetween_face::infer::plan::{
-    keeps_live_link, span_seconds, EditResources, GuideSource, LoadedGuide, MethodChoice, SPEECH_GROUPS,
+    keeps_live_link, span_seconds, visemes_groups_note, EditResources, GuideSource, LoadedGuide, MethodChoice,
 };
 use inbetween_face::infer::{EditJob, EditLimits};
-use inbetween_face::preview::{write_outcome_gif, write_outcome_png};
 use inbetween_face::procedural;
 use inbetween_face::train::{TrainData, TrainJob};
-use inbetween_face::visemes::PhonemeSpan;
-use inbetween_io::fsutil::with_stem_suffix;
 use inbetween_io::report::BenchOptions;
-use inbetween_io::{OutputSet, Progress};
+use inbetween_io::Progress;
 
 use crate::errors;
 use crate::scale::ScaleArgs;
@@ -248,8 +246,8 @@ fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow
         _ => GuideSource::None,
     };
     let loaded = source.load(a.max_rows)?;
-    if !loaded.guessed_words.is_empty() {
-        eprintln!("note: not in CMUdict, pronounced by our letter-to-sound rules: {}", loaded.guessed_words.join(", "));
+    if let Some(note) = loaded.guessed_note() {
+        eprintln!("note: {note}");
     }
     Ok(loaded)
 }
@@ -261,101 +259,29 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<Result<Vec<_>, _>>()?;
     let channels = a.groups.as_deref().map(parse_groups).transpose().map_err(anyhow::Error::msg)?;
     let LoadedGuide { guide, file: guide_file, .. } = guide_of(&a, &clip, &spans)?;
-    let speech = SPEECH_GROUPS.map(|g| g.name()).join(", ");
     // Said once the edit is written (an error stays the only line of a failed run).
-    let groups_note = (guide.kind() == ConstraintKind::Visemes).then(|| match &a.groups {
-        Some(g) => format!("note: --groups {g}: the visemes guide these groups (default: {speech}; the rest unguided)"),
-        None => format!("note: the visemes guide {speech}; eyes and brows are filled unguided (--groups overrides)"),
-    });
+    let groups_note = (guide.kind() == ConstraintKind::Visemes)
+        .then(|| format!("note: {}", visemes_groups_note(a.groups.as_deref(), "--groups", "--groups")));
     let mut res = EditResources::load_network(a.method.choice(), guide.kind(), a.weights.as_deref())?;
     if !a.library.is_empty() && !matches!(res.chosen, MethodChoice::Retrieval) {
         bail!("--library is read only by --method retrieval (with --keys or --visemes, auto picks the network)");
     }
     res.load_library(&a.library, channels.is_some(), limits.max_rows)?;
     let method = res.method(a.variants as usize)?;
-    let mut job = EditJob {
-        clip: &clip,
-        spans: spans.clone(),
-        channels,
-        guide,
-        method,
-        seed: a.seed,
-        limits,
-        cancel: cancel.clone(),
-        guide_file,
-        library: res.library.as_ref(),
+    let library = res.library.as_ref();
+    let mut job =
+        EditJob { clip: &clip, spans, channels, guide, method, seed: a.seed, limits, cancel, guide_file, library };
+    let files = EditFiles {
+        live_link: keeps_live_link(&a.input, &a.out),
+        input: a.input,
+        out: a.out,
+        png: a.png,
+        gif: a.gif,
+        variants: a.variants,
     };
-    let live_link = keeps_live_link(&a.input, &a.out);
-    // Every variant's clip, PNG and GIF appear together or not at all.
-    let mut set = OutputSet::new();
-    let mut first: Option<inbetween_face::infer::EditOutcome> = None;
-    let mut spreads = Vec::new();
-    for k in 1..=a.variants {
-        job.seed = a.seed + u64::from(k - 1);
-        let named = |p: &Path| if a.variants == 1 { p.to_path_buf() } else { with_stem_suffix(p, &k.to_string()) };
-        let (out, ms) = edit_once(&a, &job, &mut set, live_link, &named)?;
-        println!(
-            "edited {} span(s) of {} ({} frames at {:.3} fps) with {} (seed {}) in {ms:.1} ms -> {}",
-            spans.len(),
-            a.input.display(),
-            clip.num_frames(),
-            clip.measured_fps(),
-            job.method.name(),
-            job.seed,
-            named(&a.out).display(),
-        );
-        match &first {
-            None => first = Some(out),
-            Some(f) => spreads.push(out.mean_abs_difference(f)),
-        }
-    }
-    set.commit().context("moving the edit's outputs into place")?;
-    if let Some(note) = groups_note {
-        println!("{note}");
-    }
-    if !spreads.is_empty() {
-        let list: Vec<String> = spreads.iter().map(|d| format!("{d:.4}")).collect();
-        println!(
-            "variants 2..{}: mean |difference| from variant 1 inside the spans (blendshape weight, 0..1): {}",
-            a.variants,
-            list.join(", ")
-        );
-    }
+    let written = write_variants(&mut job, &files)?;
+    written.lines.iter().chain(&groups_note).chain(&written.spreads_line()).for_each(|l| println!("{l}"));
     Ok(())
-}
-
-/// One edit: runs the job, stages its clip, PNG and (with --gif) GIF under `named` paths.
-fn edit_once(
-    a: &EditArgs,
-    job: &EditJob,
-    set: &mut OutputSet,
-    live_link: bool,
-    named: &dyn Fn(&Path) -> PathBuf,
-) -> anyhow::Result<(inbetween_face::infer::EditOutcome, f64)> {
-    let cancel = &job.cancel;
-    let method = job.method;
-    let t = std::time::Instant::now();
-    let out = job.run()?;
-    let ms = t.elapsed().as_secs_f64() * 1000.0;
-    let staged = |set: &mut OutputSet, p: &Path| set.file(p).with_context(|| format!("preparing {}", p.display()));
-    let out_path = named(&a.out);
-    write_clip(&staged(set, &out_path)?, &out.clip, live_link)?;
-    let png = named(&a.png.clone().unwrap_or_else(|| a.out.with_extension("png")));
-    let title = format!("{} · {} · {}", a.input.display(), method.name(), job.guide.kind().name());
-    write_outcome_png(&staged(set, &png)?, &out, &title).with_context(|| format!("writing {}", png.display()))?;
-    cancel.check()?;
-    if let Some(gif) = a.gif.as_deref().map(named) {
-        let progress = Progress::new(0, "face gif");
-        write_outcome_gif(&staged(set, &gif)?, &out, &progress)
-            .with_context(|| format!("writing {}", gif.display()))?;
-        progress.finish();
-        cancel.check()?;
-    }
-    if let Some(gif) = a.gif.as_deref().map(named) {
-        println!("  preview {}", gif.display());
-    }
-    println!("  curves {}", png.display());
-    Ok((out, ms))
 }
 
 fn run_train(a: TrainArgs) -> anyhow::Result<()> {
@@ -391,19 +317,7 @@ fn run_bench(a: BenchArgs) -> anyhow::Result<()> {
 
 fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
     let p = procedural::generate(&procedural::ProceduralConfig { duration_s: a.seconds, ..Default::default() }, a.seed);
-    let mut set = OutputSet::new();
-    write_clip(&set.file(&a.out)?, &p.clip, a.live_link)?;
-    let spans: Vec<PhonemeSpan> =
-        p.phonemes.iter().map(|(s, e, ph)| PhonemeSpan { start_s: *s, end_s: *e, phoneme: ph.to_string() }).collect();
-    let timing = a.out.with_extension("phonemes.csv");
-    inbetween_face::visemes::write_phoneme_timing(&set.file(&timing)?, &spans)?;
-    set.commit().with_context(|| format!("moving {} and {} into place", a.out.display(), timing.display()))?;
-    println!(
-        "wrote {} ({} frames at {MODEL_FPS} fps) and its phoneme timing {}",
-        a.out.display(),
-        p.clip.num_frames(),
-        timing.display()
-    );
+    println!("{}", p.write(&a.out, a.live_link)?);
     Ok(())
 }
 

@@ -4,7 +4,7 @@ use anyhow::Context;
 use clap::Args;
 use inbetween_core::roles::RoleOverrides;
 use inbetween_core::units::{LengthUnit, UnitChoice};
-use inbetween_core::Motion;
+use inbetween_io::convert::ConvertJob;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -45,16 +45,8 @@ pub struct ConvertArgs {
     pub end: Option<usize>,
 }
 
-fn load(file: &Path, asf: Option<&Path>) -> anyhow::Result<Motion> {
-    let motion = match asf {
-        Some(asf) => inbetween_io::read_asf_amc(asf, file)?,
-        None => inbetween_io::load_motion(file)?,
-    };
-    Ok(motion)
-}
-
 pub fn info(a: InfoArgs) -> anyhow::Result<()> {
-    let m = load(&a.file, a.asf.as_deref())?;
+    let m = inbetween_io::convert::load_motion_with(&a.file, a.asf.as_deref())?;
     let unit = UnitChoice::resolve(a.unit, &m.skeleton);
     let text = inbetween_io::info::describe_motion(&a.file, &m, &unit, &read_roles(a.roles.as_deref())?);
     print_tolerating_closed_pipe(&crate::errors::with_flags(&text))
@@ -79,25 +71,7 @@ fn print_tolerating_closed_pipe(text: &str) -> anyhow::Result<()> {
 }
 
 pub fn convert(a: ConvertArgs) -> anyhow::Result<()> {
-    let mut m = load(&a.input, a.asf.as_deref())?;
-    let n = m.num_frames();
-    if a.start.is_some() || a.end.is_some() {
-        let (start, end) = (a.start.unwrap_or(0), a.end.unwrap_or(n));
-        m = m.crop(start, end).with_context(|| format!("cropping {}", a.input.display()))?;
-    }
-    if let Some(fps) = a.fps {
-        m = m.resample(fps).with_context(|| format!("resampling to {fps} fps"))?;
-    }
-    inbetween_io::write_bvh(&a.output, &m)?;
-    println!(
-        "wrote {}: {} joints, {} channels, {} frames at {:.3} fps ({:.3} s) from {} input frames",
-        a.output.display(),
-        m.skeleton.len(),
-        m.num_channels(),
-        m.num_frames(),
-        m.fps(),
-        m.duration(),
-        n
-    );
+    let job = ConvertJob { input: a.input, asf: a.asf, output: a.output, start: a.start, end: a.end, fps: a.fps };
+    println!("{}", job.run()?);
     Ok(())
 }

@@ -17,7 +17,7 @@ use inbetween_mocap::protocol::TrainingData;
 use inbetween_mocap::representation::{skip_first_frame, JointFilter};
 use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
 use inbetween_mocap::stream::{RecvOptions, SendOptions, DEFAULT_ADDR};
-use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport};
+use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport, PreviewJob, Rebuilt};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -189,8 +189,10 @@ impl BudgetArgs {
         Ok(JointFilter::parse(&self.joints).apply(&m))
     }
 
-    fn max_gap(&self, m: &Motion) -> usize {
-        max_gap_frames(self.max_gap_s, m.frame_time)
+    /// The compression these flags ask for (the version the budget picks, the default segments).
+    fn job(&self, m: &Motion) -> anyhow::Result<CompressJob> {
+        let (max_gap, unit) = (max_gap_frames(self.max_gap_s, m.frame_time), self.unit(m));
+        Ok(CompressJob { max_gap, unit, ..CompressJob::for_motion(m, self.budget()?) })
     }
 }
 
@@ -313,13 +315,9 @@ pub fn run(c: MocapCommand) -> anyhow::Result<()> {
 
 fn compress(a: CompressArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
-    let job = CompressJob {
-        budget: a.budget.budget()?,
-        version: a.format.as_deref().map(Version::parse).transpose()?,
-        segment_len: a.segment,
-        max_gap: a.budget.max_gap(&m),
-        unit: a.budget.unit(&m),
-    };
+    let job = a.budget.job(&m)?;
+    let job =
+        CompressJob { version: a.format.as_deref().map(Version::parse).transpose()?, segment_len: a.segment, ..job };
     job.validate()?;
     let t = Instant::now();
     let report = job.run(&m).with_context(|| format!("compressing {}", a.input.display()))?;
@@ -349,32 +347,11 @@ fn preview(a: PreviewArgs) -> anyhow::Result<()> {
     let m = a.budget.load(&a.input)?;
     let unit = a.budget.unit(&m);
     println!("{unit}");
-    let d = match &a.ibk {
-        Some(p) => {
-            let d = decompress_file(p)?;
-            if *d.file.skeleton() != m.skeleton || d.frames != m.num_frames() {
-                bail!(
-                    "{} does not match {} (skeleton or frame count differ; use the same --joints/--skip-first)",
-                    p.display(),
-                    a.input.display()
-                );
-            }
-            d
-        }
-        None => {
-            // Keys only (version 2), as the preview shows them.
-            let job = CompressJob {
-                budget: a.budget.budget()?,
-                version: Some(Version::V2),
-                segment_len: None,
-                max_gap: a.budget.max_gap(&m),
-                unit: unit.clone(),
-            };
-            DecompressJob.run(job.run(&m)?.bytes(), &Cancel::new(), &Progress::hidden())?
-        }
+    let rebuilt = match &a.ibk {
+        Some(p) => Rebuilt::File(p, Box::new(decompress_file(p)?)),
+        None => Rebuilt::Keys(a.budget.job(&m)?),
     };
-    let e = d.preview_gif(&m, &unit, &a.output)?;
-    println!("{} keys; mean {:.3} cm, max {:.3} cm; wrote {}", d.stored_poses, e.mean_cm, e.max_cm, a.output.display());
+    println!("{}", PreviewJob { original: &m, name: &a.input, unit, rebuilt, out: &a.output }.run()?);
     Ok(())
 }
 

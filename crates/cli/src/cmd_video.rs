@@ -6,7 +6,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use inbetween_core::cancel::Cancel;
 use inbetween_io::report::BenchOptions;
 use inbetween_io::Progress;
-use inbetween_video::frames::{procedural_clip, write_clip, Decoder, ProceduralKind, ReadOptions};
+use inbetween_video::frames::{write_clip, Decoder, ProceduralKind, ReadOptions, SynthJob};
 use inbetween_video::job::{AnalyseJob, ResequenceJob, ResequenceSource, VideoInput};
 use inbetween_video::pipeline::{MetricChoice, ResequenceConfig, VideoLimits};
 use inbetween_video::sdpf::SdpfParams;
@@ -165,13 +165,13 @@ pub struct SynthArgs {
     pub out: PathBuf,
     #[arg(long, value_enum, default_value = "mixed")]
     pub kind: KindArg,
-    #[arg(long, default_value_t = 96)]
+    #[arg(long, default_value_t = SynthJob::default().frames)]
     pub frames: usize,
-    #[arg(long, default_value_t = 320)]
+    #[arg(long, default_value_t = SynthJob::default().width)]
     pub width: u32,
-    #[arg(long, default_value_t = 180)]
+    #[arg(long, default_value_t = SynthJob::default().height)]
     pub height: u32,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = SynthJob::default().seed)]
     pub seed: u64,
 }
 
@@ -226,25 +226,13 @@ fn kind(k: KindArg) -> ProceduralKind {
 }
 
 fn run_synth(a: SynthArgs) -> anyhow::Result<()> {
-    let clip = procedural_clip(kind(a.kind), a.frames, a.width, a.height, a.seed);
-    write_clip(&a.out, &clip)?;
-    println!("wrote {} ({} frames, {}x{}, {} fps)", a.out.display(), clip.len(), clip.width(), clip.height(), clip.fps);
+    let job = SynthJob { kind: kind(a.kind), frames: a.frames, width: a.width, height: a.height, seed: a.seed };
+    println!("{}", job.write(&a.out)?);
     Ok(())
 }
 
 fn run_probe(a: ProbeArgs) -> anyhow::Result<()> {
-    let p = inbetween_video::frames::probe_openh264(&a.input)?;
-    println!(
-        "{}: H.264 profile {}, B-frames {}, {} samples, openh264 decoded {} pictures",
-        a.input.display(),
-        p.profile,
-        if p.has_b_frames { "yes (ctts box)" } else { "no" },
-        p.samples.len(),
-        p.frames()
-    );
-    for (i, s) in p.samples.iter().enumerate() {
-        println!("  sample {i}: {s:?}");
-    }
+    println!("{}: {}", a.input.display(), inbetween_video::frames::probe_openh264(&a.input)?);
     Ok(())
 }
 

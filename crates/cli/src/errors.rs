@@ -39,6 +39,8 @@ pub const OPTION_FLAGS: &[(&str, &str)] = &[
     ("roles", "--roles"),
     ("frame", "--frame"),
     ("starts", "--starts"),
+    ("joints", "--joints"),
+    ("skip_first", "--skip-first"),
 ];
 
 /// Library text with each `` `field` `` of [`OPTION_FLAGS`] written as its flag (other text,

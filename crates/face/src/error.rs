@@ -61,6 +61,13 @@ pub enum FaceError {
     /// The job's cancel token stopped it (cancelled, or its time limit passed).
     #[error("face job stopped: {0}")]
     Cancelled(#[from] inbetween_core::cancel::Cancelled),
+    /// Staging, writing or moving an output into place failed (`what`: the step and the file).
+    #[error("{what}")]
+    Output {
+        what: String,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 impl FaceError {

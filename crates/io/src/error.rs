@@ -18,6 +18,13 @@ pub enum IoError {
     /// The text parses but describes an invalid skeleton or motion.
     #[error("{file}:{line}: {message}")]
     Invalid { file: String, line: usize, message: String },
+    /// A step on a motion read (cropping, resampling) failed: `what` names the step.
+    #[error("{what}")]
+    Motion {
+        what: String,
+        #[source]
+        source: inbetween_core::CoreError,
+    },
     /// `load_motion` cannot tell the format from the file name.
     #[error("{}: unknown motion format; expected a .bvh or .amc file", path.display())]
     UnknownFormat { path: PathBuf },

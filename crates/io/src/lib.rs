@@ -10,6 +10,7 @@
 
 pub mod asf;
 pub mod bvh;
+pub mod convert;
 pub mod data;
 mod error;
 pub mod fsutil;

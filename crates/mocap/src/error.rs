@@ -20,6 +20,12 @@ pub enum MocapError {
     Nn(#[from] inbetween_nn::NnError),
     #[error("stream: {0}")]
     Stream(String),
+    /// A file given with another does not belong with it (the message names both).
+    #[error("{0}")]
+    Mismatch(String),
+    /// Drawing or writing a preview failed.
+    #[error(transparent)]
+    Render(#[from] inbetween_render::RenderError),
     /// The caller's cancel token was cancelled (or its time limit passed).
     #[error("stopped: {0}")]
     Cancelled(#[from] inbetween_core::cancel::Cancelled),

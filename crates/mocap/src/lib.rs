@@ -27,7 +27,9 @@ pub mod rotations;
 pub mod select;
 pub mod stream;
 
-pub use codec::job::{CompressJob, CompressReport, DecompressJob, DecompressReport};
+pub use codec::job::{
+    CompressJob, CompressReport, DecompressJob, DecompressReport, PreviewJob, PreviewReport, Rebuilt,
+};
 pub use error::{MocapError, Result};
 pub use metrics::{ErrorMeasure, PositionError, ReconstructionError, SegmentCost, SegmentTable};
 pub use prepared::PreparedClip;

@@ -14,7 +14,7 @@ use inbetween_face::data::{BlendshapeClip, MODEL_FPS, NUM_ARKIT};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::keys::parse_keys_json;
-use inbetween_face::infer::plan::{span_seconds, EditResources, GuideSource, MethodChoice, SPEECH_GROUPS};
+use inbetween_face::infer::plan::{span_seconds, visemes_groups_note, EditResources, GuideSource, MethodChoice};
 use inbetween_face::infer::{EditJob, EditLimits, EditOutcome, Guide};
 use inbetween_face::visemes::PhonemeSpan;
 use inbetween_io::Progress;
@@ -134,12 +134,7 @@ fn guidance(
         (GuideSource::None, None)
     };
     let loaded = source.load(limits.max_rows)?;
-    if !loaded.guessed_words.is_empty() {
-        notes.push(format!(
-            "not in CMUdict, pronounced by our letter-to-sound rules: {}",
-            loaded.guessed_words.join(", ")
-        ));
-    }
+    notes.extend(loaded.guessed_note());
     Ok((loaded.guide, loaded.file.or(label.map(String::from))))
 }
 
@@ -162,11 +157,7 @@ pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progr
     let (guide, guide_file) = guidance(r, clip, &spans, &limits, &mut notes)?;
     let kind = guide.kind();
     if kind == ConstraintKind::Visemes {
-        let speech = SPEECH_GROUPS.map(|g| g.name()).join(", ");
-        notes.push(match &r.groups {
-            Some(g) => format!("groups {g}: the visemes guide these groups (default: {speech}; the rest unguided)"),
-            None => format!("the visemes guide {speech}; eyes and brows are filled unguided (groups= overrides)"),
-        });
+        notes.push(visemes_groups_note(r.groups.as_deref(), "groups", "groups="));
     }
     let mut resources = EditResources::load_network(MethodChoice::parse(&r.method)?, kind, r.weights.as_deref())
         .map_err(|e| crate::errors::ctx(e.what)(e.source))?;

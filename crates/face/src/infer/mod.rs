@@ -1,5 +1,6 @@
 //! Editing a clip: the [`EditJob`] (validate, run) and the keyframe files it reads.
 
+pub mod files;
 pub mod job;
 pub mod keys;
 pub mod plan;

@@ -255,6 +255,14 @@ pub struct LoadedGuide {
     pub guessed_words: Vec<String>,
 }
 
+impl LoadedGuide {
+    /// The note on the words of a text that CMUdict lacks (None when every word was found).
+    pub fn guessed_note(&self) -> Option<String> {
+        let words = self.guessed_words.join(", ");
+        (!words.is_empty()).then(|| format!("not in CMUdict, pronounced by our letter-to-sound rules: {words}"))
+    }
+}
+
 impl GuideSource<'_> {
     /// The guidance, read and checked (see [`GuideSource`]); `max_rows` bounds a noisy take's rows.
     pub fn load(self, max_rows: usize) -> Result<LoadedGuide, FaceError> {
@@ -286,6 +294,18 @@ impl GuideSource<'_> {
 pub fn keeps_live_link(input: &Path, out: &Path) -> bool {
     let ext = |p: &Path, e: &str| p.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
     ext(input, "csv") && !ext(out, "json") && crate::data::is_live_link(input)
+}
+
+/// The note an edit guided by visemes gives about the groups: which ones the visemes guide, and
+/// that the others are filled unguided. `groups`: the groups the user gave, if any; `with_value`
+/// and `alone`: how the front end writes that option before a value (`--groups`, `groups`) and on
+/// its own (`--groups`, `groups=`).
+pub fn visemes_groups_note(groups: Option<&str>, with_value: &str, alone: &str) -> String {
+    let speech = SPEECH_GROUPS.map(|g| g.name()).join(", ");
+    match groups {
+        Some(g) => format!("{with_value} {g}: the visemes guide these groups (default: {speech}; the rest unguided)"),
+        None => format!("the visemes guide {speech}; eyes and brows are filled unguided ({alone} overrides)"),
+    }
 }
 
 /// Phoneme spans as viseme runs `(start_s, end_s, viseme)`; a phoneme with no viseme class is an
@@ -402,6 +422,17 @@ mod tests {
             assert!(!v[arkit_index(name).unwrap()], "{name}");
         }
         assert_eq!(guided_channels(ConstraintKind::Noisy), [true; NUM_ARKIT]);
+        let text = GuideSource::Text("hello zorblax", (0.0, 1.0)).load(100).unwrap();
+        assert_eq!(text.guessed_note().unwrap(), "not in CMUdict, pronounced by our letter-to-sound rules: zorblax");
+        assert_eq!(GuideSource::None.load(100).unwrap().guessed_note(), None);
+        assert_eq!(
+            visemes_groups_note(None, "--groups", "--groups"),
+            "the visemes guide jaw, mouth, cheeks, tongue; eyes and brows are filled unguided (--groups overrides)"
+        );
+        assert_eq!(
+            visemes_groups_note(Some("jaw"), "groups", "groups="),
+            "groups jaw: the visemes guide these groups (default: jaw, mouth, cheeks, tongue; the rest unguided)"
+        );
     }
 
     #[test]

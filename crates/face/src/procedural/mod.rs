@@ -183,6 +183,34 @@ pub struct ProceduralClip {
     pub phonemes: Vec<(f64, f64, &'static str)>,
 }
 
+impl ProceduralClip {
+    /// Writes the clip at `out` (Live Link Face CSV when `live_link`, else curve CSV/JSON by
+    /// extension) and its phoneme timing beside it (`out` with `.phonemes.csv`), both or neither
+    /// (`face synth`). Returns the line saying what was written.
+    pub fn write(&self, out: &std::path::Path, live_link: bool) -> Result<String, FaceError> {
+        let mut set = inbetween_io::OutputSet::new();
+        let timing = out.with_extension("phonemes.csv");
+        let staged = |set: &mut inbetween_io::OutputSet, p: &std::path::Path| {
+            set.file(p).map_err(|source| FaceError::Io { file: p.display().to_string(), source })
+        };
+        crate::data::write_clip(&staged(&mut set, out)?, &self.clip, live_link)?;
+        let spans: Vec<crate::visemes::PhonemeSpan> = (self.phonemes.iter())
+            .map(|(s, e, ph)| crate::visemes::PhonemeSpan { start_s: *s, end_s: *e, phoneme: ph.to_string() })
+            .collect();
+        crate::visemes::write_phoneme_timing(&staged(&mut set, &timing)?, &spans)?;
+        set.commit().map_err(|e| FaceError::Output {
+            what: format!("moving {} and {} into place", out.display(), timing.display()),
+            source: Box::new(e),
+        })?;
+        let frames = self.clip.num_frames();
+        Ok(format!(
+            "wrote {} ({frames} frames at {MODEL_FPS} fps) and its phoneme timing {}",
+            out.display(),
+            timing.display()
+        ))
+    }
+}
+
 /// Resting face: `(shape, maximum)`: each clip draws a level uniformly in `[0, maximum]` (left/right
 /// pairs nearly equal), so the corpus mean is about half the maximum — the real captures' pooled means
 /// (module docs). `CheekSquint*` rest at [`CHEEK_PER_SMILE`] × the resting smile plus up to 0.06

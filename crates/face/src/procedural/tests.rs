@@ -151,3 +151,24 @@ fn bad_settings_are_reported_by_validate_and_clamped_by_generate() {
     let fast = generate(&ProceduralConfig { fps: 60.0, ..Default::default() }, 3);
     assert_eq!(fast.clip.num_frames(), 600);
 }
+
+#[test]
+fn a_written_clip_reads_back_with_its_phoneme_timing_beside_it() {
+    let p = generate(&ProceduralConfig { duration_s: 3.0, ..Default::default() }, 5);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("take.csv");
+    let line = p.write(&out, true).unwrap();
+    let timing = dir.path().join("take.phonemes.csv");
+    assert_eq!(
+        line,
+        format!("wrote {} (75 frames at 25 fps) and its phoneme timing {}", out.display(), timing.display())
+    );
+    let back = crate::data::read_clip(&out).unwrap();
+    assert_eq!(back.num_frames(), p.clip.num_frames());
+    let spans = crate::visemes::read_phoneme_timing(&timing).unwrap();
+    assert_eq!(spans.len(), p.phonemes.len());
+    assert_eq!(spans[0].phoneme, p.phonemes[0].2);
+    // A folder that cannot be made leaves neither file.
+    let blocked = dir.path().join("take.csv").join("x.csv");
+    assert!(p.write(&blocked, false).is_err());
+}

@@ -104,3 +104,34 @@ fn decompress_job_rebuilds_every_frame_and_counts_what_the_file_stores() {
     let err = DecompressJob.run(b"not an ibk file", &Cancel::new(), &Progress::hidden()).unwrap_err();
     assert!(!err.to_string().is_empty());
 }
+
+#[test]
+fn preview_job_draws_from_keys_or_a_matching_file_and_refuses_another_clips_file() {
+    use crate::codec::job::{CompressJob, DecompressJob, PreviewJob, Rebuilt};
+    use inbetween_core::cancel::Cancel;
+    use inbetween_io::Progress;
+    let walk = |frames| gait(&GaitParams { frames, ..GaitParams::walk() });
+    let (m, dir) = (walk(40), tempfile::tempdir().unwrap());
+    let (name, out) = (std::path::Path::new("walk.bvh"), dir.path().join("p.gif"));
+    let keys = CompressJob::for_motion(&m, Budget::Keys(6));
+    let unit = keys.unit.clone();
+    let job = |rebuilt| PreviewJob { original: &m, name, unit: unit.clone(), rebuilt, out: &out };
+    let r6 = job(Rebuilt::Keys(keys)).run().unwrap();
+    let r = &r6;
+    assert_eq!(r.keys, 6);
+    assert!(r.error.max_cm > 0.0 && r.error.mean_cm <= r.error.max_cm, "{r}");
+    assert!(out.is_file() && r.to_string().ends_with(&format!("; wrote {}", out.display())), "{r}");
+    // A file of this clip (every frame within 1 cm) draws its own reconstruction.
+    let file = |m: &Motion| {
+        let bytes = CompressJob::for_motion(m, Budget::MaxErrorCm(1.0)).run(m).unwrap().bytes().to_vec();
+        DecompressJob.run(&bytes, &Cancel::new(), &Progress::hidden()).unwrap()
+    };
+    let ibk = std::path::Path::new("walk.ibk");
+    let r = job(Rebuilt::File(ibk, Box::new(file(&m)))).run().unwrap();
+    assert_eq!(r.keys, 40);
+    // The file bounds the virtual vertices at 1 cm; a joint may move a little more (0.95 cm measured).
+    assert!(r.error.max_cm < 1.5 && r.error.max_cm != r6.error.max_cm, "{r} vs {r6}");
+    // Another clip's file is refused, naming both files.
+    let e = job(Rebuilt::File(ibk, Box::new(file(&walk(30))))).run().unwrap_err().to_string();
+    assert!(e.contains("walk.ibk does not match walk.bvh"), "{e}");
+}

@@ -229,24 +229,71 @@ impl DecompressJob {
     }
 }
 
-impl DecompressReport {
-    /// `original` and the clip rebuilt from this file's stored poses, overlaid in one GIF at `path`,
-    /// titled with the joints' position error of the rebuilt clip (cm, through `unit`); returns it.
-    pub fn preview_gif(
-        &self,
-        original: &Motion,
-        unit: &UnitChoice,
-        path: &std::path::Path,
-    ) -> std::result::Result<PositionError, inbetween_render::RenderError> {
-        let keys = self.stored_poses;
-        let e = PositionError::between(&positions_clip(original), &positions_clip(&self.motion), unit.cm_per_unit());
+/// `mocap preview`: a clip and its reconstruction overlaid in one GIF, titled with the joints'
+/// position error of the reconstruction (cm, through `unit`).
+pub struct PreviewJob<'a> {
+    /// The clip (`name`: its file, named in errors).
+    pub original: &'a Motion,
+    pub name: &'a std::path::Path,
+    pub unit: UnitChoice,
+    pub rebuilt: Rebuilt<'a>,
+    /// The GIF to write.
+    pub out: &'a std::path::Path,
+}
+
+/// Where a preview's reconstruction comes from.
+pub enum Rebuilt<'a> {
+    /// An `.ibk` file of the clip (read from the path), which must have its skeleton and frame count.
+    File(&'a std::path::Path, Box<DecompressReport>),
+    /// The keys this job chooses, written as a version 2 file (keys only, as the preview shows them).
+    Keys(CompressJob),
+}
+
+/// What [`PreviewJob`] drew: the reconstruction's stored poses and position error.
+#[derive(Clone, Debug)]
+pub struct PreviewReport {
+    pub keys: usize,
+    pub error: PositionError,
+    pub out: std::path::PathBuf,
+}
+
+impl PreviewJob<'_> {
+    /// Rebuilds the clip (or checks that the `.ibk` file is of this clip: the same skeleton and
+    /// frame count) and writes the GIF.
+    pub fn run(self) -> Result<PreviewReport> {
+        let d = match self.rebuilt {
+            Rebuilt::File(path, d)
+                if *d.file.skeleton() != self.original.skeleton || d.frames != self.original.num_frames() =>
+            {
+                return Err(MocapError::Mismatch(format!(
+                    "{} does not match {} (skeleton or frame count differ; use the same `joints`/`skip_first`)",
+                    path.display(),
+                    self.name.display()
+                )))
+            }
+            Rebuilt::File(_, d) => *d,
+            Rebuilt::Keys(job) => {
+                let job = CompressJob { version: Some(Version::V2), segment_len: None, ..job };
+                DecompressJob.run(job.run(self.original)?.bytes(), &Cancel::new(), &Progress::hidden())?
+            }
+        };
+        let keys = d.stored_poses;
+        let (original, rebuilt) = (positions_clip(self.original), positions_clip(&d.motion));
+        let e = PositionError::between(&original, &rebuilt, self.unit.cm_per_unit());
         let opts = StickOptions {
             labels: vec!["original".into(), format!("from {keys} keys")],
             title: Some(format!("{keys} keys: {e}")),
             ..StickOptions::default()
         };
-        inbetween_render::render_motion_gif(path, &[original, &self.motion], &opts)?;
-        Ok(e)
+        inbetween_render::render_motion_gif(self.out, &[self.original, &d.motion], &opts)?;
+        Ok(PreviewReport { keys, error: e, out: self.out.to_path_buf() })
+    }
+}
+
+impl fmt::Display for PreviewReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (e, out) = (&self.error, self.out.display());
+        write!(f, "{} keys; mean {:.3} cm, max {:.3} cm; wrote {out}", self.keys, e.mean_cm, e.max_cm)
     }
 }
 

@@ -28,7 +28,7 @@ pub use ffmpeg::ffmpeg_available;
 pub use folder::natural_cmp;
 pub(crate) use gray::gray_downscaled;
 pub use mp4_in::{probe_openh264, OpenH264Probe, SampleOutcome};
-pub use procedural::{multi_shot_clip, procedural_clip, procedural_truth, ProceduralKind, ProceduralTruth};
+pub use procedural::{multi_shot_clip, procedural_clip, procedural_truth, ProceduralKind, ProceduralTruth, SynthJob};
 
 use crate::VideoError;
 use image::RgbImage;

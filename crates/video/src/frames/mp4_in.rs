@@ -186,6 +186,19 @@ pub struct OpenH264Probe {
     pub flushed: usize,
 }
 
+impl std::fmt::Display for OpenH264Probe {
+    /// `video probe`'s text: profile, B-frames, samples and pictures, then one line per sample.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let b_frames = if self.has_b_frames { "yes (ctts box)" } else { "no" };
+        let (profile, samples, pictures) = (self.profile, self.samples.len(), self.frames());
+        write!(
+            f,
+            "H.264 profile {profile}, B-frames {b_frames}, {samples} samples, openh264 decoded {pictures} pictures"
+        )?;
+        self.samples.iter().enumerate().try_for_each(|(i, s)| write!(f, "\n  sample {i}: {s:?}"))
+    }
+}
+
 impl OpenH264Probe {
     /// Pictures decoded, flushed ones included.
     pub fn frames(&self) -> usize {

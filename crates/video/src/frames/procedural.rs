@@ -43,6 +43,35 @@ pub struct ProceduralTruth {
     pub linear: Option<Range<usize>>,
 }
 
+/// `video synth`: a procedural clip written to a file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SynthJob {
+    pub kind: ProceduralKind,
+    pub frames: usize,
+    /// Frame size, pixels.
+    pub width: u32,
+    pub height: u32,
+    pub seed: u64,
+}
+
+impl Default for SynthJob {
+    /// The mixed clip, 96 frames (3.84 s at 25 fps) of 320×180 pixels, seed 1.
+    fn default() -> Self {
+        SynthJob { kind: ProceduralKind::Mixed, frames: 96, width: 320, height: 180, seed: 1 }
+    }
+}
+
+impl SynthJob {
+    /// Draws the clip ([`procedural_clip`]) and writes it at `out` (GIF or MP4 by extension);
+    /// returns the line saying what was written.
+    pub fn write(&self, out: &std::path::Path) -> Result<String, crate::VideoError> {
+        let clip = procedural_clip(self.kind, self.frames, self.width, self.height, self.seed);
+        super::write_clip(out, &clip)?;
+        let (w, h) = (clip.width(), clip.height());
+        Ok(format!("wrote {} ({} frames, {w}x{h}, {} fps)", out.display(), clip.len(), clip.fps))
+    }
+}
+
 /// The cut and linear segment of a `kind` clip of `frames` frames.
 pub fn procedural_truth(kind: ProceduralKind, frames: usize) -> ProceduralTruth {
     let at = |f: f32| (frames as f32 * f).round() as usize;

@@ -401,3 +401,25 @@ fn real_truncated_bigbuckbunny_is_a_decode_error_naming_the_file() {
         assert!(e.to_string().contains("bbb_cut.mp4"), "{e}");
     });
 }
+
+#[test]
+fn synth_writes_its_clip_and_a_probe_prints_every_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.gif");
+    let job = SynthJob { frames: 6, width: 40, height: 30, ..SynthJob::default() };
+    let line = job.write(&out).unwrap();
+    assert_eq!(line, format!("wrote {} (6 frames, 40x30, 25 fps)", out.display()));
+    let (clip, _) = read(&out).unwrap();
+    assert_eq!((clip.len(), clip.width(), clip.height()), (6, 40, 30));
+    let probe = OpenH264Probe {
+        profile: 66,
+        has_b_frames: false,
+        samples: vec![SampleOutcome::NoOutput, SampleOutcome::Frame, SampleOutcome::Error("bad".into())],
+        flushed: 1,
+    };
+    assert_eq!(
+        probe.to_string(),
+        "H.264 profile 66, B-frames no, 3 samples, openh264 decoded 2 pictures\n  sample 0: NoOutput\n  sample 1: \
+         Frame\n  sample 2: Error(\"bad\")"
+    );
+}
