@@ -225,7 +225,7 @@ fn run_story(a: RunArgs) -> anyhow::Result<()> {
     job.cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
         .map_err(anyhow::Error::msg)
         .context("--time-limit")?;
-    job.progress = Progress::new(6, "script run");
+    job.progress = Progress::new(0, "script run");
     let report = inbetween_script::jobs::run_story_whole(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
     print_run(&source, &report);
@@ -322,19 +322,24 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {
-    // The demo story with its directions k times (builtin_scripts::scaled_demo), limits raised to fit (a
-    // story of 100× the demo is over the default limits on purpose).
+    // The demo story with its directions k times, the limits raised to fit (builtin_scripts).
     crate::scale::run(&a, "script", "script run at multiples of the demo story's directions", |k, exe, work| {
         let text = builtin_scripts::scaled_demo(k);
         let input = work.join(format!("story-{k}.txt"));
         std::fs::write(&input, &text).with_context(|| format!("writing {}", input.display()))?;
         let sentences = inbetween_script::sentences::split(&text).len();
-        let big = (100 * k.max(1)).to_string();
+        let l = builtin_scripts::scaled_demo_limits(k);
         let mut command = std::process::Command::new(exe);
         command.args(["script".as_ref(), "run".as_ref(), input.as_os_str(), "-o".as_ref()]);
-        command.arg(work.join(format!("story-{k}")));
-        command.args(["--gif-width", "160", "--max-sentences", &big, "--max-words", &(1000 * k.max(1)).to_string()]);
-        command.args(["--max-actions", &big, "--max-animation-seconds", &(120 * k.max(1)).to_string()]);
-        Ok(crate::scale::Measured { input: format!("{sentences} sentences, {} actions", 5 * k), command })
+        command.arg(work.join(format!("story-{k}"))).args(["--gif-width", "160"]);
+        command.args(["--max-sentences", &l.max_sentences.to_string(), "--max-words", &l.max_words.to_string()]);
+        command.args([
+            "--max-actions",
+            &l.max_actions.to_string(),
+            "--max-animation-seconds",
+            &l.max_animation_s.to_string(),
+        ]);
+        let input = format!("{sentences} sentences, {} actions", builtin_scripts::DEMO_ACTIONS * k);
+        Ok(crate::scale::Measured { input, command })
     })
 }

@@ -112,6 +112,22 @@ pub fn scaled_demo(k: usize) -> String {
     text
 }
 
+/// Character actions (verbs) in one repetition of the demo's directions in [`scaled_demo`].
+pub const DEMO_ACTIONS: usize = 5;
+
+/// Limits that let [`scaled_demo`]`(k)` through (the defaults refuse a story of 100× the demo, on
+/// purpose): 100 sentences, 1 000 words, 100 actions and 120 s of animation per repetition.
+pub fn scaled_demo_limits(k: usize) -> crate::limits::ScriptLimits {
+    let k = k.max(1);
+    crate::limits::ScriptLimits {
+        max_sentences: 100 * k,
+        max_words: 1000 * k,
+        max_actions: 100 * k,
+        max_animation_s: 120.0 * k as f64,
+        ..Default::default()
+    }
+}
+
 /// A few lines in the paper's style for "Night of the Living Dead" (1968, public domain): the
 /// farmhouse living room. Our own wording: scene and actions only, no dialogue.
 pub const NIGHT_OF_THE_LIVING_DEAD: &str =
@@ -294,5 +310,21 @@ mod tests {
         assert_eq!(count(&three, "Eve types on the laptop."), 3);
         assert_eq!(crate::sentences::split(&three).len() - crate::sentences::split(&one).len(), 6);
         assert_eq!(crate::sentences::split(&one).len(), crate::sentences::split(DEMO).len());
+    }
+
+    /// 100× the demo is over the default limits and within its own; its actions are the count the
+    /// scale table gives.
+    #[test]
+    fn the_scaled_demo_passes_its_own_limits_only() {
+        let cat = crate::catalogue::builtin::builtin();
+        let big = scaled_demo(100);
+        let e = crate::limits::ScriptLimits::default().check_text(&big, "big", &cat).unwrap_err();
+        assert!(["max_sentences", "max_words", "max_actions"].contains(&e.field), "{e}");
+        scaled_demo_limits(100).check_text(&big, "big", &cat).unwrap();
+        let verbs = |t: &str| {
+            let parsed = crate::parse::parse_script(t, &cat);
+            parsed.sentences.iter().flat_map(|s| &s.ssg.characters).map(|c| c.actions.len()).sum::<usize>()
+        };
+        assert_eq!(verbs(&scaled_demo(2)) - verbs(&scaled_demo(1)), DEMO_ACTIONS);
     }
 }
