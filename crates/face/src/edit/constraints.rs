@@ -10,6 +10,7 @@ use rand::Rng;
 use crate::data::NUM_ARKIT;
 use crate::visemes::{Viseme, NUM_VISEMES};
 
+use super::groups::SPEECH_GROUPS;
 use super::mask::Mask;
 use super::Frame;
 
@@ -24,6 +25,16 @@ pub enum ConstraintKind {
     Noisy,
     /// One-hot visemes (§4.3.3).
     Visemes,
+}
+
+/// The shapes a guidance acts on when the edit names no groups: the speech groups
+/// ([`SPEECH_GROUPS`]) for visemes, every shape otherwise (keys and a noisy take say something about
+/// the whole face).
+pub fn guided_channels(kind: ConstraintKind) -> [bool; NUM_ARKIT] {
+    match kind {
+        ConstraintKind::Visemes => std::array::from_fn(|c| SPEECH_GROUPS.iter().any(|g| g.contains(c))),
+        _ => [true; NUM_ARKIT],
+    }
 }
 
 impl ConstraintKind {

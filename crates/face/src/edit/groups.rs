@@ -3,8 +3,6 @@
 
 use crate::data::{ARKIT_NAMES, NUM_ARKIT};
 
-use super::constraints::ConstraintKind;
-
 /// A named set of ARKit shapes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Group {
@@ -96,15 +94,6 @@ pub fn parse_groups(list: &str) -> Result<[bool; NUM_ARKIT], String> {
 /// The groups speech moves, which viseme guidance (text, TextGrid, phoneme timings) drives when the
 /// edit names no groups: jaw, mouth, cheeks (and nose), tongue.
 pub const SPEECH_GROUPS: [Group; 4] = [Group::Jaw, Group::Mouth, Group::Cheeks, Group::Tongue];
-
-/// The shapes a guidance acts on when the edit names no groups: the speech groups for visemes,
-/// every shape otherwise (keys and a noisy take say something about the whole face).
-pub fn guided_channels(kind: ConstraintKind) -> [bool; NUM_ARKIT] {
-    match kind {
-        ConstraintKind::Visemes => std::array::from_fn(|c| SPEECH_GROUPS.iter().any(|g| g.contains(c))),
-        _ => [true; NUM_ARKIT],
-    }
-}
 
 #[cfg(test)]
 mod tests {

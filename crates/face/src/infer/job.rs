@@ -23,7 +23,7 @@ use crate::model::input;
 use crate::visemes::Viseme;
 
 use super::keys::KeyPose;
-use crate::edit::groups::guided_channels;
+use crate::edit::constraints::guided_channels;
 use inbetween_core::cancel::Cancel;
 use inbetween_core::curve::Curve;
 use inbetween_io::LimitExceeded;
@@ -113,7 +113,7 @@ pub struct EditJob<'a> {
     pub spans: Vec<(f64, f64)>,
     /// ARKit shapes to regenerate (others stay exactly as they are), the guidance acting on all of
     /// them; `None` (the default of `face edit` and the studio): every shape, the guidance acting on
-    /// the shapes it means something for ([`crate::edit::groups::guided_channels`]: the speech groups for
+    /// the shapes it means something for ([`crate::edit::constraints::guided_channels`]: the speech groups for
     /// visemes) and the others filled as an unguided edit is, by retrieval from `library` and the
     /// clip itself.
     pub channels: Option<[bool; NUM_ARKIT]>,

@@ -15,7 +15,8 @@ use crate::infer::{read_keys, Guide, Inpainter, KeyPose, Method, DEFAULT_LIBRARY
 use crate::visemes::{phoneme_viseme, read_viseme_source, text_to_phonemes, validate_spans, PhonemeSpan, Viseme};
 use crate::weights::Network;
 
-pub use crate::edit::groups::{guided_channels, SPEECH_GROUPS};
+pub use crate::edit::constraints::guided_channels;
+pub use crate::edit::groups::SPEECH_GROUPS;
 
 /// How an edit is asked to fill, before [`MethodChoice::resolve`] applies the `auto` rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
