@@ -10,19 +10,18 @@ use crate::clip::FaceClip;
 use crate::errors::{invalid, JobError};
 use crate::runner::run_job;
 use inbetween_core::cancel::Cancel;
-use inbetween_face::data::{BlendshapeClip, MODEL_FPS, NUM_ARKIT};
+use inbetween_face::data::{BlendshapeClip, NUM_ARKIT};
 use inbetween_face::edit::groups::parse_groups;
 use inbetween_face::edit::ConstraintKind;
 use inbetween_face::infer::keys::parse_keys_json;
 use inbetween_face::infer::plan::{span_seconds, visemes_groups_note, EditResources, GuideSource, MethodChoice};
-use inbetween_face::infer::{EditJob, EditLimits, EditOutcome, Guide};
+use inbetween_face::infer::{run_variants, EditJob, EditLimits, Guide, Variant};
 use inbetween_face::visemes::PhonemeSpan;
 use inbetween_io::Progress;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-use std::time::Instant;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(face_edit, m)?)?;
@@ -64,21 +63,6 @@ pub struct EditRequest {
 }
 
 /// One variant: the job's outcome, its seed and how long the edit took.
-pub struct Variant {
-    pub outcome: EditOutcome,
-    pub seed: u64,
-    pub ms: f64,
-}
-
-/// What [`edit`] made: the variants and what is the same for all of them.
-pub struct Edited {
-    pub variants: Vec<Variant>,
-    pub method: String,
-    pub guidance: &'static str,
-    pub spans_s: Vec<(f64, f64)>,
-    pub notes: Vec<String>,
-}
-
 fn span_of(s: &SpanArg, clip: &BlendshapeClip) -> Result<(f64, f64), JobError> {
     match s {
         SpanArg::Seconds(a, b) => Ok((*a, *b)),
@@ -139,7 +123,7 @@ fn guidance(
 }
 
 /// Runs the edit `r` asks for on `clip`, once per variant, as `face edit` does.
-pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progress) -> Result<Edited, JobError> {
+pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progress) -> Result<Vec<Variant>, JobError> {
     let defaults = EditLimits::default();
     let limits = EditLimits {
         max_rows: r.max_rows.unwrap_or(defaults.max_rows),
@@ -172,7 +156,7 @@ pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progr
     resources.load_library_clips(&r.library, channels.is_some(), |i| format!("library[{i}]"))?;
     let mut job = EditJob {
         clip,
-        spans: spans.clone(),
+        spans,
         channels,
         guide,
         method: resources.method(r.variants)?,
@@ -182,17 +166,7 @@ pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progr
         guide_file,
         library: resources.library.as_ref(),
     };
-    job.validate()?;
-    bar.phase(r.variants as u64, "editing the face");
-    let mut variants = Vec::with_capacity(r.variants);
-    for k in 0..r.variants {
-        job.seed = r.seed + k as u64;
-        let t = Instant::now();
-        let outcome = job.run()?;
-        variants.push(Variant { outcome, seed: job.seed, ms: t.elapsed().as_secs_f64() * 1000.0 });
-        bar.inc(1);
-    }
-    Ok(Edited { variants, method: job.method.name(), guidance: kind.name(), spans_s: spans, notes })
+    Ok(run_variants(&mut job, r.variants, &notes, bar)?)
 }
 
 /// Runs `face edit` on `clip` (see `inbetween.face.edit`). Returns a list of (FaceClip, report dict).
@@ -244,37 +218,32 @@ fn face_edit<'py>(
     };
     let input = &clip.clip;
     let edited = run_job(py, progress.as_ref(), |cancel, bar| edit(input, &request, cancel, bar))?;
-    let spread: Vec<Option<f64>> = match edited.variants.first() {
-        Some(f) => edited.variants.iter().map(|v| Some(v.outcome.mean_abs_difference(&f.outcome))).collect(),
-        None => Vec::new(),
-    };
-    let mut out = Vec::with_capacity(edited.variants.len());
-    for (k, v) in edited.variants.into_iter().enumerate() {
-        let o = &v.outcome;
+    let mut out = Vec::with_capacity(edited.len());
+    for Variant { outcome, report: r } in edited {
         let d = PyDict::new(py);
-        d.set_item("variant", k + 1)?;
-        d.set_item("seed", v.seed)?;
-        d.set_item("method", &edited.method)?;
-        d.set_item("guidance", edited.guidance)?;
-        d.set_item("spans_s", &edited.spans_s)?;
-        d.set_item("model_fps", MODEL_FPS)?;
-        d.set_item("segments", o.mask.segments().iter().map(|s| (s.start, s.end)).collect::<Vec<_>>())?;
-        d.set_item("key_frames", o.keys.iter().map(|(f, _)| *f).collect::<Vec<_>>())?;
-        d.set_item("masked_mse", o.masked_mse())?;
-        d.set_item("difference_from_first", spread[k].filter(|_| k > 0))?;
-        let (rows, shapes) = o.changed(input);
-        d.set_item("changed_rows", (rows.start, rows.end))?;
-        let names = inbetween_face::data::ARKIT_NAMES;
-        d.set_item("changed_shapes", (0..NUM_ARKIT).filter(|c| shapes[*c]).map(|c| names[c]).collect::<Vec<_>>())?;
-        d.set_item("ms", v.ms)?;
-        d.set_item("notes", &edited.notes)?;
-        // One copy each into the new arrays.
-        let n = o.before.len();
-        d.set_item("before", PyArray1::from_slice(py, o.before.as_flattened()).reshape([n, NUM_ARKIT])?)?;
-        d.set_item("after", PyArray1::from_slice(py, o.after.as_flattened()).reshape([n, NUM_ARKIT])?)?;
-        d.set_item("mask", PyArray1::from_slice(py, o.mask.flags()).reshape([n, NUM_ARKIT])?)?;
+        d.set_item("variant", r.variant)?;
+        d.set_item("seed", r.seed)?;
+        d.set_item("method", &r.method)?;
+        d.set_item("guidance", r.guidance)?;
+        d.set_item("spans_s", &r.spans_s)?;
+        d.set_item("model_fps", r.model_fps)?;
+        d.set_item("segments", &r.segments)?;
+        d.set_item("key_frames", &r.key_frames)?;
+        d.set_item("masked_mse", r.masked_mse)?;
+        d.set_item("difference_from_first", r.difference_from_first)?;
+        d.set_item("changed_rows", r.changed_rows)?;
+        d.set_item("changed_shapes", &r.changed_shapes)?;
+        d.set_item("ms", r.ms)?;
+        d.set_item("notes", &r.notes)?;
+        d.set_item("text", r.to_string())?;
+        // The model-rate frames move into their arrays (numpy owns them now, no copy); the mask's
+        // flags are copied.
+        let n = outcome.before.len();
+        d.set_item("before", PyArray1::from_vec(py, outcome.before.into_flattened()).reshape([n, NUM_ARKIT])?)?;
+        d.set_item("after", PyArray1::from_vec(py, outcome.after.into_flattened()).reshape([n, NUM_ARKIT])?)?;
+        d.set_item("mask", PyArray1::from_slice(py, outcome.mask.flags()).reshape([n, NUM_ARKIT])?)?;
         // The edited clip is moved, not copied.
-        let edited_clip = FaceClip { clip: v.outcome.clip, source: clip.source.clone(), live_link: clip.live_link };
+        let edited_clip = FaceClip { clip: outcome.clip, source: clip.source.clone(), live_link: clip.live_link };
         out.push((edited_clip, d));
     }
     Ok(out)

@@ -17,6 +17,7 @@ mod errors;
 mod face;
 mod ibk;
 mod mocap;
+mod report;
 mod runner;
 mod script;
 mod video;
@@ -37,6 +38,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     face::register(m)?;
     ibk::register(m)?;
     mocap::register(m)?;
+    report::register(m)?;
     script::register(m)?;
     video::register(m)?;
     Ok(())

@@ -7,6 +7,7 @@
 
 use crate::clip::Clip;
 use crate::errors::{ctx, engine, invalid, JobError};
+use crate::report::JobReport;
 use crate::runner::run_job;
 use inbetween_core::cancel::Cancel;
 use inbetween_core::rotation::EulerOrder;
@@ -140,7 +141,7 @@ fn curve(name: Option<&str>) -> PyResult<RotationCurve> {
 /// Runs a `SelectJob`: `method` (uniform, greedy, sidql, optimal, error_bounded) with `k` keys or
 /// `bound_cm` / `bound_deg`, rotations along `curve` (hermite, quaternion_bezier, euler_bezier with
 /// its playback: see [`playback`]). Returns (key frames, key pose arrays, report JSON, report text,
-/// rebuilt clip).
+/// rebuilt clip, the reconstruction's report text).
 #[pyfunction]
 #[pyo3(signature = (clip, method, k=None, bound_cm=None, max_gap_s=None, progress=None, bound_deg=None, curve=None, euler_orders=None, pre_rotations=None, euler_reference=None))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
@@ -157,7 +158,7 @@ fn mocap_select<'py>(
     euler_orders: Option<Vec<Option<String>>>,
     pre_rotations: Option<Vec<f64>>,
     euler_reference: Option<Vec<f64>>,
-) -> PyResult<(Vec<usize>, Bound<'py, PyDict>, String, String, Clip)> {
+) -> PyResult<(Vec<usize>, Bound<'py, PyDict>, String, String, Clip, String)> {
     let method = Selector::parse(method).map_err(|e| engine("", &e))?;
     let defaults = SelectJob::default();
     let job = SelectJob {
@@ -176,14 +177,15 @@ fn mocap_select<'py>(
     let rebuilt = report.reconstruction.motion(&prepared).map_err(|e| engine("", &e))?;
     let poses = key_pose_arrays(py, &report.key_poses, report.key_euler.as_ref(), clip.unit.cm_per_unit())?;
     let out = Clip::new(rebuilt, clip.unit.clone(), clip.source.clone());
-    Ok((report.keys().frames().to_vec(), poses, json, report.to_string(), out))
+    Ok((report.keys().frames().to_vec(), poses, json, report.to_string(), out, report.reconstruction.to_string()))
 }
 
 /// Runs a `ReconstructJob`: the clip rebuilt from its poses at `keys` (Euler playback as for
-/// `mocap_select`). Returns (rebuilt clip, report JSON, report text).
+/// `mocap_select`). Returns (rebuilt clip, error per frame in cm, mean and max error in cm, the
+/// report).
 #[pyfunction]
 #[pyo3(signature = (clip, keys, progress=None, curve=None, euler_orders=None, pre_rotations=None, euler_reference=None))]
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn mocap_reconstruct<'py>(
     py: Python<'py>,
     clip: PyRef<'py, Clip>,
@@ -193,14 +195,16 @@ fn mocap_reconstruct<'py>(
     euler_orders: Option<Vec<Option<String>>>,
     pre_rotations: Option<Vec<f64>>,
     euler_reference: Option<Vec<f64>>,
-) -> PyResult<(Clip, String, String)> {
+) -> PyResult<(Clip, Bound<'py, PyArray1<f64>>, f64, f64, JobReport)> {
     let euler = playback(&clip, euler_orders, pre_rotations, euler_reference)?;
     let job = ReconstructJob { keys, curve: self::curve(curve)?, euler };
     job.validate(clip.motion.num_frames()).map_err(|e| engine(&clip.source, &e))?;
     let clip_ref: &Clip = &clip;
     let (report, motion) = run_job(py, progress.as_ref(), |cancel, bar| reconstruct(clip_ref, &job, cancel, bar))?;
-    let json = serde_json::to_string(&report).map_err(|e| invalid(e.to_string()))?;
-    Ok((Clip::new(motion, clip.unit.clone(), clip.source.clone()), json, report.to_string()))
+    let error = &report.error;
+    let per_frame = PyArray1::from_slice(py, &error.per_frame_cm);
+    let (mean, max) = (error.mean_cm, error.max_cm);
+    Ok((Clip::new(motion, clip.unit.clone(), clip.source.clone()), per_frame, mean, max, JobReport::new(report)))
 }
 
 /// The work of `reconstruct`: prepare the clip, run the job, rebuild the BVH form (also timed by
@@ -212,8 +216,10 @@ pub fn reconstruct(
     progress: &Progress,
 ) -> Result<(ReconstructReport, Motion), JobError> {
     let prepared = prepare(clip)?;
-    let report = job.run(&prepared, cancel, progress).map_err(ctx(format!("reconstructing {}", clip.source)))?;
+    let mut report = job.run(&prepared, cancel, progress).map_err(ctx(format!("reconstructing {}", clip.source)))?;
     let motion = report.motion(&prepared).map_err(ctx("rebuilding the clip"))?;
+    // The poses are in `motion` now; the report kept for Python holds the rest.
+    report.poses = Vec::new();
     Ok((report, motion))
 }
 

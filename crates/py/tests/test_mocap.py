@@ -38,6 +38,11 @@ def test_keys_to_one_cm_measured_in_python(take):
     assert err.mean() < 0.2, err.mean()
     assert rec.max_error_cm == pytest.approx(keys.reconstruction.max_error_cm, rel=1e-9)
     assert rec.error_per_frame_cm.shape == (take.num_frames,)
+    # The report: the same numbers as the arrays (read into a dict on first use), and in words.
+    assert rec.report["error"]["max_cm"] == rec.max_error_cm and rec.report["keys"]["frames"] == keys.frames.tolist()
+    np.testing.assert_array_equal(rec.report["error"]["per_frame_cm"], rec.error_per_frame_cm)
+    assert rec.text.startswith(f"{take.num_frames} frames from {n} keys"), rec.text
+    assert keys.reconstruction.text == rec.text
     # Fewer keys by K: a worse fit, never a crash.
     few = mocap.select_keys(take, k=4)
     assert len(few) == 4 and few.method == "optimal"

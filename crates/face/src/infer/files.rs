@@ -3,13 +3,12 @@
 //! every variant is done, or none ([`inbetween_io::OutputSet`]).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use inbetween_io::fsutil::with_stem_suffix;
 use inbetween_io::{OutputSet, Progress};
 
 use crate::data::{write_clip, FaceError};
-use crate::infer::{EditJob, EditOutcome};
+use crate::infer::{run_variants, EditJob, Variant};
 use crate::preview::{write_outcome_gif, write_outcome_png};
 
 /// Where an edit's outputs go.
@@ -37,7 +36,7 @@ pub struct WrittenEdits {
     /// milliseconds, file).
     pub lines: Vec<String>,
     /// Variants 2..N: mean |difference| from variant 1 inside the spans, in blendshape weight
-    /// ([`EditOutcome::mean_abs_difference`]).
+    /// ([`crate::infer::EditOutcome::mean_abs_difference`]).
     pub spreads: Vec<f64>,
 }
 
@@ -55,32 +54,28 @@ impl WrittenEdits {
     }
 }
 
-/// Runs `job` once per variant (its seed, then the next ones) and stages each edit's clip, PNG and
-/// GIF (see [`EditFiles`]); moves them all into place once every variant is done. `job.seed` is
-/// left at the last variant's seed.
+/// Runs `job` once per variant ([`run_variants`]: its seed, then the next ones) and stages each
+/// edit's clip, PNG and GIF (see [`EditFiles`]); moves them all into place once every variant is
+/// done. `job.seed` is left at the last variant's seed.
 pub fn write_variants(job: &mut EditJob, files: &EditFiles) -> Result<WrittenEdits, FaceError> {
     fn output<E: std::error::Error + Send + Sync + 'static>(what: String) -> impl FnOnce(E) -> FaceError {
         move |e| FaceError::Output { what, source: Box::new(e) }
     }
     let staged = |set: &mut OutputSet, p: &Path| set.file(p).map_err(output(format!("preparing {}", p.display())));
-    let (mut set, mut written, first_seed) = (OutputSet::new(), WrittenEdits::default(), job.seed);
-    let mut first: Option<EditOutcome> = None;
-    for k in 1..=files.variants {
-        job.seed = first_seed + u64::from(k - 1);
+    let (mut set, mut written) = (OutputSet::new(), WrittenEdits::default());
+    let made = run_variants(job, files.variants as usize, &[], &Progress::hidden())?;
+    for (k, Variant { outcome: out, report }) in (1..).zip(&made) {
         let named = |p: &Path| if files.variants == 1 { p.to_path_buf() } else { with_stem_suffix(p, &k.to_string()) };
-        let t = Instant::now();
-        let out = job.run()?;
-        let ms = t.elapsed().as_secs_f64() * 1000.0;
         let out_path = named(&files.out);
         write_clip(&staged(&mut set, &out_path)?, &out.clip, files.live_link)?;
         let png = named(&files.png.clone().unwrap_or_else(|| files.out.with_extension("png")));
-        let title = format!("{} · {} · {}", files.input.display(), job.method.name(), job.guide.kind().name());
-        write_outcome_png(&staged(&mut set, &png)?, &out, &title)
+        let title = format!("{} · {} · {}", files.input.display(), report.method, report.guidance);
+        write_outcome_png(&staged(&mut set, &png)?, out, &title)
             .map_err(output(format!("writing {}", png.display())))?;
         job.cancel.check()?;
         if let Some(gif) = files.gif.as_deref().map(named) {
             let progress = Progress::new(0, "face gif");
-            write_outcome_gif(&staged(&mut set, &gif)?, &out, &progress)
+            write_outcome_gif(&staged(&mut set, &gif)?, out, &progress)
                 .map_err(output(format!("writing {}", gif.display())))?;
             progress.finish();
             job.cancel.check()?;
@@ -88,19 +83,17 @@ pub fn write_variants(job: &mut EditJob, files: &EditFiles) -> Result<WrittenEdi
         }
         written.lines.push(format!("  curves {}", png.display()));
         written.lines.push(format!(
-            "edited {} span(s) of {} ({} frames at {:.3} fps) with {} (seed {}) in {ms:.1} ms -> {}",
+            "edited {} span(s) of {} ({} frames at {:.3} fps) with {} (seed {}) in {:.1} ms -> {}",
             job.spans.len(),
             files.input.display(),
             job.clip.num_frames(),
             job.clip.measured_fps(),
-            job.method.name(),
-            job.seed,
+            report.method,
+            report.seed,
+            report.ms,
             out_path.display(),
         ));
-        match &first {
-            None => first = Some(out),
-            Some(f) => written.spreads.push(out.mean_abs_difference(f)),
-        }
+        written.spreads.extend(report.difference_from_first);
     }
     set.commit().map_err(output("moving the edit's outputs into place".into()))?;
     Ok(written)

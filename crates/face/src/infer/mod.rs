@@ -4,9 +4,11 @@ pub mod files;
 pub mod job;
 pub mod keys;
 pub mod plan;
+pub mod variants;
 
 pub use job::{EditJob, EditLimits, EditOutcome, Guide, Inpainter, Method};
 pub use keys::{read_keys, KeyPose};
+pub use variants::{run_variants, Variant, VariantReport};
 
 /// Seconds of procedural motion in the default retrieval library (`face edit --method retrieval`
 /// without `--library`).

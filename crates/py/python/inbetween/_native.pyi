@@ -126,6 +126,12 @@ def ibk_compress(
     progress: _Progress,
 ) -> Tuple[bytes, str]: ...
 def ibk_decompress(data: bytes) -> Clip: ...
+class JobReport:
+    """An engine job's report: `json()` its JSON, `str()` its words."""
+
+    def json(self) -> str: ...
+    def __str__(self) -> str: ...
+
 def mocap_select(
     clip: Clip,
     method: str,
@@ -138,7 +144,7 @@ def mocap_select(
     euler_orders: Optional[List[Optional[str]]] = None,
     pre_rotations: Optional[List[float]] = None,
     euler_reference: Optional[List[float]] = None,
-) -> Tuple[List[int], Dict[str, npt.NDArray[np.float32]], str, str, Clip]: ...
+) -> Tuple[List[int], Dict[str, npt.NDArray[np.float32]], str, str, Clip, str]: ...
 def mocap_reconstruct(
     clip: Clip,
     keys: List[int],
@@ -147,7 +153,7 @@ def mocap_reconstruct(
     euler_orders: Optional[List[Optional[str]]] = None,
     pre_rotations: Optional[List[float]] = None,
     euler_reference: Optional[List[float]] = None,
-) -> Tuple[Clip, str, str]: ...
+) -> Tuple[Clip, npt.NDArray[np.float64], float, float, JobReport]: ...
 def mocap_bezier(
     clip: Clip,
     keys: List[int],

@@ -53,19 +53,8 @@ class EditReport:
     before: np.ndarray = field(repr=False)  #: the input at the model rate, float32 `[N, 52]`
     after: np.ndarray = field(repr=False)  #: the edit at the model rate, float32 `[N, 52]`
     mask: np.ndarray = field(repr=False)  #: regenerated entries at the model rate, bool `[N, 52]`
-
-    @property
-    def text(self) -> str:
-        spans = ", ".join(f"{a:.2f} s..{b:.2f} s" for a, b in self.spans_s)
-        a, b = self.changed_rows
-        line = (
-            f"variant {self.variant} (seed {self.seed}): {self.method}, {self.guidance}, spans {spans}; "
-            f"masked MSE {self.masked_mse:.5f} against what was there; rows {a}..{b} changed "
-            f"({len(self.changed_shapes)} shapes) in {self.ms:.1f} ms"
-        )
-        if self.difference_from_first is not None:
-            line += f"; mean |difference| from variant 1 inside the spans {self.difference_from_first:.4f}"
-        return "\n".join([line] + [f"note: {n}" for n in self.notes])
+    #: The report in words (the face engine's `VariantReport`), notes on their own lines.
+    text: str = field(repr=False)
 
     def __str__(self) -> str:
         return self.text
@@ -260,6 +249,7 @@ def edit(
                 before=d["before"],
                 after=d["after"],
                 mask=d["mask"],
+                text=d["text"],
             )
         )
     return Edit(clips=clips, reports=reports)

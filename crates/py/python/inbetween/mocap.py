@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass, field
 from typing import Any, Dict, Optional, Sequence
@@ -33,8 +34,19 @@ class Reconstruction:
     error_per_frame_cm: np.ndarray
     mean_error_cm: float
     max_error_cm: float
-    report: Dict[str, Any] = field(repr=False)
-    text: str = field(repr=False)
+    #: The engine's report: a dict, or the native report (read into a dict on first use).
+    _report: Any = field(repr=False, compare=False)
+    _text: Optional[str] = field(default=None, repr=False, compare=False)
+
+    @functools.cached_property
+    def report(self) -> Dict[str, Any]:
+        """The job's report (keys, curve, error) as a dict."""
+        return self._report if isinstance(self._report, dict) else json.loads(self._report.json())
+
+    @property
+    def text(self) -> str:
+        """The job's report in words."""
+        return self._text if self._text is not None else str(self._report)
 
 
 @dataclass(frozen=True)
@@ -73,8 +85,8 @@ def _reconstruction(clip: Clip, report: Dict[str, Any], text: str) -> Reconstruc
         error_per_frame_cm=np.asarray(err["per_frame_cm"], dtype=np.float64),
         mean_error_cm=float(err["mean_cm"]),
         max_error_cm=float(err["max_cm"]),
-        report=report,
-        text=text,
+        _report=report,
+        _text=text,
     )
 
 
@@ -147,7 +159,7 @@ def select_keys(
         raise InbetweenError(f"method {method!r} takes k (the number of keys, ends included), not max_error_cm")
     euler = _euler(clip, curve, euler_orders, pre_rotations, euler_reference)
     with progress_callback(progress, "choosing keys") as cb:
-        frames, poses, report_json, text, rebuilt = _native.mocap_select(
+        frames, poses, report_json, text, rebuilt, rec_text = _native.mocap_select(
             clip, method, k, max_error_cm, max_gap_s, cb, max_error_deg, curve, **euler
         )
     report = json.loads(report_json)
@@ -159,7 +171,7 @@ def select_keys(
         translations_cm=poses["translations_cm"],
         velocities_cm_s=poses["velocities_cm_s"],
         method=report["method"],
-        reconstruction=_reconstruction(rebuilt, rec, str(rebuilt)),
+        reconstruction=_reconstruction(rebuilt, rec, rec_text),
         report=report,
         text=text,
         euler_angles=poses.get("euler_angles"),
@@ -196,8 +208,8 @@ def reconstruct(
     euler = _euler(clip, curve, euler_orders, pre_rotations, euler_reference)
     frames = _frames(keys)
     with progress_callback(progress, "reconstructing") as cb:
-        rebuilt, report_json, text = _native.mocap_reconstruct(clip, frames, cb, curve, **euler)
-    return _reconstruction(rebuilt, json.loads(report_json), text)
+        rebuilt, per_frame_cm, mean_cm, max_cm, report = _native.mocap_reconstruct(clip, frames, cb, curve, **euler)
+    return Reconstruction(rebuilt, per_frame_cm, mean_cm, max_cm, report)
 
 
 @dataclass(frozen=True)
