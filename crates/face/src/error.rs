@@ -49,8 +49,9 @@ pub enum FaceError {
     /// A problem with the file as a whole (JSON structure, UTF-8).
     #[error("{file}: {message}")]
     File { file: String, message: String },
-    /// A clip that breaks the rules of [`crate::data::BlendshapeClip`], or an argument out of range.
-    #[error("invalid clip: {0}")]
+    /// An argument out of range, or a clip that breaks the rules of [`crate::data::BlendshapeClip`]
+    /// (those messages start "invalid clip: ", [`FaceError::clip`]).
+    #[error("{0}")]
     Invalid(String),
     /// Weights could not be loaded or saved.
     #[error(transparent)]
@@ -71,6 +72,11 @@ pub enum FaceError {
 }
 
 impl FaceError {
+    /// A clip that breaks the rules of [`crate::data::BlendshapeClip`].
+    pub(crate) fn clip(message: impl std::fmt::Display) -> Self {
+        FaceError::Invalid(format!("invalid clip: {message}"))
+    }
+
     pub(crate) fn parse(file: &str, line: usize, column: Option<Column>, message: impl Into<String>) -> Self {
         FaceError::Parse { file: file.to_string(), line, column, message: message.into() }
     }

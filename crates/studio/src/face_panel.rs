@@ -383,8 +383,7 @@ pub async fn edit(State(st): State<Arc<AppState>>, Json(req): Json<EditRequest>)
                 )))
             }
         };
-        let choice = MethodChoice::parse(&req.method)
-            .map_err(|e| StudioError::BadRequest(e.to_string().replace("invalid clip: ", "")))?;
+        let choice = MethodChoice::parse(&req.method).map_err(|e| StudioError::BadRequest(e.to_string()))?;
         let mut resources = EditResources::load_network(choice, guide.kind(), None)
             .map_err(|e| StudioError::Engine(format!("{}: {}", e.what, e.source)))?;
         resources.load_library(&[], channels.is_some(), EditLimits::default().max_rows).map_err(face_err)?;

@@ -42,7 +42,7 @@ impl BlendshapeClip {
         extras: Vec<String>,
         values: Vec<f32>,
     ) -> Result<Self, FaceError> {
-        let invalid = |m: String| Err(FaceError::Invalid(m));
+        let invalid = |m: String| Err(FaceError::clip(m));
         if !(fps.is_finite() && fps > 0.0) {
             return invalid(format!("fps must be a positive number, got {fps}"));
         }
@@ -94,11 +94,11 @@ impl BlendshapeClip {
     /// order given.
     pub fn from_named(fps: f64, times: Vec<f64>, channels: Vec<(String, Vec<f32>)>) -> Result<Self, FaceError> {
         let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
-        let layout = Layout::from_names(&names, |_| true).map_err(|(_, m)| FaceError::Invalid(m))?;
+        let layout = Layout::from_names(&names, |_| true).map_err(|(_, m)| FaceError::clip(m))?;
         let n = times.len();
         for (name, v) in &channels {
             if v.len() != n {
-                return Err(FaceError::Invalid(format!(
+                return Err(FaceError::clip(format!(
                     "channel {name:?} has {} values; expected {n} (one per time)",
                     v.len()
                 )));
@@ -123,7 +123,7 @@ impl BlendshapeClip {
     /// Sets the nominal frame rate (the times are unchanged).
     pub fn set_fps(&mut self, fps: f64) -> Result<(), FaceError> {
         if !(fps.is_finite() && fps > 0.0) {
-            return Err(FaceError::Invalid(format!("fps must be a positive number, got {fps}")));
+            return Err(FaceError::clip(format!("fps must be a positive number, got {fps}")));
         }
         self.fps = fps;
         Ok(())

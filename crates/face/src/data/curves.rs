@@ -169,7 +169,7 @@ pub fn parse_curve_json(text: &str, file: &str) -> Result<BlendshapeClip, FaceEr
     let to_file = |e: FaceError| FaceError::File { file: file.into(), message: e.to_string() };
     if let Some(f) = cf.fps {
         if !(f.is_finite() && f > 0.0) {
-            return Err(to_file(FaceError::Invalid(format!("fps must be a positive number, got {f}"))));
+            return Err(to_file(FaceError::clip(format!("fps must be a positive number, got {f}"))));
         }
     }
     let fps = cf.fps.unwrap_or_else(|| estimate_fps(&cf.time_s));
