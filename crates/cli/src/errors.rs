@@ -46,11 +46,7 @@ pub const OPTION_FLAGS: &[(&str, &str)] = &[
 /// Library text with each `` `field` `` of [`OPTION_FLAGS`] written as its flag (other text,
 /// other backticked words included, unchanged).
 pub fn with_flags(text: &str) -> String {
-    let mut out = text.to_string();
-    for (field, flag) in OPTION_FLAGS {
-        out = out.replace(&format!("`{field}`"), flag);
-    }
-    out
+    inbetween_io::limits::name_fields(text, OPTION_FLAGS)
 }
 
 /// `error: <message>`, one `caused by:` line per cause, and the backtrace when `debug`; options
@@ -66,40 +62,21 @@ pub fn render(error: &anyhow::Error, debug: bool) -> String {
     out
 }
 
-/// Names the flag that raises a limit: an error whose chain holds an
-/// [`inbetween_io::LimitExceeded`] for a field listed in `flags` (`(field, flag)`) becomes one line,
-/// `<contexts>: <limit message>; raise it with <flag>`; a time limit reached
-/// ([`inbetween_core::cancel::Cancelled::TimeLimit`]) names `--time-limit`. Other errors pass
-/// unchanged. The libraries speak of their fields; the commands own the flags.
+/// A command's error with its own `(field, flag)` table: an error over a limit (or the time
+/// limit) becomes one line that names the flag raising it ([`inbetween_io::limits::raise_hint`]);
+/// any other error whose messages name a `` `field` `` of the table becomes one line with the
+/// flags written in; other errors pass unchanged. The libraries speak of their fields; the
+/// commands own the flags.
 pub fn name_flags(e: anyhow::Error, flags: &[(&str, &str)]) -> anyhow::Error {
-    use inbetween_core::cancel::Cancelled;
-    use inbetween_io::LimitExceeded;
-    let mut above: Vec<String> = Vec::new();
-    for cause in e.chain() {
-        let hint = if let Some(l) = cause.downcast_ref::<LimitExceeded>() {
-            flags.iter().find(|(field, _)| *field == l.field).map(|(_, flag)| *flag)
-        } else if let Some(Cancelled::TimeLimit { .. }) = cause.downcast_ref::<Cancelled>() {
-            Some("--time-limit")
-        } else {
-            None
-        };
-        if let Some(flag) = hint {
-            let here = cause.to_string();
-            // An engine error that shows its source's message (`{0}`, `stopped: {0}`) repeats it:
-            // keep only what it adds.
-            above = above
-                .into_iter()
-                .filter_map(|m| {
-                    let own = m.strip_suffix(here.as_str()).map_or(m.as_str(), |p| p.trim_end_matches([':', ' ']));
-                    (!own.is_empty()).then(|| own.to_string())
-                })
-                .collect();
-            above.push(format!("{here}; raise it with {flag}"));
-            return anyhow::anyhow!("{}", above.join(": "));
-        }
-        above.push(cause.to_string());
+    use inbetween_io::limits::{name_fields, raise_hint};
+    if let Some(line) = raise_hint(e.as_ref(), flags, "--time-limit") {
+        return anyhow::anyhow!(line);
     }
-    e
+    let named: Vec<String> = e.chain().map(|c| name_fields(&c.to_string(), flags)).collect();
+    if e.chain().zip(&named).all(|(c, n)| c.to_string() == *n) {
+        return e;
+    }
+    anyhow::anyhow!(named.join(": "))
 }
 
 #[cfg(test)]
@@ -108,26 +85,24 @@ mod tests {
     use anyhow::Context;
 
     #[test]
-    fn limits_and_time_limits_name_their_flags() {
+    fn limits_and_fields_name_their_flags() {
         let limit = inbetween_io::LimitExceeded::check_count("a.csv", 3, 2, "rows", "max_rows").unwrap_err();
-        let e = anyhow::Error::new(limit.clone()).context("reading the input");
+        let e = anyhow::Error::new(limit).context("reading the input");
         let named = name_flags(e, &[("max_rows", "--max-rows")]);
         assert_eq!(
             render(&named, false),
             "error: reading the input: a.csv: 3 rows, more than the limit of 2 rows (max_rows); raise it with \
              --max-rows\n"
         );
-        let unmapped = name_flags(anyhow::Error::new(limit), &[("max_frames", "--max-frames")]);
-        assert!(!unmapped.to_string().contains("raise it"), "{unmapped}");
-        let stopped = anyhow::Error::new(inbetween_core::cancel::Cancelled::TimeLimit { limit_s: 2.0 });
-        assert_eq!(name_flags(stopped, &[]).to_string(), "time limit of 2 s reached; raise it with --time-limit");
         let face = inbetween_face::data::FaceError::from(inbetween_core::cancel::Cancelled::TimeLimit { limit_s: 2.0 });
         assert_eq!(
             name_flags(face.into(), &[]).to_string(),
             "face job stopped: time limit of 2 s reached; raise it with --time-limit"
         );
-        let other = name_flags(anyhow::anyhow!("disk full"), &[("max_rows", "--max-rows")]);
-        assert_eq!(other.to_string(), "disk full");
+        let batch = name_flags(anyhow::anyhow!("option `keys` does not apply"), &[("keys", "-k")]);
+        assert_eq!(batch.to_string(), "option -k does not apply");
+        let other = name_flags(anyhow::anyhow!("disk full").context("writing"), &[("keys", "-k")]);
+        assert_eq!(render(&other, false), "error: writing\n  caused by: disk full\n");
     }
 
     #[test]
@@ -136,10 +111,6 @@ mod tests {
         assert_eq!(
             render(&e, false),
             "error: refusing to overwrite w.bpk (set --overwrite-committed to replace them on purpose)\n"
-        );
-        assert_eq!(
-            with_flags("given with `unit`; build with `cargo build`"),
-            "given with --unit; build with `cargo build`"
         );
     }
 
