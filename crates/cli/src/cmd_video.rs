@@ -1,6 +1,7 @@
 //! `inbetween video …`: new frame orders from one clip (RSFNet metric + SDPF path finding).
 
 use std::path::PathBuf;
+use std::sync::LazyLock;
 
 use clap::{Args, Subcommand, ValueEnum};
 use inbetween_core::cancel::Cancel;
@@ -10,7 +11,8 @@ use inbetween_video::frames::{write_clip, Decoder, ProceduralKind, ReadOptions, 
 use inbetween_video::job::{AnalyseJob, ResequenceJob, ResequenceSource, VideoInput};
 use inbetween_video::pipeline::{MetricChoice, ResequenceConfig, VideoLimits};
 use inbetween_video::sdpf::SdpfParams;
-use inbetween_video::VideoError;
+
+use crate::errors::name_flags;
 
 #[derive(Subcommand)]
 pub enum VideoCommand {
@@ -98,7 +100,7 @@ pub struct ResequenceArgs {
     #[arg(long, default_value_t = VideoLimits::default().max_frames)]
     pub limit_frames: usize,
     /// Refuse frames larger than this, WIDTHxHEIGHT (compared as a pixel count).
-    #[arg(long, default_value = "3840x2160", value_parser = VideoLimits::parse_pixels)]
+    #[arg(long, default_value = RESOLUTION.as_str(), value_parser = VideoLimits::parse_pixels)]
     pub limit_resolution: u64,
     /// Refuse target lengths above this many frames.
     #[arg(long, default_value_t = VideoLimits::default().max_length)]
@@ -148,6 +150,12 @@ pub struct ResequenceArgs {
     pub max_frames: Option<usize>,
 }
 
+/// The engine's frame size limit, written as --limit-resolution takes it.
+static RESOLUTION: LazyLock<String> = LazyLock::new(|| {
+    let (width, height) = VideoLimits::DEFAULT_RESOLUTION;
+    format!("{width}x{height}")
+});
+
 #[derive(Clone, Copy, ValueEnum)]
 pub enum KindArg {
     Pendulum,
@@ -190,30 +198,14 @@ pub fn run(c: VideoCommand) -> anyhow::Result<()> {
     }
 }
 
-/// The command-line flag that raises each limit of [`VideoLimits`].
-fn limit_flag(field: &str) -> &'static str {
-    match field {
-        "max_frames" => "--limit-frames",
-        "max_pixels" => "--limit-resolution",
-        "max_length" => "--limit-length",
-        _ => "--limit-count",
-    }
-}
-
-/// A library error, with the flag that raises the limit when it is one.
-fn with_flag(e: VideoError) -> anyhow::Error {
-    match &e {
-        VideoError::Limit { field, .. } => anyhow::anyhow!("{e}; raise it with {}", limit_flag(field)),
-        VideoError::StartOutside { start, frames } => {
-            anyhow::anyhow!("--start {start} is outside the clip (frames 0..{})", frames.saturating_sub(1))
-        }
-        VideoError::TooManyFrames { path, limit } => anyhow::anyhow!(
-            "{}: more than {limit} frames, the limit; raise it with --limit-frames, or read only the first frames with --max-frames",
-            path.display()
-        ),
-        _ => e.into(),
-    }
-}
+/// The fields the engine names (its limits, the read options) and the flags that set them.
+const VIDEO_FLAGS: &[(&str, &str)] = &[
+    ("max_frames", "--limit-frames"),
+    ("max_pixels", "--limit-resolution"),
+    ("max_length", "--limit-length"),
+    ("max_count", "--limit-count"),
+    ("read.max_frames", "--max-frames"),
+];
 
 fn kind(k: KindArg) -> ProceduralKind {
     match k {
@@ -237,14 +229,6 @@ fn run_probe(a: ProbeArgs) -> anyhow::Result<()> {
 }
 
 fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
-    if a.length == Some(0) {
-        anyhow::bail!(
-            "--length 0 asks for no frame: give at least 1 (the start frame), or leave it out for the source's length"
-        );
-    }
-    if a.count == 0 {
-        anyhow::bail!("--count 0 asks for no sequence: give at least 1");
-    }
     let limits = VideoLimits {
         max_frames: a.limit_frames,
         max_pixels: a.limit_resolution,
@@ -299,9 +283,9 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         blend: a.blend,
         explain: a.explain,
     };
-    job.validate().map_err(with_flag)?;
+    job.validate().map_err(|e| name_flags(e.into(), VIDEO_FLAGS))?;
     let progress = Progress::new(steps, "RSFNet");
-    let report = job.run(&cancel, &progress).map_err(with_flag)?;
+    let report = job.run(&cancel, &progress).map_err(|e| name_flags(e.into(), VIDEO_FLAGS))?;
     progress.finish();
     print!("{}", crate::errors::with_flags(&report.to_string()));
     Ok(())

@@ -1,5 +1,6 @@
 //! Errors of the video engine.
 
+use inbetween_io::LimitExceeded;
 use std::path::PathBuf;
 
 /// What went wrong, naming the file (and frame) where there is one.
@@ -20,14 +21,17 @@ pub enum VideoError {
     #[error("{0}")]
     Invalid(String),
     /// An input or request beyond one of the limits of
-    /// [`VideoLimits`](crate::pipeline::VideoLimits), refused before the heavy work. `field` names
-    /// the limit (a field of `VideoLimits`), so that a front end can name its own way to raise it.
-    #[error("{subject}: {value} {what} is more than the limit of {limit} (VideoLimits::{field})")]
-    Limit { subject: String, what: &'static str, value: u64, limit: u64, field: &'static str },
-    /// A clip read from `path` has more frames than [`VideoLimits::max_frames`](crate::pipeline::VideoLimits)
-    /// (decoding stops one frame past the limit).
-    #[error("{}: more than {limit} frames, the limit (VideoLimits::max_frames); read only the first frames with ReadOptions::max_frames", path.display())]
-    TooManyFrames { path: PathBuf, limit: usize },
+    /// [`VideoLimits`](crate::pipeline::VideoLimits), refused before the heavy work. Its `field`
+    /// names the limit (a field of `VideoLimits`), so that a front end can name its own way to
+    /// raise it ([`inbetween_io::limits::raise_hint`]).
+    #[error("{0}")]
+    Limit(#[source] LimitExceeded),
+    /// A clip read from a file has more frames than
+    /// [`VideoLimits::max_frames`](crate::pipeline::VideoLimits) (decoding stops one frame past
+    /// the limit); reading only the first frames (`read.max_frames`, the job's
+    /// [`ReadOptions::max_frames`](crate::frames::ReadOptions)) is the other way out.
+    #[error("{0}; or read only the first frames with `read.max_frames`")]
+    TooManyFrames(#[source] LimitExceeded),
     /// A start frame past the clip's last frame (`frames` frames).
     #[error("start frame {start} is outside the clip (frames 0..{})", frames.saturating_sub(1))]
     StartOutside { start: usize, frames: usize },

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use inbetween_core::cancel::Cancel;
-use inbetween_io::Progress;
+use inbetween_io::{LimitExceeded, Progress};
 use rayon::prelude::*;
 
 use crate::frames::Clip;
@@ -72,11 +72,15 @@ impl Default for VideoLimits {
     /// 3 000 frames (2 minutes at 25 fps), 3840×2160 pixels (UHD), orders of 10 000 frames, 16
     /// sequences per call.
     fn default() -> Self {
-        VideoLimits { max_frames: 3000, max_pixels: 3840 * 2160, max_length: 10_000, max_count: 16 }
+        let (width, height) = VideoLimits::DEFAULT_RESOLUTION;
+        VideoLimits { max_frames: 3000, max_pixels: width * height, max_length: 10_000, max_count: 16 }
     }
 }
 
 impl VideoLimits {
+    /// The default frame size limit, width × height in pixels (UHD), as front ends write it.
+    pub const DEFAULT_RESOLUTION: (u64, u64) = (3840, 2160);
+
     /// A frame-size limit written `WIDTHxHEIGHT` (`3840x2160`, `x` or `X`), as the pixel count
     /// [`VideoLimits::max_pixels`] holds; an error says what was expected.
     pub fn parse_pixels(s: &str) -> Result<u64, String> {
@@ -94,23 +98,18 @@ impl VideoLimits {
     pub fn check_clip(&self, clip: &Clip) -> Result<(), VideoError> {
         let subject = clip.source.clone();
         if clip.len() > self.max_frames {
-            return Err(VideoError::Limit {
+            return Err(VideoError::Limit(over(
                 subject,
-                what: "frames",
-                value: clip.len() as u64,
-                limit: self.max_frames as u64,
-                field: "max_frames",
-            });
+                clip.len() as u64,
+                self.max_frames as u64,
+                "frames",
+                "max_frames",
+            )));
         }
         let pixels = clip.frames.iter().map(|f| u64::from(f.width()) * u64::from(f.height())).max().unwrap_or(0);
         if pixels > self.max_pixels {
-            return Err(VideoError::Limit {
-                subject: format!("{subject} ({}x{})", clip.width(), clip.height()),
-                what: "pixels per frame",
-                value: pixels,
-                limit: self.max_pixels,
-                field: "max_pixels",
-            });
+            let subject = format!("{subject} ({}x{})", clip.width(), clip.height());
+            return Err(VideoError::Limit(over(subject, pixels, self.max_pixels, "pixels per frame", "max_pixels")));
         }
         Ok(())
     }
@@ -128,25 +127,20 @@ impl VideoLimits {
         }
         let length = length.unwrap_or(frames);
         if length > self.max_length {
-            return Err(VideoError::Limit {
-                subject: "the requested length".into(),
-                what: "frames",
-                value: length as u64,
-                limit: self.max_length as u64,
-                field: "max_length",
-            });
+            let (length, limit) = (length as u64, self.max_length as u64);
+            return Err(VideoError::Limit(over("the requested length", length, limit, "frames", "max_length")));
         }
         if count > self.max_count {
-            return Err(VideoError::Limit {
-                subject: "the requested count".into(),
-                what: "sequences",
-                value: count as u64,
-                limit: self.max_count as u64,
-                field: "max_count",
-            });
+            let (count, limit) = (count as u64, self.max_count as u64);
+            return Err(VideoError::Limit(over("the requested count", count, limit, "sequences", "max_count")));
         }
         Ok(())
     }
+}
+
+/// `value` `unit` over the limit `limit` of the field `field` of [`VideoLimits`].
+fn over(subject: impl Into<String>, value: u64, limit: u64, unit: &str, field: &'static str) -> LimitExceeded {
+    LimitExceeded { subject: subject.into(), found: format!("{value} {unit}"), limit: format!("{limit} {unit}"), field }
 }
 
 impl Default for ResequenceConfig {
@@ -642,8 +636,8 @@ pub(crate) mod tests {
         let mut cfg = quick_config(dir.path());
         cfg.limits.max_frames = 10;
         let e = analyse(&clip, &cfg, &Progress::hidden()).err().unwrap_or_else(|| panic!("too many frames"));
-        assert!(matches!(e, VideoError::Limit { field: "max_frames", value: 12, limit: 10, .. }), "{e}");
-        assert!(e.to_string().contains("12 frames is more than the limit of 10"), "{e}");
+        assert!(matches!(&e, VideoError::Limit(l) if l.field == "max_frames"), "{e}");
+        assert!(e.to_string().contains("12 frames, more than the limit of 10 frames (max_frames)"), "{e}");
         cfg.limits = VideoLimits { max_pixels: 64 * 47, ..VideoLimits::default() };
         let e = analyse(&clip, &cfg, &Progress::hidden()).err().unwrap_or_else(|| panic!("too many pixels"));
         assert!(e.to_string().contains("64x48") && e.to_string().contains("max_pixels"), "{e}");

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use inbetween_core::cancel::Cancel;
-use inbetween_io::Progress;
+use inbetween_io::{LimitExceeded, Progress};
 use serde::Serialize;
 
 use crate::frames::{read_clip, Clip, ReadOptions};
@@ -88,7 +88,15 @@ impl AnalyseJob {
                 let max_frames = Some(self.read.max_frames.map_or(past_limit, |m| m.min(past_limit)));
                 let (clip, report) = read_clip(path, &ReadOptions { max_frames, ..self.read.clone() })?;
                 if clip.len() > limit {
-                    return Err(VideoError::TooManyFrames { path: path.clone(), limit });
+                    // Decoding stopped one frame past the limit: the file holds at least that many.
+                    let found = format!("{} frames or more", clip.len());
+                    let (subject, limit) = (path.display().to_string(), format!("{limit} frames"));
+                    return Err(VideoError::TooManyFrames(LimitExceeded {
+                        subject,
+                        found,
+                        limit,
+                        field: "max_frames",
+                    }));
                 }
                 Ok((Arc::new(clip), Some(report)))
             }

@@ -93,7 +93,7 @@ fn bad_requests_are_refused_before_the_work() {
     let job = ResequenceJob { count: 0, ..ResequenceJob::for_file("clip.mp4") };
     assert!(job.validate().unwrap_err().to_string().contains("0 sequences"));
     let job = ResequenceJob { count: 99, ..ResequenceJob::for_file("clip.mp4") };
-    assert!(matches!(job.validate(), Err(VideoError::Limit { field: "max_count", .. })));
+    assert!(matches!(job.validate(), Err(VideoError::Limit(l)) if l.field == "max_count"));
     let job = ResequenceJob {
         params: SdpfParams { length: Some(0), ..SdpfParams::default() },
         ..ResequenceJob::for_file("clip.mp4")
@@ -117,7 +117,9 @@ fn bad_requests_are_refused_before_the_work() {
     // Over the frame limit: refused after reading one frame past it.
     analyse.config.limits.max_frames = 10;
     let e = analyse.run(&Cancel::new(), &Progress::hidden()).unwrap_err();
-    assert!(matches!(e, VideoError::TooManyFrames { limit: 10, .. }), "{e}");
+    assert!(matches!(&e, VideoError::TooManyFrames(l) if l.field == "max_frames"), "{e}");
+    let said = "drift.gif: 11 frames or more, more than the limit of 10 frames (max_frames); or read only the first";
+    assert!(e.to_string().ends_with(&format!("{said} frames with `read.max_frames`")), "{e}");
 }
 
 #[test]
