@@ -27,6 +27,14 @@ pub struct BenchOptions {
     pub shards: Vec<usize>,
 }
 
+impl BenchOptions {
+    /// The bench's runs: 1 and 2 shards (the speed-up of a second process), their outputs in the
+    /// scratch folder `out/runs`, which [`run`] removes when it is done (the report is what stays).
+    pub fn new(exe: PathBuf, data: PathBuf, out: &Path, python: Option<PathBuf>) -> BenchOptions {
+        BenchOptions { exe, data, scratch: out.join("runs"), python, shards: vec![1, 2] }
+    }
+}
+
 /// One workload: a batch job over one folder.
 struct Workload {
     job: &'static str,
@@ -260,5 +268,7 @@ pub fn run(opts: &BenchOptions) -> Result<Report, BatchError> {
         "linear in files and cores (inputs are independent); the measured speed-up at 2 workers is the check on that",
     );
     report.table(runs_t).table(proj).table(slow);
+    // The runs' outputs are scratch; the report is what stays.
+    let _ = std::fs::remove_dir_all(&opts.scratch);
     Ok(report)
 }

@@ -128,7 +128,7 @@ impl Options {
         for field in self.set_fields() {
             if !kind.reads().contains(&field) {
                 return Err(BatchError::Invalid(format!(
-                    "option {field} does not apply to {}; it reads {}",
+                    "option `{field}` does not apply to {}; it reads {}",
                     kind.name(),
                     if kind.reads().is_empty() { "no option".to_string() } else { kind.reads().join(", ") }
                 )));
@@ -141,14 +141,14 @@ impl Options {
         }
         match kind {
             Kind::MocapCompress if self.max_error_cm.is_some() == self.keys.is_some() => Err(BatchError::Invalid(
-                "mocap-compress needs either an error bound (max_error_cm) or a key count (keys)".into(),
+                "mocap-compress needs either an error bound (`max_error_cm`) or a key count (`keys`)".into(),
             )),
             Kind::MocapKeys if self.max_error_cm.is_some() && self.keys.is_some() => Err(BatchError::Invalid(
-                "mocap-keys takes an error bound (max_error_cm) or a key count (keys), not both".into(),
+                "mocap-keys takes an error bound (`max_error_cm`) or a key count (`keys`), not both".into(),
             )),
-            Kind::MocapKeys if self.max_error_cm.is_none() && self.keys.is_none() => {
-                Err(BatchError::Invalid("mocap-keys needs an error bound (max_error_cm) or a key count (keys)".into()))
-            }
+            Kind::MocapKeys if self.max_error_cm.is_none() && self.keys.is_none() => Err(BatchError::Invalid(
+                "mocap-keys needs an error bound (`max_error_cm`) or a key count (`keys`)".into(),
+            )),
             Kind::FaceEdit if self.mask.is_none() => {
                 Err(BatchError::Invalid("face-edit needs a mask (the spans to regenerate, e.g. 4s..6.5s)".into()))
             }

@@ -146,7 +146,7 @@ fn bad_options_and_folders_are_refused_before_any_work() {
     let nan = Options { max_error_cm: Some(f64::NAN), ..Options::default() };
     assert!(err(BatchJob { options: nan, ..base.clone() }).contains("expected a positive length"));
     let mask = Options { mask: Some("1s..2s".into()), max_error_cm: Some(1.0), ..Options::default() };
-    assert!(err(BatchJob { options: mask, ..base.clone() }).contains("option mask does not apply to mocap-compress"));
+    assert!(err(BatchJob { options: mask, ..base.clone() }).contains("option `mask` does not apply to mocap-compress"));
     assert!(err(BatchJob { input_dir: tmp.path().join("missing"), ..base.clone() }).contains("expected a folder"));
     assert!(inbetween_batch::Kind::parse("mocap-zip").unwrap_err().to_string().contains("mocap-compress"));
 }

@@ -118,7 +118,7 @@ pub fn run(c: BatchCommand) -> anyhow::Result<()> {
         shard,
         options: Options { max_error_cm, keys: a.k, method: a.method, mask: a.mask, seed: a.seed },
     };
-    job.validate().map_err(|e| anyhow::anyhow!(flags(&e.to_string())))?;
+    job.validate().map_err(|e| crate::errors::name_flags(e.into(), BATCH_FLAGS))?;
     let progress = Progress::new(0, kind.name());
     let report = job.run(&Cancel::new(), &progress)?;
     progress.finish();
@@ -129,14 +129,9 @@ pub fn run(c: BatchCommand) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The library names options by field; the command by flag.
-fn flags(text: &str) -> String {
-    [("max_error_cm", "--max-error"), ("keys", "-k"), ("method", "--method"), ("mask", "--mask"), ("seed", "--seed")]
-        .iter()
-        .fold(text.to_string(), |t, (field, flag)| t.replace(&format!("option {field}"), &format!("option {flag}")))
-        .replace("(max_error_cm)", "(--max-error)")
-        .replace("(keys)", "(-k)")
-}
+/// The job's option fields and the flags that set them.
+const BATCH_FLAGS: &[(&str, &str)] =
+    &[("max_error_cm", "--max-error"), ("keys", "-k"), ("method", "--method"), ("mask", "--mask"), ("seed", "--seed")];
 
 fn summary(a: SummaryArgs) -> anyhow::Result<()> {
     let s = SummaryJob { out_dir: a.out, slowest: a.slowest }.run()?;
@@ -154,16 +149,8 @@ fn bench(a: BenchArgs) -> anyhow::Result<()> {
         None => inbetween_io::shared_data_dir()
             .map_err(|p| anyhow::anyhow!("no data at {} (give --data or set INBETWEEN_DATA)", p.display()))?,
     };
-    let opts = inbetween_batch::bench::BenchOptions {
-        exe: std::env::current_exe().context("finding the inbetween binary")?,
-        data,
-        scratch: a.out.join("runs"),
-        python: a.python,
-        shards: vec![1, 2],
-    };
-    let report = inbetween_batch::bench::run(&opts)?;
-    // The runs' outputs are scratch; the report is what stays.
-    let _ = std::fs::remove_dir_all(&opts.scratch);
+    let exe = std::env::current_exe().context("finding the inbetween binary")?;
+    let report = inbetween_batch::bench::run(&inbetween_batch::bench::BenchOptions::new(exe, data, &a.out, a.python))?;
     for p in report.write(&a.out)? {
         println!("wrote {}", p.display());
     }
