@@ -22,6 +22,14 @@ pub const FPS: f64 = 30.0;
 /// The networks see every 5th frame (§4.5).
 pub const DOWNSAMPLE: usize = 5;
 
+/// Frames per network step in a scene at `fps`: the networks were trained on every 5th frame at
+/// 30 fps ([`DOWNSAMPLE`], [`FPS`]: a step is 1/6 s), so a scene at another rate steps every
+/// `5 · fps / 30` frames (20 at 120 fps, 4 at 24 fps; rounded to the nearest frame where that is not
+/// whole) and its motion keeps the speed the networks learned.
+pub fn step_frames(fps: f64) -> f64 {
+    DOWNSAMPLE as f64 * fps / FPS
+}
+
 /// One filmed sequence: character features and the camera track, frame by frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Sequence {

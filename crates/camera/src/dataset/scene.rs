@@ -45,8 +45,13 @@ impl Scene {
 
     /// Checks shapes and values; the message names the character, the frame and what was expected.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.fps.is_finite() && self.fps > 0.0) {
-            return Err(format!("fps must be positive, got {}", self.fps));
+        // A network step (1/6 s, `step_frames`) must span at least one frame.
+        let min = super::FPS / super::DOWNSAMPLE as f64;
+        if !(self.fps.is_finite() && self.fps >= min) {
+            return Err(format!(
+                "{} fps: expected at least {min} fps (the camera networks step every 1/6 s)",
+                self.fps
+            ));
         }
         if self.characters.len() < 2 {
             return Err(format!("expected at least 2 characters, got {}", self.characters.len()));

@@ -1,6 +1,7 @@
 //! Causal, one-frame-at-a-time generation for live use (beyond the paper): character features
-//! arrive frame by frame and a camera comes back at once. The network runs on every 5th frame with
-//! the features of that frame; frames in between extrapolate the last network step linearly, so
+//! arrive frame by frame and a camera comes back at once. The network runs every 1/6 s (every 5th
+//! frame at 30 fps, [`step_frames`]) with the features of that frame; frames in between extrapolate
+//! the last network step linearly, so
 //! nothing waits for the future. Keys (placed ahead by the user) can be announced at any time; a
 //! live camera cannot go back, so it corrects nothing and reports its misses.
 
@@ -8,17 +9,20 @@ use super::keys::ResolvedKeys;
 use super::track::{camera_frame, GeneratedTrack, KeyResidual};
 use super::{key_vector, toric_distance, velocity_frames, Cam, FastModel, KeyVec, Rollout, Style};
 use crate::dataset::Scene;
-use crate::dataset::DOWNSAMPLE;
+use crate::dataset::{step_frames, DOWNSAMPLE, FPS};
 use crate::features::{decode_camera, encode_camera, encode_character, CharacterFeatures, CAM_DIM};
 use crate::toric::{Lens, Toric};
 use crate::CameraError;
 use inbetween_nn::runtime::LstmState;
 
-/// The live camera: a [`Rollout`] stepped on every 5th pushed frame.
+/// The live camera: a [`Rollout`] stepped every [`step_frames`] pushed frames.
 pub struct CausalCamera<'a> {
     rollout: Rollout<'a>,
     cap: usize,
     frame: usize,
+    /// Frames per network step at the scene's rate, and the steps taken.
+    step: f64,
+    steps: usize,
     velocity: Cam,
     key: Option<(usize, KeyVec)>,
 }
@@ -32,12 +36,14 @@ impl<'a> CausalCamera<'a> {
         velocity: Option<[f64; 6]>,
         fps: f64,
     ) -> CausalCamera<'a> {
-        let dt = DOWNSAMPLE as f64 / fps;
+        let dt = DOWNSAMPLE as f64 / FPS;
         let v = velocity.unwrap_or([0.0; 6]);
         CausalCamera {
-            rollout: Rollout::mapped(model, style, &velocity_frames(start, velocity, fps)),
+            rollout: Rollout::mapped(model, style, &velocity_frames(start, velocity)),
             cap: model.config.tta_max as usize,
             frame: 0,
+            step: step_frames(fps),
+            steps: 0,
             velocity: std::array::from_fn(|j| (v[j] * dt) as f32),
             key: None,
         }
@@ -56,12 +62,19 @@ impl<'a> CausalCamera<'a> {
     /// Consumes the next frame's character features and returns that frame's camera.
     pub fn push(&mut self, character: &CharacterFeatures) -> Toric {
         self.frame += 1;
-        let phase = self.frame % DOWNSAMPLE;
+        // The frames of the last network step and of the next.
+        let at = |n: usize| (n as f64 * self.step).round() as usize;
+        let (prev, next_at) = (at(self.steps), at(self.steps + 1));
         let last = self.rollout.prev();
-        if phase == 0 {
+        if self.frame >= next_at {
+            self.steps += 1;
             let chr = encode_character(character);
+            // Times to arrival in the networks' 30 fps frames.
+            let to_model = DOWNSAMPLE as f64 / self.step;
             let (tta_frames, key) = match self.key {
-                Some((kf, v)) if kf >= self.frame => ((kf - self.frame).min(self.cap), v),
+                Some((kf, v)) if kf >= self.frame => {
+                    ((((kf - self.frame) as f64 * to_model).round() as usize).min(self.cap), v)
+                }
                 Some((_, v)) => (0, v),
                 // No key yet: aim at holding the current camera, as far away as the tta cap.
                 None => (self.cap, key_vector(&last, &chr)),
@@ -70,7 +83,7 @@ impl<'a> CausalCamera<'a> {
             self.velocity = std::array::from_fn(|j| next[j] - last[j]);
             return decode_camera(&next);
         }
-        let u = phase as f32 / DOWNSAMPLE as f32;
+        let u = (self.frame - prev) as f32 / (next_at - prev).max(1) as f32;
         decode_camera(&std::array::from_fn::<f32, CAM_DIM, _>(|j| last[j] + self.velocity[j] * u))
     }
 

@@ -7,7 +7,7 @@
 use super::keys::{ResolvedKey, ResolvedKeys};
 use super::track::{camera_frame, CameraFrame, GeneratedTrack, KeyResidual};
 use super::{key_vector, toric_distance, velocity_frames, Chr, FastModel, Keys, Rollout, Style};
-use crate::dataset::{Scene, DOWNSAMPLE};
+use crate::dataset::{step_frames, Scene, DOWNSAMPLE};
 use crate::features::{decode_camera, encode_camera, encode_character, CharacterFeatures};
 use crate::toric::{Lens, Toric};
 use crate::CameraError;
@@ -143,14 +143,17 @@ impl<'a> GenerateJob<'a> {
         encode_character(&CharacterFeatures::compute(&a, &b, keys.main_is_a(pair)))
     }
 
-    /// The network's output every 5th frame from the first key: one segment per key, each key
-    /// snapped to that grid for the network (its sample then moved to the key's own frame).
+    /// The network's output every step (5 frames at 30 fps, 1/6 s at any rate: [`step_frames`])
+    /// from the first key: one segment per key, each key snapped to that grid for the network (its
+    /// sample then moved to the key's own frame); times to arrival in the networks' 30 fps frames.
     fn network_samples(&self, keys: &ResolvedKeys) -> Result<NetworkSamples, CameraError> {
         let (model, k) = (self.model, &keys.keys);
         let (first, last) = (keys.first_frame(), keys.last_frame(self.scene));
-        let grid = |f: usize| first + ((f - first) as f64 / DOWNSAMPLE as f64).round() as usize * DOWNSAMPLE;
-        let mut rollout =
-            Rollout::mapped(model, &self.style.code, &velocity_frames(&k[0].camera, k[0].velocity, self.scene.fps));
+        let step = step_frames(self.scene.fps);
+        // The frame of network step `n`, and the step nearest frame `f`.
+        let at = |n: usize| first + (n as f64 * step).round() as usize;
+        let step_of = |f: usize| ((f - first) as f64 / step).round() as usize;
+        let mut rollout = Rollout::mapped(model, &self.style.code, &velocity_frames(&k[0].camera, k[0].velocity));
         let mut out = NetworkSamples {
             samples: vec![(first, k[0].camera.to_array())],
             pairs: vec![(first, k[0].pair)],
@@ -159,15 +162,17 @@ impl<'a> GenerateJob<'a> {
         // With a single key the camera runs free to the end, aiming at that key forever (tta capped).
         let single = k.len() == 1;
         let targets: &[ResolvedKey] = if single { &k[..1] } else { &k[1..] };
-        let mut f = first;
+        let (mut n, mut f) = (0, first);
         for (ti, target) in targets.iter().enumerate() {
-            let end = if single { last - (last - first) % DOWNSAMPLE } else { grid(target.frame).max(f + DOWNSAMPLE) };
+            let end =
+                if single { ((last - first) as f64 / step).floor() as usize } else { step_of(target.frame).max(n + 1) };
             let key = key_vector(&encode_camera(&target.camera), &self.character(keys, target.frame, target.pair));
             out.pairs.push((f + 1, target.pair));
-            while f + DOWNSAMPLE <= end {
+            while n < end {
                 self.options.check_cancel()?;
-                f += DOWNSAMPLE;
-                let tta_frames = if single { model.config.tta_max as usize } else { end - f };
+                n += 1;
+                f = at(n);
+                let tta_frames = if single { model.config.tta_max as usize } else { (end - n) * DOWNSAMPLE };
                 let next = rollout.step(&self.character(keys, f.min(last), target.pair), &key, tta_frames);
                 out.samples.push((f.min(last), decode_camera(&next).to_array()));
             }
@@ -182,7 +187,7 @@ impl<'a> GenerateJob<'a> {
             out.samples[n].0 = target.frame.min(last).max(out.samples[n.saturating_sub(1)].0 + 1);
             if ti + 1 < targets.len() {
                 if target.velocity.is_some() {
-                    rollout.restart_from(&velocity_frames(&target.camera, target.velocity, self.scene.fps));
+                    rollout.restart_from(&velocity_frames(&target.camera, target.velocity));
                 } else if self.options.remap_at_keys {
                     rollout.restart_from_arrival();
                 }

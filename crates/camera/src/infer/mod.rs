@@ -51,10 +51,10 @@ pub fn key_vector(camera: &Cam, character: &Chr) -> KeyVec {
 }
 
 /// H's input for a camera at `camera` moving at `velocity` (x^c per second; none = still): the
-/// [`MAP_FRAMES`] network steps (5 frames apart at `fps`) that end on `camera`.
-pub fn velocity_frames(camera: &Toric, velocity: Option<[f64; 6]>, fps: f64) -> [Cam; MAP_FRAMES] {
+/// [`MAP_FRAMES`] network steps (1/6 s apart, [`crate::dataset::step_frames`]) that end on `camera`.
+pub fn velocity_frames(camera: &Toric, velocity: Option<[f64; 6]>) -> [Cam; MAP_FRAMES] {
     let v = velocity.unwrap_or([0.0; 6]);
-    let dt = crate::dataset::DOWNSAMPLE as f64 / fps;
+    let dt = crate::dataset::DOWNSAMPLE as f64 / crate::dataset::FPS;
     std::array::from_fn(|i| {
         let back = (MAP_FRAMES - 1 - i) as f64 * dt;
         std::array::from_fn(|j| (camera.to_array()[j] - v[j] * back) as f32)

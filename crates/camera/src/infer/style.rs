@@ -4,7 +4,7 @@
 
 use super::FastModel;
 use crate::dataset::Scene;
-use crate::dataset::{Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE};
+use crate::dataset::{step_frames, Behaviour, Dataset, BEHAVIOURS, DOWNSAMPLE, FPS};
 use crate::features::{encode_camera, encode_character, CharacterFeatures};
 use crate::model::STYLE_STEPS;
 use crate::toric::{from_pose, CameraPose, Lens, Toric};
@@ -68,26 +68,48 @@ pub fn behaviour_code(styles: &[NamedStyle], behaviour: Behaviour) -> Option<Sty
         .map(|s| Style { name: behaviour.name().into(), code: s.code.clone() })
 }
 
-/// A reference clip for style extraction: Eq. 1 and Eq. 2 features per frame (30 fps). A dataset
-/// [`crate::dataset::Sequence`] file is one.
+/// A reference clip for style extraction: Eq. 1 and Eq. 2 features per frame at `fps` (30 when a
+/// file does not say). A dataset [`crate::dataset::Sequence`] file is one.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ReferenceClip {
     pub characters: Vec<CharacterFeatures>,
     pub camera: Vec<Toric>,
+    /// Frames per second; the style is read every network step (1/6 s, [`step_frames`]).
+    #[serde(default = "training_fps")]
+    pub fps: f64,
+}
+
+fn training_fps() -> f64 {
+    FPS
 }
 
 impl ReferenceClip {
-    /// Style code of the clip; needs at least 50 frames (300 recommended, §4.5).
+    /// Style code of the clip, read every network step; needs at least 10 steps (50 frames at
+    /// 30 fps; 60 steps recommended, §4.5).
     pub fn style(&self, model: &FastModel, origin: &Path) -> Result<Vec<f32>, CameraError> {
         let n = self.characters.len().min(self.camera.len());
-        if n < DOWNSAMPLE * 10 {
+        if !(self.fps.is_finite() && self.fps > 0.0) {
             return Err(CameraError::invalid(
                 origin,
-                format!("reference clip has {n} frames; at least {} are needed (300 recommended)", DOWNSAMPLE * 10),
+                format!("reference clip at {} fps: expected a positive rate", self.fps),
             ));
         }
-        let chars: Vec<_> = (0..n).step_by(DOWNSAMPLE).map(|i| encode_character(&self.characters[i])).collect();
-        let cams: Vec<_> = (0..n).step_by(DOWNSAMPLE).map(|i| encode_camera(&self.camera[i])).collect();
+        let step = step_frames(self.fps);
+        let frames = |steps: f64| (steps * step).ceil() as usize;
+        if n < frames(10.0) {
+            return Err(CameraError::invalid(
+                origin,
+                format!(
+                    "reference clip has {n} frames; at least {} are needed ({} recommended)",
+                    frames(10.0),
+                    frames(60.0)
+                ),
+            ));
+        }
+        // The frame of every step inside the clip (every 5th at 30 fps).
+        let at: Vec<usize> = (0..).map(|s| (s as f64 * step).round() as usize).take_while(|&i| i < n).collect();
+        let chars: Vec<_> = at.iter().map(|&i| encode_character(&self.characters[i])).collect();
+        let cams: Vec<_> = at.iter().map(|&i| encode_camera(&self.camera[i])).collect();
         Ok(model.extract_style(&chars, &cams))
     }
 
@@ -117,7 +139,7 @@ impl ReferenceClip {
             .collect::<Result<Vec<_>, _>>()?;
         let mut characters = scene.character_features(0, 1, true);
         characters.truncate(camera.len());
-        Ok(ReferenceClip { characters, camera })
+        Ok(ReferenceClip { characters, camera, fps: scene.fps })
     }
 }
 
