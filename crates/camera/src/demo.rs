@@ -2,27 +2,33 @@
 //! built-in procedural scene, keyframes, the committed weights, one track per behaviour style.
 
 use crate::dataset::{film_sequence, Behaviour, Scene, BEHAVIOURS};
-use crate::infer::{example_keys, GenerateJob, Keys};
+use crate::infer::{example_keys, GenerateJob, GenerateLimits, Keys};
 use crate::toric::Lens;
 use crate::weights::committed;
 use crate::CameraError;
-use inbetween_io::Progress;
+use inbetween_io::{LimitExceeded, OutputSet, Progress};
 use std::path::Path;
 
 /// Frames of `camera scene`'s example (15 s at 30 fps).
 pub const EXAMPLE_SCENE_FRAMES: usize = 450;
 
 /// Writes `scene.json`, `keys.json` (keys at the start, middle and end) and one
-/// `reference-<behaviour>.json` filmed clip per behaviour into `dir`: everything `camera generate`
-/// needs to try each style. Returns the files written.
-pub fn write_example_scene(dir: &Path, seed: u64, frames: usize) -> Result<Vec<String>, CameraError> {
+/// `reference-<behaviour>.json` filmed clip per behaviour into `out`: everything `camera generate`
+/// needs to try each style. The files appear together in `out` (merged into it when it exists) or
+/// none do. A scene of fewer than 2 frames, or over the generate job's `limits.max_frames` (the
+/// scene could not be used), is refused before anything is written. Returns the files written.
+pub fn write_example_scene(
+    out: &Path,
+    seed: u64,
+    frames: usize,
+    limits: &GenerateLimits,
+) -> Result<Vec<String>, CameraError> {
+    LimitExceeded::check_count("the scene", frames, limits.max_frames, "frames", "max_frames")?;
     if frames < 2 {
-        return Err(CameraError::Invalid {
-            path: dir.into(),
-            message: format!("a scene needs at least 2 frames, got {frames}"),
-        });
+        return Err(CameraError::invalid(out, format!("a scene needs at least 2 frames, got {frames}")));
     }
-    std::fs::create_dir_all(dir).map_err(|source| CameraError::Io { path: dir.into(), source })?;
+    let mut set = OutputSet::new();
+    let dir = set.dir(out).map_err(|source| CameraError::Io { path: out.into(), source })?;
     let scene = Scene::procedural(seed, frames, 30.0);
     scene.save(&dir.join("scene.json"))?;
     let n = frames - 1;
@@ -36,6 +42,7 @@ pub fn write_example_scene(dir: &Path, seed: u64, frames: usize) -> Result<Vec<S
         crate::write_json(&dir.join(&name), &seq)?;
         files.push(name);
     }
+    set.commit().map_err(|source| CameraError::Io { path: out.into(), source })?;
     Ok(files)
 }
 
@@ -100,15 +107,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn example_scene_files_load_back_and_a_one_frame_scene_is_refused() {
+    fn example_scene_files_load_back_and_scenes_too_short_or_long_are_refused() {
         let dir = tempfile::tempdir().unwrap();
-        let files = write_example_scene(dir.path(), 4, 90).unwrap();
+        let limits = GenerateLimits::default();
+        let files = write_example_scene(dir.path(), 4, 90, &limits).unwrap();
         assert_eq!(files.len(), 6);
         let scene = Scene::load(&dir.path().join("scene.json")).unwrap();
         assert_eq!(scene.num_frames(), 90);
         let keys: crate::infer::Keys = crate::read_json(&dir.path().join("keys.json")).unwrap();
         assert_eq!(keys.keys.len(), 3);
-        let err = write_example_scene(dir.path(), 4, 1).unwrap_err().to_string();
-        assert!(err.contains("at least 2 frames"), "{err}");
+        let (none, short) = (dir.path().join("none"), GenerateLimits { max_frames: 89, ..limits });
+        let err = write_example_scene(&none, 4, 1, &limits).unwrap_err().to_string();
+        assert!(err.ends_with("none: a scene needs at least 2 frames, got 1"), "{err}");
+        let err = write_example_scene(&none, 4, 90, &short).unwrap_err();
+        assert!(matches!(&err, CameraError::Limit(l) if l.field == "max_frames"), "{err}");
+        assert!(!none.exists(), "nothing is written for a refused scene");
     }
 }

@@ -11,7 +11,6 @@ use inbetween_camera::weights::{self, CameraWeights};
 use inbetween_camera::TrainJob;
 use inbetween_core::cancel::Cancel;
 use inbetween_io::report::BenchOptions;
-use inbetween_io::{LimitExceeded, OutputSet};
 use std::path::{Path, PathBuf};
 
 use crate::errors;
@@ -196,7 +195,7 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
             (scene, name)
         }
     };
-    LimitExceeded::check_count(scene_name, scene.num_frames(), limits.max_frames, "frames", "max_frames")?;
+    limits.check_scene(scene_name, &scene)?;
     let keys = Keys::load(&a.keys)?;
     let options = GenerateOptions {
         exact_keys: !a.no_exact_keys,
@@ -214,15 +213,8 @@ fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
 }
 
 fn run_scene(a: SceneArgs) -> anyhow::Result<()> {
-    LimitExceeded::check_count("--frames", a.frames, a.max_frames, "frames", "max_frames")?;
-    if a.frames < 2 {
-        anyhow::bail!("--frames {}: a scene needs at least 2 frames", a.frames);
-    }
-    // The scene, keys and references appear together in OUT (merged into it when it exists), or none.
-    let mut set = OutputSet::new();
-    let staged = set.dir(&a.out).with_context(|| format!("preparing {}", a.out.display()))?;
-    let files = inbetween_camera::demo::write_example_scene(&staged, a.seed, a.frames)?;
-    set.commit().with_context(|| format!("moving the scene files into {}", a.out.display()))?;
+    let limits = GenerateLimits { max_frames: a.max_frames, ..GenerateLimits::default() };
+    let files = inbetween_camera::demo::write_example_scene(&a.out, a.seed, a.frames, &limits)?;
     println!("wrote {} to {}", files.join(", "), a.out.display());
     Ok(())
 }

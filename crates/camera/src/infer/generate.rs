@@ -32,6 +32,15 @@ impl Default for GenerateLimits {
     }
 }
 
+impl GenerateLimits {
+    /// `Err` when `scene` (named `subject` in the error) has more frames than `max_frames`: checked
+    /// by [`GenerateJob::validate`], and by a front end as soon as it has the scene, before a
+    /// reference clip's style is measured over it.
+    pub fn check_scene(&self, subject: impl Into<String>, scene: &Scene) -> Result<(), CameraError> {
+        Ok(LimitExceeded::check_count(subject, scene.num_frames(), self.max_frames, "frames", "max_frames")?)
+    }
+}
+
 /// Options of a [`GenerateJob`].
 #[derive(Debug, Clone, Copy)]
 pub struct GenerateOptions<'c> {
@@ -96,7 +105,7 @@ impl<'a> GenerateJob<'a> {
     /// targets, cameras) and the style code's size.
     pub fn validate(&self) -> Result<ResolvedKeys, CameraError> {
         let limits = &self.options.limits;
-        LimitExceeded::check_count("the scene", self.scene.num_frames(), limits.max_frames, "frames", "max_frames")?;
+        limits.check_scene("the scene", self.scene)?;
         LimitExceeded::check_count(
             self.origin.display().to_string(),
             self.keys.keys.len(),
