@@ -93,12 +93,21 @@ fn bad_inputs_name_the_problem() {
     fails_with(&inbetween(&["video", "resequence", s(&clip), "-o", s(&d.join("o.avi"))]), ".mp4 or .gif");
     fails_with(
         &inbetween(&["video", "resequence", s(&clip), "--start", "99", "-o", s(&d.join("o.gif"))]),
-        "--start 99",
+        "start frame 99 is outside the clip (frames 0..5)",
     );
     let o = d.join("o.gif");
-    fails_with(&inbetween(&["video", "resequence", s(&clip), "--length", "0", "-o", s(&o)]), "--length 0");
-    fails_with(&inbetween(&["video", "resequence", s(&clip), "--count", "0", "-o", s(&o)]), "--count 0");
-    fails_with(&inbetween(&["video", "resequence", s(&clip), "--limit-frames", "5", "-o", s(&o)]), "--limit-frames");
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--length", "0", "-o", s(&o)]),
+        "length of 0 frames asks for nothing",
+    );
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--count", "0", "-o", s(&o)]),
+        "count of 0 sequences asks for nothing",
+    );
+    fails_with(
+        &inbetween(&["video", "resequence", s(&clip), "--limit-frames", "5", "-o", s(&o)]),
+        "raise it with --limit-frames; or read only",
+    );
     fails_with(
         &inbetween(&["video", "resequence", s(&clip), "--limit-resolution", "16x16", "-o", s(&o)]),
         "raise it with --limit-resolution",
