@@ -16,9 +16,10 @@ use inbetween_mocap::dqn::{TrainJob, TrainOptions, DEFAULT_POLICY_PATH};
 use inbetween_mocap::protocol::TrainingData;
 use inbetween_mocap::representation::{skip_first_frame, JointFilter};
 use inbetween_mocap::select::job::{max_gap_frames, DEFAULT_MAX_GAP_S};
-use inbetween_mocap::stream::{RecvOptions, SendOptions, DEFAULT_ADDR};
+use inbetween_mocap::stream::{RecvJob, RecvOptions, SendOptions, DEFAULT_ADDR};
 use inbetween_mocap::{CompressJob, DecompressJob, DecompressReport, PreviewJob, Rebuilt};
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 use std::time::Instant;
 
 #[derive(Subcommand)]
@@ -105,7 +106,7 @@ pub struct SendArgs {
     pub input: PathBuf,
     #[arg(long, default_value = DEFAULT_ADDR)]
     pub addr: String,
-    #[arg(long, default_value = "1cm")]
+    #[arg(long, default_value = STREAM_MAX_ERROR.as_str())]
     pub max_error: String,
     /// Look-ahead window in frames (bounds the added latency).
     #[arg(long, default_value_t = SendOptions::default().lookahead)]
@@ -121,6 +122,17 @@ pub struct SendArgs {
     /// (e.g. 2.54). Default: inferred from the skeleton's rest pose (the report says which and why).
     #[arg(long)]
     pub unit: Option<LengthUnit>,
+}
+
+/// The engine's defaults, written as the flags take them: the stream's error bound, the bench's
+/// bounds in cm (comma-separated).
+static STREAM_MAX_ERROR: LazyLock<String> = LazyLock::new(|| format!("{}cm", SendOptions::default().max_cm));
+static CODEC_BOUNDS: LazyLock<String> = LazyLock::new(|| list(&bench::BenchConfig::default().codec_bounds_cm));
+static ACL_BOUNDS: LazyLock<String> = LazyLock::new(|| list(&bench::acl::AclConfig::default().bounds_cm));
+static RACE_BOUNDS: LazyLock<String> = LazyLock::new(|| list(&bench::acl::AclConfig::default().race_bounds));
+
+fn list(values: &[f64]) -> String {
+    values.iter().map(f64::to_string).collect::<Vec<_>>().join(",")
 }
 
 #[derive(Args)]
@@ -278,18 +290,18 @@ pub struct BenchArgs {
     ))]
     pub train_episodes: usize,
     /// Also report codec compression at these max errors (cm), on the full-rate clips.
-    #[arg(long, value_delimiter = ',', default_value = "1,0.1")]
+    #[arg(long, value_delimiter = ',', default_value = CODEC_BOUNDS.as_str())]
     pub codec_bounds: Vec<f64>,
     /// Error bounds (cm) of the codec table on ACL's protocol (24 fps, 40-byte raw, virtual
     /// vertices 3 cm away) and its rate–error curve; written as acl_codec.* beside the report.
-    #[arg(long, value_delimiter = ',', default_value = "0.01,0.02,0.05,0.1,0.2,0.5,1")]
+    #[arg(long, value_delimiter = ',', default_value = ACL_BOUNDS.as_str())]
     pub acl_bounds: Vec<f64>,
     /// Run only the codec table on ACL's protocol (skip the keyframe-selection bench).
     #[arg(long)]
     pub codec_only: bool,
     /// Bounds (cm) of the race against the real ACL (built from ../shared/peers/acl-race when it and
     /// g++ exist; otherwise `skipped: ACL not built` and our rows only).
-    #[arg(long, value_delimiter = ',', default_value = "0.01,0.05")]
+    #[arg(long, value_delimiter = ',', default_value = RACE_BOUNDS.as_str())]
     pub race_bounds: Vec<f64>,
     /// Frames per segment of the codec files on ACL's protocol.
     #[arg(long, default_value_t = inbetween_mocap::codec::v3::DEFAULT_SEGMENT_LEN)]
@@ -448,33 +460,17 @@ fn stream_send(a: SendArgs) -> anyhow::Result<()> {
 }
 
 fn stream_recv(a: RecvArgs) -> anyhow::Result<()> {
-    let listener = std::net::TcpListener::bind(&a.addr).with_context(|| format!("listening on {}", a.addr))?;
-    let opts = RecvOptions { accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s), ..Default::default() };
-    let got = inbetween_mocap::stream::recv(&listener, &opts)?;
-    for w in &got.warnings {
+    let options = RecvOptions { accept_timeout: std::time::Duration::from_secs_f64(a.timeout_s), ..Default::default() };
+    let reference = a.reference.map(|r| load(&r, a.skip_first).map(|m| (r, m))).transpose()?;
+    let job = RecvJob { addr: a.addr, output: a.output, options, reference, unit: a.unit };
+    let report = job.run()?;
+    for w in &report.received.warnings {
         eprintln!("warning: {w}");
     }
-    if got.motion.num_frames() == 0 {
-        // Nothing to keep: no output file, and the reason.
-        got.check_complete().context("no frame was rebuilt, so nothing was written")?;
+    if report.output.is_some() {
+        println!("{report}");
     }
-    inbetween_io::write_bvh(&a.output, &got.motion)?;
-    println!("{got}; wrote {}", a.output.display());
-    if got.start_frame > 0 {
-        println!("joined mid-stream: the output's frame 0 is frame {} of the sender's clip", got.start_frame);
-    }
-    if let Some(r) = &a.reference {
-        let m = load(r, a.skip_first)?;
-        let unit = UnitChoice::resolve(a.unit, &m.skeleton);
-        let e = inbetween_mocap::stream::compare(&got, &m, unit.cm_per_unit())
-            .with_context(|| format!("comparing with {}", r.display()))?;
-        println!("{unit}");
-        println!("error vs {} {e}", r.display());
-    }
-    got.check_complete().with_context(|| {
-        format!("the {} frames received were kept in {}", got.motion.num_frames(), a.output.display())
-    })?;
-    Ok(())
+    Ok(report.check()?)
 }
 
 fn run_scale(a: crate::scale::ScaleArgs) -> anyhow::Result<()> {

@@ -26,6 +26,10 @@ pub enum MocapError {
     /// Drawing or writing a preview failed.
     #[error(transparent)]
     Render(#[from] inbetween_render::RenderError),
+    /// What became of a job's work (`context`: "listening on …", "the 40 frames received were
+    /// kept in …"), then why it failed.
+    #[error("{context}")]
+    Context { context: String, source: Box<dyn std::error::Error + Send + Sync> },
     /// The caller's cancel token was cancelled (or its time limit passed).
     #[error("stopped: {0}")]
     Cancelled(#[from] inbetween_core::cancel::Cancelled),

@@ -28,6 +28,7 @@ use inbetween_core::units::{LengthUnit, UnitChoice};
 use inbetween_core::{Motion, Pose, Skeleton};
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream, ToSocketAddrs};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 const HELLO: u8 = 1;
@@ -575,6 +576,89 @@ pub fn compare(received: &Received, reference: &Motion, cm_per_unit: f64) -> Res
     Ok(StreamError { start_frame: start, frames, mean_cm: e.mean * cm_per_unit, max_cm: e.max * cm_per_unit })
 }
 
+/// `mocap stream recv` as one job: receive one stream on `addr` ([`recv`]), write the frames
+/// rebuilt to `output` as BVH (nothing when no frame was rebuilt), and compare them with the
+/// sender's clip when one is given. [`RecvReport::check`] then says what an unfinished stream lost.
+#[derive(Clone, Debug)]
+pub struct RecvJob {
+    pub addr: String,
+    pub output: PathBuf,
+    pub options: RecvOptions,
+    /// The sender's clip (its path and motion) to compare the frames rebuilt with.
+    pub reference: Option<(PathBuf, Motion)>,
+    /// The reference's length unit, for errors in cm; `None` infers it from its skeleton.
+    pub unit: Option<LengthUnit>,
+}
+
+/// What a [`RecvJob`] received, wrote and measured.
+#[derive(Debug)]
+pub struct RecvReport {
+    pub received: Received,
+    /// The BVH written; `None` when no frame was rebuilt from an unfinished stream.
+    pub output: Option<PathBuf>,
+    /// The reference's unit and path, and the frames' error against it (or why it could not be measured).
+    pub compared: Option<(UnitChoice, PathBuf, Result<StreamError>)>,
+}
+
+impl RecvJob {
+    /// Listens on `addr`, then [`RecvJob::run_on`].
+    pub fn run(&self) -> Result<RecvReport> {
+        let listener = TcpListener::bind(&self.addr)
+            .map_err(|e| MocapError::Context { context: format!("listening on {}", self.addr), source: e.into() })?;
+        self.run_on(&listener)
+    }
+
+    /// Receives one stream on `listener`, writes and compares what it rebuilt.
+    pub fn run_on(&self, listener: &TcpListener) -> Result<RecvReport> {
+        let received = recv(listener, &self.options)?;
+        if received.motion.num_frames() == 0 && !received.complete {
+            return Ok(RecvReport { received, output: None, compared: None });
+        }
+        inbetween_io::write_bvh(&self.output, &received.motion)?;
+        let compared = self.reference.as_ref().map(|(path, m)| {
+            let unit = UnitChoice::resolve(self.unit, &m.skeleton);
+            let e = compare(&received, m, unit.cm_per_unit());
+            (unit, path.clone(), e)
+        });
+        Ok(RecvReport { received, output: Some(self.output.clone()), compared })
+    }
+}
+
+impl RecvReport {
+    /// `Err` when nothing was written (no frame rebuilt), the comparison failed, or the sender's
+    /// End never arrived (the frames rebuilt were kept); each says what became of the frames.
+    pub fn check(self) -> Result<()> {
+        let within = |context: String, e: MocapError| MocapError::Context { context, source: e.into() };
+        let Some(output) = &self.output else {
+            let nothing = "no frame was rebuilt, so nothing was written".to_string();
+            return self.received.check_complete().map_err(|e| within(nothing, e));
+        };
+        if let Some((_, path, Err(e))) = self.compared {
+            return Err(within(format!("comparing with {}", path.display()), e));
+        }
+        let kept =
+            format!("the {} frames received were kept in {}", self.received.motion.num_frames(), output.display());
+        self.received.check_complete().map_err(|e| within(kept, e))
+    }
+}
+
+impl std::fmt::Display for RecvReport {
+    /// What arrived and where it was written, where it starts in the sender's clip when it joined
+    /// mid-stream, and its error against the reference.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let output = self.output.as_ref().map_or("nothing".into(), |o| o.display().to_string());
+        write!(f, "{}; wrote {output}", self.received)?;
+        if self.received.start_frame > 0 {
+            let start = self.received.start_frame;
+            write!(f, "\njoined mid-stream: the output's frame 0 is frame {start} of the sender's clip")?;
+        }
+        if let Some((unit, path, Ok(e))) = &self.compared {
+            write!(f, "\n{unit}\nerror vs {} {e}", path.display())?;
+        }
+        Ok(())
+    }
+}
+
 fn accept_with_timeout(listener: &TcpListener, timeout: Duration) -> Result<TcpStream> {
     listener.set_nonblocking(true).map_err(|e| MocapError::Stream(e.to_string()))?;
     let start = Instant::now();
@@ -679,6 +763,46 @@ mod tests {
         assert!(got.complete && got.sessions == 2, "{:?}", got.warnings);
         assert!(!got.warnings.is_empty());
         assert_eq!(got.motion.num_frames(), 90);
+    }
+
+    /// The recv job writes what arrived and measures it against the sender's clip; a sender gone
+    /// after its Hello leaves no file, and the error says so and why.
+    #[test]
+    fn the_recv_job_writes_and_compares_or_says_why_nothing_was_written() {
+        let (m, dir) = (walk(), tempfile::tempdir().unwrap());
+        let output = dir.path().join("got.bvh");
+        let reference = Some((PathBuf::from("walk.bvh"), m.clone()));
+        let job = RecvJob { addr: String::new(), output, options: recv_opts(), reference, unit: None };
+        let run = |job: &RecvJob| {
+            let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+            let addr = listener.local_addr().unwrap().to_string();
+            let job = job.clone();
+            (addr, std::thread::spawn(move || job.run_on(&listener)))
+        };
+        let (addr, rx) = run(&job);
+        send(&addr, &m, &fast(1.0, 3)).unwrap();
+        let report = rx.join().unwrap().unwrap();
+        let text = report.to_string();
+        assert!(text.contains("emitted 90 frames") && text.contains(&format!("wrote {}", job.output.display())));
+        assert!(text.contains("error vs walk.bvh frames 0..90: mean"), "{text}");
+        assert!(matches!(&report.compared, Some((_, _, Ok(e))) if e.max_cm <= 1.0), "{text}");
+        report.check().unwrap();
+        assert_eq!(inbetween_io::read_bvh(&job.output).unwrap().num_frames(), 90);
+        let gone = RecvJob {
+            output: dir.path().join("none.bvh"),
+            options: RecvOptions { max_sessions: 1, accept_timeout: Duration::from_millis(500) },
+            ..job
+        };
+        let (addr, rx) = run(&gone);
+        let model = RotationMotion::from_motion(&m).unwrap();
+        let hello = frame_message(HELLO, &hello_payload(&model.skeleton, model.frame_time, 90));
+        TcpStream::connect(&addr).unwrap().write_all(&hello).unwrap();
+        let report = rx.join().unwrap().unwrap();
+        assert!(report.output.is_none() && !gone.output.exists());
+        let e = report.check().unwrap_err();
+        assert_eq!(e.to_string(), "no frame was rebuilt, so nothing was written");
+        let why = std::error::Error::source(&e).unwrap().to_string();
+        assert!(why.contains("ended without the sender's End: 0 of the clip's 90 frames"), "{why}");
     }
 
     /// A sender that says hello, sends two keys and is cut off inside the third (or sends
