@@ -2,6 +2,7 @@
 
 use std::net::{IpAddr, Ipv4Addr};
 use std::path::PathBuf;
+use std::sync::LazyLock;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
@@ -25,12 +26,16 @@ pub struct StudioArgs {
     #[arg(long)]
     pub root: Option<PathBuf>,
     /// Largest upload: a size with a unit (B, KB, MB, GB, KiB, MiB, GiB).
-    #[arg(long, default_value = "512MB")]
+    #[arg(long, default_value = MAX_UPLOAD.as_str())]
     pub max_upload: String,
     /// Open the page in the system browser.
     #[arg(long)]
     pub open: bool,
 }
+
+/// The studio's upload limit, written as --max-upload takes it.
+static MAX_UPLOAD: LazyLock<String> =
+    LazyLock::new(|| inbetween_studio::server::format_size(StudioConfig::default().max_upload));
 
 #[derive(Subcommand)]
 pub enum StudioCommand {

@@ -27,9 +27,7 @@ pub fn run(
     mut prepare: impl FnMut(usize, &Path, &Path) -> anyhow::Result<Measured>,
 ) -> anyhow::Result<()> {
     let exe: PathBuf = std::env::current_exe().context("locating the inbetween binary")?;
-    let each = |r: &inbetween_io::scale::ScaleRow| {
-        println!("{}×: {:.3} s, peak {:.1} MiB", r.scale, r.run.seconds, r.run.peak_mib.unwrap_or(f64::NAN))
-    };
+    let each = |r: &inbetween_io::scale::ScaleRow| println!("{r}");
     let report = inbetween_io::scale::run_scales(engine, title, &a.scales, |k, work| prepare(k, &exe, work), each)?;
     report.tables().for_each(|t| print!("{}", t.to_text()));
     let out = a.out.clone().unwrap_or_else(|| PathBuf::from(format!("out/{engine}-scale")));

@@ -81,6 +81,14 @@ pub struct ScaleRow {
     pub run: ChildRun,
 }
 
+impl std::fmt::Display for ScaleRow {
+    /// The run's line as a scaling bench prints it while it goes: `10×: 1.234 s, peak 56.7 MiB`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let peak = self.run.peak_mib.unwrap_or(f64::NAN);
+        write!(f, "{}×: {:.3} s, peak {peak:.1} MiB", self.scale, self.run.seconds)
+    }
+}
+
 /// The bench table of a scaling run: time and peak memory per scale, and time relative to the
 /// smallest scale (linear work shows ≈ the scale factor, once the fixed start-up cost is small).
 pub fn scale_table(name: &str, title: &str, rows: &[ScaleRow]) -> crate::report::Table {
@@ -193,5 +201,7 @@ mod tests {
         assert_eq!(table.rows.len(), 2);
         assert_eq!((table.rows[0][5].as_str(), table.rows[1][5].as_str()), ("ok", "refused"));
         assert_eq!(table.rows[1][1], "3 lines");
+        let run = ChildRun { seconds: 1.23456, peak_mib: Some(56.72), success: true, stderr: String::new() };
+        assert_eq!(ScaleRow { scale: 10, input: "10 lines".into(), run }.to_string(), "10×: 1.235 s, peak 56.7 MiB");
     }
 }

@@ -302,6 +302,16 @@ pub fn parse_size(s: &str) -> Result<u64> {
     Ok(v.round() as u64)
 }
 
+/// A size as [`parse_size`] reads it: in the largest decimal unit that writes it whole
+/// (`512MB`), else in bytes.
+pub fn format_size(bytes: u64) -> String {
+    let units = [("GB", 1_000_000_000), ("MB", 1_000_000), ("KB", 1000)];
+    match units.into_iter().find(|&(_, m)| bytes >= m && bytes.is_multiple_of(m)) {
+        Some((unit, m)) => format!("{}{unit}", bytes / m),
+        None => format!("{bytes}B"),
+    }
+}
+
 /// Opens `url` in the system browser (`xdg-open` on Linux, `open` on macOS, `start` on Windows).
 pub fn open_browser(url: &str) -> std::io::Result<()> {
     let mut cmd = if cfg!(target_os = "macos") {
@@ -318,7 +328,7 @@ pub fn open_browser(url: &str) -> std::io::Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::parse_size;
+    use super::{format_size, parse_size};
 
     #[test]
     fn sizes() {
@@ -328,6 +338,10 @@ mod tests {
         assert_eq!(parse_size("2 GiB").unwrap(), 2 * 1024 * 1024 * 1024);
         for bad in ["", "MB", "12 parsecs", "-1MB", "0"] {
             assert!(parse_size(bad).is_err(), "{bad}");
+        }
+        for (bytes, text) in [(512_000_000, "512MB"), (2_000_000_000, "2GB"), (1500, "1500B"), (1024, "1024B")] {
+            assert_eq!(format_size(bytes), text);
+            assert_eq!(parse_size(text).unwrap(), bytes, "read back");
         }
     }
 }
