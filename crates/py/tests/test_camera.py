@@ -18,8 +18,8 @@ def pair(data):
     cg = data / "mocap" / "cmu" / "cgspeed"
     if not (cg / "131_02.bvh").exists():
         pytest.skip(f"skipped: no data at {cg}")
-    a = inbetween.read(cg / "131_01.bvh").crop(0, 200)
-    b = inbetween.read(cg / "131_02.bvh").crop(0, 200)
+    a = inbetween.read(cg / "131_01.bvh").crop(0, 640)
+    b = inbetween.read(cg / "131_02.bvh").crop(0, 640)
     # B three metres along +X of where it was recorded (the takes share one spot).
     b = inbetween.Clip.from_arrays(
         b.joints, b.parents, b.offsets_cm, b.fps, b.rotations, b.translations + np.float32([300.0, 0.0, 0.0])
@@ -123,20 +123,21 @@ def test_bad_pose_keys_name_the_key_frame(pair):
 
 def test_a_reference_camera_gives_the_style(pair):
     key = {"pa": [-0.3, 0.1], "pb": [0.3, 0.1], "theta": 1.6, "phi": 0.2}
-    keys = [{"frame": 0, "camera": key}, {"frame": 150, "camera": dict(key, theta=2.0)}]
+    # 5 s at the takes' 120 fps (30 of the networks' steps; at least 10 are needed).
+    keys = [{"frame": 0, "camera": key}, {"frame": 600, "camera": dict(key, theta=2.0)}]
     tracks = {s: camera.generate(keys, characters=pair, style=s, progress=False) for s in ("orbit", "relative")}
     ref = camera.generate(keys, characters=pair, reference=tracks["orbit"], progress=False)
     assert ref.style == "reference"
-    row = list(ref.frames).index(150)
+    row = list(ref.frames).index(600)
     np.testing.assert_allclose(ref.toric[row], [-0.3, 0.1, 0.3, 0.1, 2.0, 0.2], atol=1e-6)
     gap = {s: float(np.linalg.norm(ref.positions_m - t.positions_m, axis=1).mean()) for s, t in tracks.items()}
     print(f"\nreference = the orbit track: mean distance to the orbit camera {gap['orbit']:.3f} m, "
           f"to the relative camera {gap['relative']:.3f} m")
     # The reference's code is its own: it moves the camera unlike either named style's. (Which style
-    # a 150-frame keyed track reads as is the extractor's call: here nearer relative than orbit.)
+    # a 5 s keyed track reads as is the extractor's call: here nearer relative than orbit.)
     assert min(gap.values()) > 1e-3, gap
-    with pytest.raises(InbetweenError, match="at least 50"):
-        camera.generate(keys, characters=pair, reference=(ref.positions_m[:20], ref.rotations[:20]), progress=False)
+    with pytest.raises(InbetweenError, match="has 190 frames; at least 200"):
+        camera.generate(keys, characters=pair, reference=(ref.positions_m[:190], ref.rotations[:190]), progress=False)
     turned = ref.rotations.copy()  # frame 30 looks away from both characters
     p, mid = ref.positions_m[30], ref.targets_m[30].mean(axis=0)
     turned[30] = look_at(p, 2 * p - mid)

@@ -95,7 +95,7 @@ impl ReferenceClip {
             ));
         }
         let step = step_frames(self.fps);
-        let frames = |steps: f64| (steps * step).ceil() as usize;
+        let frames = |steps: f64| (steps * step).round() as usize;
         if n < frames(10.0) {
             return Err(CameraError::invalid(
                 origin,

@@ -125,8 +125,9 @@ def generate(
     scene JSON. `json_path`, `gltf`, `gif` also write the track, a glTF camera animation and a
     top-down preview. `reference`: a camera to take the style from instead of `style`, as world
     `(positions [T, 3] metres, rotations [T, 4] (x, y, z, w))` over the same scene, one per frame
-    from frame 0 (at least 50 frames), or a `Track` over it; the extractor's code (§4.1) from its
-    Toric track against the two characters."""
+    from frame 0 (at least 10 of the networks' 1/6 s steps: 50 frames at 30 fps, 200 at 120 fps),
+    or a `Track` over it; the extractor's code (§4.1) from its Toric track against the two
+    characters."""
     doc: Dict[str, Any] = {"keys": [_key(k) for k in keys]}
     if main is not None:
         doc["main"] = main
