@@ -411,12 +411,12 @@ fn bench_cmd(a: BenchArgs) -> anyhow::Result<()> {
     if !a.codec_only {
         let mut done = crate::bench::run("mocap bench", a.options(a.config()), bench::run)?;
         if let Some(p) = &a.csv {
-            let rows = done.report.find_table("mocap_bench").map(|t| t.to_csv()).unwrap_or_default();
+            let rows = done.report.find_table(bench::report::ROWS_TABLE).map(|t| t.to_csv()).unwrap_or_default();
             write_atomic(p, rows.as_bytes()).with_context(|| format!("writing {}", p.display()))?;
             done.files.push(p.clone());
         }
         if let Some(p) = &a.plot {
-            let png = done.report.file_bytes("table3.png").unwrap_or_default();
+            let png = done.report.file_bytes(bench::report::CHART_FILE).unwrap_or_default();
             write_atomic(p, png).with_context(|| format!("writing {}", p.display()))?;
             done.files.push(p.clone());
         }

@@ -67,7 +67,7 @@ pub struct ResequenceArgs {
     #[arg(short, long)]
     pub out: PathBuf,
     /// Start frame (0-based source index).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = ResequenceJob::default().start)]
     pub start: usize,
     /// Target length in frames, at least 1 (default: the source's frame count; with --stop-early,
     /// until no candidate is left).
@@ -76,7 +76,7 @@ pub struct ResequenceArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Distinct sequences to write (at least 1).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = ResequenceJob::default().count)]
     pub count: usize,
     /// The paper's early stop: end where no candidate is left, instead of cutting to the shot that
     /// best matches or looping back.
@@ -120,7 +120,7 @@ pub struct ResequenceArgs {
     /// Cross-fade the written clip over N frames at each jump inside a shot whose difference is
     /// above the shot's own step between frames (Schödl et al. 2000); 0: none. M_D is then measured
     /// on the written frames.
-    #[arg(long, default_value_t = 0, value_name = "N")]
+    #[arg(long, default_value_t = ResequenceJob::default().blend, value_name = "N")]
     pub blend: usize,
     /// Contact sheet PNG (default: next to the output, <out>.sheet.png).
     #[arg(long)]

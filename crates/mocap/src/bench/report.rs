@@ -9,6 +9,11 @@ use inbetween_io::report::{num, Report, Table};
 use std::collections::BTreeSet;
 use std::path::Path;
 
+/// The report's table of every row ([`rows_table`], written as `mocap_bench.csv`).
+pub const ROWS_TABLE: &str = "mocap_bench";
+/// The report's bar chart of the mean angle error (Table 3).
+pub const CHART_FILE: &str = "table3.png";
+
 /// Everything one bench run measured (see [`super::run::measure`]).
 #[derive(Clone, Debug)]
 pub struct BenchResults {
@@ -343,7 +348,7 @@ impl BenchResults {
         r.text(self.throughput_text());
         r.table(self.rows_table());
         if plot {
-            r.file("table3.png", self.plot_png()?);
+            r.file(CHART_FILE, self.plot_png()?);
         }
         Ok(r)
     }
@@ -369,10 +374,10 @@ impl BenchResults {
 
     /// The chart as PNG bytes (see [`inbetween_render::rendered_bytes`]).
     pub fn plot_png(&self) -> Result<Vec<u8>> {
-        inbetween_render::rendered_bytes("table3.png", |path| {
+        inbetween_render::rendered_bytes(CHART_FILE, |path| {
             self.plot(path).map_err(|e| inbetween_render::RenderError::InvalidInput(e.to_string()))
         })
-        .map_err(|e| MocapError::Io { path: "table3.png".into(), source: std::io::Error::other(e.to_string()) })
+        .map_err(|e| MocapError::Io { path: CHART_FILE.into(), source: std::io::Error::other(e.to_string()) })
     }
 }
 
@@ -393,7 +398,7 @@ fn fmt_ms(ms: f64) -> String {
 /// `method,k,mean_angle_error,mean_cm,max_cm,decision_ms,split,windows,paper_mean_angle_error`.
 pub fn rows_table(rows: &[Row]) -> Table {
     let mut t = Table::new(
-        "mocap_bench",
+        ROWS_TABLE,
         "Every row (mocap_bench.csv): mean angle error (rad), position error (cm), decision ms per window",
         &[
             "method",
