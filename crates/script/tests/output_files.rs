@@ -111,8 +111,12 @@ fn gltf_and_glb_reparse_with_a_node_per_object() {
     assert!((t[0] - 1.0).abs() < 1e-6 && t[1].abs() < 1e-6 && (t[2] - 1.2).abs() < 1e-6, "{t:?}");
     let q = chair["rotation"].as_array().unwrap();
     assert!((q[1].as_f64().unwrap() - 1.0).abs() < 1e-6, "half a turn about y: {q:?}");
-    // One box mesh per category, coloured by the catalogue.
+    // One box mesh per category, coloured by the catalogue; the chair as a seat and a backrest, the
+    // bed (no backrest above its seat) as one box.
     assert_eq!(doc["meshes"].as_array().unwrap().len(), 1 + 5);
+    for part in ["chair seat", "chair back", "bed box", "desk box"] {
+        assert!(names.iter().any(|n| n == part), "no node '{part}' in {names:?}");
+    }
 
     let p = dir.path().join("scene.glb");
     write_gltf(&p, &s, &cat).unwrap();
@@ -218,4 +222,57 @@ fn previews_are_written_as_pngs() {
     assert_eq!(top, top_down(&scene(), &builtin()));
     let view = image::open(&files[1]).unwrap().to_rgb8();
     assert_eq!((view.width(), view.height()), (960, 640));
+}
+
+/// Seats with a backrest are drawn as a seat at the seat contact's height and a back along their
+/// rear edge: a character seated at any of their seat contacts (the engine's seated pose, §4.3) has
+/// no point of a leg inside either box, as it had inside the one box as tall as the back. Stools,
+/// benches and beds (no backrest above the seat) stay one box.
+#[test]
+fn a_seated_character_s_legs_rest_on_the_seat_not_inside_it() {
+    use glam::DVec3;
+    use inbetween_core::fk::forward;
+    use inbetween_script::catalogue::ContactKind;
+    use inbetween_script::motion::ik::seated_pose;
+    use inbetween_script::motion::Rig;
+    use inbetween_script::output::{placed_box, placeholder_boxes};
+
+    let (cat, rig) = (builtin(), Rig::standard());
+    for name in ["chair", "officechair", "armchair", "sofa", "stool", "bench", "bed"] {
+        let c = cat.get(name).unwrap();
+        let o = obj(name, name, [0.0, 0.0, 0.0], 0.0, c.size);
+        let boxes = placeholder_boxes(&o, &cat);
+        let parts: Vec<&str> = boxes.iter().map(|b| b.part).collect();
+        let backed = matches!(name, "chair" | "officechair" | "armchair" | "sofa");
+        assert_eq!(parts, if backed { vec!["seat", "back"] } else { vec!["box"] }, "{name}");
+        if !backed {
+            continue;
+        }
+        let inside = |p: DVec3| {
+            boxes.iter().map(|b| placed_box(&o, b)).any(|b| {
+                let [w, h, d] = b.size.map(f64::from);
+                let c = DVec3::new(b.position[0] as f64, b.position[1] as f64, b.position[2] as f64);
+                (p.x - c.x).abs() < w / 2.0 - 1e-3
+                    && (p.z - c.z).abs() < d / 2.0 - 1e-3
+                    && p.y > c.y
+                    && p.y < c.y + h - 1e-3
+            })
+        };
+        let mut points = Vec::new();
+        for seat in c.contacts.iter().filter(|p| p.kind == ContactKind::Seat) {
+            let s = seat.local.map(f64::from);
+            let g = forward(&rig.skeleton, &seated_pose(&rig, DVec3::new(s[0], s[1], s[2]), 0.0));
+            for leg in rig.legs {
+                for (a, b) in [(leg[0], leg[1]), (leg[1], leg[2])] {
+                    points.extend((0..=20).map(|k| g.positions[a].lerp(g.positions[b], k as f64 / 20.0)));
+                }
+            }
+        }
+        for p in &points {
+            assert!(!inside(*p), "{name}: a leg passes through the placeholder at {p:?}");
+        }
+        // The one box as tall as the back (the placeholder before) held the thighs.
+        let [w, h, d] = c.size.map(f64::from);
+        assert!(points.iter().any(|p| p.x.abs() < w / 2.0 && p.z.abs() < d / 2.0 && p.y < h), "{name}");
+    }
 }

@@ -89,7 +89,7 @@ pub fn camera_pose(anim: &Animation, frame: usize) -> AimedCamera {
 /// The camera of every frame of the animation (at least one), what the outputs show:
 /// [`camera_pose`]'s framing (each character's forward kinematics run once per frame instead of
 /// once per frame and neighbour), moved where furniture would block the view of whom it frames
-/// (see [`keep_in_sight`]; equal to [`camera_pose`] in a scene without objects).
+/// or where it would stand too near them (see [`keep_in_sight`]).
 /// [`ShotCameras::pose`] answers any frame from it (past its end through [`camera_pose`]).
 pub fn camera_track(anim: &Animation) -> ShotCameras<'_> {
     let (poses, framed) = camera_poses(anim);
@@ -157,6 +157,10 @@ fn body_points(track: &super::CharacterTrack) -> Option<Vec<[DVec3; 2]>> {
 const SEATED_HIPS: f64 = 0.75;
 /// A line of sight ends this short of the joint it aims at (the head's radius), metres.
 pub(crate) const SIGHT_END_MARGIN: f64 = 0.1;
+/// Closest a camera may be to a head or hips it frames, metres: nearer, it looks into the
+/// character (a story's first shot put the camera at the door the characters walk in from, 0.4 m
+/// from a head).
+pub(crate) const NEAREST_EYE: f64 = 1.2;
 /// Frames the command's own camera must stay clear before a moved camera goes back to it.
 const RETURN_AFTER: usize = 30;
 
@@ -185,10 +189,10 @@ pub(crate) fn sight_targets(bodies: &[Option<Vec<[DVec3; 2]>>], frame: usize, fr
     out
 }
 
-/// Whether a camera at `eye` sees every target past the obstacles' boxes (and is not inside one);
-/// a box holding the target itself does not hide it.
+/// Whether a camera at `eye` sees every target past the obstacles' boxes (and is not inside one),
+/// from at least [`NEAREST_EYE`]; a box holding the target itself does not hide it.
 pub(crate) fn sees(obstacles: &[&PlacedObject], eye: DVec3, targets: &[DVec3]) -> bool {
-    if obstacles.iter().any(|o| geom::point_in_box(o, eye)) {
+    if obstacles.iter().any(|o| geom::point_in_box(o, eye)) || targets.iter().any(|t| t.distance(eye) < NEAREST_EYE) {
         return false;
     }
     targets.iter().all(|&t| {
@@ -244,7 +248,12 @@ const MOVES: [(f64, f64, f64); 28] = [
     (-135.0, 0.6, 1.5),
 ];
 
-/// The camera `eye` moved by `MOVES[k]` about `target`, kept inside the room.
+/// Closest to its target a moved camera is put, metres along the floor (a command's camera
+/// pressed against a wall beside the characters would otherwise stay as near after the move).
+const MOVED_DISTANCE: f64 = 2.0;
+
+/// The camera `eye` moved by `MOVES[k]` about `target` (at least [`MOVED_DISTANCE`] from it along
+/// the floor), kept inside the room.
 fn moved(anim: &Animation, k: usize, eye: [f32; 3], target: [f32; 3]) -> [f32; 3] {
     let (turn, scale, raise) = MOVES[k];
     if k == 0 {
@@ -253,6 +262,13 @@ fn moved(anim: &Animation, k: usize, eye: [f32; 3], target: [f32; 3]) -> [f32; 3
     let t = DVec3::new(target[0] as f64, target[1] as f64, target[2] as f64);
     let v = DVec3::new(eye[0] as f64, eye[1] as f64, eye[2] as f64) - t;
     let v = glam::DQuat::from_rotation_y(turn.to_radians()) * v * scale;
+    let across = DVec2::new(v.x, v.z);
+    let v = if across.length() < MOVED_DISTANCE {
+        let a = across.normalize_or(DVec2::Y) * MOVED_DISTANCE;
+        DVec3::new(a.x, v.y, a.y)
+    } else {
+        v
+    };
     let e = t + v + DVec3::Y * raise;
     let room = &anim.scene.room;
     let m = 0.05;
@@ -264,7 +280,7 @@ fn moved(anim: &Animation, k: usize, eye: [f32; 3], target: [f32; 3]) -> [f32; 3
 }
 
 /// The command's cameras (`framing`, per frame) moved where furniture would block the view
-/// (issue 27): while the camera in use sees its targets it stays; when it is blocked the first
+/// (issue 27) or the camera stands nearer than [`NEAREST_EYE`] to whom it frames: while the camera in use sees its targets it stays; when it is blocked the first
 /// of [`MOVES`] that sees them takes over (a cut), and the command's own camera comes back after
 /// it has been clear for [`RETURN_AFTER`] frames. Where no move sees both characters of a
 /// two-shot (furniture stands between them) the shot keeps the first in sight; where no move
@@ -277,7 +293,7 @@ fn keep_in_sight(
 ) -> (Vec<AimedCamera>, Vec<usize>) {
     let obstacles = obstacles(anim);
     let counts: Vec<usize> = (0..framing.len()).map(|f| framed_count(anim, f)).collect();
-    if obstacles.is_empty() || anim.characters.is_empty() {
+    if anim.characters.is_empty() {
         return (framing, counts);
     }
     let v3 = |p: [f32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::anim_gltf::{animation_frames, check_fps, CameraFn, CHARACTER_COLORS};
 pub use super::preview::plan_pixel;
 use super::preview::{draw_object, draw_room, scale_color};
-use super::{category_color, top_down};
+use super::top_down;
 use crate::catalogue::Catalogue;
 use crate::error::ScriptError;
 use crate::layout::geom;
@@ -181,7 +181,7 @@ fn draw_frame(
     let f = cam.focal_px();
     for (depth, item) in &items {
         match item {
-            Item::Object(o) => draw_object(&mut cv, cam, o, category_color(cat, &o.category)),
+            Item::Object(o) => draw_object(&mut cv, cam, o, cat),
             Item::Bone { fig, a, b } => {
                 if let Some((p, q)) = cam.project_segment(*a, *b) {
                     let w = (f * 0.05 / depth.max(0.05)).clamp(1.5, 9.0) as f32;

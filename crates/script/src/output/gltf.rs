@@ -330,10 +330,19 @@ pub(crate) fn scene_document(
                 let mat = d.material(&o.category, super::category_color(cat, &o.category));
                 d.d.push(mesh(format!("{} box", o.category), &[(Positions, bp), (Normals, bn)], Some(bi), Some(mat)))
             });
-            Node {
+            let boxes = super::placeholder_boxes(o, cat);
+            let part = |b: &super::PlaceholderBox| Node {
                 mesh: Some(mesh_index),
-                scale: Some(o.size.map(|v| v.max(1e-4))),
-                ..node(format!("{} box", o.label))
+                translation: (b.z != 0.0).then_some([0.0, 0.0, b.z]),
+                scale: Some(b.size.map(|v| v.max(1e-4))),
+                ..node(format!("{} {}", o.label, b.part))
+            };
+            match boxes.as_slice() {
+                [one] => part(one),
+                parts => {
+                    let children = parts.iter().map(|b| d.d.push(part(b))).collect();
+                    Node { children: Some(children), ..node(format!("{} box", o.label)) }
+                }
             }
         };
         let c = d.d.push(child);

@@ -65,6 +65,52 @@ pub fn write_previews(dir: &Path, scene: &Scene, cat: &Catalogue, view: &str) ->
     Ok(vec![top, persp])
 }
 
+/// One box of the placeholder drawn for an object without a model ([`placeholder_boxes`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaceholderBox {
+    /// "box" (the whole object), or "seat" and "back" (a seat with a backrest).
+    pub part: &'static str,
+    /// Where the box's base centre sits along the object's depth axis (+z the front), metres.
+    pub z: f32,
+    /// Width, height, depth, metres.
+    pub size: [f32; 3],
+}
+
+/// Fraction of a seat's depth its backrest takes.
+pub const BACKREST_DEPTH: f32 = 0.2;
+
+/// The boxes that stand for `o` when it has no model: one box of its size; or, for a seat whose
+/// seat contact lies under 90 % of its height (a chair, an armchair, a sofa: a backrest above the
+/// seat), a seat box as high as the seat contact and a backrest box along its rear edge
+/// ([`BACKREST_DEPTH`] of its depth) to its full height, so a seated character's legs rest on the
+/// seat instead of passing through a box as tall as the back. Stools, benches and beds stay one box.
+pub fn placeholder_boxes(o: &crate::scene::PlacedObject, cat: &Catalogue) -> Vec<PlaceholderBox> {
+    let whole = vec![PlaceholderBox { part: "box", z: 0.0, size: o.size }];
+    let Some(c) = cat.get(&o.category) else { return whole };
+    let seat_y = c
+        .contacts
+        .iter()
+        .filter(|p| p.kind == crate::catalogue::ContactKind::Seat)
+        .map(|p| p.local[1])
+        .fold(f32::NAN, f32::max);
+    let ([w, h, d], base_h) = (o.size, c.size[1]);
+    if !(seat_y.is_finite() && base_h > 1e-6 && seat_y < 0.9 * base_h) {
+        return whole;
+    }
+    let seat_h = seat_y / base_h * h;
+    let back_d = BACKREST_DEPTH * d;
+    vec![
+        PlaceholderBox { part: "seat", z: 0.0, size: [w, seat_h, d] },
+        PlaceholderBox { part: "back", z: -(d - back_d) / 2.0, size: [w, h, back_d] },
+    ]
+}
+
+/// `o` reduced to one of its placeholder boxes, placed in the world (same yaw).
+pub fn placed_box(o: &crate::scene::PlacedObject, b: &PlaceholderBox) -> crate::scene::PlacedObject {
+    let xz = crate::layout::geom::to_world(crate::layout::geom::center(o), o.yaw, [0.0, b.z]);
+    crate::scene::PlacedObject { position: [xz[0], o.position[1], xz[1]], size: b.size, ..o.clone() }
+}
+
 /// The preview colour of a category: the catalogue's, else a stable colour from its name.
 pub fn category_color(cat: &Catalogue, category: &str) -> [u8; 3] {
     if let Some(c) = cat.get(category) {

@@ -52,7 +52,22 @@ fn project_polygon(cam: &Camera3, pts: &[DVec3]) -> Option<Vec<(f32, f32)>> {
 }
 
 /// One object as a shaded box (faces turned away from the camera skipped).
-pub(crate) fn draw_object(cv: &mut Canvas, cam: &Camera3, o: &PlacedObject, color: [u8; 3]) {
+/// Draws `o` as its placeholder boxes ([`super::placeholder_boxes`]), farthest first.
+pub(crate) fn draw_object(cv: &mut Canvas, cam: &Camera3, o: &PlacedObject, cat: &Catalogue) {
+    let color = super::category_color(cat, &o.category);
+    let mut parts: Vec<PlacedObject> =
+        super::placeholder_boxes(o, cat).iter().map(|b| super::placed_box(o, b)).collect();
+    let depth = |p: &PlacedObject| {
+        let c = geom::center(p);
+        cam.to_camera(DVec3::new(c[0] as f64, (p.position[1] + p.size[1] / 2.0) as f64, c[1] as f64)).z
+    };
+    parts.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
+    for p in &parts {
+        draw_box(cv, cam, p, color);
+    }
+}
+
+fn draw_box(cv: &mut Canvas, cam: &Camera3, o: &PlacedObject, color: [u8; 3]) {
     let light = DVec3::new(0.4, 1.0, 0.6).normalize();
     let c = geom::center(o);
     let (y0, y1) = (o.position[1] as f64, o.top() as f64);
@@ -254,7 +269,7 @@ pub fn perspective(scene: &Scene, cat: &Catalogue, view: &str) -> RgbImage {
     let mut objs: Vec<&PlacedObject> = scene.objects.iter().collect();
     objs.sort_by(|a, b| depth(b).total_cmp(&depth(a)));
     for o in &objs {
-        draw_object(&mut cv, &cam, o, category_color(cat, &o.category));
+        draw_object(&mut cv, &cam, o, cat);
         let c = geom::center(o);
         let y1 = o.top() as f64;
         // Front marker on the top face.

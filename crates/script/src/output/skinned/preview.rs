@@ -87,7 +87,7 @@ pub fn render_skinned_frame(cast: &SkinnedCast, frame: usize, size: (u32, u32)) 
         match item {
             Ok(i) => {
                 let o = &scene.objects[i];
-                draw_object(&mut cv, &cam, o, crate::output::category_color(cat, &o.category));
+                draw_object(&mut cv, &cam, o, cat);
             }
             Err((tri, colour)) => cv.fill_convex(&tri, colour),
         }
