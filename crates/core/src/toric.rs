@@ -135,9 +135,10 @@ impl CameraPose {
         lens.project_camera_space(self.rotation.inverse() * (world - self.position))
     }
 
-    /// A camera at `position` looking at `target` with world +Y up (no roll).
+    /// A camera at `position` looking at `target` with world +Y up (no roll); looking along −Z
+    /// when the two coincide, with +X to its right when it looks straight up or down.
     pub fn look_at(position: DVec3, target: DVec3) -> CameraPose {
-        let f = (target - position).normalize();
+        let f = (target - position).try_normalize().unwrap_or(DVec3::NEG_Z);
         let right = f.cross(DVec3::Y).try_normalize().unwrap_or(DVec3::X);
         let up = right.cross(f);
         let m = DMat3::from_cols(right, up, -f);
@@ -302,5 +303,20 @@ mod tests {
         let behind = CameraPose::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::new(0.0, 0.0, 10.0));
         assert!(matches!(from_pose(&behind, a, DVec3::X, &lens), Err(ToricError::TargetBehindCamera('A'))));
         assert!(t.clamped(&lens, 0.05).theta <= t.theta_max(&lens));
+    }
+
+    /// Looking at a point: forward is −Z of the rotation, no roll; an eye on its target looks
+    /// along −Z, one straight above it has +X to its right (finite poses, never NaN).
+    #[test]
+    fn look_at_faces_its_target_and_its_degenerate_cases_stay_finite() {
+        let p = DVec3::new(1.0, 2.0, 3.0);
+        let pose = CameraPose::look_at(p, DVec3::new(4.0, 1.0, -1.0));
+        assert!((pose.forward() - (DVec3::new(4.0, 1.0, -1.0) - p).normalize()).length() < 1e-12);
+        assert!((pose.rotation * DVec3::X).y.abs() < 1e-12, "no roll");
+        let same = CameraPose::look_at(p, p);
+        assert!((same.forward() - DVec3::NEG_Z).length() < 1e-12);
+        let down = CameraPose::look_at(p + DVec3::Y, p);
+        assert!((down.forward() - DVec3::NEG_Y).length() < 1e-12);
+        assert!((down.rotation * DVec3::X - DVec3::X).length() < 1e-12);
     }
 }

@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{DQuat, DVec3, Mat3, Quat, Vec3};
+use glam::{DQuat, DVec3, Quat};
 use inbetween_core::camera::AimedCamera;
 use inbetween_core::clip::Clip;
 use inbetween_io::gltf_buffer::json::animation::{Interpolation, Property};
@@ -54,18 +54,6 @@ pub(crate) fn check_fps(fps: f64) -> Result<(), ScriptError> {
         return Err(ScriptError::Invalid(format!("animation frame rate {fps} must be a positive number")));
     }
     Ok(())
-}
-
-/// The glTF camera rotation (looking down its local -Z, +Y up) that looks from `eye` to `target`.
-pub fn look_rotation(eye: Vec3, target: Vec3) -> Quat {
-    let f = (target - eye).normalize_or(Vec3::NEG_Z);
-    let mut r = f.cross(Vec3::Y);
-    if r.length_squared() < 1e-10 {
-        r = f.any_orthonormal_vector();
-    }
-    let r = r.normalize();
-    let u = r.cross(f);
-    Quat::from_mat3(&Mat3::from_cols(r, u, -f)).normalize()
 }
 
 /// A box mesh centred on the origin, unit edges, flat normals, in `material`.
@@ -296,7 +284,9 @@ pub(crate) fn animated_document(
         return Err(ScriptError::Invalid(format!("camera pose at frame {f} is not finite")));
     }
     let cam = d.push(perspective(Some("story camera".into()), yfov.to_radians(), None, 0.05, Some(200.0)));
-    let q0 = look_rotation(shots[0].eye, shots[0].target);
+    // glTF cameras look down their local −Z with +Y up, as core's camera poses do.
+    let look = |s: &AimedCamera| s.pose().rotation.as_quat();
+    let q0 = look(&shots[0]);
     let cam_node = d.push(Node {
         camera: Some(cam),
         translation: Some(shots[0].eye.to_array()),
@@ -308,7 +298,7 @@ pub(crate) fn animated_document(
     let pos: Vec<f32> = shots.iter().flat_map(|s| s.eye.to_array()).collect();
     let out = d.floats(&pos, Type::Vec3, false, None);
     anim.channel(input, out, cam_node, Property::Translation);
-    let rot = continuous_quats(shots.iter().map(|s| look_rotation(s.eye, s.target)));
+    let rot = continuous_quats(shots.iter().map(look));
     let out = d.floats(&rot, Type::Vec4, false, None);
     anim.channel(input, out, cam_node, Property::Rotation);
     let mut fov = None;
