@@ -9,7 +9,6 @@ use inbetween_camera::infer::{GenerateLimits, GenerateOptions, Keys};
 use inbetween_camera::train::TrainConfig;
 use inbetween_camera::weights::{self, CameraWeights};
 use inbetween_camera::TrainJob;
-use inbetween_core::cancel::Cancel;
 use inbetween_io::report::BenchOptions;
 use std::path::{Path, PathBuf};
 
@@ -181,7 +180,7 @@ fn load_weights(path: Option<&Path>) -> anyhow::Result<CameraWeights> {
 }
 
 fn run_generate(a: GenerateArgs) -> anyhow::Result<()> {
-    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let cancel = errors::time_limit(a.time_limit)?;
     let limits = GenerateLimits { max_frames: a.max_frames, max_keys: a.max_keys };
     let w = load_weights(a.weights.as_deref())?;
     let (scene, scene_name) = match &a.scene {
@@ -245,7 +244,7 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         checkpoints: a.checkpoints,
         restart_lr: a.restart_lr,
     };
-    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let cancel = errors::time_limit(a.time_limit)?;
     job.validate()?;
     println!("{}", job.run(&cancel, &inbetween_io::Progress::new(0, "training"))?);
     Ok(())

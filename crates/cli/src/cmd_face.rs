@@ -2,10 +2,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 
-use inbetween_core::cancel::Cancel;
 use inbetween_face::bench;
 use inbetween_face::data::{read_clip_limited, write_clip, BlendshapeClip};
 use inbetween_face::edit::groups::parse_groups;
@@ -253,7 +252,7 @@ fn guide_of(a: &EditArgs, clip: &BlendshapeClip, spans: &[(f64, f64)]) -> anyhow
 }
 
 fn run_edit(a: EditArgs) -> anyhow::Result<()> {
-    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let cancel = errors::time_limit(a.time_limit)?;
     let limits = EditLimits { max_rows: a.max_rows, max_mask_s: a.max_mask_seconds };
     let clip = read_clip_limited(&a.input, limits.max_rows)?;
     let spans = a.mask.iter().map(|m| span_seconds(m, &clip)).collect::<Result<Vec<_>, _>>()?;
@@ -303,7 +302,7 @@ fn run_train(a: TrainArgs) -> anyhow::Result<()> {
         time_limit_s: a.minutes.map(|m| m * 60.0),
     };
     job.validate()?;
-    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(anyhow::Error::msg).context("--time-limit")?;
+    let cancel = errors::time_limit(a.time_limit)?;
     println!("{}", job.run(&cancel, &Progress::new(0, "train"))?);
     Ok(())
 }

@@ -212,9 +212,6 @@ fn print_run(source: &Path, r: &inbetween_script::jobs::RunReport) {
     for line in r.summary(source) {
         println!("{line}");
     }
-    for f in &r.files {
-        println!("  wrote {}", f.display());
-    }
 }
 
 /// `script run`: the story's outputs appear in `--out` whole or not at all; `--skinned` outputs are
@@ -222,9 +219,7 @@ fn print_run(source: &Path, r: &inbetween_script::jobs::RunReport) {
 fn run_story(a: RunArgs) -> anyhow::Result<()> {
     let (text, source) = load_script(&a.scene.script)?;
     let mut job = run_job(&a);
-    job.cancel = inbetween_core::cancel::Cancel::with_optional_limit_s(a.time_limit)
-        .map_err(anyhow::Error::msg)
-        .context("--time-limit")?;
+    job.cancel = errors::time_limit(a.time_limit)?;
     job.progress = Progress::new(0, "script run");
     let report = inbetween_script::jobs::run_story_whole(&text, &source, &job)
         .with_context(|| format!("animating {}", source.display()))?;
@@ -272,9 +267,6 @@ fn scene(a: SceneArgs) -> anyhow::Result<()> {
         eprintln!("warning: {}: {d}", source.display());
     }
     println!("{}", report.summary(&source));
-    for f in &report.files {
-        println!("  wrote {}", f.display());
-    }
     Ok(())
 }
 

@@ -4,7 +4,6 @@ use std::path::PathBuf;
 use std::sync::LazyLock;
 
 use clap::{Args, Subcommand, ValueEnum};
-use inbetween_core::cancel::Cancel;
 use inbetween_io::report::BenchOptions;
 use inbetween_io::Progress;
 use inbetween_video::frames::{write_clip, Decoder, ProceduralKind, ReadOptions, SynthJob};
@@ -235,7 +234,7 @@ fn run_resequence(a: ResequenceArgs) -> anyhow::Result<()> {
         max_length: a.limit_length,
         max_count: a.limit_count,
     };
-    let cancel = Cancel::with_optional_limit_s(a.time_limit).map_err(|e| anyhow::anyhow!("--time-limit: {e}"))?;
+    let cancel = crate::errors::time_limit(a.time_limit)?;
     let decoder = match a.decoder {
         DecoderArg::Auto => Decoder::Auto,
         DecoderArg::Openh264 => Decoder::OpenH264,

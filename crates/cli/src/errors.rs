@@ -4,6 +4,9 @@
 
 use std::fmt::Write;
 
+use anyhow::Context;
+use inbetween_core::cancel::Cancel;
+
 /// Sets up error and panic reporting; call first thing in `main`.
 pub fn install(debug: bool) {
     if !debug {
@@ -79,10 +82,14 @@ pub fn name_flags(e: anyhow::Error, flags: &[(&str, &str)]) -> anyhow::Error {
     anyhow::anyhow!(named.join(": "))
 }
 
+/// The cancel token of a command's `--time-limit` (none: never cancelled by time).
+pub fn time_limit(seconds: Option<f64>) -> anyhow::Result<Cancel> {
+    Cancel::with_optional_limit_s(seconds).map_err(anyhow::Error::msg).context("--time-limit")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use anyhow::Context;
 
     #[test]
     fn limits_and_fields_name_their_flags() {

@@ -63,10 +63,11 @@ pub struct SceneReport {
 }
 
 impl SceneReport {
-    /// The one line a front end prints for the scene: objects, room, match score, violations, time.
+    /// What a front end prints for the scene: one line of objects, room, match score, violations
+    /// and time, then `  wrote <file>` per file written.
     pub fn summary(&self, source: &Path) -> String {
         let scene = &self.composition.scene;
-        format!(
+        let line = format!(
             "{}: {} objects in a {:.1} m × {:.1} m {} (match score {:.2}, {} violations) in {:.1} ms",
             source.display(),
             scene.objects.len(),
@@ -76,8 +77,14 @@ impl SceneReport {
             self.composition.match_score,
             self.composition.violations.total(),
             self.seconds * 1e3
-        )
+        );
+        std::iter::once(line).chain(wrote(&self.files)).collect::<Vec<_>>().join("\n")
     }
+}
+
+/// `  wrote <file>` per file: how a report lists what it wrote.
+fn wrote(files: &[PathBuf]) -> impl Iterator<Item = String> + '_ {
+    files.iter().map(|f| format!("  wrote {}", f.display()))
 }
 
 /// The catalogue, with Kenney models when a folder is given.
@@ -223,7 +230,8 @@ pub struct RunReport {
 
 impl RunReport {
     /// The lines a front end prints for the run: objects, characters, frames, time and the
-    /// optimisation's costs before and after; after an edit (`watch`), what was solved again.
+    /// optimisation's costs before and after; after an edit (`watch`), what was solved again;
+    /// then `  wrote <file>` per file written.
     pub fn summary(&self, source: &Path) -> Vec<String> {
         let (a, frames) = (&self.animation, self.animation.frames());
         let mut lines = vec![format!(
@@ -248,6 +256,7 @@ impl RunReport {
                 list(&self.resolved_objects)
             ));
         }
+        lines.extend(wrote(&self.files));
         lines
     }
 }
