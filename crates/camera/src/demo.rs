@@ -9,6 +9,9 @@ use crate::CameraError;
 use inbetween_io::{LimitExceeded, OutputSet, Progress};
 use std::path::Path;
 
+/// The steps [`run`] counts on its progress bar.
+pub const STEPS: u64 = 1;
+
 /// Frames of `camera scene`'s example (15 s at 30 fps).
 pub const EXAMPLE_SCENE_FRAMES: usize = 450;
 
@@ -61,7 +64,8 @@ pub fn scaled_example(k: usize) -> (Scene, Keys) {
 
 /// The demo: a 300-frame scene with keys at frames 0, 150 and 299, a track per behaviour style
 /// with the committed weights (`out/camera/cam-<style>.json`), and the orbit track as
-/// `out/cam.json`, `out/cam.gltf` and `out/cam.gif`. Returns one line per result.
+/// `out/cam.json`, `out/cam.gltf` and `out/cam.gif`. Returns one line per result; counts [`STEPS`]
+/// step on `progress`.
 pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>, CameraError> {
     let t0 = std::time::Instant::now();
     let w = committed()?;

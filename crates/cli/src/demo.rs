@@ -18,8 +18,8 @@ pub struct DemoArgs {
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    // One step for the walk, four for the mocap demo, one each for the camera, face, video and script demos.
-    let steps = Progress::new(9, "demo");
+    // The mocap and camera demos count their own steps; one here for the walk, the face, video and script demos.
+    let steps = Progress::new(inbetween_mocap::demo::STEPS + inbetween_camera::demo::STEPS + 4, "demo");
     let mut lines = vec![inbetween_mocap::demo::opening_walk(&a.out, a.seed)?];
     steps.inc(1);
     lines.extend(inbetween_mocap::demo::run(&a.out, &steps)?);

@@ -42,8 +42,12 @@ pub fn opening_walk(out: &Path, seed: u64) -> Result<String> {
     ))
 }
 
+/// The steps [`run`] counts on its progress bar.
+pub const STEPS: u64 = 4;
+
 /// Runs the demo, writes `mocap_walk.ibk`, `mocap_walk_reconstructed.bvh` and `mocap_overlay.gif`
-/// into `out` (which must exist) and returns the lines to print. Counts 4 steps on `progress`.
+/// into `out` (which must exist) and returns the lines to print. Counts [`STEPS`] steps on
+/// `progress`.
 pub fn run(out: &Path, progress: &Progress) -> Result<Vec<String>> {
     let t = Instant::now();
     let walk = scaled_walk(1);
