@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use anyhow::bail;
 use clap::{Args, Subcommand, ValueEnum};
 
 use inbetween_face::bench;
@@ -134,7 +133,12 @@ impl MethodArg {
 }
 
 /// The edit job's limit fields and the flags that set them.
-const EDIT_FLAGS: &[(&str, &str)] = &[("max_rows", "--max-rows"), ("max_mask_s", "--max-mask-seconds")];
+const EDIT_FLAGS: &[(&str, &str)] = &[
+    ("max_rows", "--max-rows"),
+    ("max_mask_s", "--max-mask-seconds"),
+    ("library", "--library"),
+    ("method", "--method"),
+];
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum DataArg {
@@ -262,9 +266,7 @@ fn run_edit(a: EditArgs) -> anyhow::Result<()> {
     let groups_note = (guide.kind() == ConstraintKind::Visemes)
         .then(|| format!("note: {}", visemes_groups_note(a.groups.as_deref(), "--groups", "--groups")));
     let mut res = EditResources::load_network(a.method.choice(), guide.kind(), a.weights.as_deref())?;
-    if !a.library.is_empty() && !matches!(res.chosen, MethodChoice::Retrieval) {
-        bail!("--library is read only by --method retrieval (with --keys or --visemes, auto picks the network)");
-    }
+    res.check_library_given(!a.library.is_empty())?;
     res.load_library(&a.library, channels.is_some(), limits.max_rows)?;
     let method = res.method(a.variants as usize)?;
     let library = res.library.as_ref();

@@ -145,14 +145,12 @@ pub fn edit(clip: &BlendshapeClip, r: &EditRequest, cancel: &Cancel, bar: &Progr
     }
     let mut resources = EditResources::load_network(MethodChoice::parse(&r.method)?, kind, r.weights.as_deref())
         .map_err(|e| crate::errors::ctx(e.what)(e.source))?;
-    if !r.library.is_empty() && resources.chosen != MethodChoice::Retrieval {
-        return Err(JobError::Failed(format!(
-            "library is read only by method='retrieval' (method '{}' resolved to {} for {} guidance)",
-            r.method,
-            resources.chosen.name(),
-            kind.name()
-        )));
-    }
+    resources.check_library_given(!r.library.is_empty()).map_err(|e| {
+        JobError::Failed(inbetween_io::limits::name_fields(
+            &e.to_string(),
+            &[("library", "library"), ("method", "method")],
+        ))
+    })?;
     resources.load_library_clips(&r.library, channels.is_some(), |i| format!("library[{i}]"))?;
     let mut job = EditJob {
         clip,

@@ -149,7 +149,7 @@ def test_bad_spans_and_arguments_raise_clear_errors(synthetic):
         (dict(spans=[(1.0, 2.0)], variants=0), InbetweenError, "at least 1"),
         (dict(spans=[(1.0, 2.0)], visemes=[(1.0, 1.5, "QQ")]), InbetweenError, "QQ"),
         (dict(spans=[(1.0, 2.0)], library=[clip], keys=[{"time_s": 1.5, "shapes": {"JawOpen": 0.5}}]),
-         InbetweenError, "library is read only by method='retrieval'"),
+         InbetweenError, "library is read only by method retrieval"),
         (dict(spans=[(1.0, 2.0)], max_rows=10), InbetweenError, r"200 rows, more than the limit of 10 rows \(max_rows\)"),
     ]
     for kwargs, kind, pattern in cases:

@@ -169,6 +169,21 @@ impl EditResources {
         Ok(EditResources { chosen, kind, network, library: None })
     }
 
+    /// Refuses a retrieval library given for an edit whose method is not retrieval (it would be
+    /// ignored). The message names the options in backticks (`library`, `method`) for a front end
+    /// to write as its own.
+    pub fn check_library_given(&self, given: bool) -> Result<(), FaceError> {
+        if given && self.chosen != MethodChoice::Retrieval {
+            return Err(FaceError::Invalid(format!(
+                "`library` is read only by `method` retrieval (the method resolved to {} for {} guidance; auto \
+                 picks the network for keys and visemes)",
+                self.chosen.name(),
+                self.kind.name()
+            )));
+        }
+        Ok(())
+    }
+
     /// Loads the retrieval library ([`retrieval_library`] of `files`, each at most `max_rows` rows)
     /// when the method is retrieval, or the default one when the guidance is visemes and
     /// `groups_given` is false (the groups the visemes leave unguided are drawn from it).
