@@ -22,14 +22,15 @@ def pair(data):
 
 
 def test_camera_track_through_keys(pair, tmp_path):
-    keys = [{"frame": 0, "camera": KEY}, {"frame": 60, "camera": dict(KEY, theta=2.2, phi=0.35)}]
+    # 2 s apart at the takes' 120 fps (12 of the networks' 1/6 s steps).
+    keys = [{"frame": 0, "camera": KEY}, {"frame": 240, "camera": dict(KEY, theta=2.2, phi=0.35)}]
     track = camera.generate(keys, characters=pair, style="orbit", gltf=tmp_path / "cam.gltf", progress=False)
     t = len(track.frames)
-    assert t > 60 and track.positions_m.shape == (t, 3) and track.rotations.shape == (t, 4)
+    assert t > 240 and track.positions_m.shape == (t, 3) and track.rotations.shape == (t, 4)
     assert track.toric.shape == (t, 6) and track.fov_y_rad.shape == (t,) and track.targets.shape == (t, 2)
     np.testing.assert_allclose(np.linalg.norm(track.rotations, axis=1), 1.0, atol=1e-9)
     # Exact keys: the track passes through each key (the correction's residual is rounding).
-    row = list(track.frames).index(60)
+    row = list(track.frames).index(240)
     np.testing.assert_allclose(track.toric[row], [-0.3, 0.1, 0.3, 0.1, 2.2, 0.35], atol=1e-6)
     assert track.max_corrected_residual < 1e-6 and track.style == "orbit"
     assert json.loads((tmp_path / "cam.gltf").read_text())["asset"]["version"] == "2.0"
