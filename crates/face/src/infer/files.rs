@@ -102,24 +102,8 @@ pub fn write_variants(job: &mut EditJob, files: &EditFiles) -> Result<WrittenEdi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::infer::{EditLimits, Guide, Method};
+    use crate::infer::linear_test_job as job;
     use crate::procedural::{generate, ProceduralConfig};
-    use inbetween_core::cancel::Cancel;
-
-    fn job(clip: &crate::data::BlendshapeClip) -> EditJob<'_> {
-        EditJob {
-            clip,
-            spans: vec![(2.0, 3.5)],
-            channels: None,
-            guide: Guide::None,
-            method: Method::Linear,
-            seed: 7,
-            limits: EditLimits::default(),
-            cancel: Cancel::new(),
-            guide_file: None,
-            library: None,
-        }
-    }
 
     /// Two variants of a linear fill: both clips and PNGs under numbered names, a line per file and
     /// edit, the seeds 7 and 8, and a spread of exactly 0 (the method draws nothing); a cancelled

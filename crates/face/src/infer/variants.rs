@@ -125,9 +125,7 @@ pub fn run_variants(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::infer::{EditLimits, Guide, Method};
     use crate::procedural::{generate, ProceduralConfig};
-    use inbetween_core::cancel::Cancel;
 
     /// Three variants of a linear fill: seeds 7, 8, 9, numbered 1..3; the spans' rows changed and
     /// nothing else; a spread of exactly 0 from variant 1 (the method draws nothing) and none for
@@ -135,18 +133,7 @@ mod tests {
     #[test]
     fn variants_are_seeded_in_turn_and_report_what_changed() {
         let clip = generate(&ProceduralConfig { duration_s: 6.0, ..Default::default() }, 3).clip;
-        let mut job = EditJob {
-            clip: &clip,
-            spans: vec![(2.0, 3.5)],
-            channels: None,
-            guide: Guide::None,
-            method: Method::Linear,
-            seed: 7,
-            limits: EditLimits::default(),
-            cancel: Cancel::new(),
-            guide_file: None,
-            library: None,
-        };
+        let mut job = crate::infer::linear_test_job(&clip);
         let made = run_variants(&mut job, 3, &["a note".into()], &Progress::hidden()).unwrap();
         assert_eq!(
             made.iter().map(|v| (v.report.variant, v.report.seed)).collect::<Vec<_>>(),
