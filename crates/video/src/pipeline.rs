@@ -96,20 +96,19 @@ impl VideoLimits {
 
     /// The clip's frame count and frame size.
     pub fn check_clip(&self, clip: &Clip) -> Result<(), VideoError> {
-        let subject = clip.source.clone();
-        if clip.len() > self.max_frames {
-            return Err(VideoError::Limit(over(
-                subject,
-                clip.len() as u64,
-                self.max_frames as u64,
-                "frames",
-                "max_frames",
-            )));
-        }
+        LimitExceeded::check_count(clip.source.clone(), clip.len(), self.max_frames, "frames", "max_frames")
+            .map_err(VideoError::Limit)?;
         let pixels = clip.frames.iter().map(|f| u64::from(f.width()) * u64::from(f.height())).max().unwrap_or(0);
         if pixels > self.max_pixels {
-            let subject = format!("{subject} ({}x{})", clip.width(), clip.height());
-            return Err(VideoError::Limit(over(subject, pixels, self.max_pixels, "pixels per frame", "max_pixels")));
+            let subject = format!("{} ({}x{})", clip.source, clip.width(), clip.height());
+            let over = LimitExceeded::check_count(
+                subject,
+                pixels as usize,
+                self.max_pixels as usize,
+                "pixels per frame",
+                "max_pixels",
+            );
+            return over.map_err(VideoError::Limit);
         }
         Ok(())
     }
@@ -126,21 +125,11 @@ impl VideoLimits {
             return Err(VideoError::Invalid("a count of 0 sequences asks for nothing: give at least 1".into()));
         }
         let length = length.unwrap_or(frames);
-        if length > self.max_length {
-            let (length, limit) = (length as u64, self.max_length as u64);
-            return Err(VideoError::Limit(over("the requested length", length, limit, "frames", "max_length")));
-        }
-        if count > self.max_count {
-            let (count, limit) = (count as u64, self.max_count as u64);
-            return Err(VideoError::Limit(over("the requested count", count, limit, "sequences", "max_count")));
-        }
-        Ok(())
+        LimitExceeded::check_count("the requested length", length, self.max_length, "frames", "max_length")
+            .map_err(VideoError::Limit)?;
+        LimitExceeded::check_count("the requested count", count, self.max_count, "sequences", "max_count")
+            .map_err(VideoError::Limit)
     }
-}
-
-/// `value` `unit` over the limit `limit` of the field `field` of [`VideoLimits`].
-fn over(subject: impl Into<String>, value: u64, limit: u64, unit: &str, field: &'static str) -> LimitExceeded {
-    LimitExceeded { subject: subject.into(), found: format!("{value} {unit}"), limit: format!("{limit} {unit}"), field }
 }
 
 impl Default for ResequenceConfig {
